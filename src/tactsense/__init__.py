@@ -1,0 +1,59 @@
+"""tactsense: the capacitive tactile finger of Fearing (IJRR 1990), modelled and interpreted.
+
+The forward model (a digital twin of the finger) lives in
+:mod:`tactsense.physics` and :mod:`tactsense.simulate`; sensors are
+described by :class:`tactsense.SensorSpec`; recordings are HDF5 files read
+and written by :mod:`tactsense.io`.
+"""
+
+from tactsense.io.recording import Recording, read_recording, write_recording
+from tactsense.physics.array_response import tactel_deflection
+from tactsense.physics.contact import (
+    FlatContact,
+    LineContact,
+    Probe,
+    grams_force,
+    knife_edge,
+    newtons_to_grams,
+    rod,
+    soft_object,
+)
+from tactsense.sensor import (
+    SensorSpec,
+    SensorSpecError,
+    fearing1990_improved,
+    fearing1990_initial,
+    load_sensor,
+    preset,
+)
+from tactsense.simulate import Scenario, Step, probe_sweep, repeated_load, simulate, static
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "FlatContact",
+    "LineContact",
+    "Probe",
+    "Recording",
+    "Scenario",
+    "SensorSpec",
+    "SensorSpecError",
+    "Step",
+    "__version__",
+    "fearing1990_improved",
+    "fearing1990_initial",
+    "grams_force",
+    "knife_edge",
+    "load_sensor",
+    "newtons_to_grams",
+    "preset",
+    "probe_sweep",
+    "read_recording",
+    "repeated_load",
+    "rod",
+    "simulate",
+    "soft_object",
+    "static",
+    "tactel_deflection",
+    "write_recording",
+]

@@ -1,0 +1,384 @@
+"""The simulator: a scenario of contacts over time in, a recording of A/D frames out.
+
+A :class:`Scenario` is a sequence of :class:`Step` s, each a set of contacts
+held for a duration (an empty set: nothing touches). :func:`simulate` runs
+it through the forward model:
+
+contacts -> elastic deflection (array_response) -> per-tactel gain ->
+viscoelastic memory -> stiffening -> capacitance and voltage (eqs. 1-2) ->
+read noise -> A/D counts, each tactel sampled at its own instant of the
+row/column scan.
+
+The scan clock (``rows * cols`` samples per frame) is the simulation's time
+step: the load is held constant over each sample interval, so step
+boundaries are resolved to one sample (2.2 ms at 7 Hz on an 8x8 array).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tactsense._validation import TactsenseInputError, check_positive
+from tactsense.io.recording import Recording
+from tactsense.physics.array_response import deflection_batch
+from tactsense.physics.contact import Probe, contact_from_dict, grams_force
+from tactsense.physics.flaws import FLAW_NAMES, draw_gains, stiffening
+from tactsense.physics.transduction import (
+    amplifier_gain,
+    divider_voltage,
+    sample_offsets,
+    voltage_to_counts,
+)
+from tactsense.physics.viscoelastic import viscoelastic_response
+from tactsense.sensor import SensorSpec
+
+_CHUNK_FRAMES = 128
+
+
+@dataclass(frozen=True)
+class Step:
+    """Contacts held for a duration.
+
+    Parameters
+    ----------
+    contacts : tuple of contacts
+        What touches the skin during the step; empty for nothing.
+    duration_s : float
+        [s].
+    label : str
+        Free text stored with the recording.
+    """
+
+    contacts: tuple = ()
+    duration_s: float = 1.0
+    label: str = ""
+
+    def __post_init__(self) -> None:
+        check_positive(self.duration_s, "step duration_s")
+        object.__setattr__(self, "contacts", tuple(self.contacts))
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A time line of steps, with a name and a description for the recording."""
+
+    steps: tuple[Step, ...]
+    name: str = "custom"
+    description: str = ""
+    parameters: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if not self.steps:
+            raise TactsenseInputError("a scenario needs at least one step")
+        object.__setattr__(self, "steps", tuple(self.steps))
+
+    @property
+    def duration_s(self) -> float:
+        """Total duration [s]."""
+        return float(sum(step.duration_s for step in self.steps))
+
+    def to_dict(self) -> dict:
+        return {
+            "name": self.name,
+            "description": self.description,
+            "parameters": self.parameters,
+            "steps": [
+                {"duration_s": s.duration_s, "label": s.label,
+                 "contacts": [c.to_dict() for c in s.contacts]}
+                for s in self.steps
+            ],
+        }
+
+    @classmethod
+    def from_dict(cls, data: dict) -> Scenario:
+        try:
+            steps = tuple(
+                Step(tuple(contact_from_dict(c) for c in s["contacts"]), s["duration_s"],
+                     s.get("label", ""))
+                for s in data["steps"]
+            )
+        except (KeyError, TypeError) as error:
+            raise TactsenseInputError(f"malformed scenario description: {error}") from None
+        return cls(steps, data.get("name", "custom"), data.get("description", ""),
+                   data.get("parameters", {}))
+
+
+# ---- scenario builders ----------------------------------------------------------
+
+
+def probe_sweep(spec: SensorSpec, *, along: str = "axial", row: int = 4, col: int = 0,
+                start: float | None = None, stop: float | None = None,
+                increment: float | None = None, force_n: float | None = None,
+                dwell_s: float = 0.5, lift_s: float = 0.0, settle_s: float = 1.0,
+                contact_diameter_mm: float = 3.0) -> Scenario:
+    """The paper's probe sweep (Figs. 7 and 13): a 50-g probe stepped along a row or around.
+
+    Parameters
+    ----------
+    along : {"axial", "around"}
+        Sweep along the finger at the angle of column ``col`` (Fig. 7,
+        0.6-mm increments), or around it at the axial position of row
+        ``row`` (Fig. 13, 3-deg increments).
+    start, stop : float, optional
+        First and last position [mm] (axial) or [deg] (around); default the
+        whole cylinder, or one column spacing either side of ``col``... for
+        a full turn on a closed layout.
+    increment : float, optional
+        Step between positions [mm] or [deg]; default 0.6 mm or 3 deg.
+    force_n : float, optional
+        Probe force [N]; default 50 g.
+    dwell_s : float
+        Time the probe is held at each position (equal times, as in the paper) [s].
+    lift_s : float
+        Time the probe is lifted between positions (0: it slides) [s].
+    settle_s : float
+        Untouched time before the sweep, for a baseline [s].
+    """
+    if along not in ("axial", "around"):
+        raise TactsenseInputError(f"along must be 'axial' or 'around'; got {along!r}")
+    rows, cols = spec.shape
+    if not (0 <= row < rows and 0 <= col < cols):
+        raise TactsenseInputError(f"tactel ({row}, {col}) is outside the {rows}x{cols} array")
+    force_n = grams_force(50.0) if force_n is None else check_positive(force_n, "force_n")
+    if along == "axial":
+        increment = 0.6 if increment is None else increment
+        start = 0.0 if start is None else start
+        stop = spec.body.cylinder_length_mm if stop is None else stop
+        fixed_angle = float(spec.col_angle_deg[col])
+    else:
+        increment = 3.0 if increment is None else increment
+        half_span = 180.0 if spec.closes_circumference else (
+            spec.array.wired_cols / 2 * spec.array.spacing_angle_deg)
+        centre = 0.0 if spec.closes_circumference else float(np.mean(spec.col_angle_deg))
+        start = centre - half_span if start is None else start
+        stop = centre + half_span if stop is None else stop
+        fixed_axial = float(spec.row_axial_mm[row])
+    check_positive(increment, "increment")
+    if stop < start:
+        raise TactsenseInputError(f"stop ({stop}) must not be smaller than start ({start})")
+    positions = np.arange(start, stop + 1e-9, increment)
+    steps = [Step((), settle_s, "baseline")] if settle_s > 0 else []
+    for position in positions:
+        if along == "axial":
+            probe = Probe(float(position), fixed_angle, force_n, contact_diameter_mm)
+        else:
+            probe = Probe(fixed_axial, float(position), force_n, contact_diameter_mm)
+        steps.append(Step((probe,), dwell_s, f"{along}={position:.4g}"))
+        if lift_s > 0:
+            steps.append(Step((), lift_s, "lifted"))
+    unit = "mm" if along == "axial" else "deg"
+    return Scenario(
+        tuple(steps), name=f"probe_sweep_{along}",
+        description=(f"{force_n:.3g} N probe swept {along} from {start:g} to {stop:g} {unit} "
+                     f"in {increment:g} {unit} increments, {dwell_s:g} s each"),
+        parameters={"along": along, "row": row, "col": col, "start": start, "stop": stop,
+                    "increment": increment, "force_n": force_n, "dwell_s": dwell_s,
+                    "lift_s": lift_s, "settle_s": settle_s},
+    )
+
+
+def repeated_load(spec: SensorSpec, *, row: int = 4, col: int = 0, force_n: float | None = None,
+                  repeats: int = 100, on_s: float = 1.0, off_s: float = 1.0,
+                  settle_s: float = 1.0) -> Scenario:
+    """A weight applied repeatedly above one tactel (Figs. 10-12: jitter and creep)."""
+    rows, cols = spec.shape
+    if not (0 <= row < rows and 0 <= col < cols):
+        raise TactsenseInputError(f"tactel ({row}, {col}) is outside the {rows}x{cols} array")
+    force_n = grams_force(50.0) if force_n is None else check_positive(force_n, "force_n")
+    if repeats < 1:
+        raise TactsenseInputError(f"repeats must be at least 1; got {repeats}")
+    probe = Probe(float(spec.row_axial_mm[row]), float(spec.col_angle_deg[col]), force_n)
+    steps = [Step((), settle_s, "baseline")] if settle_s > 0 else []
+    for k in range(repeats):
+        steps += [Step((probe,), on_s, f"on {k}"), Step((), off_s, f"off {k}")]
+    return Scenario(
+        tuple(steps), name="repeated_load",
+        description=f"{force_n:.3g} N applied {repeats} times above tactel ({row}, {col})",
+        parameters={"row": row, "col": col, "force_n": force_n, "repeats": repeats,
+                    "on_s": on_s, "off_s": off_s, "settle_s": settle_s},
+    )
+
+
+def static(contacts, duration_s: float = 1.0, *, settle_s: float = 1.0) -> Scenario:
+    """Contacts held still after an untouched settle time."""
+    if not isinstance(contacts, list | tuple):
+        contacts = [contacts]
+    steps = [Step((), settle_s, "baseline")] if settle_s > 0 else []
+    steps.append(Step(tuple(contacts), duration_s, "hold"))
+    return Scenario(tuple(steps), name="static", description=f"{len(contacts)} contact(s) held")
+
+
+# ---- the simulator --------------------------------------------------------------
+
+
+def _resolve_flaws(flaws) -> tuple[str, ...]:
+    if flaws is None or flaws == "none":
+        return ()
+    if flaws == "all":
+        return FLAW_NAMES
+    names = tuple(flaws.split(",")) if isinstance(flaws, str) else tuple(flaws)
+    names = tuple(n.strip() for n in names if n.strip())
+    unknown = [n for n in names if n not in FLAW_NAMES]
+    if unknown:
+        raise TactsenseInputError(
+            f"unknown flaw(s) {', '.join(unknown)}; choose from {', '.join(FLAW_NAMES)}, "
+            "'all' or 'none'"
+        )
+    return names
+
+
+def _jittered_steps(spec: SensorSpec, steps: Sequence[Step], rng) -> list[tuple]:
+    """Each application drawn once: force and position jitter of Figs. 10-11."""
+    flaws = spec.flaws
+    out = []
+    for step in steps:
+        contacts = []
+        for contact in step.contacts:
+            scale = 1.0
+            if contact.force_n > 0:
+                scale = max(0.0, 1.0 + rng.normal(0.0, flaws.force_jitter_n) / contact.force_n)
+            d_axial = rng.normal(0.0, flaws.position_jitter_mm)
+            d_angle = math.degrees(rng.normal(0.0, flaws.position_jitter_mm) / spec.radius_mm)
+            contacts.append(contact.moved(d_axial, d_angle, scale))
+        out.append(tuple(contacts))
+    return out
+
+
+def simulate(spec: SensorSpec, scenario: Scenario, *, flaws="all", rng=None,
+             gains: np.ndarray | None = None,
+             progress: Callable[[int, int], None] | None = None) -> Recording:
+    """Run a scenario through the forward model and return the recorded frames.
+
+    Parameters
+    ----------
+    spec : SensorSpec
+        The finger.
+    scenario : Scenario
+        Contacts over time.
+    flaws : "all", "none" or iterable of str
+        Flaws to switch on, from ``gain_spread``, ``jitter``, ``noise``,
+        ``quantization``, ``nonlinearity``, ``viscoelastic``, ``dead``.
+        Their parameters come from ``spec.flaws``.
+    rng : int, numpy.random.Generator or None
+        Source of every random draw (gains, jitter, noise).
+    gains : ndarray, shape (rows, cols), optional
+        Per-tactel gains to use instead of drawing them (``gain_spread``).
+    progress : callable(done, total), optional
+        Called after each chunk of frames.
+
+    Returns
+    -------
+    Recording
+        ``frames`` (T, rows, cols) A/D counts, timestamps, the truth of
+        every step, the sensor and the scenario.
+    """
+    if not isinstance(spec, SensorSpec):
+        raise TactsenseInputError(f"spec must be a SensorSpec; got {type(spec).__name__}")
+    if not isinstance(scenario, Scenario):
+        raise TactsenseInputError(f"scenario must be a Scenario; got {type(scenario).__name__}")
+    active = _resolve_flaws(flaws)
+    rng = np.random.default_rng(rng)
+    rows, cols = spec.shape
+    period = spec.scan_period_s
+    n_frames = max(1, math.floor(scenario.duration_s / period + 1e-9))
+    ticks_per_frame = rows * cols
+    dt = period / ticks_per_frame
+
+    if gains is not None:
+        gains = np.asarray(gains, dtype=float)
+        if gains.shape != spec.shape:
+            raise TactsenseInputError(f"gains has shape {gains.shape}; expected {spec.shape}")
+    elif "gain_spread" in active:
+        gains = draw_gains(spec, rng)
+    else:
+        gains = np.ones(spec.shape)
+    applied = (_jittered_steps(spec, scenario.steps, rng) if "jitter" in active
+               else [step.contacts for step in scenario.steps])
+    elastic = deflection_batch(spec, applied) * gains  # (S, rows, cols)
+
+    boundaries = np.cumsum([0.0] + [s.duration_s for s in scenario.steps])
+    offsets = sample_offsets(spec)
+    flat_index = np.arange(ticks_per_frame)
+    row_of_tick, col_of_tick = np.divmod(flat_index, cols)
+    dead = np.zeros(spec.shape, dtype=bool)
+    if "dead" in active:
+        for r, c in spec.flaws.dead_tactels:
+            dead[r, c] = True
+    gain_v = amplifier_gain(spec)
+    c0 = spec.junction_capacitance_f
+    frames = np.empty((n_frames, rows, cols), dtype=np.float64)
+    state = None
+    for first in range(0, n_frames, _CHUNK_FRAMES):
+        last = min(n_frames, first + _CHUNK_FRAMES)
+        ticks = np.arange(first * ticks_per_frame, last * ticks_per_frame)
+        step_of_tick = np.clip(np.searchsorted(boundaries, ticks * dt, side="right") - 1,
+                               0, len(scenario.steps) - 1)
+        u = elastic[step_of_tick]  # (ticks, rows, cols): what every tactel feels at every tick
+        if "viscoelastic" in active:
+            f = spec.flaws
+            u, state = viscoelastic_response(
+                u, dt, delayed_fraction=f.delayed_fraction,
+                delayed_time_constant_s=f.delayed_time_constant_s,
+                creep_fraction=f.creep_fraction, creep_time_constant_s=f.creep_time_constant_s,
+                state=state)
+        sampled = u.reshape(last - first, ticks_per_frame, rows, cols)[
+            :, flat_index, row_of_tick, col_of_tick].reshape(last - first, rows, cols)
+        if "nonlinearity" in active:
+            sampled = stiffening(sampled, spec.flaws.nonlinear_saturation)
+        sampled = np.minimum(sampled, 0.95)  # plates cannot touch
+        counts = voltage_to_counts(spec, gain_v * divider_voltage(spec, c0 / (1.0 - sampled)),
+                                   quantize=False)
+        if "noise" in active:
+            counts = counts + rng.normal(0.0, spec.flaws.read_noise_counts, counts.shape)
+        full_scale = 2**spec.electronics.adc_bits - 1
+        counts = np.clip(np.rint(counts) if "quantization" in active else counts, 0, full_scale)
+        counts[:, dead] = 0.0
+        frames[first:last] = counts
+        if progress is not None:
+            progress(last, n_frames)
+
+    time_s = np.arange(n_frames) * period
+    mid_scan = time_s + 0.5 * period
+    frame_step = np.clip(np.searchsorted(boundaries, mid_scan, side="right") - 1, 0,
+                         len(scenario.steps) - 1)
+    truth = _truth(spec, applied, frame_step)
+    dtype = np.uint16 if "quantization" in active else np.float64
+    return Recording(
+        frames=frames.astype(dtype) if dtype is np.uint16 else frames,
+        time_s=time_s,
+        sample_offset_s=offsets,
+        sensor=spec,
+        scenario=scenario.to_dict(),
+        flaws=active,
+        truth=truth,
+        gains=gains,
+    )
+
+
+def _truth(spec: SensorSpec, applied: list[tuple], frame_step: np.ndarray) -> dict:
+    """Per-step truth (as applied, jitter included) and the step of each frame."""
+    n = len(applied)
+    axial = np.full(n, np.nan)
+    angle = np.full(n, np.nan)
+    force = np.zeros(n)
+    count = np.zeros(n, dtype=np.int64)
+    for k, contacts in enumerate(applied):
+        count[k] = len(contacts)
+        force[k] = sum(c.force_n for c in contacts)
+        if contacts:
+            axial[k] = contacts[0].axial_mm
+            angle[k] = contacts[0].angle_deg
+    return {
+        "frame_step": frame_step.astype(np.int64),
+        "step_axial_mm": axial,
+        "step_angle_deg": angle,
+        "step_force_n": force,
+        "step_n_contacts": count,
+        "step_contacts_json": json.dumps([[c.to_dict() for c in s] for s in applied]),
+    }
+
