@@ -244,7 +244,9 @@ class SensorSpec:
         cylinder = layout.first_row_axial_mm + layout.spacing_axial_mm * np.arange(
             layout.cylinder_rows
         )
-        positions = np.concatenate([[layout.tip_row_axial_mm], cylinder]) if layout.tip_row else cylinder
+        positions = (
+            np.concatenate([[layout.tip_row_axial_mm], cylinder]) if layout.tip_row else cylinder
+        )
         return positions[: layout.wired_rows]
 
     @property
@@ -317,7 +319,9 @@ class SensorSpec:
         (:func:`fearing1990_initial`).
         """
         if not isinstance(data, dict):
-            raise SensorSpecError(f"{source}: expected a table of sections, got {type(data).__name__}")
+            raise SensorSpecError(
+                f"{source}: expected a table of sections, got {type(data).__name__}"
+            )
         problems: list[str] = []
         allowed_top = {"name", "description", *_SECTIONS}
         for key in data:
@@ -406,7 +410,9 @@ class SensorSpec:
                 updates[key] = value
         for section, values in nested.items():
             if section not in _SECTIONS:
-                raise SensorSpecError(f"unknown section {section!r}; allowed: {', '.join(_SECTIONS)}")
+                raise SensorSpecError(
+                    f"unknown section {section!r}; allowed: {', '.join(_SECTIONS)}"
+                )
             current = updates.get(section, getattr(self, section))
             try:
                 updates[section] = dataclasses.replace(current, **values)
@@ -455,12 +461,31 @@ def _validate(spec: SensorSpec) -> list[str]:
         if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
             problems.append(f"[{section}] {key} must be positive; got {value!r}")
 
-    a, b, e, r, el, f = spec.array, spec.body, spec.elastic, spec.rings, spec.electronics, spec.flaws
-    for section, obj in (("array", a), ("body", b), ("elastic", e), ("rings", r), ("electronics", el)):
+    a, b, e, r, el, f = (
+        spec.array,
+        spec.body,
+        spec.elastic,
+        spec.rings,
+        spec.electronics,
+        spec.flaws,
+    )
+    for section, obj in (
+        ("array", a),
+        ("body", b),
+        ("elastic", e),
+        ("rings", r),
+        ("electronics", el),
+    ):
         for fld in dataclasses.fields(obj):
             value = getattr(obj, fld.name)
-            if fld.name in {"first_row_axial_mm", "tip_row_axial_mm", "first_col_angle_deg",
-                            "wired_col_offset", "tip_row", "model"}:
+            if fld.name in {
+                "first_row_axial_mm",
+                "tip_row_axial_mm",
+                "first_col_angle_deg",
+                "wired_col_offset",
+                "tip_row",
+                "model",
+            }:
                 continue
             positive(section, fld.name, value)
     if problems:
@@ -509,7 +534,9 @@ def _validate(spec: SensorSpec) -> list[str]:
     for key in ("poisson_ratio", "effective_poisson_ratio"):
         nu = getattr(e, key)
         if not (-1.0 < nu <= 0.5):
-            problems.append(f"[elastic] {key} = {nu:g} is out of range; Poisson's ratio lies in (-1, 0.5]")
+            problems.append(
+                f"[elastic] {key} = {nu:g} is out of range; Poisson's ratio lies in (-1, 0.5]"
+            )
     if e.model not in ("plane_stress", "plane_strain"):
         problems.append(f"[elastic] model = {e.model!r}; expected 'plane_stress' or 'plane_strain'")
     if not 1 <= el.adc_bits <= 24:
@@ -519,16 +546,28 @@ def _validate(spec: SensorSpec) -> list[str]:
             f"[electronics] nominal_counts = {el.nominal_counts:g} does not fit in a "
             f"{el.adc_bits}-bit converter (max {2**el.adc_bits - 1})"
         )
-    for key in ("gain_spread_sd", "force_jitter_n", "position_jitter_mm", "read_noise_counts",
-                "creep_fraction"):
+    for key in (
+        "gain_spread_sd",
+        "force_jitter_n",
+        "position_jitter_mm",
+        "read_noise_counts",
+        "creep_fraction",
+    ):
         value = getattr(f, key)
         if not (math.isfinite(value) and value >= 0):
             problems.append(f"[flaws] {key} must be non-negative; got {value!r}")
-    for key in ("nonlinear_saturation", "delayed_time_constant_s", "creep_time_constant_s",
-                "gain_min", "gain_max"):
+    for key in (
+        "nonlinear_saturation",
+        "delayed_time_constant_s",
+        "creep_time_constant_s",
+        "gain_min",
+        "gain_max",
+    ):
         positive("flaws", key, getattr(f, key))
     if f.gain_min > 1.0 or f.gain_max < 1.0:
-        problems.append(f"[flaws] gain_min <= 1 <= gain_max is required; got {f.gain_min}, {f.gain_max}")
+        problems.append(
+            f"[flaws] gain_min <= 1 <= gain_max is required; got {f.gain_min}, {f.gain_max}"
+        )
     if not 0.0 <= f.delayed_fraction <= 1.0:
         problems.append(f"[flaws] delayed_fraction must lie in [0, 1]; got {f.delayed_fraction!r}")
     for row, col in f.dead_tactels:
@@ -551,9 +590,17 @@ def fearing1990_initial() -> SensorSpec:
         name="fearing1990_initial",
         description="Fearing (1990) initial finger: 3.8 mm along the length, 45 deg around",
         array=ArrayLayout(
-            cylinder_rows=7, cols=8, tip_row=True, wired_rows=8, wired_cols=8,
-            wired_col_offset=0, spacing_axial_mm=3.8, spacing_angle_deg=45.0,
-            first_row_axial_mm=1.1, tip_row_axial_mm=-9.975, first_col_angle_deg=0.0,
+            cylinder_rows=7,
+            cols=8,
+            tip_row=True,
+            wired_rows=8,
+            wired_cols=8,
+            wired_col_offset=0,
+            spacing_axial_mm=3.8,
+            spacing_angle_deg=45.0,
+            first_row_axial_mm=1.1,
+            tip_row_axial_mm=-9.975,
+            first_col_angle_deg=0.0,
         ),
     )
 
@@ -568,9 +615,17 @@ def fearing1990_improved() -> SensorSpec:
         name="fearing1990_improved",
         description="Fearing (1990) improved finger: 3.3 mm along the length, 18 deg around",
         array=ArrayLayout(
-            cylinder_rows=7, cols=12, tip_row=True, wired_rows=8, wired_cols=8,
-            wired_col_offset=2, spacing_axial_mm=3.3, spacing_angle_deg=18.0,
-            first_row_axial_mm=2.6, tip_row_axial_mm=-9.975, first_col_angle_deg=-99.0,
+            cylinder_rows=7,
+            cols=12,
+            tip_row=True,
+            wired_rows=8,
+            wired_cols=8,
+            wired_col_offset=2,
+            spacing_axial_mm=3.3,
+            spacing_angle_deg=18.0,
+            first_row_axial_mm=2.6,
+            tip_row_axial_mm=-9.975,
+            first_col_angle_deg=-99.0,
         ),
     )
 

@@ -88,8 +88,11 @@ class Scenario:
             "description": self.description,
             "parameters": self.parameters,
             "steps": [
-                {"duration_s": s.duration_s, "label": s.label,
-                 "contacts": [c.to_dict() for c in s.contacts]}
+                {
+                    "duration_s": s.duration_s,
+                    "label": s.label,
+                    "contacts": [c.to_dict() for c in s.contacts],
+                }
                 for s in self.steps
             ],
         }
@@ -98,24 +101,41 @@ class Scenario:
     def from_dict(cls, data: dict) -> Scenario:
         try:
             steps = tuple(
-                Step(tuple(contact_from_dict(c) for c in s["contacts"]), s["duration_s"],
-                     s.get("label", ""))
+                Step(
+                    tuple(contact_from_dict(c) for c in s["contacts"]),
+                    s["duration_s"],
+                    s.get("label", ""),
+                )
                 for s in data["steps"]
             )
         except (KeyError, TypeError) as error:
             raise TactsenseInputError(f"malformed scenario description: {error}") from None
-        return cls(steps, data.get("name", "custom"), data.get("description", ""),
-                   data.get("parameters", {}))
+        return cls(
+            steps,
+            data.get("name", "custom"),
+            data.get("description", ""),
+            data.get("parameters", {}),
+        )
 
 
 # ---- scenario builders ----------------------------------------------------------
 
 
-def probe_sweep(spec: SensorSpec, *, along: str = "axial", row: int = 4, col: int = 0,
-                start: float | None = None, stop: float | None = None,
-                increment: float | None = None, force_n: float | None = None,
-                dwell_s: float = 0.5, lift_s: float = 0.0, settle_s: float = 1.0,
-                contact_diameter_mm: float = 3.0) -> Scenario:
+def probe_sweep(
+    spec: SensorSpec,
+    *,
+    along: str = "axial",
+    row: int = 4,
+    col: int = 0,
+    start: float | None = None,
+    stop: float | None = None,
+    increment: float | None = None,
+    force_n: float | None = None,
+    dwell_s: float = 0.5,
+    lift_s: float = 0.0,
+    settle_s: float = 1.0,
+    contact_diameter_mm: float = 3.0,
+) -> Scenario:
     """The paper's probe sweep (Figs. 7 and 13): a 50-g probe stepped along a row or around.
 
     Parameters
@@ -152,8 +172,11 @@ def probe_sweep(spec: SensorSpec, *, along: str = "axial", row: int = 4, col: in
         fixed_angle = float(spec.col_angle_deg[col])
     else:
         increment = 3.0 if increment is None else increment
-        half_span = 180.0 if spec.closes_circumference else (
-            spec.array.wired_cols / 2 * spec.array.spacing_angle_deg)
+        half_span = (
+            180.0
+            if spec.closes_circumference
+            else (spec.array.wired_cols / 2 * spec.array.spacing_angle_deg)
+        )
         centre = 0.0 if spec.closes_circumference else float(np.mean(spec.col_angle_deg))
         start = centre - half_span if start is None else start
         stop = centre + half_span if stop is None else stop
@@ -173,18 +196,38 @@ def probe_sweep(spec: SensorSpec, *, along: str = "axial", row: int = 4, col: in
             steps.append(Step((), lift_s, "lifted"))
     unit = "mm" if along == "axial" else "deg"
     return Scenario(
-        tuple(steps), name=f"probe_sweep_{along}",
-        description=(f"{force_n:.3g} N probe swept {along} from {start:g} to {stop:g} {unit} "
-                     f"in {increment:g} {unit} increments, {dwell_s:g} s each"),
-        parameters={"along": along, "row": row, "col": col, "start": start, "stop": stop,
-                    "increment": increment, "force_n": force_n, "dwell_s": dwell_s,
-                    "lift_s": lift_s, "settle_s": settle_s},
+        tuple(steps),
+        name=f"probe_sweep_{along}",
+        description=(
+            f"{force_n:.3g} N probe swept {along} from {start:g} to {stop:g} {unit} "
+            f"in {increment:g} {unit} increments, {dwell_s:g} s each"
+        ),
+        parameters={
+            "along": along,
+            "row": row,
+            "col": col,
+            "start": start,
+            "stop": stop,
+            "increment": increment,
+            "force_n": force_n,
+            "dwell_s": dwell_s,
+            "lift_s": lift_s,
+            "settle_s": settle_s,
+        },
     )
 
 
-def repeated_load(spec: SensorSpec, *, row: int = 4, col: int = 0, force_n: float | None = None,
-                  repeats: int = 100, on_s: float = 1.0, off_s: float = 1.0,
-                  settle_s: float = 1.0) -> Scenario:
+def repeated_load(
+    spec: SensorSpec,
+    *,
+    row: int = 4,
+    col: int = 0,
+    force_n: float | None = None,
+    repeats: int = 100,
+    on_s: float = 1.0,
+    off_s: float = 1.0,
+    settle_s: float = 1.0,
+) -> Scenario:
     """A weight applied repeatedly above one tactel (Figs. 10-12: jitter and creep)."""
     rows, cols = spec.shape
     if not (0 <= row < rows and 0 <= col < cols):
@@ -197,10 +240,18 @@ def repeated_load(spec: SensorSpec, *, row: int = 4, col: int = 0, force_n: floa
     for k in range(repeats):
         steps += [Step((probe,), on_s, f"on {k}"), Step((), off_s, f"off {k}")]
     return Scenario(
-        tuple(steps), name="repeated_load",
+        tuple(steps),
+        name="repeated_load",
         description=f"{force_n:.3g} N applied {repeats} times above tactel ({row}, {col})",
-        parameters={"row": row, "col": col, "force_n": force_n, "repeats": repeats,
-                    "on_s": on_s, "off_s": off_s, "settle_s": settle_s},
+        parameters={
+            "row": row,
+            "col": col,
+            "force_n": force_n,
+            "repeats": repeats,
+            "on_s": on_s,
+            "off_s": off_s,
+            "settle_s": settle_s,
+        },
     )
 
 
@@ -249,9 +300,15 @@ def _jittered_steps(spec: SensorSpec, steps: Sequence[Step], rng) -> list[tuple]
     return out
 
 
-def simulate(spec: SensorSpec, scenario: Scenario, *, flaws="all", rng=None,
-             gains: np.ndarray | None = None,
-             progress: Callable[[int, int], None] | None = None) -> Recording:
+def simulate(
+    spec: SensorSpec,
+    scenario: Scenario,
+    *,
+    flaws="all",
+    rng=None,
+    gains: np.ndarray | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> Recording:
     """Run a scenario through the forward model and return the recorded frames.
 
     Parameters
@@ -297,8 +354,11 @@ def simulate(spec: SensorSpec, scenario: Scenario, *, flaws="all", rng=None,
         gains = draw_gains(spec, rng)
     else:
         gains = np.ones(spec.shape)
-    applied = (_jittered_steps(spec, scenario.steps, rng) if "jitter" in active
-               else [step.contacts for step in scenario.steps])
+    applied = (
+        _jittered_steps(spec, scenario.steps, rng)
+        if "jitter" in active
+        else [step.contacts for step in scenario.steps]
+    )
     elastic = deflection_batch(spec, applied) * gains  # (S, rows, cols)
 
     boundaries = np.cumsum([0.0] + [s.duration_s for s in scenario.steps])
@@ -316,23 +376,30 @@ def simulate(spec: SensorSpec, scenario: Scenario, *, flaws="all", rng=None,
     for first in range(0, n_frames, _CHUNK_FRAMES):
         last = min(n_frames, first + _CHUNK_FRAMES)
         ticks = np.arange(first * ticks_per_frame, last * ticks_per_frame)
-        step_of_tick = np.clip(np.searchsorted(boundaries, ticks * dt, side="right") - 1,
-                               0, len(scenario.steps) - 1)
+        step_of_tick = np.clip(
+            np.searchsorted(boundaries, ticks * dt, side="right") - 1, 0, len(scenario.steps) - 1
+        )
         u = elastic[step_of_tick]  # (ticks, rows, cols): what every tactel feels at every tick
         if "viscoelastic" in active:
             f = spec.flaws
             u, state = viscoelastic_response(
-                u, dt, delayed_fraction=f.delayed_fraction,
+                u,
+                dt,
+                delayed_fraction=f.delayed_fraction,
                 delayed_time_constant_s=f.delayed_time_constant_s,
-                creep_fraction=f.creep_fraction, creep_time_constant_s=f.creep_time_constant_s,
-                state=state)
+                creep_fraction=f.creep_fraction,
+                creep_time_constant_s=f.creep_time_constant_s,
+                state=state,
+            )
         sampled = u.reshape(last - first, ticks_per_frame, rows, cols)[
-            :, flat_index, row_of_tick, col_of_tick].reshape(last - first, rows, cols)
+            :, flat_index, row_of_tick, col_of_tick
+        ].reshape(last - first, rows, cols)
         if "nonlinearity" in active:
             sampled = stiffening(sampled, spec.flaws.nonlinear_saturation)
         sampled = np.minimum(sampled, 0.95)  # plates cannot touch
-        counts = voltage_to_counts(spec, gain_v * divider_voltage(spec, c0 / (1.0 - sampled)),
-                                   quantize=False)
+        counts = voltage_to_counts(
+            spec, gain_v * divider_voltage(spec, c0 / (1.0 - sampled)), quantize=False
+        )
         if "noise" in active:
             counts = counts + rng.normal(0.0, spec.flaws.read_noise_counts, counts.shape)
         full_scale = 2**spec.electronics.adc_bits - 1
@@ -344,8 +411,9 @@ def simulate(spec: SensorSpec, scenario: Scenario, *, flaws="all", rng=None,
 
     time_s = np.arange(n_frames) * period
     mid_scan = time_s + 0.5 * period
-    frame_step = np.clip(np.searchsorted(boundaries, mid_scan, side="right") - 1, 0,
-                         len(scenario.steps) - 1)
+    frame_step = np.clip(
+        np.searchsorted(boundaries, mid_scan, side="right") - 1, 0, len(scenario.steps) - 1
+    )
     truth = _truth(spec, applied, frame_step)
     dtype = np.uint16 if "quantization" in active else np.float64
     return Recording(
@@ -381,4 +449,3 @@ def _truth(spec: SensorSpec, applied: list[tuple], frame_step: np.ndarray) -> di
         "step_n_contacts": count,
         "step_contacts_json": json.dumps([[c.to_dict() for c in s] for s in applied]),
     }
-

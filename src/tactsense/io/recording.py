@@ -121,8 +121,12 @@ def write_recording(path: str | Path, recording: Recording, *, overwrite: bool =
         h5.attrs["scenario_json"] = json.dumps(recording.scenario)
         h5.attrs["flaws"] = ",".join(recording.flaws)
         h5.attrs["scan_rate_hz"] = recording.sensor.electronics.scan_rate_hz
-        frames = h5.create_dataset("frames", data=recording.frames, compression="gzip",
-                                   chunks=(min(len(recording), 1024), *recording.sensor.shape))
+        frames = h5.create_dataset(
+            "frames",
+            data=recording.frames,
+            compression="gzip",
+            chunks=(min(len(recording), 1024), *recording.sensor.shape),
+        )
         frames.attrs["units"] = "counts"
         frames.attrs["axes"] = "time, row (along the finger, 0 = tip), col (around)"
         h5.create_dataset("time", data=np.asarray(recording.time_s, float)).attrs["units"] = "s"

@@ -77,8 +77,9 @@ def axial_response(spec: SensorSpec, patches: Patches) -> np.ndarray:
     ``-A[p, i] * F_p / width`` would be the plane-stress strain at row i for
     a line load F_p / width; A already includes the tangential part beta.
     """
-    E, nu = _plane_stress_constants(spec.elastic.youngs_modulus_pa,
-                                    spec.elastic.effective_poisson_ratio, spec.elastic.model)
+    E, nu = _plane_stress_constants(
+        spec.elastic.youngs_modulus_pa, spec.elastic.effective_poisson_ratio, spec.elastic.model
+    )
     depth = spec.row_depth_mm[None, :, None] * 1e-3  # (1, rows, 1)
     row_x = spec.row_axial_mm[None, :, None] * 1e-3
     centre = patches.axial_mm[:, None, None] * 1e-3
@@ -125,8 +126,9 @@ def around_response(spec: SensorSpec, patches: Patches) -> np.ndarray:
             values[point] = ring_kernel(s[point] * 1e-3, flex * 1e-3)
         spread = ~point
         if np.any(spread):
-            edges = (s[spread][:, :, None]
-                     - r_ring * half_angle[spread, None, None] * u[None, None, :]) * 1e-3
+            edges = (
+                s[spread][:, :, None] - r_ring * half_angle[spread, None, None] * u[None, None, :]
+            ) * 1e-3
             cum = ring_cumulative(edges, flex * 1e-3)  # decreasing along u
             width = 2.0 * r_ring * half_angle[spread, None, None] * 1e-3 / _CELLS
             values[spread] = np.sum(

@@ -103,8 +103,13 @@ class Patches:
 
 def _single(axial_mm, angle_deg, force_n, half_length, half_width, prof_ax, prof_ar, beta):
     return Patches(
-        np.array([axial_mm], float), np.array([angle_deg], float), np.array([force_n], float),
-        np.array([half_length], float), np.array([half_width], float), (prof_ax,), (prof_ar,),
+        np.array([axial_mm], float),
+        np.array([angle_deg], float),
+        np.array([force_n], float),
+        np.array([half_length], float),
+        np.array([half_width], float),
+        (prof_ax,),
+        (prof_ar,),
         np.array([beta], float),
     )
 
@@ -139,7 +144,9 @@ class _ContactBase:
     def moved(self, d_axial_mm: float = 0.0, d_angle_deg: float = 0.0, force_scale: float = 1.0):
         """A copy moved on the surface and with the force scaled."""
         return dataclasses.replace(
-            self, axial_mm=self.axial_mm + d_axial_mm, angle_deg=self.angle_deg + d_angle_deg,
+            self,
+            axial_mm=self.axial_mm + d_axial_mm,
+            angle_deg=self.angle_deg + d_angle_deg,
             force_n=self.force_n * force_scale,
         )
 
@@ -178,8 +185,16 @@ class Probe(_ContactBase):
     def patches(self) -> Patches:
         half = self.contact_diameter_mm / 2.0
         profile = "parabolic" if half > 0 else "point"
-        return _single(self.axial_mm, self.angle_deg, self.normal_force_n, half, half,
-                       profile, profile, self.beta)
+        return _single(
+            self.axial_mm,
+            self.angle_deg,
+            self.normal_force_n,
+            half,
+            half,
+            profile,
+            profile,
+            self.beta,
+        )
 
 
 @dataclass(frozen=True)
@@ -213,8 +228,16 @@ class FlatContact(_ContactBase):
         check_choice(self.profile, "flat profile", PROFILES[1:])
 
     def patches(self) -> Patches:
-        return _single(self.axial_mm, self.angle_deg, self.normal_force_n, self.length_mm / 2,
-                       self.width_mm / 2, self.profile, self.profile, self.beta)
+        return _single(
+            self.axial_mm,
+            self.angle_deg,
+            self.normal_force_n,
+            self.length_mm / 2,
+            self.width_mm / 2,
+            self.profile,
+            self.profile,
+            self.beta,
+        )
 
 
 @dataclass(frozen=True)
@@ -272,25 +295,63 @@ class LineContact(_ContactBase):
         )
 
 
-def knife_edge(axial_mm: float, angle_deg: float, force_n: float, *, length_mm: float = 10.0,
-               alpha_deg: float = 0.0) -> LineContact:
+def knife_edge(
+    axial_mm: float,
+    angle_deg: float,
+    force_n: float,
+    *,
+    length_mm: float = 10.0,
+    alpha_deg: float = 0.0,
+) -> LineContact:
     """A knife edge across the finger: the line load of section 4.1 and Fig. 28."""
-    return LineContact(axial_mm, angle_deg, force_n, length_mm=length_mm, orientation_deg=90.0,
-                       width_mm=0.2, alpha_deg=alpha_deg)
+    return LineContact(
+        axial_mm,
+        angle_deg,
+        force_n,
+        length_mm=length_mm,
+        orientation_deg=90.0,
+        width_mm=0.2,
+        alpha_deg=alpha_deg,
+    )
 
 
-def rod(axial_mm: float, angle_deg: float, force_n: float, *, orientation_deg: float = 45.0,
-        length_mm: float = 30.0, width_mm: float = 2.0) -> LineContact:
+def rod(
+    axial_mm: float,
+    angle_deg: float,
+    force_n: float,
+    *,
+    orientation_deg: float = 45.0,
+    length_mm: float = 30.0,
+    width_mm: float = 2.0,
+) -> LineContact:
     """A rod lying on the cylinder at ``orientation_deg`` to its axis (Fig. 22)."""
-    return LineContact(axial_mm, angle_deg, force_n, length_mm=length_mm,
-                       orientation_deg=orientation_deg, width_mm=width_mm)
+    return LineContact(
+        axial_mm,
+        angle_deg,
+        force_n,
+        length_mm=length_mm,
+        orientation_deg=orientation_deg,
+        width_mm=width_mm,
+    )
 
 
-def soft_object(axial_mm: float, angle_deg: float, force_n: float, *, length_mm: float,
-                width_mm: float | None = None) -> FlatContact:
+def soft_object(
+    axial_mm: float,
+    angle_deg: float,
+    force_n: float,
+    *,
+    length_mm: float,
+    width_mm: float | None = None,
+) -> FlatContact:
     """A large soft object (another finger, Figs. 21 and 26): Hertzian elliptic pressure."""
-    return FlatContact(axial_mm, angle_deg, force_n, length_mm=length_mm,
-                       width_mm=length_mm if width_mm is None else width_mm, profile="elliptic")
+    return FlatContact(
+        axial_mm,
+        angle_deg,
+        force_n,
+        length_mm=length_mm,
+        width_mm=length_mm if width_mm is None else width_mm,
+        profile="elliptic",
+    )
 
 
 CONTACT_TYPES = {"probe": Probe, "flat": FlatContact, "line": LineContact}

@@ -11,8 +11,15 @@ import numpy as np
 
 from tactsense.sensor import SensorSpec
 
-FLAW_NAMES = ("gain_spread", "jitter", "noise", "quantization", "nonlinearity", "viscoelastic",
-              "dead")
+FLAW_NAMES = (
+    "gain_spread",
+    "jitter",
+    "noise",
+    "quantization",
+    "nonlinearity",
+    "viscoelastic",
+    "dead",
+)
 
 
 def draw_gains(spec: SensorSpec, rng=None) -> np.ndarray:

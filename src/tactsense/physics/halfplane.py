@@ -136,8 +136,9 @@ def _plane_stress_constants(youngs_modulus, poisson_ratio, model):
     return E, nu
 
 
-def line_load_strain(x, z, line_load, alpha=0.0, *, youngs_modulus, poisson_ratio,
-                     model="plane_stress"):
+def line_load_strain(
+    x, z, line_load, alpha=0.0, *, youngs_modulus, poisson_ratio, model="plane_stress"
+):
     """Normal strain eps_z under a line load at angle ``alpha`` (eqs. 7 and 9 of [1]).
 
     Parameters
@@ -165,7 +166,9 @@ def line_load_strain(x, z, line_load, alpha=0.0, *, youngs_modulus, poisson_rati
     z = as_float_array(z, "z")
     r4 = (x * x + z * z) ** 2
     return (
-        -2.0 * line_load / (E * np.pi * r4)
+        -2.0
+        * line_load
+        / (E * np.pi * r4)
         * (z * np.cos(alpha) + x * np.sin(alpha))
         * (z * z - nu * x * x)
     )
@@ -187,12 +190,12 @@ def impulse_response(x, depth, *, youngs_modulus, poisson_ratio, model="plane_st
         h(x) [m/N] (strain per N/m of line load), negative.
     """
     depth = check_positive(depth, "depth")
-    return line_load_strain(x, depth, 1.0, 0.0, youngs_modulus=youngs_modulus,
-                            poisson_ratio=poisson_ratio, model=model)
+    return line_load_strain(
+        x, depth, 1.0, 0.0, youngs_modulus=youngs_modulus, poisson_ratio=poisson_ratio, model=model
+    )
 
 
-def impulse_response_tangential(x, depth, *, youngs_modulus, poisson_ratio,
-                                model="plane_stress"):
+def impulse_response_tangential(x, depth, *, youngs_modulus, poisson_ratio, model="plane_stress"):
     """Normal-strain response to a unit tangential line load toward +x (odd in x).
 
     Returns
@@ -201,8 +204,15 @@ def impulse_response_tangential(x, depth, *, youngs_modulus, poisson_ratio,
         h_t(x) [m/N].
     """
     depth = check_positive(depth, "depth")
-    return line_load_strain(x, depth, 1.0, np.pi / 2, youngs_modulus=youngs_modulus,
-                            poisson_ratio=poisson_ratio, model=model)
+    return line_load_strain(
+        x,
+        depth,
+        1.0,
+        np.pi / 2,
+        youngs_modulus=youngs_modulus,
+        poisson_ratio=poisson_ratio,
+        model=model,
+    )
 
 
 def frequency_response(s, depth, *, youngs_modulus, poisson_ratio, model="plane_stress"):
@@ -233,8 +243,7 @@ def frequency_response(s, depth, *, youngs_modulus, poisson_ratio, model="plane_
     return -((1.0 - nu) + k * (1.0 + nu)) * np.exp(-k) / E
 
 
-def frequency_response_tangential(s, depth, *, youngs_modulus, poisson_ratio,
-                                  model="plane_stress"):
+def frequency_response_tangential(s, depth, *, youngs_modulus, poisson_ratio, model="plane_stress"):
     """Fourier transform H_t(s) of the tangential impulse response (eq. 69 of [1]).
 
     ``H_t(s) = (2 i / E) [pi (1 + nu) d s - nu sign(s)] exp(-2 pi d |s|)``,
@@ -248,8 +257,11 @@ def frequency_response_tangential(s, depth, *, youngs_modulus, poisson_ratio,
     E, nu = _plane_stress_constants(youngs_modulus, poisson_ratio, model)
     depth = check_positive(depth, "depth")
     s = as_float_array(s, "s")
-    return 2j / E * (np.pi * (1.0 + nu) * depth * s - nu * np.sign(s)) * np.exp(
-        -2.0 * np.pi * depth * np.abs(s)
+    return (
+        2j
+        / E
+        * (np.pi * (1.0 + nu) * depth * s - nu * np.sign(s))
+        * np.exp(-2.0 * np.pi * depth * np.abs(s))
     )
 
 
@@ -271,8 +283,9 @@ def cumulative_normal(x, depth, youngs_modulus, poisson_ratio):
     so that ``integral_a^b h(x) dx = G_n(b) - G_n(a)``.
     """
     r2 = x * x + depth * depth
-    return -((1.0 + poisson_ratio) * x * depth / r2
-             + (1.0 - poisson_ratio) * np.arctan2(x, depth)) / (np.pi * youngs_modulus)
+    return -(
+        (1.0 + poisson_ratio) * x * depth / r2 + (1.0 - poisson_ratio) * np.arctan2(x, depth)
+    ) / (np.pi * youngs_modulus)
 
 
 def cumulative_tangential(x, depth, youngs_modulus, poisson_ratio):
@@ -281,12 +294,14 @@ def cumulative_tangential(x, depth, youngs_modulus, poisson_ratio):
     ``G_t(x) = [(1 + nu) d^2 / (x^2 + d^2) + nu ln((x^2 + d^2) / d^2)] / (pi E)``.
     """
     r2 = x * x + depth * depth
-    return ((1.0 + poisson_ratio) * depth * depth / r2
-            + poisson_ratio * np.log(r2 / (depth * depth))) / (np.pi * youngs_modulus)
+    return (
+        (1.0 + poisson_ratio) * depth * depth / r2 + poisson_ratio * np.log(r2 / (depth * depth))
+    ) / (np.pi * youngs_modulus)
 
 
-def strain_from_pressure(x, depth, cell_edges, pressure, *, beta=0.0, youngs_modulus,
-                         poisson_ratio, model="plane_stress"):
+def strain_from_pressure(
+    x, depth, cell_edges, pressure, *, beta=0.0, youngs_modulus, poisson_ratio, model="plane_stress"
+):
     """Normal strain at depth under a surface pressure p(x) with traction beta*p(x).
 
     The pressure is taken as constant on each cell (eq. 58-59 of [1]: the
@@ -330,4 +345,31 @@ def strain_from_pressure(x, depth, cell_edges, pressure, *, beta=0.0, youngs_mod
     weights = -np.diff(cumulative_normal(offset, depth, E, nu), axis=1)
     if beta:
         weights = weights - beta * np.diff(cumulative_tangential(offset, depth, E, nu), axis=1)
-    return (pressure @ weights.T).reshape(*pressure.shape[:-1], *x.shape)
+    return (pressure @ weights.T).reshape(pressure.shape[:-1] + x.shape)
+
+
+def odd_peak_offset(depth, poisson_ratio):
+    """Offset from the load at which the odd (tangential) strain of a line load peaks [m].
+
+    ``x = d sqrt(T)``, ``T = [3 (1 + nu) - sqrt(9 (1 + nu)^2 - 4 nu)] / (2 nu)``:
+    the root of ``nu T^2 - 3 (1 + nu) T + 1 = 0``. Eq. 65 of [1] prints
+    ``- 4`` for ``- 4 nu`` under the inner root (``docs/errata.md``). For nu = 0
+    the offset is ``d / sqrt(3)``.
+    """
+    nu = check_poisson_ratio(poisson_ratio)
+    depth = check_positive(depth, "depth")
+    if nu == 0.0:
+        return depth / np.sqrt(3.0)
+    root = (3.0 * (1.0 + nu) - np.sqrt(9.0 * (1.0 + nu) ** 2 - 4.0 * nu)) / (2.0 * nu)
+    return depth * np.sqrt(root)
+
+
+def line_load_skew_coefficient(poisson_ratio):
+    """Skew index of a line load per unit tan(alpha), plane stress (eqs. 63-67 of [1]) [-].
+
+    ``max eps_odd / max eps_even = k tan(alpha)`` with
+    ``k = t (1 - nu t^2) / (1 + t^2)^2`` at ``t = odd_peak_offset / d``; 0.2805
+    for nu = 0.5 (the paper prints 0.2441, see ``docs/errata.md``).
+    """
+    t = odd_peak_offset(1.0, poisson_ratio)
+    return t * (1.0 - poisson_ratio * t * t) / (1.0 + t * t) ** 2

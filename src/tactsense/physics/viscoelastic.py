@@ -55,8 +55,17 @@ def first_order_memory(u, dt, time_constant, axis=0, state=None):
     return np.moveaxis(m, 0, axis), m[-1]
 
 
-def viscoelastic_response(u, dt, *, delayed_fraction, delayed_time_constant_s, creep_fraction,
-                          creep_time_constant_s, axis=0, state=None):
+def viscoelastic_response(
+    u,
+    dt,
+    *,
+    delayed_fraction,
+    delayed_time_constant_s,
+    creep_fraction,
+    creep_time_constant_s,
+    axis=0,
+    state=None,
+):
     """Reading of a viscoelastic sensor for an elastic deflection history.
 
     Parameters

@@ -1,0 +1,100 @@
+import re
+
+from typer.testing import CliRunner
+
+import tactsense as ts
+from tactsense.cli import app
+
+runner = CliRunner()
+
+
+def plain(text: str) -> str:
+    return re.sub(r"\x1b\[[0-9;]*m", "", text)
+
+
+def test_simulate_writes_recording_and_plot(tmp_path):
+    out, png = tmp_path / "s.h5", tmp_path / "s.png"
+    result = runner.invoke(
+        app,
+        [
+            "simulate",
+            "--out",
+            str(out),
+            "--plot",
+            str(png),
+            "--increment",
+            "2.0",
+            "--dwell-s",
+            "0.3",
+        ],
+    )
+    assert result.exit_code == 0, result.output
+    assert ts.read_recording(out).frames.shape[1:] == (8, 8)
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    again = runner.invoke(app, ["simulate", "--out", str(out)])
+    assert again.exit_code == 2 and "--force" in plain(again.output)
+    forced = runner.invoke(
+        app,
+        [
+            "simulate",
+            "--out",
+            str(out),
+            "--force",
+            "--scenario",
+            "repeated",
+            "--repeats",
+            "2",
+            "--flaws",
+            "none",
+        ],
+    )
+    assert forced.exit_code == 0, forced.output
+
+
+def test_simulate_help_explains_every_option():
+    result = runner.invoke(app, ["simulate", "--help"])
+    assert result.exit_code == 0
+    text = plain(result.output)
+    options = [
+        "--out",
+        "--sensor",
+        "--scenario",
+        "--row",
+        "--col",
+        "--force-g",
+        "--increment",
+        "--dwell-s",
+        "--lift-s",
+        "--repeats",
+        "--flaws",
+        "--seed",
+        "--plot",
+        "--force",
+    ]
+    for option in options:
+        line = next(line for line in text.splitlines() if option in line)
+        assert len(line.split(option, 1)[1].strip()) > 10, f"{option} lacks help"
+
+
+def test_bad_inputs_give_clear_errors(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[array]\nspacing_axial_mm = -1\n")
+    result = runner.invoke(app, ["simulate", "--sensor", str(bad), "--out", str(tmp_path / "x.h5")])
+    assert result.exit_code == 2 and "spacing_axial_mm must be positive" in plain(result.output)
+    result = runner.invoke(
+        app, ["simulate", "--flaws", "gremlins", "--out", str(tmp_path / "y.h5")]
+    )
+    assert result.exit_code == 2 and "unknown flaw" in plain(result.output)
+    result = runner.invoke(app, ["info", str(bad)])
+    assert result.exit_code == 2 and "not a readable HDF5" in plain(result.output)
+
+
+def test_sensor_show_and_check(tmp_path):
+    path = tmp_path / "improved.toml"
+    result = runner.invoke(app, ["sensor", "show", "--sensor", "improved", "--out", str(path)])
+    assert result.exit_code == 0
+    assert ts.SensorSpec.from_toml(path) == ts.fearing1990_improved()
+    result = runner.invoke(app, ["sensor", "check", str(path)])
+    assert result.exit_code == 0 and "valid" in plain(result.output)
+    shown = runner.invoke(app, ["sensor", "show"])
+    assert "spacing_axial_mm = 3.8" in shown.output
