@@ -98,3 +98,49 @@ def test_sensor_show_and_check(tmp_path):
     assert result.exit_code == 0 and "valid" in plain(result.output)
     shown = runner.invoke(app, ["sensor", "show"])
     assert "spacing_axial_mm = 3.8" in shown.output
+
+
+def test_design_strip_json_matches_the_python_function():
+    import json
+
+    from tactsense.analysis import strip_capacitor_design
+
+    result = runner.invoke(
+        app,
+        [
+            "design",
+            "strip",
+            "--thickness",
+            "3.8",
+            "--separation",
+            "0.5",
+            "--load",
+            "200",
+            "--width",
+            "3",
+            "--json",
+        ],
+    )
+    assert result.exit_code == 0, result.output
+    data = json.loads(result.output)
+    want = strip_capacitor_design(3.8e-3, 0.5e-3, 200.0, 3e-3)
+    assert data["gain"] == want["gain"]
+    assert data["closing_m"] == want["closing"]
+    assert data["bottom_plate_deflection_m"] == 0.0
+    table = runner.invoke(app, ["design", "strip", "--backing", "1.2"])
+    assert table.exit_code == 0 and "gain" in table.output
+    bad = runner.invoke(app, ["design", "strip", "--separation", "5"])
+    assert bad.exit_code == 2 and "separation" in plain(bad.output)
+    help_text = plain(runner.invoke(app, ["design", "strip", "--help"]).output)
+    for option in (
+        "--thickness",
+        "--separation",
+        "--load",
+        "--width",
+        "--backing",
+        "--modulus",
+        "--poisson",
+        "--model",
+        "--json",
+    ):
+        assert option in help_text

@@ -28,6 +28,12 @@ sensor_app = typer.Typer(
     no_args_is_help=True, rich_markup_mode=None, help="Show, export and check sensor descriptions."
 )
 app.add_typer(sensor_app, name="sensor")
+design_app = typer.Typer(
+    no_args_is_help=True,
+    rich_markup_mode=None,
+    help="Design questions: capacitor gain in the skin, aliasing (coming), bounds (coming).",
+)
+app.add_typer(design_app, name="design")
 
 console = Console(stderr=True)
 
@@ -235,6 +241,109 @@ def sensor_check(
     table.add_row("closes the circumference", str(spec.closes_circumference))
     table.add_row("junction capacitance", f"{spec.junction_capacitance_f * 1e12:.3f} pF")
     table.add_row("ring flexural length", f"{spec.ring_flexural_length_mm:.3f} mm")
+    Console().print(table)
+
+
+class ElasticModel(StrEnum):
+    plane_stress = "plane_stress"
+    plane_strain = "plane_strain"
+
+
+@design_app.command("strip")
+def design_strip(
+    thickness: Annotated[
+        float,
+        typer.Option(
+            help="Depth of the bottom capacitor plate below the skin surface "
+            "(the skin thickness when the plate sits on the core), in mm."
+        ),
+    ] = 3.8,
+    separation: Annotated[
+        float,
+        typer.Option(
+            help="Nominal plate separation d_o, in mm; the top plate lies this "
+            "far above the bottom one."
+        ),
+    ] = 0.5,
+    load: Annotated[
+        float,
+        typer.Option(
+            help="Load per unit length of the finger slab, in N/m (the paper: "
+            "about 200 N/m for its calibration probe)."
+        ),
+    ] = 200.0,
+    width: Annotated[
+        float,
+        typer.Option(
+            help="Width of the parabolic contact pressure, in mm (the paper's probe: 3 mm)."
+        ),
+    ] = 3.0,
+    backing: Annotated[
+        float,
+        typer.Option(
+            help="Elastic layer between the bottom plate and the rigid core, "
+            "in mm (0: the plate sits on the core)."
+        ),
+    ] = 0.0,
+    modulus: Annotated[float, typer.Option(help="Young's modulus of the skin, in Pa.")] = 2.5e5,
+    poisson: Annotated[float, typer.Option(help="Poisson's ratio of the skin material.")] = 0.5,
+    model: Annotated[
+        ElasticModel,
+        typer.Option(
+            help="Two-dimensional elastic model; plane stress uses the "
+            "paper's substitution nu/(1+nu)."
+        ),
+    ] = ElasticModel.plane_stress,
+    as_json: Annotated[
+        bool, typer.Option("--json", help="Print the result as JSON (SI units) instead of a table.")
+    ] = False,
+) -> None:
+    """Capacitor gain of a plate pair in a skin bonded to the rigid core (section 5, Fig. 17)."""
+    import json
+
+    from tactsense.analysis import strip_capacitor_design
+
+    try:
+        result = strip_capacitor_design(
+            thickness * 1e-3,
+            separation * 1e-3,
+            load,
+            width * 1e-3,
+            backing=backing * 1e-3,
+            youngs_modulus=modulus,
+            poisson_ratio=poisson,
+            model=model.value,
+        )
+    except TactsenseInputError as error:
+        _fail(str(error))
+    values = {key: float(value) for key, value in result.items()}
+    inputs = {
+        "thickness_m": thickness * 1e-3,
+        "separation_m": separation * 1e-3,
+        "line_load_n_per_m": load,
+        "width_m": width * 1e-3,
+        "backing_m": backing * 1e-3,
+        "youngs_modulus_pa": modulus,
+        "poisson_ratio": poisson,
+        "model": model.value,
+    }
+    if as_json:
+        output = {
+            "inputs": inputs,
+            "gain": values["gain"],
+            "top_plate_deflection_m": values["top_plate_deflection"],
+            "bottom_plate_deflection_m": values["bottom_plate_deflection"],
+            "surface_deflection_m": values["surface_deflection"],
+            "closing_m": values["closing"],
+        }
+        typer.echo(json.dumps(output, indent=2))
+        return
+    table = Table(title="Capacitor in an elastic strip on a rigid core", show_header=False)
+    table.add_row("gain dd/d_o (eq. 36)", f"{100 * values['gain']:.2f} %")
+    table.add_row("plate closing dd", f"{1e6 * values['closing']:.2f} um")
+    table.add_row("top plate deflection", f"{1e6 * values['top_plate_deflection']:.2f} um")
+    table.add_row("bottom plate deflection", f"{1e6 * values['bottom_plate_deflection']:.2f} um")
+    table.add_row("surface deflection", f"{1e6 * values['surface_deflection']:.2f} um")
     Console().print(table)
 
 

@@ -83,7 +83,8 @@ def _kernels(k, z, h, nu):
         decay = np.exp(-k * z)
         H = decay * numerator / (k * denominator)
         dH = decay * (d_numerator - k * numerator) / (k * denominator)
-    H, dH = np.array(H, dtype=float), np.array(dH, dtype=float)
+    H = np.where(z >= h, 0.0, H)  # bonded to the core: exactly no displacement there
+    dH = np.array(dH, dtype=float)
     small = k * h < _SERIES_LIMIT
     if np.any(small):
         ks, zs, hs, ns = k[small], z[small], h[small], nu[small]
