@@ -6,6 +6,7 @@ described by :class:`tactsense.SensorSpec`; recordings are HDF5 files read
 and written by :mod:`tactsense.io`.
 """
 
+from tactsense.estimate import Estimates, Flag, baseline_from, locate
 from tactsense.io.recording import Recording, read_recording, write_recording
 from tactsense.physics.array_response import tactel_deflection
 from tactsense.physics.contact import (
@@ -31,6 +32,10 @@ from tactsense.simulate import Scenario, Step, probe_sweep, repeated_load, simul
 __version__ = "0.1.0"
 
 __all__ = [
+    "Estimates",
+    "Flag",
+    "baseline_from",
+    "locate",
     "FlatContact",
     "LineContact",
     "Probe",

@@ -1,0 +1,177 @@
+"""One call from frames to contacts: position, peak deflection, force, skew, flags."""
+
+from __future__ import annotations
+
+import csv
+from dataclasses import dataclass, fields
+from pathlib import Path
+
+import numpy as np
+
+from tactsense._validation import TactsenseInputError, check_frames
+from tactsense.estimate.angle import skew_along_finger
+from tactsense.estimate.deflection import Flag, deflection_from_counts
+from tactsense.estimate.force import total_force
+from tactsense.estimate.localize import newton_peak, tactel_maxima
+from tactsense.geometry import tactel_to_surface
+from tactsense.sensor import SensorSpec
+
+CONTACT_THRESHOLD = 0.005  # fractional deflection: 10 counts at 2000, about 5 g on the probe
+
+
+@dataclass
+class Estimates:
+    """Per-frame estimates; every field has the batch shape of the frames."""
+
+    row: np.ndarray
+    """Fractional row of the peak [tactel]; NaN without contact."""
+    col: np.ndarray
+    """Fractional column of the peak [tactel]."""
+    axial_mm: np.ndarray
+    """Surface position along the finger [mm]."""
+    angle_deg: np.ndarray
+    """Surface position around the finger [deg]."""
+    peak_deflection: np.ndarray
+    """Interpolated fractional deflection at the peak [-]."""
+    force_n: np.ndarray
+    """Total normal force from the integral of the deflection [N]."""
+    skew: np.ndarray
+    """Skew index along the finger (eq. 63) [-]."""
+    iterations: np.ndarray
+    """Newton steps."""
+    converged: np.ndarray
+    """Newton reached 0.01 tactel."""
+    flags: np.ndarray
+    """:class:`~tactsense.estimate.deflection.Flag` bits."""
+
+    UNITS = {"row": "tactel", "col": "tactel", "axial_mm": "mm", "angle_deg": "deg",
+             "peak_deflection": "1", "force_n": "N", "skew": "1", "iterations": "1",
+             "converged": "bool", "flags": "names"}
+
+    def __len__(self) -> int:
+        return int(np.size(self.row))
+
+
+def locate(frames, sensor: SensorSpec, *, baseline=None, counts: bool = True, dead=None,
+           threshold: float = CONTACT_THRESHOLD, second_contact: float = 0.3) -> Estimates:
+    """Locate the contact in every frame of a batch.
+
+    Parameters
+    ----------
+    frames : array_like, shape (..., rows, cols)
+        A/D readings [counts] (``counts=True``, the default) or fractional
+        deflections [-] (``counts=False``).
+    sensor : SensorSpec
+        The finger the frames come from.
+    baseline : array_like, shape (rows, cols)
+        Undeflected readings [counts]; required with counts (see
+        :func:`~tactsense.estimate.deflection.baseline_from`).
+    dead : array_like of bool, shape (rows, cols), optional
+        Tactels to ignore.
+    threshold : float
+        Smallest peak tactel deflection that counts as a contact [-].
+    second_contact : float
+        A separate local maximum larger than this share of the largest sets
+        the MULTIPLE flag [-].
+
+    Returns
+    -------
+    Estimates
+        Positions, force and skew per frame; NaN and NO_CONTACT where no
+        tactel passes the threshold. Frames with unusable tactels are
+        processed with those tactels ignored, and flagged.
+    """
+    if not isinstance(sensor, SensorSpec):
+        raise TactsenseInputError(f"sensor must be a SensorSpec; got {type(sensor).__name__}")
+    frames = check_frames(frames, sensor.shape)
+    if counts:
+        if baseline is None:
+            raise TactsenseInputError(
+                "counts need a baseline (the untouched readings): pass baseline=, e.g. "
+                "tactsense.estimate.baseline_from(frames), or counts=False for deflections"
+            )
+        deflection, flags = deflection_from_counts(frames, baseline, sensor, dead=dead)
+    else:
+        deflection = np.asarray(frames, dtype=float)
+        bad = ~np.isfinite(deflection)
+        flags = np.where(bad.any(axis=(-2, -1)), int(Flag.NAN_INPUT), 0).astype(np.int64)
+        deflection = np.where(bad, 0.0, deflection)
+        if dead is not None:
+            deflection = np.where(np.asarray(dead, bool), 0.0, deflection)
+    lead = deflection.shape[:-2]
+    rows, cols = sensor.shape
+    flat = deflection.reshape(-1, rows, cols)
+    flags = flags.reshape(-1).copy()
+    periodic = sensor.closes_circumference
+    best = flat.reshape(flat.shape[0], -1).argmax(axis=1)
+    start_row, start_col = np.divmod(best, cols)
+    peak_tactel = flat.reshape(flat.shape[0], -1).max(axis=1)
+    touched = peak_tactel >= threshold
+    flags[~touched] |= int(Flag.NO_CONTACT)
+
+    n = flat.shape[0]
+    row = np.full(n, np.nan)
+    col = np.full(n, np.nan)
+    value = np.full(n, np.nan)
+    iterations = np.zeros(n, dtype=np.int64)
+    converged = np.zeros(n, dtype=bool)
+    skew = np.full(n, np.nan)
+    force = np.full(n, np.nan)
+    if touched.any():
+        peak = newton_peak(flat[touched], start_row[touched], start_col[touched],
+                           periodic=periodic)
+        row[touched], col[touched] = peak.row, peak.col
+        value[touched] = peak.value
+        iterations[touched] = peak.iterations
+        converged[touched] = peak.converged
+        with np.errstate(invalid="ignore"):
+            skew[touched] = skew_along_finger(flat[touched], peak.row, peak.col,
+                                              periodic=periodic,
+                                              first_row=1 if sensor.array.tip_row else 0)
+        force[touched] = total_force(flat[touched], sensor)
+        flags[touched & ~converged] |= int(Flag.NOT_CONVERGED)
+        edge = (row < 0.5) | (row > rows - 1.5)
+        if not periodic:
+            edge |= (col < 0.5) | (col > cols - 1.5)
+        flags[touched & edge] |= int(Flag.EDGE)
+        if sensor.array.tip_row:
+            flags[touched & (row < 1.0)] |= int(Flag.TIP)
+        for k in np.flatnonzero(touched):
+            maxima = tactel_maxima(flat[k], periodic=periodic, threshold=threshold)
+            if len(maxima) > 1 and flat[k][maxima[1]] >= second_contact * flat[k][maxima[0]]:
+                flags[k] |= int(Flag.MULTIPLE)
+    axial, angle = tactel_to_surface(sensor, np.nan_to_num(row), np.nan_to_num(col))
+    axial = np.where(touched, axial, np.nan)
+    angle = np.where(touched, angle, np.nan)
+    shaped = [a.reshape(lead) for a in (row, col, axial, angle, value, force, skew, iterations,
+                                        converged, flags)]
+    return Estimates(*shaped)
+
+
+def write_estimates_csv(path: str | Path, estimates: Estimates, time_s=None, *,
+                        overwrite: bool = False) -> Path:
+    """Write one row per frame, with the units in the header."""
+    path = Path(path)
+    if path.exists() and not overwrite:
+        raise FileExistsError(f"{path} exists; pass --force to replace it")
+    names = [f.name for f in fields(Estimates)]
+    header = ["frame", "time [s]"] + [f"{name} [{Estimates.UNITS[name]}]" for name in names]
+    columns = [np.ravel(getattr(estimates, name)) for name in names]
+    times = np.full(len(estimates), np.nan) if time_s is None else np.ravel(time_s)
+    with path.open("w", newline="", encoding="utf-8") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(header)
+        for k in range(len(estimates)):
+            values = []
+            for name, column in zip(names, columns, strict=True):
+                item = column[k]
+                if name == "flags":
+                    values.append(Flag.describe(int(item)))
+                elif name in ("iterations",):
+                    values.append(int(item))
+                elif name == "converged":
+                    values.append(bool(item))
+                else:
+                    values.append(f"{item:.6g}")
+            writer.writerow([k, f"{times[k]:.6g}", *values])
+    return path
