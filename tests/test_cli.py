@@ -1,5 +1,6 @@
 import re
 
+import pytest
 from typer.testing import CliRunner
 
 import tactsense as ts
@@ -144,3 +145,47 @@ def test_design_strip_json_matches_the_python_function():
         "--json",
     ):
         assert option in help_text
+
+
+def test_locate_writes_csv_with_units(tmp_path):
+    import csv
+
+    rec, out = tmp_path / "s.h5", tmp_path / "e.csv"
+    assert (
+        runner.invoke(
+            app,
+            ["simulate", "--out", str(rec), "--increment", "1.5", "--flaws", "noise,quantization"],
+        ).exit_code
+        == 0
+    )
+    result = runner.invoke(app, ["locate", str(rec), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    rows = list(csv.reader(out.open()))
+    assert rows[0][:6] == [
+        "frame",
+        "time [s]",
+        "row [tactel]",
+        "col [tactel]",
+        "axial [mm]",
+        "angle [deg]",
+    ]
+    recording = ts.read_recording(rec)
+    assert len(rows) == len(recording) + 1
+    assert rows[1][-1] == "NO_CONTACT"  # the untouched start
+    touched = [r for r in rows[1:] if r[-1] == ""]
+    assert len(touched) > 0.7 * len(recording)
+    again = runner.invoke(app, ["locate", str(rec), "--out", str(out)])
+    assert again.exit_code == 2 and "--force" in plain(again.output)
+
+
+def test_design_aliasing_json():
+    import json
+
+    result = runner.invoke(
+        app, ["design", "aliasing", "--depth", "3.8", "--spacing", "3.8", "--json"]
+    )
+    assert result.exit_code == 0, result.output
+    data = json.loads(result.output)
+    assert data["xi"] == pytest.approx(0.0317, abs=2e-4)
+    assert runner.invoke(app, ["design", "aliasing"]).exit_code == 0
+    assert runner.invoke(app, ["design", "aliasing", "--poisson", "0.7"]).exit_code == 2

@@ -31,7 +31,7 @@ app.add_typer(sensor_app, name="sensor")
 design_app = typer.Typer(
     no_args_is_help=True,
     rich_markup_mode=None,
-    help="Design questions: capacitor gain in the skin, aliasing (coming), bounds (coming).",
+    help="Design questions: capacitor gain in the skin, aliasing of the sampled strain.",
 )
 app.add_typer(design_app, name="design")
 
@@ -189,6 +189,45 @@ def simulate(
 
 
 @app.command()
+def locate(
+    recording: Annotated[Path, typer.Argument(help="HDF5 recording to analyse.")],
+    out: Annotated[
+        Path, typer.Option("--out", "-o", help="CSV file to write, one row per frame.")
+    ] = Path("estimates.csv"),
+    baseline_frames: Annotated[
+        int,
+        typer.Option(
+            help="Number of untouched frames at the start of the recording "
+            "whose median is the undeflected reading V_o of eq. 4."
+        ),
+    ] = 5,
+    threshold: Annotated[
+        float,
+        typer.Option(
+            help="Smallest tactel deflection that counts as a contact, as a "
+            "fraction (0.005 = 0.5 %, about 10 counts at 2000)."
+        ),
+    ] = 0.005,
+    force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
+) -> None:
+    """Locate the contact in every frame: position, force, skew and quality flags to CSV."""
+    from tactsense.estimate import baseline_from, write_estimates_csv
+    from tactsense.estimate import locate as run_locate
+
+    try:
+        if out.exists() and not force:
+            _fail(f"{out} exists; pass --force to replace it, or choose another name")
+        rec = read_recording(recording)
+        baseline = baseline_from(rec.frames, baseline_frames)
+        estimates = run_locate(rec.frames, rec.sensor, baseline=baseline, threshold=threshold)
+        write_estimates_csv(out, estimates, rec.time_s, overwrite=force)
+    except (TactsenseInputError, FileExistsError) as error:
+        _fail(str(error))
+    touched = int(np.count_nonzero(np.isfinite(estimates.row)))
+    console.print(f"wrote {out}: {len(estimates)} frames, {touched} with a contact")
+
+
+@app.command()
 def info(recording: Annotated[Path, typer.Argument(help="HDF5 recording to describe.")]) -> None:
     """Describe a recording: sensor, scenario, frames and their range."""
     try:
@@ -241,6 +280,56 @@ def sensor_check(
     table.add_row("closes the circumference", str(spec.closes_circumference))
     table.add_row("junction capacitance", f"{spec.junction_capacitance_f * 1e12:.3f} pF")
     table.add_row("ring flexural length", f"{spec.ring_flexural_length_mm:.3f} mm")
+    Console().print(table)
+
+
+@design_app.command("aliasing")
+def design_aliasing(
+    depth: Annotated[float, typer.Option(help="Sensor depth d below the surface, in mm.")] = 3.8,
+    spacing: Annotated[float, typer.Option(help="Sensor spacing b, in mm.")] = 3.8,
+    poisson: Annotated[
+        float,
+        typer.Option(
+            help="Poisson's ratio of the plane-stress model (the paper's fit: "
+            "0.4; the rubber: 0.5)."
+        ),
+    ] = 0.5,
+    as_json: Annotated[
+        bool, typer.Option("--json", help="Print the result as JSON instead of a table.")
+    ] = False,
+) -> None:
+    """How much a sensor depth and spacing alias (section 6, eq. 45, Fig. 20)."""
+    import json
+
+    from tactsense.analysis.aliasing import aliasing_summary
+
+    try:
+        summary = aliasing_summary(depth, spacing, poisson)
+    except (TactsenseInputError, ValueError) as error:
+        _fail(str(error))
+    if as_json:
+        keys = {
+            "depth": "depth_mm",
+            "spacing": "spacing_mm",
+            "peak_frequency": "peak_frequency_per_mm",
+            "nyquist_frequency": "nyquist_frequency_per_mm",
+        }
+        typer.echo(json.dumps({keys.get(k, k): v for k, v in summary.items()}, indent=2))
+        return
+    table = Table(
+        title=f"Aliasing at depth {depth:g} mm, spacing {spacing:g} mm", show_header=False
+    )
+    table.add_row("xi, energy lost outside the band (eq. 45)", f"{summary['xi']:.4f}")
+    table.add_row("RMS amplitude error, sqrt(xi)", f"{summary['rms_amplitude_error']:.3f}")
+    table.add_row("peak of H(s)", f"{summary['peak_frequency']:.4f} cycles/mm")
+    table.add_row("H at the Nyquist frequency / H(0)", f"{summary['response_at_nyquist']:.3f}")
+    table.add_row(
+        "worst peak-position error, line load",
+        f"{summary['worst_position_error_tactel']:.3f} tactel",
+    )
+    table.add_row(
+        "worst peak-amplitude error, line load", f"{100 * summary['worst_amplitude_error']:.1f} %"
+    )
     Console().print(table)
 
 

@@ -4,8 +4,8 @@ from tactsense.estimate.angle import angle_from_skew, even_odd, inverse_filter, 
 from tactsense.estimate.deflection import Flag, baseline_from, deflection_from_counts
 from tactsense.estimate.force import force_per_deflection, total_force
 from tactsense.estimate.interpolate import kernel, reconstruct_row, surface
-from tactsense.estimate.locate import Estimates, locate, write_estimates_csv
 from tactsense.estimate.localize import locate_contacts, newton_peak
+from tactsense.estimate.locate import Estimates, locate, write_estimates_csv
 
 __all__ = [
     "Estimates",

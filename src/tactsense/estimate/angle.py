@@ -52,8 +52,16 @@ def skew_index(even, odd):
         return np.where(even_peak > 0, odd_peak / even_peak, np.nan)
 
 
-def skew_along_finger(deflection, row, col, *, periodic: bool = False, first_row: int = 1,
-                      reach: float = 2.0, step: float = 0.05):
+def skew_along_finger(
+    deflection,
+    row,
+    col,
+    *,
+    periodic: bool = False,
+    first_row: int = 1,
+    reach: float = 2.0,
+    step: float = 0.05,
+):
     """Skew index of the interpolated profile along the finger through the peak.
 
     Parameters
@@ -79,10 +87,12 @@ def skew_along_finger(deflection, row, col, *, periodic: bool = False, first_row
     usable = t[None, :] <= np.atleast_1d(room)[:, None]
     offsets = np.broadcast_to(t, (*row.shape, t.size))
     zz = z[..., None, :, :]
-    plus = surface(zz, row[..., None] + offsets, np.asarray(col, float)[..., None],
-                   periodic=periodic)
-    minus = surface(zz, row[..., None] - offsets, np.asarray(col, float)[..., None],
-                    periodic=periodic)
+    plus = surface(
+        zz, row[..., None] + offsets, np.asarray(col, float)[..., None], periodic=periodic
+    )
+    minus = surface(
+        zz, row[..., None] - offsets, np.asarray(col, float)[..., None], periodic=periodic
+    )
     usable = usable.reshape(offsets.shape)
     even, odd = even_odd(np.where(usable, plus, -np.inf), np.where(usable, minus, -np.inf))
     odd = np.where(usable, odd, 0.0)
@@ -95,8 +105,17 @@ def angle_from_skew(skew, poisson_ratio):
     return np.arctan(np.asarray(skew, float) / line_load_skew_coefficient(poisson_ratio))
 
 
-def inverse_filter(profile, spacing, depth, *, youngs_modulus, poisson_ratio,
-                   model="plane_stress", band=None, regularization=0.05):
+def inverse_filter(
+    profile,
+    spacing,
+    depth,
+    *,
+    youngs_modulus,
+    poisson_ratio,
+    model="plane_stress",
+    band=None,
+    regularization=0.05,
+):
     """Recover the pressure spectrum and the tangential ratio beta (eqs. 68-72).
 
     The deflection profile (compression positive) about its peak has the
@@ -142,7 +161,16 @@ def inverse_filter(profile, spacing, depth, *, youngs_modulus, poisson_ratio,
     tangential = spectrum.imag * g_t / (g_t**2 + eps**2)
     band = 1.0 / (4.0 * depth) if band is None else band
     inside = (s > 0) & (s <= band)
-    beta = float(np.sum(tangential[inside] * pressure[inside])
-                 / np.sum(pressure[inside] ** 2)) if inside.any() else float("nan")
-    return {"s": s, "pressure": pressure, "tangential": tangential,
-            "line_load": float(pressure[0]), "beta": beta, "alpha": float(np.arctan(beta))}
+    beta = (
+        float(np.sum(tangential[inside] * pressure[inside]) / np.sum(pressure[inside] ** 2))
+        if inside.any()
+        else float("nan")
+    )
+    return {
+        "s": s,
+        "pressure": pressure,
+        "tangential": tangential,
+        "line_load": float(pressure[0]),
+        "beta": beta,
+        "alpha": float(np.arctan(beta)),
+    }

@@ -52,8 +52,7 @@ def baseline_from(frames, n_frames: int = 5) -> np.ndarray:
         raise TactsenseInputError(f"frames has shape {frames.shape}; expected (T, rows, cols)")
     if not 1 <= n_frames <= frames.shape[0]:
         raise TactsenseInputError(
-            f"need {n_frames} untouched frames for a baseline; the recording has "
-            f"{frames.shape[0]}"
+            f"need {n_frames} untouched frames for a baseline; the recording has {frames.shape[0]}"
         )
     return np.nanmedian(frames[:n_frames], axis=0)
 

@@ -40,13 +40,23 @@ def ideal_force_per_deflection(sensor: SensorSpec) -> float:
     and kappa the integral of the interpolation kernel (0.9994 for 8 samples).
     """
     elastic = sensor.elastic
-    zero_gain = -float(frequency_response(0.0, elastic.effective_depth_mm * 1e-3,
-                                          youngs_modulus=elastic.youngs_modulus_pa,
-                                          poisson_ratio=elastic.effective_poisson_ratio,
-                                          model=elastic.model))
+    zero_gain = -float(
+        frequency_response(
+            0.0,
+            elastic.effective_depth_mm * 1e-3,
+            youngs_modulus=elastic.youngs_modulus_pa,
+            poisson_ratio=elastic.effective_poisson_ratio,
+            model=elastic.model,
+        )
+    )
     rows, cols = sensor.shape
-    area = (sensor.array.spacing_axial_mm * 1e-3
-            * sensor.ring_radius_mm * 1e-3 * np.deg2rad(sensor.array.spacing_angle_deg))
+    area = (
+        sensor.array.spacing_axial_mm
+        * 1e-3
+        * sensor.ring_radius_mm
+        * 1e-3
+        * np.deg2rad(sensor.array.spacing_angle_deg)
+    )
     return area * kernel_integral(rows) * kernel_integral(cols) / zero_gain
 
 

@@ -173,4 +173,5 @@ def reconstruct_row(samples, x, *, n_window: int | None = None):
     n = samples.shape[-1]
     weights = kernel(np.asarray(x, float)[..., None] - np.arange(n), n_window or n)
     return np.einsum("...n,xn->...x", samples, np.atleast_2d(weights).reshape(-1, n)).reshape(
-        *samples.shape[:-1], *np.shape(x))
+        *samples.shape[:-1], *np.shape(x)
+    )

@@ -29,8 +29,15 @@ class Peak:
     """Whether the last step was shorter than 0.01 tactel."""
 
 
-def newton_peak(deflection, start_row, start_col, *, periodic: bool = False,
-                tolerance: float = TOLERANCE, max_iterations: int = MAX_ITERATIONS) -> Peak:
+def newton_peak(
+    deflection,
+    start_row,
+    start_col,
+    *,
+    periodic: bool = False,
+    tolerance: float = TOLERANCE,
+    max_iterations: int = MAX_ITERATIONS,
+) -> Peak:
     """Find the maximum of the interpolated surface near a starting tactel (eq. 53).
 
     Where the Hessian is not negative definite (outside the peak's cap) a
@@ -52,8 +59,10 @@ def newton_peak(deflection, start_row, start_col, *, periodic: bool = False,
     """
     z = np.asarray(deflection, dtype=float)
     rows, cols = z.shape[-2:]
-    x = np.array(np.broadcast_to(start_row, z.shape[:-2]), dtype=float)
-    y = np.array(np.broadcast_to(start_col, z.shape[:-2]), dtype=float)
+    lead = z.shape[:-2]
+    x = np.array(np.broadcast_to(start_row, lead), dtype=float).reshape(-1)
+    y = np.array(np.broadcast_to(start_col, lead), dtype=float).reshape(-1)
+    z = z.reshape(-1, rows, cols)
     iterations = np.zeros(x.shape, dtype=np.int64)
     converged = np.zeros(x.shape, dtype=bool)
     active = np.ones(x.shape, dtype=bool)
@@ -61,15 +70,16 @@ def newton_peak(deflection, start_row, start_col, *, periodic: bool = False,
         if not active.any():
             break
         index = np.nonzero(active)
-        _, fx, fy, fxx, fxy, fyy = surface(z[index], x[index], y[index], periodic=periodic,
-                                           derivatives=2)
+        _, fx, fy, fxx, fxy, fyy = surface(
+            z[index], x[index], y[index], periodic=periodic, derivatives=2
+        )
         det = fxx * fyy - fxy * fxy
         concave = (fxx < 0) & (det > 0)
         safe_det = np.where(concave, det, 1.0)
         newton_dx = -(fyy * fx - fxy * fy) / safe_det
         newton_dy = -(fxx * fy - fxy * fx) / safe_det
         gradient = np.hypot(fx, fy)
-        scale = np.where(gradient > 0, 0.25 / np.where(gradient > 0, gradient, 1.0), 0.0)
+        scale = np.where(gradient > 0, MAX_STEP / np.where(gradient > 0, gradient, 1.0), 0.0)
         dx = np.where(concave, newton_dx, fx * scale)
         dy = np.where(concave, newton_dy, fy * scale)
         length = np.hypot(dx, dy)
@@ -84,7 +94,13 @@ def newton_peak(deflection, start_row, start_col, *, periodic: bool = False,
         converged[index] = done
         active[index] = ~done
     value = surface(z, x, y, periodic=periodic)
-    return Peak(row=x, col=y, value=value, iterations=iterations, converged=converged)
+    return Peak(
+        row=x.reshape(lead),
+        col=y.reshape(lead),
+        value=value.reshape(lead),
+        iterations=iterations.reshape(lead),
+        converged=converged.reshape(lead),
+    )
 
 
 def tactel_maxima(frame, *, periodic: bool = False, threshold: float = 0.0):
@@ -104,18 +120,28 @@ def tactel_maxima(frame, *, periodic: bool = False, threshold: float = 0.0):
     if periodic:
         padded[1:-1, 0] = z[:, -1]
         padded[1:-1, -1] = z[:, 0]
-    neighbours = np.stack([
-        padded[1 + dr: 1 + dr + z.shape[0], 1 + dc: 1 + dc + z.shape[1]]
-        for dr in (-1, 0, 1) for dc in (-1, 0, 1) if (dr, dc) != (0, 0)
-    ])
+    neighbours = np.stack(
+        [
+            padded[1 + dr : 1 + dr + z.shape[0], 1 + dc : 1 + dc + z.shape[1]]
+            for dr in (-1, 0, 1)
+            for dc in (-1, 0, 1)
+            if (dr, dc) != (0, 0)
+        ]
+    )
     is_max = (z >= neighbours.max(axis=0)) & (z > threshold)
     rows, cols = np.nonzero(is_max)
     order = np.argsort(-z[rows, cols])
     return [(int(rows[k]), int(cols[k])) for k in order]
 
 
-def locate_contacts(frame, *, periodic: bool = False, threshold: float = 0.005,
-                    relative: float = 0.2, min_separation: float = 1.5) -> list[Peak]:
+def locate_contacts(
+    frame,
+    *,
+    periodic: bool = False,
+    threshold: float = 0.005,
+    relative: float = 0.2,
+    min_separation: float = 1.5,
+) -> list[Peak]:
     """Every separate contact of one frame, each located by Newton's method.
 
     Parameters

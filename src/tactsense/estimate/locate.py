@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 from dataclasses import dataclass, fields
 from pathlib import Path
+from typing import ClassVar
 
 import numpy as np
 
@@ -44,16 +45,39 @@ class Estimates:
     flags: np.ndarray
     """:class:`~tactsense.estimate.deflection.Flag` bits."""
 
-    UNITS = {"row": "tactel", "col": "tactel", "axial_mm": "mm", "angle_deg": "deg",
-             "peak_deflection": "1", "force_n": "N", "skew": "1", "iterations": "1",
-             "converged": "bool", "flags": "names"}
+    UNITS: ClassVar[dict[str, str]] = {
+        "row": "tactel",
+        "col": "tactel",
+        "axial_mm": "mm",
+        "angle_deg": "deg",
+        "peak_deflection": "1",
+        "force_n": "N",
+        "skew": "1",
+        "iterations": "1",
+        "converged": "bool",
+        "flags": "names",
+    }
 
     def __len__(self) -> int:
         return int(np.size(self.row))
 
+    def _asdict_rows(self) -> list[dict]:
+        """One dict per frame (flattened batch), for tests and quick looks."""
+        names = [f.name for f in fields(self)]
+        columns = {name: np.ravel(getattr(self, name)) for name in names}
+        return [{name: columns[name][k] for name in names} for k in range(len(self))]
 
-def locate(frames, sensor: SensorSpec, *, baseline=None, counts: bool = True, dead=None,
-           threshold: float = CONTACT_THRESHOLD, second_contact: float = 0.3) -> Estimates:
+
+def locate(
+    frames,
+    sensor: SensorSpec,
+    *,
+    baseline=None,
+    counts: bool = True,
+    dead=None,
+    threshold: float = CONTACT_THRESHOLD,
+    second_contact: float = 0.3,
+) -> Estimates:
     """Locate the contact in every frame of a batch.
 
     Parameters
@@ -118,16 +142,19 @@ def locate(frames, sensor: SensorSpec, *, baseline=None, counts: bool = True, de
     skew = np.full(n, np.nan)
     force = np.full(n, np.nan)
     if touched.any():
-        peak = newton_peak(flat[touched], start_row[touched], start_col[touched],
-                           periodic=periodic)
+        peak = newton_peak(flat[touched], start_row[touched], start_col[touched], periodic=periodic)
         row[touched], col[touched] = peak.row, peak.col
         value[touched] = peak.value
         iterations[touched] = peak.iterations
         converged[touched] = peak.converged
         with np.errstate(invalid="ignore"):
-            skew[touched] = skew_along_finger(flat[touched], peak.row, peak.col,
-                                              periodic=periodic,
-                                              first_row=1 if sensor.array.tip_row else 0)
+            skew[touched] = skew_along_finger(
+                flat[touched],
+                peak.row,
+                peak.col,
+                periodic=periodic,
+                first_row=1 if sensor.array.tip_row else 0,
+            )
         force[touched] = total_force(flat[touched], sensor)
         flags[touched & ~converged] |= int(Flag.NOT_CONVERGED)
         edge = (row < 0.5) | (row > rows - 1.5)
@@ -143,19 +170,30 @@ def locate(frames, sensor: SensorSpec, *, baseline=None, counts: bool = True, de
     axial, angle = tactel_to_surface(sensor, np.nan_to_num(row), np.nan_to_num(col))
     axial = np.where(touched, axial, np.nan)
     angle = np.where(touched, angle, np.nan)
-    shaped = [a.reshape(lead) for a in (row, col, axial, angle, value, force, skew, iterations,
-                                        converged, flags)]
+    shaped = [
+        a.reshape(lead)
+        for a in (row, col, axial, angle, value, force, skew, iterations, converged, flags)
+    ]
     return Estimates(*shaped)
 
 
-def write_estimates_csv(path: str | Path, estimates: Estimates, time_s=None, *,
-                        overwrite: bool = False) -> Path:
+def write_estimates_csv(
+    path: str | Path, estimates: Estimates, time_s=None, *, overwrite: bool = False
+) -> Path:
     """Write one row per frame, with the units in the header."""
     path = Path(path)
     if path.exists() and not overwrite:
         raise FileExistsError(f"{path} exists; pass --force to replace it")
     names = [f.name for f in fields(Estimates)]
-    header = ["frame", "time [s]"] + [f"{name} [{Estimates.UNITS[name]}]" for name in names]
+    labels = {
+        "axial_mm": "axial",
+        "angle_deg": "angle",
+        "force_n": "force",
+        "peak_deflection": "peak deflection",
+    }
+    header = ["frame", "time [s]"] + [
+        f"{labels.get(name, name)} [{Estimates.UNITS[name]}]" for name in names
+    ]
     columns = [np.ravel(getattr(estimates, name)) for name in names]
     times = np.full(len(estimates), np.nan) if time_s is None else np.ravel(time_s)
     with path.open("w", newline="", encoding="utf-8") as handle:
