@@ -194,3 +194,14 @@ def test_bad_designs_are_reported():
         strip.strip_kernel(10.0, 0.0, -1.0, 0.4)
     with pytest.raises(ValueError, match="backing"):
         strip_capacitor_design(3.8e-3, 0.5e-3, 200.0, 3e-3, backing=-1e-3)
+
+
+def test_strain_integral_of_the_strip():
+    # docs/estimation.md: the integral of eps_z at depth is P(0) dH/dz(0) / (2 mu), with
+    # dH/dz(0) = -(1 - 2 nu)/(1 - nu): zero for an incompressible layer in plane strain
+    for z in (0.5e-3, 3.3e-3):
+        assert strip.strip_strain_kernel(0.0, z, H, 0.5, "plane_strain") == 0.0
+        assert strip.strip_strain_kernel(0.0, z, H, 0.5, "plane_stress") == pytest.approx(-0.5)
+        assert strip.strip_strain_kernel(0.0, z, H, 0.3, "plane_strain") == pytest.approx(
+            -0.4 / 0.7
+        )
