@@ -189,3 +189,32 @@ def test_design_aliasing_json():
     assert data["xi"] == pytest.approx(0.0317, abs=2e-4)
     assert runner.invoke(app, ["design", "aliasing"]).exit_code == 0
     assert runner.invoke(app, ["design", "aliasing", "--poisson", "0.7"]).exit_code == 2
+
+
+def test_calibrate_then_locate_with_the_calibration(tmp_path):
+    spec = ts.fearing1990_initial()
+    sweep, steps, knife = tmp_path / "sweep.h5", tmp_path / "steps.h5", tmp_path / "knife.h5"
+    ts.write_recording(sweep, ts.simulate(spec, ts.calibration_sweep(spec, increment=1.2), rng=1))
+    ts.write_recording(steps, ts.simulate(spec, ts.force_steps(spec, repeats=3), rng=2))
+    ts.write_recording(knife, ts.simulate(spec, ts.knife_edge_sweep(spec), rng=3))
+    out = tmp_path / "cal.json"
+    result = runner.invoke(
+        app,
+        ["calibrate", str(sweep), "--out", str(out), "--steps", str(steps), "--knife", str(knife)],
+    )
+    assert result.exit_code == 0, result.output
+    calibration = ts.estimate.Calibration.load(out, spec)
+    assert calibration.viscoelastic is not None and calibration.model_fit is not None
+    estimates = tmp_path / "e.csv"
+    result = runner.invoke(
+        app, ["locate", str(steps), "--calibration", str(out), "--out", str(estimates)]
+    )
+    assert result.exit_code == 0, result.output
+    assert estimates.exists()
+    other = tmp_path / "other.h5"
+    improved = ts.fearing1990_improved()
+    ts.write_recording(other, ts.simulate(improved, ts.force_steps(improved, repeats=1)))
+    result = runner.invoke(
+        app, ["locate", str(other), "--calibration", str(out), "--out", str(tmp_path / "x.csv")]
+    )
+    assert result.exit_code == 2 and "belongs to sensor" in plain(result.output)

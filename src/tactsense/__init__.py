@@ -27,7 +27,18 @@ from tactsense.sensor import (
     load_sensor,
     preset,
 )
-from tactsense.simulate import Scenario, Step, probe_sweep, repeated_load, simulate, static
+from tactsense.simulate import (
+    Scenario,
+    Step,
+    calibration_sweep,
+    force_steps,
+    knife_edge_sweep,
+    load_series,
+    probe_sweep,
+    repeated_load,
+    simulate,
+    static,
+)
 
 __version__ = "0.1.0"
 
@@ -44,11 +55,15 @@ __all__ = [
     "Step",
     "__version__",
     "baseline_from",
+    "calibration_sweep",
     "fearing1990_improved",
     "fearing1990_initial",
+    "force_steps",
     "grams_force",
     "knife_edge",
+    "knife_edge_sweep",
     "load_sensor",
+    "load_series",
     "locate",
     "newtons_to_grams",
     "preset",

@@ -166,6 +166,8 @@ class Flaws:
     """Smallest per-tactel gain multiplier (worst threshold 0.8 g at mean 0.4 g) [-]."""
     gain_max: float = 2.0
     """Largest per-tactel gain multiplier (best threshold 0.2 g at mean 0.4 g) [-]."""
+    gain_seed: int = 1990
+    """Seed of this finger's gain spread: the gains belong to the finger, not to a run."""
     force_jitter_n: float = 0.0098
     """Standard deviation of the applied force per application, 1 gram-force (Figs. 10-11) [N]."""
     position_jitter_mm: float = 0.05

@@ -26,7 +26,7 @@ import numpy as np
 from tactsense._validation import TactsenseInputError, check_positive
 from tactsense.io.recording import Recording
 from tactsense.physics.array_response import deflection_batch
-from tactsense.physics.contact import Probe, contact_from_dict, grams_force
+from tactsense.physics.contact import Probe, contact_from_dict, grams_force, knife_edge
 from tactsense.physics.flaws import FLAW_NAMES, draw_gains, stiffening
 from tactsense.physics.transduction import (
     amplifier_gain,
@@ -255,6 +255,129 @@ def repeated_load(
     )
 
 
+def calibration_sweep(
+    spec: SensorSpec,
+    *,
+    force_n: float | None = None,
+    increment: float = 0.6,
+    dwell_s: float = 0.3,
+    settle_s: float = 1.0,
+) -> Scenario:
+    """The section 3.1 calibration: a 50-g probe swept along every column in turn.
+
+    Each sweep runs the length of the cylinder at the angle of one wired
+    column; the probe is lifted for a second between columns.
+    """
+    force_n = grams_force(50.0) if force_n is None else check_positive(force_n, "force_n")
+    steps = [Step((), settle_s, "baseline")] if settle_s > 0 else []
+    positions = np.arange(0.0, spec.body.cylinder_length_mm + 1e-9, increment)
+    for col, angle in enumerate(spec.col_angle_deg):
+        steps += [
+            Step((Probe(float(p), float(angle), force_n),), dwell_s, f"col {col}")
+            for p in positions
+        ]
+        steps.append(Step((), 1.0, "lifted"))
+    return Scenario(
+        tuple(steps),
+        name="calibration_sweep",
+        description=f"{force_n:.3g} N probe swept along each of {spec.shape[1]} columns",
+        parameters={"force_n": force_n, "increment": increment, "dwell_s": dwell_s},
+    )
+
+
+def force_steps(
+    spec: SensorSpec,
+    *,
+    row: int = 4,
+    col: int = 0,
+    force_n: float | None = None,
+    on_s: float = 1.0,
+    off_s: float = 1.0,
+    repeats: int = 3,
+    settle_s: float = 1.0,
+) -> Scenario:
+    """Force steps above one tactel (Fig. 12): the load applied and removed ``repeats`` times."""
+    scene = repeated_load(
+        spec,
+        row=row,
+        col=col,
+        force_n=force_n,
+        repeats=repeats,
+        on_s=on_s,
+        off_s=off_s,
+        settle_s=settle_s,
+    )
+    return Scenario(
+        scene.steps, name="force_steps", description=scene.description, parameters=scene.parameters
+    )
+
+
+def knife_edge_sweep(
+    spec: SensorSpec,
+    *,
+    row: int = 4,
+    col: int = 0,
+    force_n: float = 0.5,
+    span_mm: float = 12.0,
+    increment: float = 0.6,
+    dwell_s: float = 0.5,
+    lift_s: float = 0.5,
+    settle_s: float = 1.0,
+) -> Scenario:
+    """Section 4.1: a knife edge across the finger stepped past one tactel (Fig. 16)."""
+    centre = float(spec.row_axial_mm[row])
+    angle = float(spec.col_angle_deg[col])
+    positions = np.arange(centre - span_mm / 2, centre + span_mm / 2 + 1e-9, increment)
+    steps = [Step((), settle_s, "baseline")] if settle_s > 0 else []
+    for position in positions:
+        steps.append(
+            Step((knife_edge(float(position), angle, force_n),), dwell_s, f"axial={position:.4g}")
+        )
+        if lift_s > 0:
+            steps.append(Step((), lift_s, "lifted"))
+    return Scenario(
+        tuple(steps),
+        name="knife_edge_sweep",
+        description=f"{force_n:.3g} N knife edge stepped past tactel ({row}, {col})",
+        parameters={
+            "row": row,
+            "col": col,
+            "force_n": force_n,
+            "increment": increment,
+            "dwell_s": dwell_s,
+            "lift_s": lift_s,
+        },
+    )
+
+
+def load_series(
+    spec: SensorSpec,
+    *,
+    row: int = 4,
+    col: int = 0,
+    forces_n=None,
+    on_s: float = 1.0,
+    off_s: float = 1.0,
+    settle_s: float = 1.0,
+) -> Scenario:
+    """Increasing weights on one cell (Fig. 6): each applied, held and removed."""
+    forces = np.linspace(0.1, 1.0, 10) if forces_n is None else np.asarray(forces_n, float)
+    probe = Probe(float(spec.row_axial_mm[row]), float(spec.col_angle_deg[col]), 1.0)
+    steps = [Step((), settle_s, "baseline")] if settle_s > 0 else []
+    for force in forces:
+        steps += [
+            Step((probe.moved(force_scale=float(force)),), on_s, f"{force:.4g} N"),
+            Step((), off_s, "off"),
+        ]
+    return Scenario(
+        tuple(steps),
+        name="load_series",
+        description=f"{forces.size} loads from {forces.min():.3g} to "
+        f"{forces.max():.3g} N on tactel ({row}, {col})",
+        parameters={"row": row, "col": col, "forces_n": forces.tolist()},
+    )
+
+
 def static(contacts, duration_s: float = 1.0, *, settle_s: float = 1.0) -> Scenario:
     """Contacts held still after an untouched settle time."""
     if not isinstance(contacts, list | tuple):
@@ -324,7 +447,8 @@ def simulate(
     rng : int, numpy.random.Generator or None
         Source of every random draw (gains, jitter, noise).
     gains : ndarray, shape (rows, cols), optional
-        Per-tactel gains to use instead of drawing them (``gain_spread``).
+        Per-tactel gains to use instead of the finger's own (``gain_spread``;
+        those are drawn from ``spec.flaws.gain_seed``, the same in every run).
     progress : callable(done, total), optional
         Called after each chunk of frames.
 
@@ -351,7 +475,7 @@ def simulate(
         if gains.shape != spec.shape:
             raise TactsenseInputError(f"gains has shape {gains.shape}; expected {spec.shape}")
     elif "gain_spread" in active:
-        gains = draw_gains(spec, rng)
+        gains = draw_gains(spec)  # the finger's own gains (flaws.gain_seed)
     else:
         gains = np.ones(spec.shape)
     applied = (
@@ -376,8 +500,10 @@ def simulate(
     for first in range(0, n_frames, _CHUNK_FRAMES):
         last = min(n_frames, first + _CHUNK_FRAMES)
         ticks = np.arange(first * ticks_per_frame, last * ticks_per_frame)
+        # the same arithmetic as Recording.sample_step: frame start + the tactel's offset
+        tick_time = (ticks // ticks_per_frame) * period + offsets.ravel()[ticks % ticks_per_frame]
         step_of_tick = np.clip(
-            np.searchsorted(boundaries, ticks * dt, side="right") - 1, 0, len(scenario.steps) - 1
+            np.searchsorted(boundaries, tick_time, side="right") - 1, 0, len(scenario.steps) - 1
         )
         u = elastic[step_of_tick]  # (ticks, rows, cols): what every tactel feels at every tick
         if "viscoelastic" in active:

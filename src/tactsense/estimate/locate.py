@@ -77,6 +77,8 @@ def locate(
     dead=None,
     threshold: float = CONTACT_THRESHOLD,
     second_contact: float = 0.3,
+    calibration=None,
+    frame_period_s: float | None = None,
 ) -> Estimates:
     """Locate the contact in every frame of a batch.
 
@@ -97,6 +99,10 @@ def locate(
     second_contact : float
         A separate local maximum larger than this share of the largest sets
         the MULTIPLE flag [-].
+    calibration : Calibration, optional
+        Applied to counts before estimation (its baseline replaces
+        ``baseline``; gains, nonlinearity, excluded tactels, and creep
+        compensation when ``frame_period_s`` is given for frames in time order).
 
     Returns
     -------
@@ -108,7 +114,11 @@ def locate(
     if not isinstance(sensor, SensorSpec):
         raise TactsenseInputError(f"sensor must be a SensorSpec; got {type(sensor).__name__}")
     frames = check_frames(frames, sensor.shape)
-    if counts:
+    if calibration is not None:
+        if not counts:
+            raise TactsenseInputError("a calibration applies to counts, not to deflections")
+        deflection, flags = calibration.apply(frames, sensor, frame_period_s=frame_period_s)
+    elif counts:
         if baseline is None:
             raise TactsenseInputError(
                 "counts need a baseline (the untouched readings): pass baseline=, e.g. "

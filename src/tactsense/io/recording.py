@@ -88,6 +88,19 @@ class Recording:
     def __len__(self) -> int:
         return int(self.frames.shape[0])
 
+    def sample_step(self, row: int, col: int) -> np.ndarray:
+        """Scenario step in force when tactel (row, col) was sampled, per frame (simulated only).
+
+        ``truth["frame_step"]`` is the step at the middle of each frame's scan; a
+        tactel sampled early or late in the scan may see the step before or after.
+        """
+        steps = self.scenario.get("steps")
+        if not steps:
+            raise RecordingError("this recording carries no scenario steps")
+        bounds = np.cumsum([0.0] + [float(step["duration_s"]) for step in steps])
+        instants = np.asarray(self.time_s) + float(self.sample_offset_s[row, col])
+        return np.clip(np.searchsorted(bounds, instants, side="right") - 1, 0, len(steps) - 1)
+
     @property
     def baseline_frames(self) -> np.ndarray:
         """Indices of frames during which nothing touched (simulated recordings only)."""

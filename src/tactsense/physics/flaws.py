@@ -25,13 +25,17 @@ FLAW_NAMES = (
 def draw_gains(spec: SensorSpec, rng=None) -> np.ndarray:
     """Per-tactel gain multipliers, shape (rows, cols) [-].
 
+    Without ``rng`` the draw uses the finger's own ``flaws.gain_seed``, so
+    every simulation of one finger sees the same gains, as a real finger
+    would; pass an ``rng`` to draw another finger.
+
     The force threshold for one A/D unit (Fig. 8) relative to the mean is
     drawn normal with standard deviation ``gain_spread_sd`` and clipped to
     ``[1 / gain_max, 1 / gain_min]``; the gain is its inverse. With the
     preset (sd 0.35, gains 0.5-2) about 5 of 56 cells sit at half the mean
     threshold, as in Fig. 8.
     """
-    rng = np.random.default_rng(rng)
+    rng = np.random.default_rng(spec.flaws.gain_seed if rng is None else rng)
     flaws = spec.flaws
     threshold = rng.normal(1.0, flaws.gain_spread_sd, spec.shape)
     threshold = np.clip(threshold, 1.0 / flaws.gain_max, 1.0 / flaws.gain_min)

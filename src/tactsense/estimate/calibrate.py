@@ -1,0 +1,654 @@
+"""Calibration and compensation of a real finger (sections 3 and 4.1 of the paper).
+
+Everything here works from recordings alone, simulated or measured; where the truth
+(what load was applied, when) is needed it is taken from the recording's metadata if
+present, else detected from the frames.
+
+* :func:`gain_table` - per-tactel gain from a probe swept along every row (section 3.1).
+* :func:`track_baseline` - baseline, drift and re-zero after contact (section 3.4).
+* :func:`nonlinearity_table` - measured -> linear deflection lookup table (section 3, Fig. 6).
+* :func:`fit_viscoelastic`, :func:`compensate_viscoelastic` - creep (section 3.4, Fig. 12).
+* :func:`fit_plane_stress` - depth and nu from a knife-edge sweep (section 4.1, Fig. 16).
+* :func:`array_health` - sensitivity histogram, jitter, dead/weak/noisy tactels (Figs. 8-11).
+* :class:`Calibration` - all of it, saved as JSON with the sensor it belongs to.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+from scipy.optimize import least_squares
+from scipy.signal import lfilter
+
+from tactsense._validation import TactsenseInputError, check_frames
+from tactsense.estimate.deflection import deflection_from_counts
+from tactsense.physics.array_response import deflection_batch
+from tactsense.physics.contact import Probe
+from tactsense.physics.halfplane import impulse_response
+from tactsense.sensor import STANDARD_GRAVITY, SensorSpec
+
+FORMAT = "tactsense-calibration"
+
+
+class CalibrationError(TactsenseInputError):
+    """Raised when a calibration cannot be built, loaded or applied."""
+
+
+# ---- gains -------------------------------------------------------------------------
+
+
+def gain_table(deflection, *, min_response: float = 0.01, reference: float | None = None):
+    """Per-tactel gain from a recording of a probe swept over every tactel (section 3.1).
+
+    The gain parameter of the paper is each tactel's largest fractional
+    deflection during the sweep; divided by a reference it becomes the gain
+    that normalizes frames (Fig. 7 after calibration). The reference is the
+    deflection the model predicts for the calibration probe centred on a
+    tactel (absolute gains), or, without it, the median over the array
+    (relative gains, as in the paper).
+
+    Parameters
+    ----------
+    deflection : ndarray, shape (T, rows, cols)
+        Fractional deflection of the sweep [-].
+    min_response : float
+        A tactel whose largest deflection stays below this is left uncalibrated
+        (gain 1, reported in ``uncalibrated``) [-].
+
+    Returns
+    -------
+    gains : ndarray, shape (rows, cols)
+        Relative gain [-].
+    peak : ndarray, shape (rows, cols)
+        Largest deflection of each tactel [-].
+    uncalibrated : ndarray of bool, shape (rows, cols)
+    """
+    deflection = np.asarray(deflection, dtype=float)
+    if deflection.ndim != 3 or deflection.shape[0] < 2:
+        raise CalibrationError(
+            f"a gain calibration needs a sweep of frames (T, rows, cols); got {deflection.shape}"
+        )
+    peak = deflection.max(axis=0)
+    calibrated = peak >= min_response
+    if not calibrated.any():
+        raise CalibrationError(
+            f"no tactel deflected more than {min_response:.3g}: the recording has no contact"
+        )
+    if reference is None:
+        reference = np.median(peak[calibrated])
+    gains = np.where(calibrated, peak / reference, 1.0)
+    return gains, peak, ~calibrated
+
+
+# ---- baseline, drift and re-zero ---------------------------------------------------
+
+
+def track_baseline(
+    frames,
+    initial_baseline,
+    sensor: SensorSpec,
+    *,
+    touch: float = 0.005,
+    release: float = 0.003,
+    rate: float = 0.2,
+    settle_frames: int = 2,
+):
+    """Follow the zero of every tactel while nothing touches, and re-zero after contact.
+
+    A frame is *touched* when its largest deflection against the current
+    baseline exceeds ``touch``; contact is *broken* when it falls below
+    ``release``. While untouched, the baseline follows the readings with an
+    exponential average (``rate`` per frame), which absorbs slow drift; once
+    contact has been broken for ``settle_frames`` frames, the baseline is reset
+    to the current reading (the paper's "new zero deflection point after
+    contact is broken"), so that residual strain is not read as force.
+
+    Parameters
+    ----------
+    frames : ndarray, shape (T, rows, cols)
+        Readings [counts].
+    initial_baseline : ndarray, shape (rows, cols)
+        Zero before the first frame [counts].
+
+    Returns
+    -------
+    baselines : ndarray, shape (T, rows, cols)
+        Baseline to use for each frame [counts].
+    touched : ndarray of bool, shape (T,)
+    """
+    frames = check_frames(frames, sensor.shape).astype(float)
+    if frames.ndim != 3:
+        raise CalibrationError(f"frames has shape {frames.shape}; expected (T, rows, cols)")
+    baseline = np.array(initial_baseline, dtype=float)
+    baselines = np.empty_like(frames)
+    touched = np.zeros(frames.shape[0], dtype=bool)
+    in_contact, quiet = False, 0
+    for k, frame in enumerate(frames):
+        level = np.nanmax((frame - baseline) / np.where(frame > 0, frame, np.inf))
+        if in_contact:
+            if level < release:
+                quiet += 1
+                if quiet >= settle_frames:
+                    in_contact, quiet = False, 0
+                    baseline = frame.copy()
+        elif level > touch:
+            in_contact, quiet = True, 0
+        touched[k] = in_contact
+        if not in_contact:
+            baseline = np.where(np.isfinite(frame), (1 - rate) * baseline + rate * frame, baseline)
+        baselines[k] = baseline
+    return baselines, touched
+
+
+# ---- nonlinearity -----------------------------------------------------------------
+
+
+def nonlinearity_table(loads, deflections, *, linear_below: float | None = None):
+    """Lookup table from measured deflection to the deflection of a linear sensor (Fig. 6).
+
+    The linear reference is the straight line through the origin and the
+    response to the loads up to ``linear_below`` (default: the smallest half
+    of the series), as the paper compares the 1-N response with "the straight
+    line from the origin through the strain for a 0.5-N load".
+
+    Parameters
+    ----------
+    loads : array_like, shape (n,)
+        Applied forces [N], increasing.
+    deflections : array_like, shape (n,)
+        Measured fractional deflection of one cell at each load [-].
+
+    Returns
+    -------
+    measured, linear : ndarray, shape (n + 1,)
+        Table knots, starting at (0, 0); apply with :func:`apply_nonlinearity`.
+    """
+    loads = np.asarray(loads, dtype=float)
+    deflections = np.asarray(deflections, dtype=float)
+    if loads.shape != deflections.shape or loads.ndim != 1 or loads.size < 2:
+        raise CalibrationError("loads and deflections must be 1-D arrays of the same length >= 2")
+    order = np.argsort(loads)
+    loads, deflections = loads[order], deflections[order]
+    if np.any(np.diff(deflections) <= 0):
+        raise CalibrationError("the deflection must grow with the load to build a lookup table")
+    limit = np.median(loads) if linear_below is None else linear_below
+    low = loads <= limit
+    slope = np.sum(deflections[low] * loads[low]) / np.sum(loads[low] ** 2)
+    return np.r_[0.0, deflections], np.r_[0.0, slope * loads]
+
+
+def apply_nonlinearity(deflection, measured, linear):
+    """Map measured deflection to linear deflection; the end slopes extrapolate."""
+    deflection = np.asarray(deflection, dtype=float)
+    result = np.interp(deflection, measured, linear)
+    high = (linear[-1] - linear[-2]) / (measured[-1] - measured[-2])
+    low = (linear[1] - linear[0]) / (measured[1] - measured[0])
+    result = np.where(
+        deflection > measured[-1], linear[-1] + high * (deflection - measured[-1]), result
+    )
+    return np.where(deflection < measured[0], linear[0] + low * (deflection - measured[0]), result)
+
+
+# ---- viscoelastic behaviour --------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Viscoelastic:
+    """Delayed elasticity and creep: ``y = (1 - a_d) u + a_d m_d + a_c m_c`` (Fig. 12)."""
+
+    delayed_fraction: float
+    delayed_time_constant_s: float
+    creep_fraction: float
+    creep_time_constant_s: float
+
+
+def _memory_response(u, dt, model: Viscoelastic):
+    """Reading for an elastic input u sampled every dt (input held over each sample)."""
+    y = (1.0 - model.delayed_fraction) * u
+    for fraction, tau in (
+        (model.delayed_fraction, model.delayed_time_constant_s),
+        (model.creep_fraction, model.creep_time_constant_s),
+    ):
+        decay = np.exp(-dt / tau)
+        y = y + fraction * lfilter([1.0 - decay], [1.0, -decay], u, axis=0)
+    return y
+
+
+def fit_viscoelastic(signal, dt, loaded, *, fine: int = 16) -> tuple[Viscoelastic, float, float]:
+    """Fit delayed elasticity and creep to a tactel's response to force steps.
+
+    Parameters
+    ----------
+    signal : ndarray, shape (T,)
+        Fractional deflection of the tactel under the load, one sample per frame [-].
+    dt : float
+        Frame period [s].
+    loaded : ndarray of bool, shape (T,) or (T * fine,)
+        Whether the load was on, per frame or on a ``fine`` times denser clock
+        (from the recording's truth, or from contact detection).
+    fine : int
+        Sub-steps per frame on which the model is integrated.
+
+    Returns
+    -------
+    model : Viscoelastic
+    gain : float
+        Elastic deflection of the load [-].
+    rms : float
+        RMS residual as a share of the largest reading [-].
+    """
+    signal = np.asarray(signal, dtype=float)
+    loaded = np.asarray(loaded, dtype=bool)
+    n = signal.size
+    if n < 10 or not loaded.any() or loaded.all():
+        raise CalibrationError(
+            "a creep fit needs a recording with load steps on and off (at least 10 frames)"
+        )
+    if loaded.size == n:
+        loaded = np.repeat(loaded, fine)
+    elif loaded.size != n * fine:
+        raise CalibrationError(f"loaded has {loaded.size} samples; expected {n} or {n * fine}")
+    u = loaded.astype(float)
+
+    def model_output(p):
+        gain, a_d, log_tau_d, a_c, log_tau_c = p
+        model = Viscoelastic(a_d, np.exp(log_tau_d), a_c, np.exp(log_tau_c))
+        return gain * _memory_response(u, dt / fine, model)[fine - 1 :: fine]
+
+    start = [signal.max(), 0.3, np.log(0.05), 0.2, np.log(10.0)]
+    fit = least_squares(
+        lambda p: model_output(p) - signal,
+        start,
+        bounds=(
+            [0, 0, np.log(dt / fine), 0, np.log(0.5)],
+            [np.inf, 1, np.log(5.0), 10, np.log(1000.0)],
+        ),
+    )
+    gain, a_d, log_tau_d, a_c, log_tau_c = fit.x
+    rms = float(np.sqrt(np.mean(fit.fun**2)) / np.abs(signal).max())
+    return (
+        Viscoelastic(float(a_d), float(np.exp(log_tau_d)), float(a_c), float(np.exp(log_tau_c))),
+        float(gain),
+        rms,
+    )
+
+
+def load_schedule(frame_times, sample_offset: float, step_durations, step_loaded, fine: int = 16):
+    """Whether the load was on, on a clock ``fine`` times denser than the frames.
+
+    Sub-sample k of frame n ends at ``frame_times[n] + sample_offset - (fine - 1 - k) dt / fine``
+    so that the last sub-sample of each frame is the tactel's sampling instant.
+
+    Parameters
+    ----------
+    frame_times : ndarray, shape (T,)
+        Frame start times [s].
+    sample_offset : float
+        When the tactel is sampled within a frame [s].
+    step_durations : sequence of float
+        Durations of the recording's scenario steps [s].
+    step_loaded : sequence of bool
+        Whether each step loads the tactel.
+    """
+    times = np.asarray(frame_times, dtype=float)
+    if times.size < 2:
+        raise CalibrationError("a load schedule needs at least two frames")
+    dt = times[1] - times[0]
+    sub = (np.arange(fine) - (fine - 1)) * dt / fine
+    instants = (times[:, None] + sample_offset + sub[None, :]).ravel()
+    bounds = np.cumsum(np.r_[0.0, np.asarray(step_durations, dtype=float)])
+    index = np.clip(np.searchsorted(bounds, instants, side="right") - 1, 0, len(bounds) - 2)
+    return np.asarray(step_loaded, dtype=bool)[index]
+
+
+def compensate_viscoelastic(deflection, dt, model: Viscoelastic):
+    """Invert the creep model frame by frame: the elastic deflection from the readings.
+
+    With the input held over each frame, ``y[n] = c u[n] + a_d e_d m_d[n-1] +
+    a_c e_c m_c[n-1]`` with ``c = (1 - a_d) + a_d (1 - e_d) + a_c (1 - e_c)``, so
+    ``u[n]`` follows exactly from ``y[n]`` and the memories, which are then
+    updated. Causal: usable in a real-time loop.
+
+    Parameters
+    ----------
+    deflection : ndarray, shape (T, ...)
+        Readings over time (axis 0) [-].
+    dt : float
+        Frame period [s].
+
+    Returns
+    -------
+    ndarray, shape (T, ...)
+        Estimated elastic deflection [-].
+    """
+    y = np.asarray(deflection, dtype=float)
+    e_d = np.exp(-dt / model.delayed_time_constant_s)
+    e_c = np.exp(-dt / model.creep_time_constant_s)
+    a_d, a_c = model.delayed_fraction, model.creep_fraction
+    c = (1 - a_d) + a_d * (1 - e_d) + a_c * (1 - e_c)
+    m_d = np.zeros(y.shape[1:])
+    m_c = np.zeros(y.shape[1:])
+    u = np.empty_like(y)
+    for n in range(y.shape[0]):
+        u[n] = (y[n] - a_d * e_d * m_d - a_c * e_c * m_c) / c
+        m_d = e_d * m_d + (1 - e_d) * u[n]
+        m_c = e_c * m_c + (1 - e_c) * u[n]
+    return u
+
+
+# ---- the plane-stress fit of section 4.1 --------------------------------------------
+
+
+@dataclass(frozen=True)
+class ModelFit:
+    """Depth and Poisson's ratio fitted to a knife-edge sweep (section 4.1)."""
+
+    depth_mm: float
+    poisson_ratio: float
+    centre_mm: float
+    amplitude: float
+    rms_percent: float
+    """RMS residual as a percentage of full scale (the largest reading)."""
+
+
+def fit_plane_stress(positions_mm, response, *, youngs_modulus: float = 2.5e5) -> ModelFit:
+    """Least-squares fit of eq. 7's depth and nu to one tactel's knife-edge sweep.
+
+    After amplitude normalization (a free amplitude) and a free centre, the
+    shape of the plane-stress line-load response fixes the depth and nu.
+
+    Parameters
+    ----------
+    positions_mm : ndarray, shape (n,)
+        Knife-edge positions along the finger [mm].
+    response : ndarray, shape (n,)
+        Fractional deflection of the tactel [-].
+    """
+    x = np.asarray(positions_mm, dtype=float)
+    r = np.asarray(response, dtype=float)
+    if x.shape != r.shape or x.size < 6:
+        raise CalibrationError("a model fit needs at least 6 positions with one response each")
+    if r.max() <= 0:
+        raise CalibrationError("the tactel never responded: no contact in the sweep")
+
+    def shape(p):
+        depth, nu, centre, amplitude = p
+        h = -impulse_response(
+            (x - centre) * 1e-3, depth * 1e-3, youngs_modulus=youngs_modulus, poisson_ratio=nu
+        )
+        return amplitude * h / h.max() if h.max() > 0 else amplitude * h
+
+    start = [3.0, 0.3, float(x[np.argmax(r)]), float(r.max())]
+    fit = least_squares(
+        lambda p: shape(p) - r,
+        start,
+        bounds=([0.2, -0.99, x.min(), 0], [30.0, 0.5, x.max(), np.inf]),
+    )
+    depth, nu, centre, amplitude = fit.x
+    rms = 100 * float(np.sqrt(np.mean(fit.fun**2)) / r.max())
+    return ModelFit(float(depth), float(nu), float(centre), float(amplitude), rms)
+
+
+# ---- health of the array ------------------------------------------------------------
+
+
+def array_health(
+    peak_deflection,
+    baseline_frames,
+    *,
+    probe_grams: float = 50.0,
+    nominal_counts: float = 2000.0,
+    weak: float = 0.5,
+    noisy: float = 4.0,
+):
+    """Sensitivity of every tactel and detection of dead, weak and noisy ones (Figs. 8-11).
+
+    Parameters
+    ----------
+    peak_deflection : ndarray, shape (rows, cols)
+        Largest deflection of each tactel under the calibration probe [-].
+    baseline_frames : ndarray, shape (T, rows, cols)
+        Untouched readings [counts].
+    probe_grams : float
+        Load of the calibration probe [g].
+    weak : float
+        A tactel below this share of the median sensitivity is weak [-].
+    noisy : float
+        A tactel whose untouched noise exceeds this many times the median is noisy [-].
+
+    Returns
+    -------
+    dict
+        ``threshold_g`` (grams per A/D unit, Fig. 8), ``noise_counts`` (standard
+        deviation untouched), and boolean masks ``dead``, ``weak``, ``noisy``.
+    """
+    peak = np.asarray(peak_deflection, dtype=float)
+    base = np.asarray(baseline_frames, dtype=float)
+    counts_change = nominal_counts * peak / np.maximum(1.0 - peak, 1e-9)
+    with np.errstate(divide="ignore"):
+        threshold = np.where(counts_change > 0, probe_grams / counts_change, np.inf)
+    dead = (base.mean(axis=0) <= 0) | (peak <= 0)
+    alive = ~dead
+    median_peak = np.median(peak[alive]) if alive.any() else 0.0
+    noise = base.std(axis=0)
+    # quantization alone gives 1/sqrt(12) counts; do not call a quiet array noisy
+    floor = max(np.median(noise[alive]) if alive.any() else 0.0, 1 / np.sqrt(12))
+    return {
+        "threshold_g": threshold,
+        "noise_counts": noise,
+        "dead": dead,
+        "weak": alive & (peak < weak * median_peak),
+        "noisy": alive & (noise > noisy * floor),
+    }
+
+
+def jitter_statistics(readings, counts_per_gram):
+    """Jitter of repeated loads (Figs. 10-11): standard deviation in counts and grams."""
+    readings = np.asarray(readings, dtype=float)
+    if readings.size < 3:
+        raise CalibrationError("jitter needs at least 3 repeated applications")
+    std = float(readings.std(ddof=1))
+    return {
+        "mean_counts": float(readings.mean()),
+        "std_counts": std,
+        "std_grams": std / counts_per_gram,
+        "applications": int(readings.size),
+    }
+
+
+# ---- the calibration object ---------------------------------------------------------
+
+
+@dataclass
+class Calibration:
+    """A finger's calibration: gains, baseline, masks and the fitted models.
+
+    Saved as JSON by :meth:`save`, with the sensor description it belongs to;
+    :meth:`load` refuses to apply it to another sensor.
+    """
+
+    sensor_toml: str
+    gains: np.ndarray
+    baseline: np.ndarray
+    dead: np.ndarray
+    weak: np.ndarray
+    noisy: np.ndarray
+    threshold_g: np.ndarray
+    nonlinearity: tuple[list, list] | None = None
+    viscoelastic: Viscoelastic | None = None
+    model_fit: ModelFit | None = None
+    notes: dict = field(default_factory=dict)
+
+    def check_sensor(self, sensor: SensorSpec) -> None:
+        """Raise unless this calibration was made for ``sensor``."""
+        mine = SensorSpec.from_toml_string(self.sensor_toml)
+        if mine != sensor:
+            raise CalibrationError(
+                f"this calibration belongs to sensor {mine.name!r}, not {sensor.name!r} "
+                "(or a differently configured one): calibrate this finger anew"
+            )
+
+    @property
+    def excluded(self) -> np.ndarray:
+        """Tactels the estimation ignores: dead, weak or noisy."""
+        return self.dead | self.weak | self.noisy
+
+    def to_dict(self) -> dict:
+        return {
+            "format": FORMAT,
+            "version": 1,
+            "sensor_toml": self.sensor_toml,
+            "gains": self.gains.tolist(),
+            "baseline_counts": self.baseline.tolist(),
+            "dead": self.dead.tolist(),
+            "weak": self.weak.tolist(),
+            "noisy": self.noisy.tolist(),
+            "threshold_g_per_count": np.where(
+                np.isfinite(self.threshold_g), self.threshold_g, -1.0
+            ).tolist(),
+            "nonlinearity": None
+            if self.nonlinearity is None
+            else {"measured": list(self.nonlinearity[0]), "linear": list(self.nonlinearity[1])},
+            "viscoelastic": None if self.viscoelastic is None else asdict(self.viscoelastic),
+            "model_fit": None if self.model_fit is None else asdict(self.model_fit),
+            "notes": self.notes,
+        }
+
+    def save(self, path: str | Path, *, overwrite: bool = False) -> Path:
+        path = Path(path)
+        if path.exists() and not overwrite:
+            raise FileExistsError(f"{path} exists; pass --force to replace it")
+        path.write_text(json.dumps(self.to_dict(), indent=1), encoding="utf-8")
+        return path
+
+    @classmethod
+    def load(cls, path: str | Path, sensor: SensorSpec | None = None) -> Calibration:
+        path = Path(path)
+        try:
+            data = json.loads(path.read_text(encoding="utf-8"))
+        except OSError as error:
+            raise CalibrationError(f"cannot read calibration {path}: {error.strerror}") from None
+        except json.JSONDecodeError as error:
+            raise CalibrationError(f"{path} is not valid JSON ({error})") from None
+        if not isinstance(data, dict) or data.get("format") != FORMAT:
+            raise CalibrationError(f"{path} is not a tactsense calibration")
+        try:
+            threshold = np.array(data["threshold_g_per_count"], dtype=float)
+            nonlinear = data.get("nonlinearity")
+            calibration = cls(
+                sensor_toml=data["sensor_toml"],
+                gains=np.array(data["gains"], dtype=float),
+                baseline=np.array(data["baseline_counts"], dtype=float),
+                dead=np.array(data["dead"], dtype=bool),
+                weak=np.array(data["weak"], dtype=bool),
+                noisy=np.array(data["noisy"], dtype=bool),
+                threshold_g=np.where(threshold < 0, np.inf, threshold),
+                nonlinearity=None
+                if nonlinear is None
+                else (nonlinear["measured"], nonlinear["linear"]),
+                viscoelastic=None
+                if data.get("viscoelastic") is None
+                else Viscoelastic(**data["viscoelastic"]),
+                model_fit=None if data.get("model_fit") is None else ModelFit(**data["model_fit"]),
+                notes=data.get("notes", {}),
+            )
+        except (KeyError, TypeError, ValueError) as error:
+            raise CalibrationError(f"{path} is damaged: {error}") from None
+        shape = SensorSpec.from_toml_string(calibration.sensor_toml).shape
+        for name in ("gains", "baseline", "dead", "weak", "noisy"):
+            if getattr(calibration, name).shape != shape:
+                raise CalibrationError(f"{path}: {name} has the wrong shape, expected {shape}")
+        if sensor is not None:
+            calibration.check_sensor(sensor)
+        return calibration
+
+    def apply(self, frames, sensor: SensorSpec, *, frame_period_s: float | None = None):
+        """Calibrated fractional deflection of a sequence of frames, and their flags.
+
+        Order: eq. 4 against the stored baseline -> nonlinearity table ->
+        creep compensation (frames in time order, needs ``frame_period_s``) ->
+        division by the gains; excluded tactels are zeroed and flagged.
+        """
+        self.check_sensor(sensor)
+        deflection, flags = deflection_from_counts(
+            frames, self.baseline, sensor, dead=self.excluded
+        )
+        if self.nonlinearity is not None:
+            measured, linear = (np.asarray(v, float) for v in self.nonlinearity)
+            deflection = apply_nonlinearity(deflection, measured, linear)
+        if self.viscoelastic is not None and frame_period_s is not None and deflection.ndim == 3:
+            deflection = compensate_viscoelastic(deflection, frame_period_s, self.viscoelastic)
+        deflection = np.where(self.excluded, 0.0, deflection / self.gains)
+        return deflection, flags
+
+
+def calibrate_sweep(
+    frames,
+    sensor: SensorSpec,
+    *,
+    baseline_frames: int = 5,
+    probe_grams: float = 50.0,
+    min_response: float = 0.01,
+) -> Calibration:
+    """Build a calibration from a recording of a probe swept over every tactel.
+
+    Parameters
+    ----------
+    frames : ndarray, shape (T, rows, cols)
+        Readings [counts]; the first ``baseline_frames`` untouched.
+    probe_grams : float
+        Load of the sweeping probe, for the sensitivity thresholds [g].
+
+    Returns
+    -------
+    Calibration
+        Gains (relative to the model's deflection for the probe centred on a
+        tactel), baseline, health masks and thresholds; no fitted models yet.
+    """
+    frames = check_frames(frames, sensor.shape).astype(float)
+    if frames.ndim != 3:
+        raise CalibrationError(f"frames has shape {frames.shape}; expected (T, rows, cols)")
+    if frames.shape[0] <= baseline_frames + 1:
+        raise CalibrationError(
+            f"the recording has {frames.shape[0]} frames: too short for a baseline of "
+            f"{baseline_frames} frames and a sweep"
+        )
+    full_scale = 2**sensor.electronics.adc_bits - 1
+    saturated = np.mean(frames >= full_scale)
+    if saturated > 0.001:
+        raise CalibrationError(
+            f"{100 * saturated:.2g} % of the readings are saturated at {full_scale} counts: "
+            "lighten the probe or lower the amplifier gain and record again"
+        )
+    base = frames[:baseline_frames]
+    baseline = np.median(base, axis=0)
+    deflection, _ = deflection_from_counts(frames[baseline_frames:], baseline, sensor)
+    middle = sensor.shape[0] // 2
+    probe = Probe(
+        float(sensor.row_axial_mm[middle]),
+        float(sensor.col_angle_deg[0]),
+        probe_grams * 1e-3 * STANDARD_GRAVITY,
+    )
+    reference = float(deflection_batch(sensor, [(probe,)])[0, middle, 0])
+    gains, peak, uncalibrated = gain_table(
+        deflection, min_response=min_response, reference=reference
+    )
+    health = array_health(
+        peak, base, probe_grams=probe_grams, nominal_counts=float(np.median(baseline))
+    )
+    return Calibration(
+        sensor_toml=sensor.to_toml_string(),
+        gains=gains,
+        baseline=baseline,
+        dead=health["dead"],
+        weak=health["weak"] & ~uncalibrated,
+        noisy=health["noisy"],
+        threshold_g=np.where(uncalibrated, np.inf, health["threshold_g"]),
+        notes={
+            "uncalibrated_tactels": np.argwhere(uncalibrated).tolist(),
+            "probe_grams": probe_grams,
+        },
+    )
