@@ -218,3 +218,13 @@ def test_calibrate_then_locate_with_the_calibration(tmp_path):
         app, ["locate", str(other), "--calibration", str(out), "--out", str(tmp_path / "x.csv")]
     )
     assert result.exit_code == 2 and "belongs to sensor" in plain(result.output)
+
+
+def test_reproduce_quick_from_the_command_line(tmp_path):
+    out = tmp_path / "paper"
+    result = runner.invoke(app, ["reproduce", "--out", str(out), "--quick"])
+    assert result.exit_code == 0, result.output
+    assert (out / "report.html").exists() and (out / "results.json").exists()
+    assert "claims agree" in plain(result.output)
+    again = runner.invoke(app, ["reproduce", "--out", str(out), "--quick"])
+    assert again.exit_code == 2 and "--force" in plain(again.output)

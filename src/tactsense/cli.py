@@ -59,6 +59,75 @@ def _fail(message: str) -> None:
 
 
 @app.command()
+def reproduce(
+    out: Annotated[
+        Path,
+        typer.Option(
+            "--out",
+            "-o",
+            help="New directory for the figures, report.md, report.html and results.json.",
+        ),
+    ] = Path("paper-report"),
+    quick: Annotated[
+        bool,
+        typer.Option(
+            help="Fewer positions and repetitions: a reduced run for tests and a first look."
+        ),
+    ] = False,
+    sensor: SensorOption = "initial",
+    force: Annotated[
+        bool,
+        typer.Option(
+            "--force",
+            help="Write into OUT even if it exists (its report files "
+            "are replaced; nothing else in it is touched).",
+        ),
+    ] = False,
+) -> None:
+    """Run the paper's experiments on the digital twin and write the claims report."""
+    from tactsense.reproduce import reproduce as run_reproduce
+
+    try:
+        spec = load_sensor(sensor)
+        if out.exists() and not force:
+            _fail(f"{out} exists; pass --force to write into it, or choose another directory")
+        with Progress(
+            TextColumn("{task.description:<36}"),
+            BarColumn(),
+            MofNCompleteColumn(),
+            TimeRemainingColumn(),
+            console=console,
+            disable=None,
+        ) as bar:
+            task = bar.add_task("experiments", total=None)
+
+            def update(name: str, done: int, total: int) -> None:
+                bar.update(task, description=name, completed=done, total=total)
+
+            result = run_reproduce(out, quick=quick, force=force, sensor=spec, progress=update)
+    except (TactsenseInputError, FileExistsError) as error:
+        _fail(str(error))
+    claims = result["claims"].values()
+    agree = sum(claim.verdict == "agrees" for claim in claims)
+    table = Table(title=f"{len(result['figures'])} figures and {len(claims)} claims in {out}")
+    for column in ("claim", "paper", "tactsense", "unit", "verdict"):
+        table.add_column(column)
+    for claim in claims:
+        table.add_row(
+            claim.id,
+            "-" if claim.paper is None else f"{claim.paper:.4g}",
+            f"{claim.computed:.4g}",
+            claim.unit,
+            claim.verdict,
+        )
+    Console().print(table)
+    console.print(
+        f"{agree} of {len(claims)} claims agree; open {out / 'report.html'} for the "
+        "figures and the reasons behind each difference"
+    )
+
+
+@app.command()
 def simulate(
     out: Annotated[Path, typer.Option("--out", "-o", help="HDF5 recording to write.")] = Path(
         "sweep.h5"

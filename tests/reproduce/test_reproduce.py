@@ -1,0 +1,113 @@
+"""The main job end to end: report, figures and results.json complete, values from the code."""
+
+import json
+import re
+
+import numpy as np
+import pytest
+
+from tactsense.analysis import aliasing as al
+from tactsense.analysis.design import strip_capacitor_design
+from tactsense.physics import halfplane as hp
+from tactsense.physics.transduction import deflection_to_counts
+from tactsense.reproduce import reproduce
+from tactsense.sensor import fearing1990_initial
+
+REQUIRED = [
+    "sensitivity_bits_50g",
+    "nonlinearity_1N_pct",
+    "creep_decay_time_s",
+    "creep_residual_pct",
+    "creep_error_25Hz_pct",
+    "planestress_equivalent_nu",
+    "fit_depth_mm",
+    "fit_nu",
+    "fit_rms_pct",
+    "strip_gain_d0_0.5mm",
+    "strip_gain_increase_backing",
+    "frequency_peak_per_mm",
+    "aliasing_xi",
+    "newton_iterations",
+    "localization_length_mm",
+    "localization_circumference_deg",
+    "localization_tactel",
+    "force_error_pct",
+    "skew_slope",
+    "skew_odd_peak_x_over_z",
+    "skew_measured_30deg",
+    "superposition_error_pct",
+]
+FIGURES = [6, 7, 8, 9, 10, 11, 12, 13, 14, 16, 17, 18, 19, 20, 21, 22, 23, 24, 25, 26, 27, 28]
+
+
+@pytest.fixture(scope="module")
+def report(tmp_path_factory):
+    out = tmp_path_factory.mktemp("run") / "report"
+    reproduce(out, quick=True)
+    return out, json.loads((out / "results.json").read_text())
+
+
+def test_every_claim_is_present_and_well_formed(report):
+    _, results = report
+    for claim_id in REQUIRED:
+        entry = results["claims"][claim_id]
+        assert set(entry) >= {"paper", "computed", "unit", "verdict", "note"}
+        assert np.isfinite(entry["computed"])
+        assert entry["verdict"] in ("agrees", "differs")
+        assert len(entry["note"]) > 20
+
+
+def test_every_figure_is_written_and_reported(report):
+    out, results = report
+    numbers = sorted(f["number"] for f in results["figures"])
+    assert numbers == FIGURES
+    markdown = (out / "report.md").read_text()
+    page = (out / "report.html").read_text()
+    for number in FIGURES:
+        png = out / f"fig{number:02d}.png"
+        assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+        assert f"Fig. {number}:" in markdown and f"Fig. {number}:" in page
+    # self-contained: every image inline, no links to files
+    assert page.count("data:image/png;base64,") == len(FIGURES)
+    assert not re.search(r"src=['\"](?!data:)", page)
+    for claim_id in REQUIRED:
+        assert claim_id in markdown and claim_id in page
+
+
+def test_computed_values_are_the_public_functions(report):
+    _, results = report
+    claims = results["claims"]
+    spec = fearing1990_initial()
+    assert (
+        claims["planestress_equivalent_nu"]["computed"] == hp.plane_strain_equivalent(2.5e5, 0.5)[1]
+    )
+    assert claims["aliasing_xi"]["computed"] == pytest.approx(
+        float(al.reconstruction_error(3.8, 3.8, 0.5)), rel=1e-12
+    )
+    assert claims["skew_slope"]["computed"] == pytest.approx(
+        hp.line_load_skew_coefficient(0.5), rel=1e-12
+    )
+    assert claims["skew_odd_peak_x_over_z"]["computed"] == pytest.approx(
+        hp.odd_peak_offset(1.0, 0.5), rel=1e-12
+    )
+    assert claims["strip_gain_d0_0.5mm"]["computed"] == pytest.approx(
+        float(strip_capacitor_design(3.8e-3, 0.5e-3, 200.0, 3e-3)["gain"]), rel=1e-12
+    )
+    assert claims["frequency_peak_per_mm"]["computed"] == pytest.approx(
+        hp.frequency_peak(3.8, 0.5), rel=1e-6
+    )
+    bits = np.log2(deflection_to_counts(spec, 0.06) - 2000)
+    assert claims["sensitivity_bits_50g"]["computed"] == pytest.approx(bits, rel=1e-12)
+    # simulated claims land near the paper's numbers even in the quick run
+    assert claims["creep_decay_time_s"]["computed"] == pytest.approx(0.1, abs=0.02)
+    assert claims["fit_depth_mm"]["computed"] == pytest.approx(3.8, abs=0.3)
+    assert claims["localization_length_mm"]["computed"] < 1.0
+    assert claims["force_error_pct"]["computed"] < 30
+
+
+def test_existing_directory_is_not_overwritten(report):
+    out, _ = report
+    before = (out / "results.json").read_text()
+    with pytest.raises(FileExistsError, match="force"):
+        reproduce(out, quick=True)
+    assert (out / "results.json").read_text() == before
