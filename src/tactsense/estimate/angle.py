@@ -60,7 +60,7 @@ def skew_along_finger(
     periodic: bool = False,
     first_row: int = 1,
     reach: float = 2.0,
-    step: float = 0.05,
+    step: float = 0.25,
 ):
     """Skew index of the interpolated profile along the finger through the peak.
 

@@ -10,10 +10,10 @@ from typing import ClassVar
 import numpy as np
 
 from tactsense._validation import TactsenseInputError, check_frames
-from tactsense.estimate.angle import skew_along_finger
-from tactsense.estimate.deflection import Flag, deflection_from_counts
-from tactsense.estimate.force import total_force
-from tactsense.estimate.localize import newton_peak, tactel_maxima
+from tactsense.estimate._fast import locate_frames, prepare_frames
+from tactsense.estimate.deflection import Flag
+from tactsense.estimate.force import force_per_deflection
+from tactsense.estimate.localize import MAX_ITERATIONS, MAX_STEP, TOLERANCE
 from tactsense.geometry import tactel_to_surface
 from tactsense.sensor import SensorSpec
 
@@ -124,7 +124,26 @@ def locate(
                 "counts need a baseline (the untouched readings): pass baseline=, e.g. "
                 "tactsense.estimate.baseline_from(frames), or counts=False for deflections"
             )
-        deflection, flags = deflection_from_counts(frames, baseline, sensor, dead=dead)
+        baseline = check_frames(baseline, sensor.shape, "baseline").astype(float)
+        if baseline.ndim != 2:
+            raise TactsenseInputError(
+                f"baseline has shape {baseline.shape}; expected {sensor.shape}"
+            )
+        unusable = ~np.isfinite(baseline) | (baseline <= 0)
+        if dead is not None:
+            unusable = unusable | np.asarray(dead, dtype=bool)
+        lead = frames.shape[:-2]
+        deflection, flags, _ = prepare_frames(
+            np.ascontiguousarray(frames, dtype=np.float64).reshape(-1, *sensor.shape),
+            np.where(unusable, 1.0, baseline),
+            unusable,
+            float(2**sensor.electronics.adc_bits - 1),
+            int(Flag.NAN_INPUT),
+            int(Flag.SATURATED),
+            int(Flag.DEAD_TACTEL),
+        )
+        deflection = deflection.reshape(*lead, *sensor.shape)
+        flags = flags.reshape(lead)
     else:
         deflection = np.asarray(frames, dtype=float)
         bad = ~np.isfinite(deflection)
@@ -137,46 +156,29 @@ def locate(
     flat = deflection.reshape(-1, rows, cols)
     flags = flags.reshape(-1).copy()
     periodic = sensor.closes_circumference
-    best = flat.reshape(flat.shape[0], -1).argmax(axis=1)
-    start_row, start_col = np.divmod(best, cols)
     peak_tactel = flat.reshape(flat.shape[0], -1).max(axis=1)
     touched = peak_tactel >= threshold
     flags[~touched] |= int(Flag.NO_CONTACT)
 
-    n = flat.shape[0]
-    row = np.full(n, np.nan)
-    col = np.full(n, np.nan)
-    value = np.full(n, np.nan)
-    iterations = np.zeros(n, dtype=np.int64)
-    converged = np.zeros(n, dtype=bool)
-    skew = np.full(n, np.nan)
-    force = np.full(n, np.nan)
-    if touched.any():
-        peak = newton_peak(flat[touched], start_row[touched], start_col[touched], periodic=periodic)
-        row[touched], col[touched] = peak.row, peak.col
-        value[touched] = peak.value
-        iterations[touched] = peak.iterations
-        converged[touched] = peak.converged
-        with np.errstate(invalid="ignore"):
-            skew[touched] = skew_along_finger(
-                flat[touched],
-                peak.row,
-                peak.col,
-                periodic=periodic,
-                first_row=1 if sensor.array.tip_row else 0,
-            )
-        force[touched] = total_force(flat[touched], sensor)
-        flags[touched & ~converged] |= int(Flag.NOT_CONVERGED)
+    row, col, value, iterations, converged, summed, skew, second = locate_frames(
+        np.ascontiguousarray(flat, dtype=np.float64),
+        touched,
+        periodic,
+        1 if sensor.array.tip_row else 0,
+        TOLERANCE,
+        MAX_ITERATIONS,
+        MAX_STEP,
+    )
+    force = force_per_deflection(sensor) * summed
+    flags[touched & ~converged] |= int(Flag.NOT_CONVERGED)
+    with np.errstate(invalid="ignore"):
         edge = (row < 0.5) | (row > rows - 1.5)
         if not periodic:
             edge |= (col < 0.5) | (col > cols - 1.5)
         flags[touched & edge] |= int(Flag.EDGE)
         if sensor.array.tip_row:
             flags[touched & (row < 1.0)] |= int(Flag.TIP)
-        for k in np.flatnonzero(touched):
-            maxima = tactel_maxima(flat[k], periodic=periodic, threshold=threshold)
-            if len(maxima) > 1 and flat[k][maxima[1]] >= second_contact * flat[k][maxima[0]]:
-                flags[k] |= int(Flag.MULTIPLE)
+    flags[touched & (second >= second_contact)] |= int(Flag.MULTIPLE)
     axial, angle = tactel_to_surface(sensor, np.nan_to_num(row), np.nan_to_num(col))
     axial = np.where(touched, axial, np.nan)
     angle = np.where(touched, angle, np.nan)
