@@ -228,3 +228,18 @@ def test_reproduce_quick_from_the_command_line(tmp_path):
     assert "claims agree" in plain(result.output)
     again = runner.invoke(app, ["reproduce", "--out", str(out), "--quick"])
     assert again.exit_code == 2 and "--force" in plain(again.output)
+
+
+def test_design_bound_json():
+    import json
+
+    from tactsense.analysis.bound import cramer_rao_bound
+
+    result = runner.invoke(
+        app, ["design", "bound", "--axial", "12", "--angle", "10", "--force-g", "50", "--json"]
+    )
+    assert result.exit_code == 0, result.output
+    data = json.loads(result.output)
+    want = cramer_rao_bound(ts.fearing1990_initial(), 12.0, 10.0, ts.grams_force(50))
+    assert data["bound"]["axial_mm"] == pytest.approx(want["axial_mm"], rel=1e-12)
+    assert runner.invoke(app, ["design", "bound", "--sensor", "improved"]).exit_code == 0

@@ -31,7 +31,7 @@ app.add_typer(sensor_app, name="sensor")
 design_app = typer.Typer(
     no_args_is_help=True,
     rich_markup_mode=None,
-    help="Design questions: capacitor gain in the skin, aliasing of the sampled strain.",
+    help="Design questions: capacitor gain in the skin, aliasing, the Cramer-Rao bound.",
 )
 app.add_typer(design_app, name="design")
 
@@ -556,6 +556,76 @@ def design_aliasing(
     )
     table.add_row(
         "worst peak-amplitude error, line load", f"{100 * summary['worst_amplitude_error']:.1f} %"
+    )
+    Console().print(table)
+
+
+@design_app.command("bound")
+def design_bound(
+    axial: Annotated[
+        float,
+        typer.Option(
+            help="Probe position along the finger, arc length from the "
+            "junction of tip and cylinder, in mm."
+        ),
+    ] = 12.5,
+    angle: Annotated[float, typer.Option(help="Probe angle around the finger, in deg.")] = 0.0,
+    force_g: Annotated[float, typer.Option(help="Probe load in grams-force.")] = 50.0,
+    diameter: Annotated[
+        float, typer.Option(help="Contact diameter of the hemispherical probe, in mm.")
+    ] = 3.0,
+    sensor: SensorOption = "initial",
+    as_json: Annotated[
+        bool, typer.Option("--json", help="Print the result as JSON instead of a table.")
+    ] = False,
+) -> None:
+    """Cramer-Rao lower bound on contact position and force at the sensor's reading noise."""
+    import json
+
+    from tactsense.analysis.bound import cramer_rao_bound, noise_variance
+
+    try:
+        spec = load_sensor(sensor)
+        bound = cramer_rao_bound(
+            spec, axial, angle, grams_force(force_g), contact_diameter_mm=diameter
+        )
+    except TactsenseInputError as error:
+        _fail(str(error))
+    if as_json:
+        typer.echo(
+            json.dumps(
+                {
+                    "inputs": {
+                        "axial_mm": axial,
+                        "angle_deg": angle,
+                        "force_n": grams_force(force_g),
+                        "sensor": spec.name,
+                        "noise_counts": float(np.sqrt(noise_variance(spec))),
+                    },
+                    "bound": bound,
+                },
+                indent=2,
+            )
+        )
+        return
+    table = Table(
+        title=f"Cramer-Rao bound, {force_g:g} g at ({axial:g} mm, {angle:g} deg) on {spec.name}",
+        show_header=False,
+    )
+    table.add_row(
+        "reading noise",
+        f"{np.sqrt(noise_variance(spec)):.3f} counts RMS (read noise and quantization)",
+    )
+    table.add_row(
+        "along the finger", f"{1e3 * bound['axial_mm']:.1f} um ({bound['row_tactel']:.4f} tactel)"
+    )
+    table.add_row(
+        "around the finger",
+        f"{bound['angle_deg']:.3f} deg "
+        f"({bound['col_tactel']:.4f} tactel, {1e3 * bound['arc_mm']:.1f} um of arc)",
+    )
+    table.add_row(
+        "force", f"{1e3 * bound['force_n']:.2f} mN ({100 * bound['force_relative']:.2f} %)"
     )
     Console().print(table)
 

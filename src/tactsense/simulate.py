@@ -505,9 +505,9 @@ def simulate(
         step_of_tick = np.clip(
             np.searchsorted(boundaries, tick_time, side="right") - 1, 0, len(scenario.steps) - 1
         )
-        u = elastic[step_of_tick]  # (ticks, rows, cols): what every tactel feels at every tick
         if "viscoelastic" in active:
             f = spec.flaws
+            u = elastic[step_of_tick]  # (ticks, rows, cols): every tactel at every tick
             u, state = viscoelastic_response(
                 u,
                 dt,
@@ -517,9 +517,12 @@ def simulate(
                 creep_time_constant_s=f.creep_time_constant_s,
                 state=state,
             )
-        sampled = u.reshape(last - first, ticks_per_frame, rows, cols)[
-            :, flat_index, row_of_tick, col_of_tick
-        ].reshape(last - first, rows, cols)
+            sampled = u.reshape(last - first, ticks_per_frame, rows, cols)[
+                :, flat_index, row_of_tick, col_of_tick
+            ].reshape(last - first, rows, cols)
+        else:  # no memory: only the sampled instants matter
+            own_step = step_of_tick.reshape(last - first, ticks_per_frame)
+            sampled = elastic[own_step, row_of_tick, col_of_tick].reshape(last - first, rows, cols)
         if "nonlinearity" in active:
             sampled = stiffening(sampled, spec.flaws.nonlinear_saturation)
         sampled = np.minimum(sampled, 0.95)  # plates cannot touch

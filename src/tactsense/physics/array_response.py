@@ -25,7 +25,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from tactsense.physics.contact import Patches, contacts_to_patches, profile_cdf
+from tactsense.physics._fast import probe_frames
+from tactsense.physics.contact import Patches, Probe, contacts_to_patches, profile_cdf
 from tactsense.physics.halfplane import (
     _plane_stress_constants,
     cumulative_normal,
@@ -185,6 +186,17 @@ def deflection_batch(spec: SensorSpec, states) -> np.ndarray:
     flat = [c for s in states for c in s]
     if not flat:
         return out
+    probes = [s[0] for s in states if len(s) == 1 and type(s[0]) is Probe]
+    if len(probes) == len(states) and len({p.contact_diameter_mm for p in probes}) == 1:
+        # every state one probe: the compiled path
+        return probe_response(
+            spec,
+            [p.axial_mm for p in probes],
+            [p.angle_deg for p in probes],
+            [p.force_n for p in probes],
+            contact_diameter_mm=probes[0].contact_diameter_mm,
+            alpha_deg=[p.alpha_deg for p in probes],
+        )
     parts = [contacts_to_patches([c], spec.radius_mm) for c in flat]
     counts = np.array([len(p) for p in parts], dtype=int)
     patches = Patches.concatenate(parts)
@@ -195,3 +207,76 @@ def deflection_batch(spec: SensorSpec, states) -> np.ndarray:
     state_of_patch = np.repeat(state_of_contact, counts)
     np.add.at(out, state_of_patch, per_patch)
     return out
+
+
+def probe_response(
+    spec: SensorSpec,
+    axial_mm,
+    angle_deg,
+    force_n,
+    *,
+    contact_diameter_mm: float = 3.0,
+    alpha_deg=0.0,
+) -> np.ndarray:
+    """Fractional deflection for many single-probe contacts at once, shape (N, rows, cols).
+
+    The vectorized equivalent of calling :func:`tactel_deflection` with one
+    :class:`~tactsense.physics.contact.Probe` per element of the broadcast inputs,
+    without building contact objects (the fast path of the simulator and of
+    model-based estimation).
+
+    Parameters
+    ----------
+    axial_mm, angle_deg, force_n, alpha_deg : array_like, broadcast to (N,)
+        Probe position [mm], [deg], total force [N] and angle from the normal [deg].
+    contact_diameter_mm : float
+        [mm].
+    """
+    axial, angle, force, alpha = np.broadcast_arrays(
+        *(
+            np.atleast_1d(np.asarray(v, dtype=float))
+            for v in (axial_mm, angle_deg, force_n, alpha_deg)
+        )
+    )
+    half = contact_diameter_mm / 2.0
+    alpha_rad = np.deg2rad(alpha.ravel())
+    if half <= 0:
+        n = axial.size
+        patches = Patches(
+            axial.ravel(),
+            angle.ravel(),
+            force.ravel() * np.cos(alpha_rad),
+            np.zeros(n),
+            np.zeros(n),
+            ("point",) * n,
+            ("point",) * n,
+            np.tan(alpha_rad),
+        )
+        return np.einsum(
+            "p,pr,prc->prc",
+            patches.force_n,
+            axial_response(spec, patches),
+            around_response(spec, patches),
+        )
+    E, nu = _plane_stress_constants(
+        spec.elastic.youngs_modulus_pa, spec.elastic.effective_poisson_ratio, spec.elastic.model
+    )
+    u = np.linspace(-1.0, 1.0, _CELLS + 1)
+    latitude = np.clip(-spec.row_axial_mm / spec.radius_mm, 0.0, np.pi / 2)
+    return probe_frames(
+        spec.row_axial_mm * 1e-3,
+        spec.row_depth_mm * 1e-3,
+        spec.ring_radius_mm * np.cos(latitude),
+        np.deg2rad(spec.col_angle_deg),
+        E,
+        nu,
+        spec.ring_flexural_length_mm * 1e-3,
+        spec.radius_mm,
+        np.ascontiguousarray(axial.ravel()),
+        np.ascontiguousarray(angle.ravel()),
+        np.ascontiguousarray(force.ravel() * np.cos(alpha_rad)),
+        half,
+        np.ascontiguousarray(np.tan(alpha_rad)),
+        u,
+        np.diff(profile_cdf(u, "parabolic")),
+    )

@@ -151,7 +151,11 @@ class _ContactBase:
         )
 
     def to_dict(self) -> dict:
-        return {"kind": self.kind, **dataclasses.asdict(self)}
+        """Plain dictionary of the contact's fields and kind (recording metadata)."""
+        return {
+            "kind": self.kind,
+            **{name: getattr(self, name) for name in self.__dataclass_fields__},
+        }
 
 
 @dataclass(frozen=True)
