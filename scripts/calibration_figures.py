@@ -23,12 +23,6 @@ OUT = Path(__file__).resolve().parents[1] / "docs" / "images"
 FLAWS = ["noise", "quantization", "gain_spread"]
 
 
-def last_frames(rec, row, col):
-    step = rec.sample_step(row, col)
-    loaded = rec.truth["step_n_contacts"][step] > 0
-    return np.flatnonzero(loaded & np.r_[step[1:] != step[:-1], True]), step
-
-
 def gains_figure(spec):
     sweep = ts.simulate(spec, ts.calibration_sweep(spec), flaws=FLAWS, rng=1)
     calibration = cal.calibrate_sweep(sweep.frames, spec)
@@ -135,8 +129,8 @@ def fit_figure(spec):
         spec, ts.knife_edge_sweep(spec), flaws=["noise", "quantization", "jitter"], rng=3
     )
     d = fractional_deflection(rec.frames.astype(float), ts.baseline_from(rec.frames, 5))[:, 4, 0]
-    last, step = last_frames(rec, 4, 0)
-    x = rec.truth["step_axial_mm"][step[last]]
+    last, steps = rec.last_loaded_frames(4, 0)
+    x = rec.truth["step_axial_mm"][steps]
     fit = cal.fit_plane_stress(x, d[last])
     print(f"knife-edge fit: {fit}")
     fine = np.linspace(x.min(), x.max(), 300)
@@ -167,7 +161,7 @@ def nonlinearity_figure(spec):
     forces = np.linspace(0.1, 1.0, 10)
     rec = ts.simulate(spec, ts.load_series(spec, forces_n=forces), flaws=["nonlinearity"])
     d = fractional_deflection(rec.frames, ts.baseline_from(rec.frames, 5))[:, 4, 0]
-    last, _ = last_frames(rec, 4, 0)
+    last, _ = rec.last_loaded_frames(4, 0)
     knots = cal.nonlinearity_table(forces, d[last], linear_below=0.5)
     linear = cal.apply_nonlinearity(d[last], *knots)
     print(

@@ -448,10 +448,8 @@ def _fit_knife(rec, sensor, row, col, baseline_frames):
             "scenario truth"
         )
     signal = _deflection_of(rec, row, col, baseline_frames)
-    step = rec.sample_step(row, col)
-    loaded = rec.truth["step_n_contacts"][step] > 0
-    last = np.flatnonzero(loaded & np.r_[step[1:] != step[:-1], True])
-    return cal.fit_plane_stress(rec.truth["step_axial_mm"][step[last]], signal[last])
+    last, steps = rec.last_loaded_frames(row, col)
+    return cal.fit_plane_stress(rec.truth["step_axial_mm"][steps], signal[last])
 
 
 @app.command()

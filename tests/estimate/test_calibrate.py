@@ -92,10 +92,8 @@ def test_model_fit_recovers_depth_and_nu(initial):
         initial, ts.knife_edge_sweep(initial), flaws=["noise", "quantization", "jitter"], rng=3
     )
     d = fractional_deflection(rec.frames.astype(float), ts.baseline_from(rec.frames, 5))[:, 4, 0]
-    step = rec.sample_step(4, 0)
-    loaded = rec.truth["step_n_contacts"][step] > 0
-    last = np.flatnonzero(loaded & np.r_[step[1:] != step[:-1], True])
-    fit = cal.fit_plane_stress(rec.truth["step_axial_mm"][step[last]], d[last])
+    last, steps = rec.last_loaded_frames(4, 0)
+    fit = cal.fit_plane_stress(rec.truth["step_axial_mm"][steps], d[last])
     # at the paper's noise (quantization, read noise, 1-g and 0.05-mm jitter)
     assert fit.depth_mm == pytest.approx(3.8, abs=0.2)
     assert fit.poisson_ratio == pytest.approx(0.4, abs=0.06)
@@ -144,10 +142,7 @@ def test_nonlinearity_table_restores_the_line(initial):
         initial, ts.load_series(initial, forces_n=forces), flaws=["nonlinearity"], rng=0
     )
     d = fractional_deflection(rec.frames, ts.baseline_from(rec.frames, 5))[:, 4, 0]
-    step = rec.sample_step(4, 0)
-    last = np.flatnonzero(
-        (rec.truth["step_n_contacts"][step] > 0) & np.r_[step[1:] != step[:-1], True]
-    )
+    last, _ = rec.last_loaded_frames(4, 0)
     measured = d[last]
     # Fig. 6: 6 % below the line at 1 N
     assert 1 - measured[-1] / (2 * measured[4]) == pytest.approx(0.06, abs=0.01)

@@ -101,6 +101,21 @@ class Recording:
         instants = np.asarray(self.time_s) + float(self.sample_offset_s[row, col])
         return np.clip(np.searchsorted(bounds, instants, side="right") - 1, 0, len(steps) - 1)
 
+    def last_loaded_frames(self, row: int, col: int) -> tuple[np.ndarray, np.ndarray]:
+        """The last frame of every step that loads the finger, as tactel (row, col) saw it.
+
+        Returns
+        -------
+        frames : ndarray of int
+            Frame indices, one per loaded step (simulated recordings only).
+        steps : ndarray of int
+            The step each of those frames belongs to.
+        """
+        step = self.sample_step(row, col)
+        loaded = np.asarray(self.truth["step_n_contacts"])[step] > 0
+        last = np.flatnonzero(loaded & np.r_[step[1:] != step[:-1], True])
+        return last, step[last]
+
     @property
     def baseline_frames(self) -> np.ndarray:
         """Indices of frames during which nothing touched (simulated recordings only)."""

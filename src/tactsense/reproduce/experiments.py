@@ -117,10 +117,6 @@ class Context:
         self.figures.append(Figure(number, title, paper_did, simulated, came_out, path))
 
 
-def _last_of_steps(step, loaded):
-    return np.flatnonzero(loaded & np.r_[step[1:] != step[:-1], True])
-
-
 def _deflection(rec):
     return fractional_deflection(rec.frames.astype(float), ts.baseline_from(rec.frames, 5))
 
@@ -154,8 +150,7 @@ def fig06_nonlinearity(ctx: Context) -> None:
             rng=trial,
         )
         d = _deflection(rec)[:, 4, 0]
-        step = rec.sample_step(4, 0)
-        last = _last_of_steps(step, rec.truth["step_n_contacts"][step] > 0)
+        last, _ = rec.last_loaded_frames(4, 0)
         readings.append(d[last])
     mean = np.mean(readings, axis=0)
     half = np.argmin(np.abs(forces - 0.5))
@@ -317,8 +312,7 @@ def fig10_11_jitter(ctx: Context) -> None:
         flaws=["jitter", "noise", "quantization"],
         rng=4,
     )
-    step = rec.sample_step(4, 0)
-    last = _last_of_steps(step, rec.truth["step_n_contacts"][step] > 0)
+    last, _ = rec.last_loaded_frames(4, 0)
     counts = rec.frames[last].astype(float)
     under = counts[:, 4, 0]
     per_gram = (under.mean() - spec.electronics.nominal_counts) / 50.0
@@ -454,10 +448,9 @@ def fig13_around(ctx: Context) -> None:
     d = _deflection(rec)
     fig, ax = plt.subplots(figsize=(7, 4), constrained_layout=True)
     for col in (0, 1, 2):
-        step = rec.sample_step(4, col)
-        last = _last_of_steps(step, rec.truth["step_n_contacts"][step] > 0)
+        last, last_step = rec.last_loaded_frames(4, col)
         ax.plot(
-            rec.truth["step_angle_deg"][step[last]],
+            rec.truth["step_angle_deg"][last_step],
             100 * d[last, 4, col],
             ".-",
             label=f"col {col} ({spec.col_angle_deg[col]:.0f} deg)",
@@ -495,10 +488,9 @@ def fig14_tip(ctx: Context) -> None:
     d = _deflection(rec)
     fig, ax = plt.subplots(figsize=(7, 4), constrained_layout=True)
     for row in (0, 1):
-        step = rec.sample_step(row, 0)
-        last = _last_of_steps(step, rec.truth["step_n_contacts"][step] > 0)
+        last, last_step = rec.last_loaded_frames(row, 0)
         ax.plot(
-            rec.truth["step_axial_mm"][step[last]],
+            rec.truth["step_axial_mm"][last_step],
             100 * d[last, row, 0],
             ".-",
             label=f"row {row}" + (" (tip)" if row == 0 else ""),
@@ -534,9 +526,8 @@ def fig16_fit(ctx: Context) -> None:
             rng=20 + trial,
         )
         d = _deflection(rec)[:, 4, 0]
-        step = rec.sample_step(4, 0)
-        last = _last_of_steps(step, rec.truth["step_n_contacts"][step] > 0)
-        x = rec.truth["step_axial_mm"][step[last]]
+        last, last_step = rec.last_loaded_frames(4, 0)
+        x = rec.truth["step_axial_mm"][last_step]
         fits.append((cal.fit_plane_stress(x, d[last]), x, d[last]))
     fit, x, r = fits[0]
     fine = np.linspace(x.min(), x.max(), 300)
@@ -829,10 +820,12 @@ def fig23_24_25_localization(ctx: Context) -> None:
         steps += [ts.Step((ts.Probe(a, g, G50),), 3 / 7), ts.Step((), 2 / 7, "lifted")]
     rec = ts.simulate(spec, ts.Scenario(tuple(steps)), flaws=MEASURED, rng=8)
     est = ts.locate(rec.frames, spec, calibration=calibration)
-    step = rec.truth["frame_step"]
-    last = _last_of_steps(step, rec.truth["step_n_contacts"][step] > 0)
-    true_axial = rec.truth["step_axial_mm"][step[last]]
-    true_angle = rec.truth["step_angle_deg"][step[last]]
+    step = rec.truth["frame_step"]  # whole frames: the step at the middle of each scan
+    loaded = rec.truth["step_n_contacts"][step] > 0
+    last = np.flatnonzero(loaded & np.r_[step[1:] != step[:-1], True])
+    last_step = step[last]
+    true_axial = rec.truth["step_axial_mm"][last_step]
+    true_angle = rec.truth["step_angle_deg"][last_step]
     n_along = along.size
     d_axial = est.axial_mm[last] - true_axial
     d_angle = wrap_angle_deg(est.angle_deg[last] - true_angle)
