@@ -114,6 +114,7 @@ def locate(
     if not isinstance(sensor, SensorSpec):
         raise TactsenseInputError(f"sensor must be a SensorSpec; got {type(sensor).__name__}")
     frames = check_frames(frames, sensor.shape)
+    peak_tactel = None
     if calibration is not None:
         if not counts:
             raise TactsenseInputError("a calibration applies to counts, not to deflections")
@@ -133,7 +134,7 @@ def locate(
         if dead is not None:
             unusable = unusable | np.asarray(dead, dtype=bool)
         lead = frames.shape[:-2]
-        deflection, flags, _ = prepare_frames(
+        deflection, flags, peak_tactel = prepare_frames(
             np.ascontiguousarray(frames, dtype=np.float64).reshape(-1, *sensor.shape),
             np.where(unusable, 1.0, baseline),
             unusable,
@@ -156,7 +157,8 @@ def locate(
     flat = deflection.reshape(-1, rows, cols)
     flags = flags.reshape(-1).copy()
     periodic = sensor.closes_circumference
-    peak_tactel = flat.reshape(flat.shape[0], -1).max(axis=1)
+    if peak_tactel is None:
+        peak_tactel = flat.reshape(flat.shape[0], -1).max(axis=1)
     touched = peak_tactel >= threshold
     flags[~touched] |= int(Flag.NO_CONTACT)
 
