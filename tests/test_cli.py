@@ -243,3 +243,35 @@ def test_design_bound_json():
     want = cramer_rao_bound(ts.fearing1990_initial(), 12.0, 10.0, ts.grams_force(50))
     assert data["bound"]["axial_mm"] == pytest.approx(want["axial_mm"], rel=1e-12)
     assert runner.invoke(app, ["design", "bound", "--sensor", "improved"]).exit_code == 0
+
+
+def test_calibration_workflow_from_the_command_line_alone(tmp_path):
+    sweep, knife, steps = tmp_path / "sweep.h5", tmp_path / "knife.h5", tmp_path / "steps.h5"
+    for args in (
+        ["--scenario", "calibration", "--increment", "1.2", "--out", str(sweep)],
+        ["--scenario", "knife-edge", "--out", str(knife)],
+        ["--scenario", "repeated", "--repeats", "3", "--dwell-s", "1", "--out", str(steps)],
+    ):
+        result = runner.invoke(app, ["simulate", *args])
+        assert result.exit_code == 0, result.output
+    out = tmp_path / "cal.json"
+    result = runner.invoke(
+        app,
+        ["calibrate", str(sweep), "--knife", str(knife), "--steps", str(steps), "--out", str(out)],
+    )
+    assert result.exit_code == 0, result.output
+    fit = ts.estimate.Calibration.load(out).model_fit
+    assert fit.depth_mm == pytest.approx(3.8, abs=0.4)
+    bad = runner.invoke(
+        app,
+        [
+            "simulate",
+            "--scenario",
+            "knife-edge",
+            "--plot",
+            str(tmp_path / "k.png"),
+            "--out",
+            str(tmp_path / "k.h5"),
+        ],
+    )
+    assert bad.exit_code == 2 and "--plot" in plain(bad.output)

@@ -51,6 +51,8 @@ class ScenarioKind(StrEnum):
     sweep_axial = "sweep-axial"
     sweep_around = "sweep-around"
     repeated = "repeated"
+    calibration = "calibration"
+    knife = "knife-edge"
 
 
 def _fail(message: str) -> None:
@@ -138,7 +140,10 @@ def simulate(
         typer.Option(
             help="What touches the finger: 'sweep-axial' steps a probe along the finger "
             "(Fig. 7), 'sweep-around' steps it around (Fig. 13), 'repeated' applies it "
-            "again and again above one tactel (Figs. 10-12)."
+            "again and again above one tactel (Figs. 10-12; also the force steps for "
+            "'calibrate --steps'), 'calibration' sweeps the probe along every column "
+            "(section 3.1, for 'calibrate'), 'knife-edge' steps a 0.5-N knife edge past "
+            "tactel (row, col) (section 4.1, for 'calibrate --knife')."
         ),
     ] = ScenarioKind.sweep_axial,
     row: Annotated[
@@ -197,7 +202,12 @@ def simulate(
 ) -> None:
     """Simulate the finger under a scenario and write an HDF5 recording of A/D frames."""
     from tactsense.plotting import plot_sweep
-    from tactsense.simulate import probe_sweep, repeated_load
+    from tactsense.simulate import (
+        calibration_sweep,
+        knife_edge_sweep,
+        probe_sweep,
+        repeated_load,
+    )
     from tactsense.simulate import simulate as run_simulation
 
     try:
@@ -205,10 +215,17 @@ def simulate(
         for target in (out, plot):
             if target is not None and target.exists() and not force:
                 _fail(f"{target} exists; pass --force to replace it, or choose another name")
-        if plot is not None and scenario is ScenarioKind.repeated:
-            _fail("--plot draws sweeps; it is not available for the 'repeated' scenario")
+        if plot is not None and scenario not in (
+            ScenarioKind.sweep_axial,
+            ScenarioKind.sweep_around,
+        ):
+            _fail("--plot draws the sweeps along or around; not available for this scenario")
         force_n = grams_force(force_g)
-        if scenario is ScenarioKind.repeated:
+        if scenario is ScenarioKind.calibration:
+            scene = calibration_sweep(spec, force_n=force_n, increment=increment or 0.6)
+        elif scenario is ScenarioKind.knife:
+            scene = knife_edge_sweep(spec, row=row, col=col, increment=increment or 0.6)
+        elif scenario is ScenarioKind.repeated:
             scene = repeated_load(
                 spec,
                 row=row,
