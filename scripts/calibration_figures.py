@@ -84,13 +84,7 @@ def creep_figure(spec):
         flaws=["viscoelastic", "noise", "quantization"],
         rng=0,
     )
-    signal = fractional_deflection(rec.frames.astype(float), ts.baseline_from(rec.frames, 5))[
-        :, 4, 0
-    ]
-    durations = [s["duration_s"] for s in rec.scenario["steps"]]
-    loaded = [bool(s["contacts"]) for s in rec.scenario["steps"]]
-    schedule = cal.load_schedule(rec.time_s, rec.sample_offset_s[4, 0], durations, loaded, 16)
-    model, _, rms = cal.fit_viscoelastic(signal, fast.scan_period_s, schedule, fine=16)
+    model, _, rms = cal.fit_viscoelastic_recording(rec, 4, 0)
     print(
         f"creep fit: {model}, RMS {100 * rms:.2f} % (truth {spec.flaws.delayed_fraction}, "
         f"{spec.flaws.delayed_time_constant_s}, {spec.flaws.creep_fraction}, "

@@ -440,17 +440,9 @@ def _fit_steps(rec, sensor, row, col, baseline_frames):
 
     if rec.sensor != sensor:
         raise TactsenseInputError("the steps recording comes from another sensor than the sweep")
-    signal = _deflection_of(rec, row, col, baseline_frames)
-    fine = 16
-    if rec.scenario.get("steps"):
-        durations = [s["duration_s"] for s in rec.scenario["steps"]]
-        loaded = [bool(s["contacts"]) for s in rec.scenario["steps"]]
-        schedule = cal.load_schedule(
-            rec.time_s, rec.sample_offset_s[row, col], durations, loaded, fine
-        )
-    else:
-        schedule = signal > 0.5 * signal.max()
-    model, _, _ = cal.fit_viscoelastic(signal, rec.sensor.scan_period_s, schedule, fine=fine)
+    if not (0 <= row < rec.sensor.shape[0] and 0 <= col < rec.sensor.shape[1]):
+        raise TactsenseInputError(f"tactel ({row}, {col}) is outside the array")
+    model, _, _ = cal.fit_viscoelastic_recording(rec, row, col, baseline_frames=baseline_frames)
     return model
 
 

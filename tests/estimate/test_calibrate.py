@@ -109,13 +109,7 @@ def test_creep_fit_and_compensation():
         flaws=["viscoelastic", "noise", "quantization"],
         rng=0,
     )
-    signal = fractional_deflection(rec.frames.astype(float), ts.baseline_from(rec.frames, 5))[
-        :, 4, 0
-    ]
-    durations = [s["duration_s"] for s in rec.scenario["steps"]]
-    loaded = [bool(s["contacts"]) for s in rec.scenario["steps"]]
-    schedule = cal.load_schedule(rec.time_s, rec.sample_offset_s[4, 0], durations, loaded, 16)
-    model, _, rms = cal.fit_viscoelastic(signal, spec.scan_period_s, schedule, fine=16)
+    model, _, rms = cal.fit_viscoelastic_recording(rec, 4, 0)
     truth = spec.flaws
     assert model.delayed_fraction == pytest.approx(truth.delayed_fraction, rel=0.1)
     assert model.delayed_time_constant_s == pytest.approx(truth.delayed_time_constant_s, rel=0.1)

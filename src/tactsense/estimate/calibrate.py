@@ -304,6 +304,43 @@ def load_schedule(frame_times, sample_offset: float, step_durations, step_loaded
     return np.asarray(step_loaded, dtype=bool)[index]
 
 
+def fit_viscoelastic_recording(
+    recording, row: int = 4, col: int = 0, *, baseline_frames: int = 5, fine: int = 16
+):
+    """Fit the creep model to tactel (row, col) of a recording of force steps.
+
+    The load schedule comes from the recording's scenario when it has one
+    (simulated), else from the signal itself (on above half its largest value).
+
+    Parameters
+    ----------
+    recording : Recording
+        Anything with ``frames``, ``time_s``, ``sample_offset_s``, ``scenario`` and
+        ``sensor`` (a :class:`tactsense.io.Recording`).
+
+    Returns
+    -------
+    model, gain, rms : see :func:`fit_viscoelastic`
+    """
+    frames = np.asarray(recording.frames, dtype=float)
+    if frames.shape[0] <= baseline_frames:
+        raise CalibrationError("the steps recording is too short for its baseline")
+    baseline = np.median(frames[:baseline_frames], axis=0)
+    signal = (frames[:, row, col] - baseline[row, col]) / frames[:, row, col]
+    steps = recording.scenario.get("steps") if recording.scenario else None
+    if steps:
+        schedule = load_schedule(
+            recording.time_s,
+            recording.sample_offset_s[row, col],
+            [s["duration_s"] for s in steps],
+            [bool(s["contacts"]) for s in steps],
+            fine,
+        )
+    else:
+        schedule = signal > 0.5 * signal.max()
+    return fit_viscoelastic(signal, recording.sensor.scan_period_s, schedule, fine=fine)
+
+
 def compensate_viscoelastic(deflection, dt, model: Viscoelastic):
     """Invert the creep model frame by frame: the elastic deflection from the readings.
 
