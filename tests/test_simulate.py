@@ -90,6 +90,10 @@ def test_bad_arguments_are_reported(initial):
         ts.simulate(initial, scene, gains=np.ones((3, 3)))
     with pytest.raises(ValueError, match="outside the 8x8 array"):
         ts.probe_sweep(initial, row=9)
+    with pytest.raises(ValueError, match="outside the 8x8 array"):
+        ts.knife_edge_sweep(initial, col=8)
+    with pytest.raises(ValueError, match="outside the 8x8 array"):
+        ts.load_series(initial, row=-1)
     with pytest.raises(ValueError, match="at least one step"):
         ts.Scenario(())
     with pytest.raises(ValueError, match="SensorSpec"):

@@ -429,8 +429,7 @@ def _deflection_of(rec, row, col, baseline_frames):
     from tactsense.estimate import baseline_from
     from tactsense.physics.transduction import fractional_deflection
 
-    if not (0 <= row < rec.sensor.shape[0] and 0 <= col < rec.sensor.shape[1]):
-        raise TactsenseInputError(f"tactel ({row}, {col}) is outside the array")
+    rec.sensor.check_tactel(row, col)
     base = baseline_from(rec.frames, baseline_frames)
     return fractional_deflection(rec.frames.astype(float), base)[:, row, col]
 
@@ -440,8 +439,7 @@ def _fit_steps(rec, sensor, row, col, baseline_frames):
 
     if rec.sensor != sensor:
         raise TactsenseInputError("the steps recording comes from another sensor than the sweep")
-    if not (0 <= row < rec.sensor.shape[0] and 0 <= col < rec.sensor.shape[1]):
-        raise TactsenseInputError(f"tactel ({row}, {col}) is outside the array")
+    rec.sensor.check_tactel(row, col)
     model, _, _ = cal.fit_viscoelastic_recording(rec, row, col, baseline_frames=baseline_frames)
     return model
 

@@ -229,6 +229,16 @@ class SensorSpec:
         """Shape ``(rows, cols)`` of a frame: the wired array [-]."""
         return (self.array.wired_rows, self.array.wired_cols)
 
+    def check_tactel(self, row: int, col: int) -> tuple[int, int]:
+        """Return ``(row, col)`` after checking it addresses a wired tactel."""
+        rows, cols = self.shape
+        if not (0 <= row < rows and 0 <= col < cols):
+            raise SensorSpecError(
+                f"tactel ({row}, {col}) is outside the {rows}x{cols} array of wired tactels "
+                f"of {self.name!r}"
+            )
+        return int(row), int(col)
+
     @property
     def radius_mm(self) -> float:
         """Outer radius of the finger [mm]."""

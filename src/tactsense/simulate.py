@@ -121,6 +121,11 @@ class Scenario:
 # ---- scenario builders ----------------------------------------------------------
 
 
+def _settle(settle_s: float) -> list[Step]:
+    """The untouched start of a scenario, from which a baseline is taken."""
+    return [Step((), settle_s, "baseline")] if settle_s > 0 else []
+
+
 def probe_sweep(
     spec: SensorSpec,
     *,
@@ -161,9 +166,7 @@ def probe_sweep(
     """
     if along not in ("axial", "around"):
         raise TactsenseInputError(f"along must be 'axial' or 'around'; got {along!r}")
-    rows, cols = spec.shape
-    if not (0 <= row < rows and 0 <= col < cols):
-        raise TactsenseInputError(f"tactel ({row}, {col}) is outside the {rows}x{cols} array")
+    spec.check_tactel(row, col)
     force_n = grams_force(50.0) if force_n is None else check_positive(force_n, "force_n")
     if along == "axial":
         increment = 0.6 if increment is None else increment
@@ -185,7 +188,7 @@ def probe_sweep(
     if stop < start:
         raise TactsenseInputError(f"stop ({stop}) must not be smaller than start ({start})")
     positions = np.arange(start, stop + 1e-9, increment)
-    steps = [Step((), settle_s, "baseline")] if settle_s > 0 else []
+    steps = _settle(settle_s)
     for position in positions:
         if along == "axial":
             probe = Probe(float(position), fixed_angle, force_n, contact_diameter_mm)
@@ -229,14 +232,12 @@ def repeated_load(
     settle_s: float = 1.0,
 ) -> Scenario:
     """A weight applied repeatedly above one tactel (Figs. 10-12: jitter and creep)."""
-    rows, cols = spec.shape
-    if not (0 <= row < rows and 0 <= col < cols):
-        raise TactsenseInputError(f"tactel ({row}, {col}) is outside the {rows}x{cols} array")
+    spec.check_tactel(row, col)
     force_n = grams_force(50.0) if force_n is None else check_positive(force_n, "force_n")
     if repeats < 1:
         raise TactsenseInputError(f"repeats must be at least 1; got {repeats}")
     probe = Probe(float(spec.row_axial_mm[row]), float(spec.col_angle_deg[col]), force_n)
-    steps = [Step((), settle_s, "baseline")] if settle_s > 0 else []
+    steps = _settle(settle_s)
     for k in range(repeats):
         steps += [Step((probe,), on_s, f"on {k}"), Step((), off_s, f"off {k}")]
     return Scenario(
@@ -269,7 +270,7 @@ def calibration_sweep(
     column; the probe is lifted for a second between columns.
     """
     force_n = grams_force(50.0) if force_n is None else check_positive(force_n, "force_n")
-    steps = [Step((), settle_s, "baseline")] if settle_s > 0 else []
+    steps = _settle(settle_s)
     positions = np.arange(0.0, spec.body.cylinder_length_mm + 1e-9, increment)
     for col, angle in enumerate(spec.col_angle_deg):
         steps += [
@@ -325,10 +326,11 @@ def knife_edge_sweep(
     settle_s: float = 1.0,
 ) -> Scenario:
     """Section 4.1: a knife edge across the finger stepped past one tactel (Fig. 16)."""
+    spec.check_tactel(row, col)
     centre = float(spec.row_axial_mm[row])
     angle = float(spec.col_angle_deg[col])
     positions = np.arange(centre - span_mm / 2, centre + span_mm / 2 + 1e-9, increment)
-    steps = [Step((), settle_s, "baseline")] if settle_s > 0 else []
+    steps = _settle(settle_s)
     for position in positions:
         steps.append(
             Step((knife_edge(float(position), angle, force_n),), dwell_s, f"axial={position:.4g}")
@@ -361,9 +363,10 @@ def load_series(
     settle_s: float = 1.0,
 ) -> Scenario:
     """Increasing weights on one cell (Fig. 6): each applied, held and removed."""
+    spec.check_tactel(row, col)
     forces = np.linspace(0.1, 1.0, 10) if forces_n is None else np.asarray(forces_n, float)
     probe = Probe(float(spec.row_axial_mm[row]), float(spec.col_angle_deg[col]), 1.0)
-    steps = [Step((), settle_s, "baseline")] if settle_s > 0 else []
+    steps = _settle(settle_s)
     for force in forces:
         steps += [
             Step((probe.moved(force_scale=float(force)),), on_s, f"{force:.4g} N"),
@@ -382,7 +385,7 @@ def static(contacts, duration_s: float = 1.0, *, settle_s: float = 1.0) -> Scena
     """Contacts held still after an untouched settle time."""
     if not isinstance(contacts, list | tuple):
         contacts = [contacts]
-    steps = [Step((), settle_s, "baseline")] if settle_s > 0 else []
+    steps = _settle(settle_s)
     steps.append(Step(tuple(contacts), duration_s, "hold"))
     return Scenario(tuple(steps), name="static", description=f"{len(contacts)} contact(s) held")
 
