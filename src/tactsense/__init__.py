@@ -6,6 +6,7 @@ described by :class:`tactsense.SensorSpec`; recordings are HDF5 files read
 and written by :mod:`tactsense.io`.
 """
 
+from tactsense._version import __version__
 from tactsense.estimate import Estimates, Flag, baseline_from, locate
 from tactsense.io.recording import Recording, read_recording, write_recording
 from tactsense.physics.array_response import tactel_deflection
@@ -39,8 +40,6 @@ from tactsense.simulate import (
     simulate,
     static,
 )
-
-__version__ = "0.1.0"
 
 __all__ = [
     "Estimates",

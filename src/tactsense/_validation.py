@@ -16,6 +16,10 @@ class TactsenseInputError(ValueError):
     """Raised when an input to a public tactsense function is malformed."""
 
 
+class CalibrationError(TactsenseInputError):
+    """Raised when a calibration cannot be built, loaded or applied."""
+
+
 def as_float_array(value, name: str, *, allow_nan: bool = False) -> np.ndarray:
     """Convert ``value`` to a float64 array and check that it is finite.
 

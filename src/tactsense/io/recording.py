@@ -25,6 +25,7 @@ import h5py
 import numpy as np
 
 from tactsense._validation import TactsenseInputError
+from tactsense._version import __version__
 from tactsense.sensor import SensorSpec, SensorSpecError
 
 FORMAT = "tactsense-recording"
@@ -132,8 +133,6 @@ def write_recording(path: str | Path, recording: Recording, *, overwrite: bool =
     new file is written next to it first and moved in place only when
     complete, so an interrupted write loses nothing.
     """
-    from tactsense import __version__
-
     path = Path(path)
     if path.exists() and not overwrite:
         raise FileExistsError(f"{path} exists; pass overwrite=True (--force) to replace it")

@@ -6,7 +6,9 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-from tactsense.reproduce.experiments import EXPERIMENTS, Claim, Context, Figure
+from tactsense._version import __version__
+from tactsense.reproduce._common import Claim, Context, Figure
+from tactsense.reproduce.registry import EXPERIMENTS
 from tactsense.reproduce.report import write_html, write_markdown, write_results
 from tactsense.sensor import SensorSpec, fearing1990_initial
 
@@ -52,8 +54,6 @@ def reproduce(
         experiment(ctx)
     if progress is not None:
         progress("report", len(EXPERIMENTS), len(EXPERIMENTS))
-    from tactsense import __version__
-
     meta = {
         "sensor": ctx.spec.name,
         "mode": "quick" if quick else "full",

@@ -7,7 +7,7 @@ import html
 import json
 from pathlib import Path
 
-from tactsense.reproduce.experiments import Claim, Figure
+from tactsense.reproduce._common import Claim, Figure
 
 
 def _format(value: float | None) -> str:

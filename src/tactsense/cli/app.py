@@ -1,0 +1,28 @@
+"""The ``tactsense`` command line, one module per group of commands.
+
+Each group (``model``, ``estimate``, ``design``, ``reproduce``) is a typer app of its own;
+this module mounts them. A new command is a function in its group's module.
+"""
+
+from __future__ import annotations
+
+import typer
+
+from tactsense.cli import design, estimate, model, reproduce
+
+app = typer.Typer(
+    no_args_is_help=True,
+    add_completion=False,
+    rich_markup_mode=None,
+    help="tactsense: digital twin and analysis of the capacitive tactile finger of Fearing (1990).",
+)
+app.add_typer(reproduce.app)
+app.add_typer(model.app)
+app.add_typer(estimate.app)
+app.add_typer(model.sensor_app, name="sensor")
+app.add_typer(design.app, name="design")
+
+
+def main() -> None:
+    """Entry point of the ``tactsense`` script."""
+    app()

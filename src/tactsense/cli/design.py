@@ -1,0 +1,241 @@
+"""``tactsense design``: the paper's design questions (section 5 and 6)."""
+
+from __future__ import annotations
+
+from enum import StrEnum
+from typing import Annotated
+
+import numpy as np
+import typer
+from rich.console import Console
+from rich.table import Table
+
+from tactsense._validation import TactsenseInputError
+from tactsense.cli._common import SensorOption, fail, new_group
+from tactsense.physics.contact import grams_force
+from tactsense.sensor import load_sensor
+
+app = new_group("Design questions: capacitor gain in the skin, aliasing, the Cramer-Rao bound.")
+
+
+@app.command("aliasing")
+def design_aliasing(
+    depth: Annotated[float, typer.Option(help="Sensor depth d below the surface, in mm.")] = 3.8,
+    spacing: Annotated[float, typer.Option(help="Sensor spacing b, in mm.")] = 3.8,
+    poisson: Annotated[
+        float,
+        typer.Option(
+            help="Poisson's ratio of the plane-stress model (the paper's fit: "
+            "0.4; the rubber: 0.5)."
+        ),
+    ] = 0.5,
+    as_json: Annotated[
+        bool, typer.Option("--json", help="Print the result as JSON instead of a table.")
+    ] = False,
+) -> None:
+    """How much a sensor depth and spacing alias (section 6, eq. 45, Fig. 20)."""
+    import json
+
+    from tactsense.analysis.aliasing import aliasing_summary
+
+    try:
+        summary = aliasing_summary(depth, spacing, poisson)
+    except (TactsenseInputError, ValueError) as error:
+        fail(str(error))
+    if as_json:
+        keys = {
+            "depth": "depth_mm",
+            "spacing": "spacing_mm",
+            "peak_frequency": "peak_frequency_per_mm",
+            "nyquist_frequency": "nyquist_frequency_per_mm",
+        }
+        typer.echo(json.dumps({keys.get(k, k): v for k, v in summary.items()}, indent=2))
+        return
+    table = Table(
+        title=f"Aliasing at depth {depth:g} mm, spacing {spacing:g} mm", show_header=False
+    )
+    table.add_row("xi, energy lost outside the band (eq. 45)", f"{summary['xi']:.4f}")
+    table.add_row("RMS amplitude error, sqrt(xi)", f"{summary['rms_amplitude_error']:.3f}")
+    table.add_row("peak of H(s)", f"{summary['peak_frequency']:.4f} cycles/mm")
+    table.add_row("H at the Nyquist frequency / H(0)", f"{summary['response_at_nyquist']:.3f}")
+    table.add_row(
+        "worst peak-position error, line load",
+        f"{summary['worst_position_error_tactel']:.3f} tactel",
+    )
+    table.add_row(
+        "worst peak-amplitude error, line load", f"{100 * summary['worst_amplitude_error']:.1f} %"
+    )
+    Console().print(table)
+
+
+@app.command("bound")
+def design_bound(
+    axial: Annotated[
+        float,
+        typer.Option(
+            help="Probe position along the finger, arc length from the "
+            "junction of tip and cylinder, in mm."
+        ),
+    ] = 12.5,
+    angle: Annotated[float, typer.Option(help="Probe angle around the finger, in deg.")] = 0.0,
+    force_g: Annotated[float, typer.Option(help="Probe load in grams-force.")] = 50.0,
+    diameter: Annotated[
+        float, typer.Option(help="Contact diameter of the hemispherical probe, in mm.")
+    ] = 3.0,
+    sensor: SensorOption = "initial",
+    as_json: Annotated[
+        bool, typer.Option("--json", help="Print the result as JSON instead of a table.")
+    ] = False,
+) -> None:
+    """Cramer-Rao lower bound on contact position and force at the sensor's reading noise."""
+    import json
+
+    from tactsense.analysis.bound import cramer_rao_bound, noise_variance
+
+    try:
+        spec = load_sensor(sensor)
+        bound = cramer_rao_bound(
+            spec, axial, angle, grams_force(force_g), contact_diameter_mm=diameter
+        )
+    except TactsenseInputError as error:
+        fail(str(error))
+    if as_json:
+        typer.echo(
+            json.dumps(
+                {
+                    "inputs": {
+                        "axial_mm": axial,
+                        "angle_deg": angle,
+                        "force_n": grams_force(force_g),
+                        "sensor": spec.name,
+                        "noise_counts": float(np.sqrt(noise_variance(spec))),
+                    },
+                    "bound": bound,
+                },
+                indent=2,
+            )
+        )
+        return
+    table = Table(
+        title=f"Cramer-Rao bound, {force_g:g} g at ({axial:g} mm, {angle:g} deg) on {spec.name}",
+        show_header=False,
+    )
+    table.add_row(
+        "reading noise",
+        f"{np.sqrt(noise_variance(spec)):.3f} counts RMS (read noise and quantization)",
+    )
+    table.add_row(
+        "along the finger", f"{1e3 * bound['axial_mm']:.1f} um ({bound['row_tactel']:.4f} tactel)"
+    )
+    table.add_row(
+        "around the finger",
+        f"{bound['angle_deg']:.3f} deg "
+        f"({bound['col_tactel']:.4f} tactel, {1e3 * bound['arc_mm']:.1f} um of arc)",
+    )
+    table.add_row(
+        "force", f"{1e3 * bound['force_n']:.2f} mN ({100 * bound['force_relative']:.2f} %)"
+    )
+    Console().print(table)
+
+
+class ElasticModel(StrEnum):
+    plane_stress = "plane_stress"
+    plane_strain = "plane_strain"
+
+
+@app.command("strip")
+def design_strip(
+    thickness: Annotated[
+        float,
+        typer.Option(
+            help="Depth of the bottom capacitor plate below the skin surface "
+            "(the skin thickness when the plate sits on the core), in mm."
+        ),
+    ] = 3.8,
+    separation: Annotated[
+        float,
+        typer.Option(
+            help="Nominal plate separation d_o, in mm; the top plate lies this "
+            "far above the bottom one."
+        ),
+    ] = 0.5,
+    load: Annotated[
+        float,
+        typer.Option(
+            help="Load per unit length of the finger slab, in N/m (the paper: "
+            "about 200 N/m for its calibration probe)."
+        ),
+    ] = 200.0,
+    width: Annotated[
+        float,
+        typer.Option(
+            help="Width of the parabolic contact pressure, in mm (the paper's probe: 3 mm)."
+        ),
+    ] = 3.0,
+    backing: Annotated[
+        float,
+        typer.Option(
+            help="Elastic layer between the bottom plate and the rigid core, "
+            "in mm (0: the plate sits on the core)."
+        ),
+    ] = 0.0,
+    modulus: Annotated[float, typer.Option(help="Young's modulus of the skin, in Pa.")] = 2.5e5,
+    poisson: Annotated[float, typer.Option(help="Poisson's ratio of the skin material.")] = 0.5,
+    model: Annotated[
+        ElasticModel,
+        typer.Option(
+            help="Two-dimensional elastic model; plane stress uses the "
+            "paper's substitution nu/(1+nu)."
+        ),
+    ] = ElasticModel.plane_stress,
+    as_json: Annotated[
+        bool, typer.Option("--json", help="Print the result as JSON (SI units) instead of a table.")
+    ] = False,
+) -> None:
+    """Capacitor gain of a plate pair in a skin bonded to the rigid core (section 5, Fig. 17)."""
+    import json
+
+    from tactsense.analysis import strip_capacitor_design
+
+    try:
+        result = strip_capacitor_design(
+            thickness * 1e-3,
+            separation * 1e-3,
+            load,
+            width * 1e-3,
+            backing=backing * 1e-3,
+            youngs_modulus=modulus,
+            poisson_ratio=poisson,
+            model=model.value,
+        )
+    except TactsenseInputError as error:
+        fail(str(error))
+    values = {key: float(value) for key, value in result.items()}
+    inputs = {
+        "thickness_m": thickness * 1e-3,
+        "separation_m": separation * 1e-3,
+        "line_load_n_per_m": load,
+        "width_m": width * 1e-3,
+        "backing_m": backing * 1e-3,
+        "youngs_modulus_pa": modulus,
+        "poisson_ratio": poisson,
+        "model": model.value,
+    }
+    if as_json:
+        output = {
+            "inputs": inputs,
+            "gain": values["gain"],
+            "top_plate_deflection_m": values["top_plate_deflection"],
+            "bottom_plate_deflection_m": values["bottom_plate_deflection"],
+            "surface_deflection_m": values["surface_deflection"],
+            "closing_m": values["closing"],
+        }
+        typer.echo(json.dumps(output, indent=2))
+        return
+    table = Table(title="Capacitor in an elastic strip on a rigid core", show_header=False)
+    table.add_row("gain dd/d_o (eq. 36)", f"{100 * values['gain']:.2f} %")
+    table.add_row("plate closing dd", f"{1e6 * values['closing']:.2f} um")
+    table.add_row("top plate deflection", f"{1e6 * values['top_plate_deflection']:.2f} um")
+    table.add_row("bottom plate deflection", f"{1e6 * values['bottom_plate_deflection']:.2f} um")
+    table.add_row("surface deflection", f"{1e6 * values['surface_deflection']:.2f} um")
+    Console().print(table)

@@ -1,0 +1,202 @@
+"""Commands that estimate from recordings: ``locate`` and ``calibrate``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import numpy as np
+import typer
+from rich.console import Console
+from rich.table import Table
+
+from tactsense._validation import TactsenseInputError
+from tactsense.cli._common import console, fail, new_group
+from tactsense.io.recording import read_recording
+
+app = new_group("Estimate contacts and calibrations from recordings.")
+
+
+@app.command()
+def locate(
+    recording: Annotated[Path, typer.Argument(help="HDF5 recording to analyse.")],
+    out: Annotated[
+        Path, typer.Option("--out", "-o", help="CSV file to write, one row per frame.")
+    ] = Path("estimates.csv"),
+    baseline_frames: Annotated[
+        int,
+        typer.Option(
+            help="Number of untouched frames at the start of the recording "
+            "whose median is the undeflected reading V_o of eq. 4."
+        ),
+    ] = 5,
+    threshold: Annotated[
+        float,
+        typer.Option(
+            help="Smallest tactel deflection that counts as a contact, as a "
+            "fraction (0.005 = 0.5 %, about 10 counts at 2000)."
+        ),
+    ] = 0.005,
+    calibration: Annotated[
+        Path | None,
+        typer.Option(
+            help="Calibration JSON from 'tactsense calibrate': its baseline, gains, "
+            "excluded tactels and creep model are applied."
+        ),
+    ] = None,
+    force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
+) -> None:
+    """Locate the contact in every frame: position, force, skew and quality flags to CSV."""
+    from tactsense.estimate import baseline_from, write_estimates_csv
+    from tactsense.estimate import locate as run_locate
+
+    try:
+        if out.exists() and not force:
+            fail(f"{out} exists; pass --force to replace it, or choose another name")
+        rec = read_recording(recording)
+        if calibration is not None:
+            from tactsense.estimate import Calibration
+
+            calibrated = Calibration.load(calibration, rec.sensor)
+            estimates = run_locate(
+                rec.frames,
+                rec.sensor,
+                calibration=calibrated,
+                frame_period_s=rec.sensor.scan_period_s,
+                threshold=threshold,
+            )
+        else:
+            baseline = baseline_from(rec.frames, baseline_frames)
+            estimates = run_locate(rec.frames, rec.sensor, baseline=baseline, threshold=threshold)
+        write_estimates_csv(out, estimates, rec.time_s, overwrite=force)
+    except (TactsenseInputError, FileExistsError) as error:
+        fail(str(error))
+    touched = int(np.count_nonzero(np.isfinite(estimates.row)))
+    console.print(f"wrote {out}: {len(estimates)} frames, {touched} with a contact")
+
+
+@app.command()
+def calibrate(
+    sweep: Annotated[
+        Path,
+        typer.Argument(
+            help="Recording of a probe swept along every column (section 3.1), "
+            "starting with untouched frames."
+        ),
+    ],
+    out: Annotated[
+        Path, typer.Option("--out", "-o", help="Calibration JSON file to write.")
+    ] = Path("calibration.json"),
+    probe_g: Annotated[
+        float,
+        typer.Option(
+            help="Load of the sweeping probe in grams-force, for the "
+            "sensitivity thresholds of Fig. 8."
+        ),
+    ] = 50.0,
+    baseline_frames: Annotated[
+        int, typer.Option(help="Untouched frames at the start of each recording.")
+    ] = 5,
+    steps: Annotated[
+        Path | None,
+        typer.Option(
+            help="Recording of force steps on one tactel (Fig. 12): fit and store the "
+            "creep model. Needs the recording's scenario (simulated) or clear on/off "
+            "steps, which are then detected."
+        ),
+    ] = None,
+    knife: Annotated[
+        Path | None,
+        typer.Option(
+            help="Recording of a knife edge stepped past one tactel (section 4.1): "
+            "fit and store depth and Poisson's ratio. Needs the recording's scenario "
+            "for the edge positions."
+        ),
+    ] = None,
+    row: Annotated[int, typer.Option(help="Row of the tactel under --steps and --knife.")] = 4,
+    col: Annotated[int, typer.Option(help="Column of the tactel under --steps and --knife.")] = 0,
+    force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
+) -> None:
+    """Build a calibration (gains, baseline, dead/weak/noisy tactels, creep, model fit)."""
+    from tactsense.estimate import calibrate as cal
+
+    try:
+        if out.exists() and not force:
+            fail(f"{out} exists; pass --force to replace it, or choose another name")
+        rec = read_recording(sweep)
+        calibration = cal.calibrate_sweep(
+            rec.frames, rec.sensor, baseline_frames=baseline_frames, probe_grams=probe_g
+        )
+        if steps is not None:
+            calibration.viscoelastic = _fit_steps(
+                read_recording(steps), rec.sensor, row, col, baseline_frames
+            )
+        if knife is not None:
+            calibration.model_fit = _fit_knife(
+                read_recording(knife), rec.sensor, row, col, baseline_frames
+            )
+        calibration.save(out, overwrite=force)
+    except (TactsenseInputError, FileExistsError) as error:
+        fail(str(error))
+    table = Table(title=f"wrote {out}", show_header=False)
+    gains = calibration.gains
+    table.add_row("gain spread (max/min)", f"{gains.max() / gains.min():.2f}")
+    finite = calibration.threshold_g[np.isfinite(calibration.threshold_g)]
+    table.add_row(
+        "threshold per A/D unit",
+        f"mean {finite.mean():.2f} g, {finite.min():.2f}-{finite.max():.2f} g",
+    )
+    table.add_row(
+        "dead / weak / noisy",
+        f"{calibration.dead.sum()} / {calibration.weak.sum()} / {calibration.noisy.sum()}",
+    )
+    if calibration.viscoelastic is not None:
+        v = calibration.viscoelastic
+        table.add_row(
+            "creep model",
+            f"delayed {v.delayed_fraction:.3f} x "
+            f"{1e3 * v.delayed_time_constant_s:.1f} ms, creep {v.creep_fraction:.3f} "
+            f"x {v.creep_time_constant_s:.1f} s",
+        )
+    if calibration.model_fit is not None:
+        m = calibration.model_fit
+        table.add_row(
+            "plane-stress fit",
+            f"depth {m.depth_mm:.2f} mm, nu {m.poisson_ratio:.3f}, "
+            f"RMS {m.rms_percent:.2f} % of full scale",
+        )
+    Console(stderr=True).print(table)
+
+
+def _deflection_of(rec, row, col, baseline_frames):
+    from tactsense.estimate import baseline_from
+    from tactsense.physics.transduction import fractional_deflection
+
+    rec.sensor.check_tactel(row, col)
+    base = baseline_from(rec.frames, baseline_frames)
+    return fractional_deflection(rec.frames.astype(float), base)[:, row, col]
+
+
+def _fit_steps(rec, sensor, row, col, baseline_frames):
+    from tactsense.estimate import calibrate as cal
+
+    if rec.sensor != sensor:
+        raise TactsenseInputError("the steps recording comes from another sensor than the sweep")
+    rec.sensor.check_tactel(row, col)
+    model, _, _ = cal.fit_viscoelastic_recording(rec, row, col, baseline_frames=baseline_frames)
+    return model
+
+
+def _fit_knife(rec, sensor, row, col, baseline_frames):
+    from tactsense.estimate import calibrate as cal
+
+    if rec.sensor != sensor:
+        raise TactsenseInputError("the knife recording comes from another sensor than the sweep")
+    if "step_axial_mm" not in rec.truth:
+        raise TactsenseInputError(
+            "the knife-edge fit needs the edge position of every step: this recording has no "
+            "scenario truth"
+        )
+    signal = _deflection_of(rec, row, col, baseline_frames)
+    last, steps = rec.last_loaded_frames(row, col)
+    return cal.fit_plane_stress(rec.truth["step_axial_mm"][steps], signal[last])

@@ -1,0 +1,86 @@
+"""``tactsense reproduce``: the main job."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.console import Console
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+from rich.table import Table
+
+from tactsense._validation import TactsenseInputError
+from tactsense.cli._common import SensorOption, console, fail, new_group
+from tactsense.sensor import load_sensor
+
+app = new_group("The paper's experiments on the twin.")
+
+
+@app.command()
+def reproduce(
+    out: Annotated[
+        Path,
+        typer.Option(
+            "--out",
+            "-o",
+            help="New directory for the figures, report.md, report.html and results.json.",
+        ),
+    ] = Path("paper-report"),
+    quick: Annotated[
+        bool,
+        typer.Option(
+            help="Fewer positions and repetitions: a reduced run for tests and a first look."
+        ),
+    ] = False,
+    sensor: SensorOption = "initial",
+    force: Annotated[
+        bool,
+        typer.Option(
+            "--force",
+            help="Write into OUT even if it exists (its report files "
+            "are replaced; nothing else in it is touched).",
+        ),
+    ] = False,
+) -> None:
+    """Run the paper's experiments on the digital twin and write the claims report."""
+    from tactsense.reproduce import reproduce as run_reproduce
+
+    try:
+        spec = load_sensor(sensor)
+        if out.exists() and not force:
+            fail(f"{out} exists; pass --force to write into it, or choose another directory")
+        with Progress(
+            TextColumn("{task.description:<36}"),
+            BarColumn(),
+            MofNCompleteColumn(),
+            TimeRemainingColumn(),
+            console=console,
+            disable=None,
+        ) as bar:
+            task = bar.add_task("experiments", total=None)
+
+            def update(name: str, done: int, total: int) -> None:
+                bar.update(task, description=name, completed=done, total=total)
+
+            result = run_reproduce(out, quick=quick, force=force, sensor=spec, progress=update)
+    except (TactsenseInputError, FileExistsError) as error:
+        fail(str(error))
+    claims = result["claims"].values()
+    agree = sum(claim.verdict == "agrees" for claim in claims)
+    table = Table(title=f"{len(result['figures'])} figures and {len(claims)} claims in {out}")
+    for column in ("claim", "paper", "tactsense", "unit", "verdict"):
+        table.add_column(column)
+    for claim in claims:
+        table.add_row(
+            claim.id,
+            "-" if claim.paper is None else f"{claim.paper:.4g}",
+            f"{claim.computed:.4g}",
+            claim.unit,
+            claim.verdict,
+        )
+    Console().print(table)
+    console.print(
+        f"{agree} of {len(claims)} claims agree; open {out / 'report.html'} for the "
+        "figures and the reasons behind each difference"
+    )

@@ -1,0 +1,193 @@
+"""Delayed elasticity and creep of the skin (section 3.4 of the paper, Fig. 12): fit the
+two-memory model to force steps on one tactel, and compensate frames with it."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import least_squares
+from scipy.signal import lfilter
+
+from tactsense._validation import CalibrationError
+
+
+@dataclass(frozen=True)
+class Viscoelastic:
+    """Delayed elasticity and creep: ``y = (1 - a_d) u + a_d m_d + a_c m_c`` (Fig. 12)."""
+
+    delayed_fraction: float
+    delayed_time_constant_s: float
+    creep_fraction: float
+    creep_time_constant_s: float
+
+
+def _memory_response(u, dt, model: Viscoelastic):
+    """Reading for an elastic input u sampled every dt (input held over each sample)."""
+    y = (1.0 - model.delayed_fraction) * u
+    for fraction, tau in (
+        (model.delayed_fraction, model.delayed_time_constant_s),
+        (model.creep_fraction, model.creep_time_constant_s),
+    ):
+        decay = np.exp(-dt / tau)
+        y = y + fraction * lfilter([1.0 - decay], [1.0, -decay], u, axis=0)
+    return y
+
+
+def fit_viscoelastic(signal, dt, loaded, *, fine: int = 16) -> tuple[Viscoelastic, float, float]:
+    """Fit delayed elasticity and creep to a tactel's response to force steps.
+
+    Parameters
+    ----------
+    signal : ndarray, shape (T,)
+        Fractional deflection of the tactel under the load, one sample per frame [-].
+    dt : float
+        Frame period [s].
+    loaded : ndarray of bool, shape (T,) or (T * fine,)
+        Whether the load was on, per frame or on a ``fine`` times denser clock
+        (from the recording's truth, or from contact detection).
+    fine : int
+        Sub-steps per frame on which the model is integrated.
+
+    Returns
+    -------
+    model : Viscoelastic
+    gain : float
+        Elastic deflection of the load [-].
+    rms : float
+        RMS residual as a share of the largest reading [-].
+    """
+    signal = np.asarray(signal, dtype=float)
+    loaded = np.asarray(loaded, dtype=bool)
+    n = signal.size
+    if n < 10 or not loaded.any() or loaded.all():
+        raise CalibrationError(
+            "a creep fit needs a recording with load steps on and off (at least 10 frames)"
+        )
+    if loaded.size == n:
+        loaded = np.repeat(loaded, fine)
+    elif loaded.size != n * fine:
+        raise CalibrationError(f"loaded has {loaded.size} samples; expected {n} or {n * fine}")
+    u = loaded.astype(float)
+
+    def model_output(p):
+        gain, a_d, log_tau_d, a_c, log_tau_c = p
+        model = Viscoelastic(a_d, np.exp(log_tau_d), a_c, np.exp(log_tau_c))
+        return gain * _memory_response(u, dt / fine, model)[fine - 1 :: fine]
+
+    start = [signal.max(), 0.3, np.log(0.05), 0.2, np.log(10.0)]
+    fit = least_squares(
+        lambda p: model_output(p) - signal,
+        start,
+        bounds=(
+            [0, 0, np.log(dt / fine), 0, np.log(0.5)],
+            [np.inf, 1, np.log(5.0), 10, np.log(1000.0)],
+        ),
+    )
+    gain, a_d, log_tau_d, a_c, log_tau_c = fit.x
+    rms = float(np.sqrt(np.mean(fit.fun**2)) / np.abs(signal).max())
+    return (
+        Viscoelastic(float(a_d), float(np.exp(log_tau_d)), float(a_c), float(np.exp(log_tau_c))),
+        float(gain),
+        rms,
+    )
+
+
+def load_schedule(frame_times, sample_offset: float, step_durations, step_loaded, fine: int = 16):
+    """Whether the load was on, on a clock ``fine`` times denser than the frames.
+
+    Sub-sample k of frame n ends at ``frame_times[n] + sample_offset - (fine - 1 - k) dt / fine``
+    so that the last sub-sample of each frame is the tactel's sampling instant.
+
+    Parameters
+    ----------
+    frame_times : ndarray, shape (T,)
+        Frame start times [s].
+    sample_offset : float
+        When the tactel is sampled within a frame [s].
+    step_durations : sequence of float
+        Durations of the recording's scenario steps [s].
+    step_loaded : sequence of bool
+        Whether each step loads the tactel.
+    """
+    times = np.asarray(frame_times, dtype=float)
+    if times.size < 2:
+        raise CalibrationError("a load schedule needs at least two frames")
+    dt = times[1] - times[0]
+    sub = (np.arange(fine) - (fine - 1)) * dt / fine
+    instants = (times[:, None] + sample_offset + sub[None, :]).ravel()
+    bounds = np.cumsum(np.r_[0.0, np.asarray(step_durations, dtype=float)])
+    index = np.clip(np.searchsorted(bounds, instants, side="right") - 1, 0, len(bounds) - 2)
+    return np.asarray(step_loaded, dtype=bool)[index]
+
+
+def fit_viscoelastic_recording(
+    recording, row: int = 4, col: int = 0, *, baseline_frames: int = 5, fine: int = 16
+):
+    """Fit the creep model to tactel (row, col) of a recording of force steps.
+
+    The load schedule comes from the recording's scenario when it has one
+    (simulated), else from the signal itself (on above half its largest value).
+
+    Parameters
+    ----------
+    recording : Recording
+        Anything with ``frames``, ``time_s``, ``sample_offset_s``, ``scenario`` and
+        ``sensor`` (a :class:`tactsense.io.Recording`).
+
+    Returns
+    -------
+    model, gain, rms : see :func:`fit_viscoelastic`
+    """
+    frames = np.asarray(recording.frames, dtype=float)
+    if frames.shape[0] <= baseline_frames:
+        raise CalibrationError("the steps recording is too short for its baseline")
+    baseline = np.median(frames[:baseline_frames], axis=0)
+    signal = (frames[:, row, col] - baseline[row, col]) / frames[:, row, col]
+    steps = recording.scenario.get("steps") if recording.scenario else None
+    if steps:
+        schedule = load_schedule(
+            recording.time_s,
+            recording.sample_offset_s[row, col],
+            [s["duration_s"] for s in steps],
+            [bool(s["contacts"]) for s in steps],
+            fine,
+        )
+    else:
+        schedule = signal > 0.5 * signal.max()
+    return fit_viscoelastic(signal, recording.sensor.scan_period_s, schedule, fine=fine)
+
+
+def compensate_viscoelastic(deflection, dt, model: Viscoelastic):
+    """Invert the creep model frame by frame: the elastic deflection from the readings.
+
+    With the input held over each frame, ``y[n] = c u[n] + a_d e_d m_d[n-1] +
+    a_c e_c m_c[n-1]`` with ``c = (1 - a_d) + a_d (1 - e_d) + a_c (1 - e_c)``, so
+    ``u[n]`` follows exactly from ``y[n]`` and the memories, which are then
+    updated. Causal: usable in a real-time loop.
+
+    Parameters
+    ----------
+    deflection : ndarray, shape (T, ...)
+        Readings over time (axis 0) [-].
+    dt : float
+        Frame period [s].
+
+    Returns
+    -------
+    ndarray, shape (T, ...)
+        Estimated elastic deflection [-].
+    """
+    y = np.asarray(deflection, dtype=float)
+    e_d = np.exp(-dt / model.delayed_time_constant_s)
+    e_c = np.exp(-dt / model.creep_time_constant_s)
+    a_d, a_c = model.delayed_fraction, model.creep_fraction
+    c = (1 - a_d) + a_d * (1 - e_d) + a_c * (1 - e_c)
+    m_d = np.zeros(y.shape[1:])
+    m_c = np.zeros(y.shape[1:])
+    u = np.empty_like(y)
+    for n in range(y.shape[0]):
+        u[n] = (y[n] - a_d * e_d * m_d - a_c * e_c * m_c) / c
+        m_d = e_d * m_d + (1 - e_d) * u[n]
+        m_c = e_c * m_c + (1 - e_c) * u[n]
+    return u

@@ -1,0 +1,116 @@
+"""What every experiment shares: the claim and figure records, the run context, and the
+finger calibration that several figures use."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+
+import tactsense as ts
+from tactsense.estimate import calibrate as cal
+from tactsense.physics.transduction import fractional_deflection
+
+G50 = ts.grams_force(50)
+MEASURED = ["gain_spread", "noise", "quantization", "jitter", "nonlinearity"]
+
+
+@dataclass
+class Claim:
+    """One quantitative statement of the paper against what the model computes."""
+
+    id: str
+    statement: str
+    paper: float | None
+    computed: float
+    unit: str
+    tolerance: float
+    """Relative difference within which the claim agrees (for 'within' claims: computed
+    may be up to paper * (1 + tolerance))."""
+    note: str
+    kind: str = "value"  # "value", "within" (paper is a bound), "qualitative"
+
+    @property
+    def relative_difference(self) -> float | None:
+        if self.paper in (None, 0):
+            return None
+        return (self.computed - self.paper) / abs(self.paper)
+
+    @property
+    def verdict(self) -> str:
+        if self.kind == "qualitative" or self.paper is None:
+            return "agrees" if self.tolerance >= abs(self.computed) else "differs"
+        if self.kind == "within":
+            return (
+                "agrees"
+                if abs(self.computed) <= abs(self.paper) * (1 + self.tolerance)
+                else ("differs")
+            )
+        return "agrees" if abs(self.relative_difference) <= self.tolerance else "differs"
+
+    def to_dict(self) -> dict:
+        return {
+            "statement": self.statement,
+            "paper": self.paper,
+            "computed": self.computed,
+            "unit": self.unit,
+            "relative_difference": self.relative_difference,
+            "verdict": self.verdict,
+            "note": self.note,
+        }
+
+
+@dataclass
+class Figure:
+    """One reproduced figure and its text."""
+
+    number: int
+    title: str
+    paper_did: str
+    simulated: str
+    came_out: str
+    path: Path
+
+
+@dataclass
+class Context:
+    out: Path
+    quick: bool
+    spec: ts.SensorSpec
+    figures: list[Figure] = field(default_factory=list)
+    claims: list[Claim] = field(default_factory=list)
+    cache: dict = field(default_factory=dict)
+
+    def n(self, full: int, quick: int) -> int:
+        return quick if self.quick else full
+
+    def save(
+        self, fig, number: int, title: str, paper_did: str, simulated: str, came_out: str
+    ) -> None:
+        path = self.out / f"fig{number:02d}.png"
+        fig.suptitle(f"Fig. {number}: {title}", fontsize=11)
+        fig.savefig(path, dpi=100)
+        plt.close(fig)
+        self.figures.append(Figure(number, title, paper_did, simulated, came_out, path))
+
+
+def recording_deflection(rec):
+    """Fractional deflection of a recording against the median of its first 5 frames."""
+    return fractional_deflection(rec.frames.astype(float), ts.baseline_from(rec.frames, 5))
+
+
+def calibration_of(ctx: Context):
+    """The finger's gain calibration from a section 3.1 sweep (shared by several figures)."""
+    if "calibration" not in ctx.cache:
+        spec = ctx.spec
+        increment = 0.6 if not ctx.quick else 1.2
+        sweep = ts.simulate(
+            spec, ts.calibration_sweep(spec, increment=increment), flaws=MEASURED, rng=11
+        )
+        ctx.cache["calibration"] = cal.calibrate_sweep(sweep.frames, spec)
+        ctx.cache["sweep"] = sweep
+    return ctx.cache["calibration"]
