@@ -158,13 +158,44 @@ def fit_viscoelastic_recording(
     return fit_viscoelastic(signal, recording.sensor.scan_period_s, schedule, fine=fine)
 
 
-def compensate_viscoelastic(deflection, dt, model: Viscoelastic):
-    """Invert the creep model frame by frame: the elastic deflection from the readings.
+class CreepCompensator:
+    """Causal creep compensation, one frame at a time (for a live stream).
 
     With the input held over each frame, ``y[n] = c u[n] + a_d e_d m_d[n-1] +
     a_c e_c m_c[n-1]`` with ``c = (1 - a_d) + a_d (1 - e_d) + a_c (1 - e_c)``, so
-    ``u[n]`` follows exactly from ``y[n]`` and the memories, which are then
-    updated. Causal: usable in a real-time loop.
+    ``u[n]`` follows exactly from ``y[n]`` and the memories, which are then updated.
+
+    Parameters
+    ----------
+    model : Viscoelastic
+    dt : float
+        Frame period [s].
+    shape : tuple of int
+        Shape of one frame.
+    """
+
+    def __init__(self, model: Viscoelastic, dt: float, shape: tuple[int, ...] = ()):
+        self._e_d = float(np.exp(-dt / model.delayed_time_constant_s))
+        self._e_c = float(np.exp(-dt / model.creep_time_constant_s))
+        self._a_d, self._a_c = model.delayed_fraction, model.creep_fraction
+        self._c = (1 - self._a_d) + self._a_d * (1 - self._e_d) + self._a_c * (1 - self._e_c)
+        self._m_d = np.zeros(shape)
+        self._m_c = np.zeros(shape)
+
+    def __call__(self, reading) -> np.ndarray:
+        """The elastic deflection of one frame of readings [-]."""
+        y = np.asarray(reading, dtype=float)
+        u = (y - self._a_d * self._e_d * self._m_d - self._a_c * self._e_c * self._m_c) / self._c
+        self._m_d = self._e_d * self._m_d + (1 - self._e_d) * u
+        self._m_c = self._e_c * self._m_c + (1 - self._e_c) * u
+        return u
+
+
+def compensate_viscoelastic(deflection, dt, model: Viscoelastic):
+    """Invert the creep model frame by frame: the elastic deflection from the readings.
+
+    Causal (:class:`CreepCompensator` applied to each frame in turn): usable in a
+    real-time loop.
 
     Parameters
     ----------
@@ -179,15 +210,8 @@ def compensate_viscoelastic(deflection, dt, model: Viscoelastic):
         Estimated elastic deflection [-].
     """
     y = np.asarray(deflection, dtype=float)
-    e_d = np.exp(-dt / model.delayed_time_constant_s)
-    e_c = np.exp(-dt / model.creep_time_constant_s)
-    a_d, a_c = model.delayed_fraction, model.creep_fraction
-    c = (1 - a_d) + a_d * (1 - e_d) + a_c * (1 - e_c)
-    m_d = np.zeros(y.shape[1:])
-    m_c = np.zeros(y.shape[1:])
+    compensate = CreepCompensator(model, dt, y.shape[1:])
     u = np.empty_like(y)
     for n in range(y.shape[0]):
-        u[n] = (y[n] - a_d * e_d * m_d - a_c * e_c * m_c) / c
-        m_d = e_d * m_d + (1 - e_d) * u[n]
-        m_c = e_c * m_c + (1 - e_c) * u[n]
+        u[n] = compensate(y[n])
     return u

@@ -1,14 +1,23 @@
 """Recordings: frames of A/D counts with their time stamps, sensor and scenario, in HDF5.
 
-Layout of a recording file (format ``tactsense-recording``, version 1)::
+Layout of a recording file (format ``tactsense-recording``, version 2)::
 
     /                    attrs: format, format_version, tactsense_version, created,
-                                sensor_toml, scenario_json, flaws, scan_rate_hz
+                                sensor_toml, scenario_json, flaws, scan_rate_hz,
+                                source (recorded streams: the URL)
     /frames              (T, rows, cols) counts       attrs: units = "counts"
     /time                (T,) frame start time        attrs: units = "s"
     /sample_offset       (rows, cols) sample instant within a frame, attrs: units = "s"
     /gains               (rows, cols) per-tactel gain used by the simulator (optional)
     /truth/...           what was applied, for simulated recordings (optional)
+    /sequence            (T,) uint16 sequence number on the wire (recorded streams, v2)
+    /host_time           (T,) arrival on the host, Unix time [s] (recorded streams, v2)
+    /losses              (K,) int64 loss counters, attrs: kinds = comma list (v2)
+
+Version 1 (no stream datasets) is still read. A recorded stream is written in HDF5's
+single-writer/multiple-reader mode and flushed at least once a second: a recorder killed
+mid-way leaves a file that :func:`read_recording` opens, holding every frame up to the
+last flush (``Recording.closed_cleanly`` is then False).
 
 Axis -2 of ``frames`` runs along the finger (row 0 under the tip), axis -1
 around it (``docs/nomenclature.md``).
@@ -18,6 +27,7 @@ from __future__ import annotations
 
 import datetime as _dt
 import json
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -29,7 +39,7 @@ from tactsense._version import __version__
 from tactsense.sensor import SensorSpec, SensorSpecError
 
 FORMAT = "tactsense-recording"
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
 
 
 class RecordingError(TactsenseInputError):
@@ -57,6 +67,17 @@ class Recording:
         Ground truth of a simulated recording; empty for a measured one.
     gains : ndarray, shape (rows, cols), optional
         Per-tactel gains used by the simulator.
+    sequence : ndarray of uint16, shape (T,), optional
+        Sequence number of each frame on the wire (recorded streams).
+    host_time_s : ndarray, shape (T,), optional
+        Arrival of each frame on the host, Unix time [s] (recorded streams).
+    losses : dict
+        Loss counters of the stream it was recorded from (``tactsense.stream``).
+    source : str
+        Where the frames came from (the stream's URL), empty for a simulation.
+    closed_cleanly : bool
+        False when the writer did not close the file (it was killed): the frames are
+        those up to its last flush.
     """
 
     frames: np.ndarray
@@ -67,6 +88,11 @@ class Recording:
     flaws: tuple[str, ...] = ()
     truth: dict = field(default_factory=dict)
     gains: np.ndarray | None = None
+    sequence: np.ndarray | None = None
+    host_time_s: np.ndarray | None = None
+    losses: dict = field(default_factory=dict)
+    source: str = ""
+    closed_cleanly: bool = True
 
     def __post_init__(self) -> None:
         frames = np.asarray(self.frames)
@@ -161,6 +187,15 @@ def write_recording(path: str | Path, recording: Recording, *, overwrite: bool =
         offset.attrs["units"] = "s"
         if recording.gains is not None:
             h5.create_dataset("gains", data=recording.gains).attrs["units"] = "1"
+        h5.attrs["source"] = recording.source
+        if recording.sequence is not None:
+            h5.create_dataset("sequence", data=np.asarray(recording.sequence, np.uint16))
+        if recording.host_time_s is not None:
+            host = h5.create_dataset("host_time", data=np.asarray(recording.host_time_s, float))
+            host.attrs["units"] = "s"
+        if recording.losses:
+            losses = h5.create_dataset("losses", data=np.array(list(recording.losses.values())))
+            losses.attrs["kinds"] = ",".join(recording.losses)
         if recording.truth:
             group = h5.create_group("truth")
             units = {"step_axial_mm": "mm", "step_angle_deg": "deg", "step_force_n": "N"}
@@ -185,17 +220,30 @@ def read_recording(path: str | Path) -> Recording:
     path = Path(path)
     if not path.exists():
         raise RecordingError(f"recording {path} does not exist")
+    closed_cleanly = True
     try:
         h5 = h5py.File(path, "r")
     except OSError as error:
-        raise RecordingError(f"{path} is not a readable HDF5 file ({error})") from None
+        if "already open for write" not in str(error):
+            raise RecordingError(f"{path} is not a readable HDF5 file ({error})") from None
+        # a recorder still writing, or killed: SWMR readers see everything flushed
+        closed_cleanly = False
+        try:
+            h5 = h5py.File(path, "r", swmr=True)
+        except OSError as again:
+            raise RecordingError(f"{path} is not a readable HDF5 file ({again})") from None
     with h5:
         if h5.attrs.get("format") != FORMAT:
             raise RecordingError(
                 f"{path} is not a tactsense recording (format attribute "
                 f"{h5.attrs.get('format')!r}, expected {FORMAT!r})"
             )
-        version = int(h5.attrs.get("format_version", -1))
+        try:
+            version = int(h5.attrs.get("format_version", -1))
+        except (TypeError, ValueError):
+            raise RecordingError(
+                f"{path}: format_version {h5.attrs.get('format_version')!r} is not a number"
+            ) from None
         if version > FORMAT_VERSION:
             raise RecordingError(
                 f"{path} has format version {version}; this tactsense reads up to "
@@ -208,7 +256,13 @@ def read_recording(path: str | Path) -> Recording:
             sensor = SensorSpec.from_toml_string(str(h5.attrs["sensor_toml"]))
         except (KeyError, SensorSpecError) as error:
             raise RecordingError(f"{path}: sensor description unreadable: {error}") from None
-        frames = h5["frames"][()]
+        per_frame = [
+            h5[name].shape[0]
+            for name in ("frames", "time", "sequence", "host_time")
+            if name in h5 and h5[name].ndim >= 1
+        ]
+        n = min(per_frame)  # a killed writer may have flushed one dataset further
+        frames = h5["frames"][:n]
         if frames.ndim != 3 or frames.shape[1:] != sensor.shape:
             raise RecordingError(
                 f"{path}: /frames has shape {frames.shape}; expected (T, {sensor.shape[0]}, "
@@ -224,13 +278,168 @@ def read_recording(path: str | Path) -> Recording:
         except json.JSONDecodeError as error:
             raise RecordingError(f"{path}: scenario metadata is not valid JSON ({error})") from None
         flaws = tuple(f for f in str(h5.attrs.get("flaws", "")).split(",") if f)
+        losses = {}
+        if "losses" in h5:
+            kinds = str(h5["losses"].attrs.get("kinds", "")).split(",")
+            losses = {k: int(v) for k, v in zip(kinds, h5["losses"][()], strict=False) if k}
         return Recording(
             frames=frames,
-            time_s=h5["time"][()],
+            time_s=h5["time"][:n],
             sample_offset_s=h5["sample_offset"][()],
             sensor=sensor,
             scenario=scenario,
             flaws=flaws,
             truth=truth,
             gains=h5["gains"][()] if "gains" in h5 else None,
+            sequence=h5["sequence"][:n] if "sequence" in h5 else None,
+            host_time_s=h5["host_time"][:n] if "host_time" in h5 else None,
+            losses=losses,
+            source=str(h5.attrs.get("source", "")),
+            closed_cleanly=closed_cleanly,
         )
+
+
+class RecordingWriter:
+    """Append frames to a new recording as they arrive; crash-safe.
+
+    The file is created at once at its final name, in HDF5's single-writer /
+    multiple-reader mode, with resizable chunked datasets; :meth:`append` buffers and
+    :meth:`flush` (called at least every ``flush_interval_s``) writes and flushes, so a
+    writer killed at any moment leaves a file holding every frame up to its last flush,
+    which :func:`read_recording` and ``tactsense info`` read. :meth:`close` ends it
+    cleanly. Use it as a context manager.
+
+    Parameters
+    ----------
+    path : path
+        The new recording; an existing file is refused unless ``overwrite``.
+    sensor : SensorSpec
+    sample_offset_s : array_like, shape (rows, cols)
+        When within a frame each tactel is sampled [s].
+    source : str
+        Where the frames come from (a stream's URL).
+    loss_kinds : sequence of str
+        Names of the loss counters kept with the recording.
+    flush_interval_s : float
+        Longest time between flushes [s].
+    """
+
+    def __init__(
+        self,
+        path: str | Path,
+        sensor: SensorSpec,
+        sample_offset_s,
+        *,
+        source: str = "",
+        loss_kinds=(),
+        overwrite: bool = False,
+        flush_interval_s: float = 1.0,
+        chunk_frames: int = 1024,
+    ):
+        path = Path(path)
+        if path.exists() and not overwrite:
+            raise FileExistsError(f"{path} exists; pass --force to replace it")
+        if np.shape(sample_offset_s) != sensor.shape:
+            raise RecordingError(
+                f"sample_offset_s has shape {np.shape(sample_offset_s)}; expected {sensor.shape}"
+            )
+        if not path.parent.is_dir():
+            raise RecordingError(f"folder {path.parent} does not exist")
+        self.path = path
+        self.sensor = sensor
+        self._clock = time.monotonic
+        self._interval = float(flush_interval_s)
+        self._last_flush = self._clock()
+        self._buffer: list[tuple] = []
+        self._count = 0
+        rows, cols = sensor.shape
+        h5 = h5py.File(path, "w", libver="latest")
+        try:
+            h5.attrs["format"] = FORMAT
+            h5.attrs["format_version"] = FORMAT_VERSION
+            h5.attrs["tactsense_version"] = __version__
+            h5.attrs["created"] = _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds")
+            h5.attrs["sensor_toml"] = sensor.to_toml_string()
+            h5.attrs["scenario_json"] = json.dumps({"description": f"recorded from {source}"})
+            h5.attrs["flaws"] = ""
+            h5.attrs["scan_rate_hz"] = sensor.electronics.scan_rate_hz
+            h5.attrs["source"] = source
+            chunk = max(1, int(chunk_frames))
+            self._frames = h5.create_dataset(
+                "frames",
+                (0, rows, cols),
+                np.uint16,
+                maxshape=(None, rows, cols),
+                chunks=(chunk, rows, cols),
+                compression="gzip",
+                compression_opts=1,
+            )
+            self._frames.attrs["units"] = "counts"
+            self._frames.attrs["axes"] = "time, row (along the finger, 0 = tip), col (around)"
+            self._time = h5.create_dataset("time", (0,), float, maxshape=(None,), chunks=(chunk,))
+            self._time.attrs["units"] = "s"
+            self._sequence = h5.create_dataset(
+                "sequence", (0,), np.uint16, maxshape=(None,), chunks=(chunk,)
+            )
+            self._host = h5.create_dataset(
+                "host_time", (0,), float, maxshape=(None,), chunks=(chunk,)
+            )
+            self._host.attrs["units"] = "s"
+            offset = h5.create_dataset("sample_offset", data=np.asarray(sample_offset_s, float))
+            offset.attrs["units"] = "s"
+            self._kinds = list(loss_kinds)
+            self._losses = h5.create_dataset(
+                "losses", data=np.zeros(max(len(self._kinds), 1), np.int64)
+            )
+            self._losses.attrs["kinds"] = ",".join(self._kinds)
+            h5.swmr_mode = True
+            h5.flush()
+        except BaseException:
+            h5.close()
+            path.unlink(missing_ok=True)
+            raise
+        self._h5 = h5
+
+    def __len__(self) -> int:
+        return self._count + len(self._buffer)
+
+    def append(self, counts, device_time_s: float, sequence: int, host_time_s: float) -> None:
+        """Add one frame; flushes when ``flush_interval_s`` has passed since the last."""
+        self._buffer.append((counts, device_time_s, sequence, host_time_s))
+        if self._clock() - self._last_flush >= self._interval:
+            self.flush()
+
+    def set_losses(self, counters: dict) -> None:
+        """Loss counters to store at the next flush."""
+        self._pending_losses = [int(counters.get(kind, 0)) for kind in self._kinds]
+
+    def flush(self) -> None:
+        """Write the buffered frames and the loss counters, and flush the file."""
+        if self._buffer:
+            n, k = self._count, len(self._buffer)
+            counts, times, seqs, hosts = zip(*self._buffer, strict=True)
+            for dataset in (self._frames, self._time, self._sequence, self._host):
+                dataset.resize(n + k, axis=0)
+            self._frames[n:] = np.stack(counts)
+            self._time[n:] = times
+            self._sequence[n:] = seqs
+            self._host[n:] = hosts
+            self._count += k
+            self._buffer.clear()
+        pending = getattr(self, "_pending_losses", None)
+        if pending:
+            self._losses[: len(pending)] = pending
+        self._h5.flush()
+        self._last_flush = self._clock()
+
+    def close(self) -> None:
+        """Flush and close the file (idempotent)."""
+        if self._h5.id.valid:
+            self.flush()
+            self._h5.close()
+
+    def __enter__(self) -> RecordingWriter:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()

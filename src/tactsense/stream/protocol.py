@@ -1,0 +1,232 @@
+"""The tactsense wire protocol, version 1: packets, their encoding and their decoding.
+
+Specified for firmware authors in ``docs/protocol.md``; this module is its reference
+implementation. In short: every packet is ``version | kind | body | CRC-32``, COBS-encoded
+(so it contains no zero byte) and followed by one zero byte, the delimiter. A reader that
+joins the line at any moment, or loses bytes, resynchronises at the next zero byte.
+
+Frame packet body (all little-endian)::
+
+    sequence     u16   frame counter, wraps from 65535 to 0
+    device_time  u64   start of the frame's scan on the device clock [us]
+    rows, cols   u8    shape of the array
+    counts       u16 x rows*cols, row-major (row 0 = tip row, axis -1 around the finger)
+
+The CRC is CRC-32/ISO-HDLC (the CRC of zlib, Ethernet and PNG: polynomial 0x04C11DB7,
+reflected, initial value and final XOR 0xFFFFFFFF) of every byte before it, stored
+little-endian. It is computed with :func:`zlib.crc32` and the framing with the ``cobs``
+package: no hand-written CRC or framing.
+"""
+
+from __future__ import annotations
+
+import json
+import struct
+import zlib
+from dataclasses import dataclass
+from enum import IntEnum
+
+import numpy as np
+from cobs import cobs
+
+VERSION = 1
+DELIMITER = b"\x00"
+
+_HEAD = struct.Struct("<BB")  # version, kind
+_FRAME = struct.Struct("<BBHQBB")  # version, kind, sequence, device time [us], rows, cols
+_CRC = struct.Struct("<I")
+_END = struct.Struct("<BBHI")  # version, kind, last sequence sent, frames sent (mod 2**32)
+
+SEQUENCE_MODULUS = 1 << 16
+
+
+class Kind(IntEnum):
+    """Packet kinds: device to host below 0x80, host to device from 0x80."""
+
+    FRAME = 0x01
+    """One scan of the array."""
+    IDENT = 0x02
+    """The device's identity: a UTF-8 JSON object (``docs/protocol.md``)."""
+    END = 0x03
+    """The device stopped streaming: the last sequence number sent and the frames sent."""
+    IDENTIFY = 0x81
+    """Host asks for an IDENT packet."""
+    START = 0x82
+    """Host asks the device to start streaming frames."""
+    STOP = 0x83
+    """Host asks the device to stop; the device answers with END."""
+
+
+class ProtocolError(ValueError):
+    """Raised when a packet cannot be decoded; ``reason`` names the kind of loss."""
+
+    def __init__(self, reason: str, message: str):
+        super().__init__(message)
+        self.reason = reason
+
+
+@dataclass(frozen=True)
+class FramePacket:
+    """A decoded frame: its counter, device time and counts."""
+
+    sequence: int
+    device_time_us: int
+    counts: np.ndarray
+    """(rows, cols) uint16 [counts]"""
+
+
+@dataclass(frozen=True)
+class EndPacket:
+    last_sequence: int
+    frames_sent: int
+
+
+@dataclass(frozen=True)
+class ControlPacket:
+    """IDENT (with its JSON body), IDENTIFY, START or STOP."""
+
+    kind: Kind
+    body: dict
+
+
+def frame_size(rows: int, cols: int) -> int:
+    """Bytes of a frame packet before COBS encoding (header, counts and CRC)."""
+    return _FRAME.size + 2 * rows * cols + _CRC.size
+
+
+def encoded_frame_size(rows: int, cols: int) -> int:
+    """Bytes of a frame on the wire: COBS adds one byte per 254 (at least one), plus the
+    delimiter."""
+    raw = frame_size(rows, cols)
+    return raw + raw // 254 + 1 + 1
+
+
+def _seal(packet: bytes) -> bytes:
+    return cobs.encode(packet + _CRC.pack(zlib.crc32(packet))) + DELIMITER
+
+
+def encode_frame(sequence: int, device_time_us: int, counts: np.ndarray) -> bytes:
+    """Encode one frame, delimiter included.
+
+    Parameters
+    ----------
+    sequence : int
+        Frame counter; taken modulo 65536.
+    device_time_us : int
+        Start of the frame's scan on the device clock [us].
+    counts : ndarray, shape (rows, cols)
+        A/D readings [counts], 0..65535.
+    """
+    counts = np.asarray(counts)
+    if counts.ndim != 2 or not (0 < counts.shape[0] < 256 and 0 < counts.shape[1] < 256):
+        raise ValueError(f"counts must be (rows, cols) with 1..255 each; got {counts.shape}")
+    rows, cols = counts.shape
+    head = _FRAME.pack(
+        VERSION, Kind.FRAME, sequence % SEQUENCE_MODULUS, int(device_time_us), rows, cols
+    )
+    return _seal(head + counts.astype("<u2", copy=False).tobytes())
+
+
+def encode_control(kind: Kind, body: dict | None = None) -> bytes:
+    """Encode an IDENT, IDENTIFY, START or STOP packet; IDENT carries a JSON body."""
+    payload = b"" if body is None else json.dumps(body, separators=(",", ":")).encode()
+    return _seal(_HEAD.pack(VERSION, kind) + payload)
+
+
+def encode_end(last_sequence: int, frames_sent: int) -> bytes:
+    """Encode the END packet a device sends when it stops streaming."""
+    return _seal(
+        _END.pack(VERSION, Kind.END, last_sequence % SEQUENCE_MODULUS, frames_sent % (1 << 32))
+    )
+
+
+def _looks_like_frame(raw: bytes) -> bool:
+    # COBS leaves the bytes before the first zero in place after the code byte: a frame
+    # starts with (code >= 3, version, FRAME).
+    return len(raw) >= 3 and raw[0] >= 3 and raw[1] == VERSION and raw[2] == Kind.FRAME
+
+
+def decode_packet(raw: bytes, expected_frame_bytes: int | None = None):
+    """Decode one packet (the bytes between two delimiters, without them).
+
+    Parameters
+    ----------
+    raw : bytes
+        COBS-encoded packet.
+    expected_frame_bytes : int, optional
+        Encoded length of a whole frame (without delimiter), to tell a truncated
+        frame from line noise.
+
+    Returns
+    -------
+    FramePacket, EndPacket or ControlPacket
+
+    Raises
+    ------
+    ProtocolError
+        ``reason`` is ``"truncated"`` (the start of a frame, cut short),
+        ``"bad_check"`` (a whole packet whose CRC fails) or ``"garbage"`` (bytes that
+        are no packet: noise, or the tail of a packet the reader joined mid-way).
+    """
+    framelike = _looks_like_frame(raw)
+    short = expected_frame_bytes is not None and len(raw) < expected_frame_bytes
+    try:
+        packet = cobs.decode(raw)
+    except cobs.DecodeError:
+        reason = "truncated" if framelike and short else "garbage"
+        raise ProtocolError(reason, f"not a COBS packet ({len(raw)} bytes)") from None
+    if len(packet) < _HEAD.size + _CRC.size or packet[0] != VERSION:
+        reason = "truncated" if framelike else "garbage"
+        raise ProtocolError(reason, f"no version-{VERSION} packet ({len(packet)} bytes)")
+    body, (crc,) = packet[: -_CRC.size], _CRC.unpack_from(packet, len(packet) - _CRC.size)
+    if zlib.crc32(body) != crc:
+        reason = "truncated" if framelike and short else "bad_check"
+        raise ProtocolError(reason, "CRC-32 mismatch")
+    kind = body[1]
+    if kind == Kind.FRAME:
+        if len(body) < _FRAME.size:
+            raise ProtocolError("truncated", "frame header cut short")
+        _, _, sequence, device_time, rows, cols = _FRAME.unpack_from(body)
+        if len(body) != _FRAME.size + 2 * rows * cols:
+            raise ProtocolError(
+                "bad_check", f"frame of {rows}x{cols} tactels has {len(body)} bytes"
+            )
+        counts = np.frombuffer(body, dtype="<u2", offset=_FRAME.size).reshape(rows, cols)
+        return FramePacket(sequence, device_time, counts)
+    if kind == Kind.END and len(body) == _END.size:
+        _, _, last, sent = _END.unpack(body)
+        return EndPacket(last, sent)
+    if kind in (Kind.IDENT, Kind.IDENTIFY, Kind.START, Kind.STOP):
+        text = body[_HEAD.size :]
+        try:
+            data = json.loads(text) if text else {}
+        except (UnicodeDecodeError, json.JSONDecodeError):
+            raise ProtocolError("bad_check", "control packet body is not JSON") from None
+        return ControlPacket(Kind(kind), data if isinstance(data, dict) else {})
+    raise ProtocolError("garbage", f"unknown packet kind 0x{kind:02x}")
+
+
+class PacketSplitter:
+    """Cut a byte stream into packets at the delimiters; keeps the unfinished tail."""
+
+    def __init__(self, max_packet: int = 1 << 20):
+        self._tail = b""
+        self._max = max_packet
+        self.overflow_bytes = 0
+        """Bytes dropped because no delimiter came within ``max_packet`` bytes."""
+
+    def feed(self, data: bytes) -> list[bytes]:
+        """Packets completed by ``data`` (empty ones, from repeated delimiters, skipped)."""
+        if not data:
+            return []
+        parts = (self._tail + data).split(DELIMITER)
+        self._tail = parts.pop()
+        if len(self._tail) > self._max:
+            self.overflow_bytes += len(self._tail)
+            self._tail = b""
+        return [part for part in parts if part]
+
+    @property
+    def pending(self) -> int:
+        """Bytes received since the last delimiter."""
+        return len(self._tail)

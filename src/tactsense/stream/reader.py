@@ -1,0 +1,347 @@
+"""Read frames from a tactile device speaking the tactsense protocol, over any pyserial URL.
+
+Every frame that does not arrive is counted: by the kind of damage seen on the line
+(bad check, truncated, garbage), and in total from the gaps in the sequence counter
+(and, when the device ends the stream, from its END packet). ``received + lost`` is
+the number of frames the device sent.
+"""
+
+from __future__ import annotations
+
+import select
+import time
+from collections import deque
+from collections.abc import Iterator
+from dataclasses import asdict, dataclass
+
+import numpy as np
+import serial
+
+from tactsense._validation import TactsenseInputError
+from tactsense.sensor import SensorSpec, SensorSpecError
+from tactsense.stream.protocol import (
+    SEQUENCE_MODULUS,
+    ControlPacket,
+    EndPacket,
+    FramePacket,
+    Kind,
+    PacketSplitter,
+    ProtocolError,
+    decode_packet,
+    encode_control,
+    encoded_frame_size,
+)
+
+LOSS_KINDS = ("lost", "gaps", "bad_check", "truncated", "garbage", "timeouts", "duplicates")
+"""Counters of :class:`LossCounters` written with a recording, in this order."""
+
+
+class StreamError(TactsenseInputError):
+    """Raised when a stream cannot be opened or does not speak the protocol."""
+
+
+@dataclass
+class LossCounters:
+    """What the reader received and what it lost, by kind."""
+
+    frames: int = 0
+    """Frames received intact."""
+    lost: int = 0
+    """Frames missing from the sequence (every gap, and the tail reported by END)."""
+    gaps: int = 0
+    """Breaks in the sequence (one gap may lose many frames)."""
+    bad_check: int = 0
+    """Whole packets whose CRC-32 failed."""
+    truncated: int = 0
+    """Frames cut short before their delimiter."""
+    garbage: int = 0
+    """Runs of bytes between delimiters that were no packet: the reader resynchronised."""
+    garbage_bytes: int = 0
+    timeouts: int = 0
+    """Intervals of ``timeout_s`` with no frame."""
+    duplicates: int = 0
+    """Frames whose sequence number was not newer than the last one (dropped)."""
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+    def summary(self) -> str:
+        """One line for a terminal: every counter that is not zero."""
+        parts = [f"{self.frames} frames"]
+        for kind in LOSS_KINDS:
+            value = getattr(self, kind)
+            if value:
+                parts.append(f"{kind.replace('_', ' ')} {value}")
+        return ", ".join(parts)
+
+
+@dataclass(frozen=True)
+class StreamFrame:
+    """One frame as it arrived."""
+
+    sequence: int
+    """Sequence number on the wire (wraps at 65536)."""
+    index: int
+    """Frames the device sent before this one since the first frame received (unwrapped)."""
+    device_time_s: float
+    """Start of the frame's scan on the device clock [s]."""
+    host_time_s: float
+    """Arrival of the frame's last byte on the host's wall clock, Unix time [s]."""
+    arrival: float
+    """Arrival on :func:`time.perf_counter` [s], for latency measurements."""
+    counts: np.ndarray
+    """(rows, cols) readings [counts]."""
+
+
+def open_port(url: str, *, baudrate: int = 921600) -> serial.SerialBase:
+    """Open a pyserial port (device path, pty path, ``socket://HOST:PORT``, ``loop://``)."""
+    try:
+        return serial.serial_for_url(url, baudrate=baudrate, timeout=0)
+    except (serial.SerialException, ValueError, OSError) as error:
+        raise StreamError(f"cannot open {url}: {error}") from None
+
+
+class StreamReader:
+    """Frames from one device, with their losses counted.
+
+    Parameters
+    ----------
+    url : str
+        Any pyserial URL: ``/dev/ttyUSB0``, a pty path, ``socket://127.0.0.1:PORT``,
+        ``loop://``; or an open pyserial port.
+    sensor : SensorSpec, optional
+        The finger on the line. Default: ask the device (IDENTIFY) and use the sensor
+        description it returns.
+    timeout_s : float, optional
+        A frame later than this after the previous one counts as a timeout [s].
+        Default: 3 frame periods plus 50 ms.
+    start : bool
+        Send START once open (a device streams only after START).
+    identify_timeout_s : float
+        How long to wait for the device's IDENT answer [s].
+
+    Examples
+    --------
+    >>> with StreamReader("socket://127.0.0.1:5000") as stream:   # doctest: +SKIP
+    ...     for frame in stream.frames(max_frames=100):
+    ...         print(frame.sequence, frame.counts.max())
+    ...     print(stream.stats.summary())
+    """
+
+    def __init__(
+        self,
+        url,
+        *,
+        sensor: SensorSpec | None = None,
+        timeout_s: float | None = None,
+        start: bool = True,
+        identify_timeout_s: float = 3.0,
+    ):
+        self.url = url if isinstance(url, str) else getattr(url, "port", repr(url))
+        self.port = open_port(url) if isinstance(url, str) else url
+        self.stats = LossCounters()
+        self.identity: dict = {}
+        self.ended = False
+        self.frames_sent: int | None = None
+        self._splitter = PacketSplitter()
+        self._ready: deque[StreamFrame] = deque()
+        self._last_seq: int | None = None
+        self._last_time_us = 0
+        self._index = -1
+        self._fileno = self._fileno_of(self.port)
+        try:
+            if sensor is None:
+                sensor = self._identify(identify_timeout_s)
+            self.sensor = sensor
+            rows, cols = sensor.shape
+            self._frame_bytes = encoded_frame_size(rows, cols) - 1
+            rate = float(self.identity.get("frame_rate_hz") or sensor.electronics.scan_rate_hz)
+            self.frame_period_s = 1.0 / rate if rate > 0 else 0.0
+            self.timeout_s = (
+                float(timeout_s) if timeout_s is not None else 3 * self.frame_period_s + 0.05
+            )
+            if not self.timeout_s > 0:
+                raise StreamError(f"timeout_s must be positive; got {timeout_s!r}")
+            if start:
+                self.port.write(encode_control(Kind.START))
+        except BaseException:
+            self.port.close()
+            raise
+
+    @staticmethod
+    def _fileno_of(port) -> int | None:
+        try:
+            return port.fileno()
+        except (AttributeError, OSError, serial.SerialException):
+            return None
+
+    # ---- receiving ---------------------------------------------------------------
+
+    def _receive(self, wait_s: float) -> bytes:
+        """Bytes that arrived, waiting up to ``wait_s`` for the first."""
+        if self._fileno is not None:
+            ready, _, _ = select.select([self._fileno], [], [], max(wait_s, 0.0))
+            if not ready:
+                return b""
+            data = self.port.read(1 << 16)
+            if not data:
+                raise StreamError(f"{self.url}: the device closed the line")
+            return data
+        deadline = time.perf_counter() + wait_s
+        while True:  # ports without a file descriptor (loop://): poll
+            waiting = self.port.in_waiting
+            if waiting:
+                return self.port.read(waiting)
+            if time.perf_counter() >= deadline:
+                return b""
+            time.sleep(0.0005)
+
+    def _pump(self, wait_s: float) -> bool:
+        """Receive and decode what arrives within ``wait_s``; True if anything came."""
+        try:
+            data = self._receive(wait_s)
+        except (serial.SerialException, OSError) as error:
+            raise StreamError(f"{self.url}: {error}") from None
+        if not data:
+            return False
+        host_time, arrival = time.time(), time.perf_counter()
+        for raw in self._splitter.feed(data):
+            self._handle(raw, host_time, arrival)
+        return True
+
+    def _handle(self, raw: bytes, host_time: float, arrival: float) -> None:
+        try:
+            packet = decode_packet(raw, getattr(self, "_frame_bytes", None))
+        except ProtocolError as error:
+            setattr(self.stats, error.reason, getattr(self.stats, error.reason) + 1)
+            if error.reason == "garbage":
+                self.stats.garbage_bytes += len(raw)
+            return
+        if isinstance(packet, FramePacket):
+            self._accept(packet, host_time, arrival)
+        elif isinstance(packet, EndPacket):
+            if self._last_seq is not None:
+                tail = (packet.last_sequence - self._last_seq) % SEQUENCE_MODULUS
+                if tail:
+                    self.stats.lost += tail
+                    self.stats.gaps += 1
+            self.frames_sent = packet.frames_sent
+            self.ended = True
+        elif isinstance(packet, ControlPacket) and packet.kind == Kind.IDENT:
+            self.identity = packet.body
+
+    def _accept(self, packet: FramePacket, host_time: float, arrival: float) -> None:
+        if hasattr(self, "sensor") and packet.counts.shape != self.sensor.shape:
+            self.stats.bad_check += 1
+            return
+        if self._last_seq is None:
+            step = 1
+        elif packet.device_time_us <= self._last_time_us:
+            self.stats.duplicates += 1  # the device clock only moves forward
+            return
+        else:
+            step = (packet.sequence - self._last_seq) % SEQUENCE_MODULUS
+            if self.frame_period_s > 0:
+                # the device clock tells how many times the counter wrapped in a long gap
+                elapsed = (packet.device_time_us - self._last_time_us) * 1e-6
+                wraps = round((elapsed / self.frame_period_s - step) / SEQUENCE_MODULUS)
+                step += SEQUENCE_MODULUS * max(wraps, 0)
+            if step == 0:
+                self.stats.duplicates += 1
+                return
+            if step > 1:
+                self.stats.lost += step - 1
+                self.stats.gaps += 1
+        self._last_seq = packet.sequence
+        self._last_time_us = packet.device_time_us
+        self._index += step
+        self.stats.frames += 1
+        self._ready.append(
+            StreamFrame(
+                packet.sequence,
+                self._index,
+                packet.device_time_us * 1e-6,
+                host_time,
+                arrival,
+                packet.counts,
+            )
+        )
+
+    def _identify(self, timeout_s: float) -> SensorSpec:
+        self.port.write(encode_control(Kind.IDENTIFY))
+        deadline = time.perf_counter() + timeout_s
+        while not self.identity and time.perf_counter() < deadline:
+            self._pump(min(0.05, timeout_s))
+        if not self.identity:
+            raise StreamError(
+                f"{self.url}: no answer to IDENTIFY within {timeout_s:g} s; is a device "
+                "speaking the tactsense protocol on this line? (pass a sensor to skip IDENTIFY)"
+            )
+        try:
+            sensor = SensorSpec.from_toml_string(str(self.identity.get("sensor_toml", "")))
+        except SensorSpecError as error:
+            raise StreamError(f"{self.url}: the device's sensor description: {error}") from None
+        self._ready.clear()  # frames before START belong to nobody's run
+        self._last_seq = None
+        self._index = -1
+        self.stats = LossCounters()
+        return sensor
+
+    # ---- the public iteration ----------------------------------------------------
+
+    def frames(
+        self, *, max_frames: int | None = None, duration_s: float | None = None
+    ) -> Iterator[StreamFrame]:
+        """Yield frames as they arrive, until ``max_frames``, ``duration_s`` or END."""
+        deadline = None if duration_s is None else time.perf_counter() + duration_s
+        delivered = 0
+        last_frame = time.perf_counter()
+        while max_frames is None or delivered < max_frames:
+            while self._ready and (max_frames is None or delivered < max_frames):
+                yield self._ready.popleft()
+                delivered += 1
+                last_frame = time.perf_counter()
+            if max_frames is not None and delivered >= max_frames:
+                return
+            if self.ended and not self._ready:
+                return
+            now = time.perf_counter()
+            if deadline is not None and now >= deadline:
+                return
+            wait = self.timeout_s - (now - last_frame)
+            if deadline is not None:
+                wait = min(wait, deadline - now)
+            if wait <= 0:
+                self.stats.timeouts += 1
+                last_frame = now
+                continue
+            self._pump(wait)
+
+    __iter__ = frames
+
+    def read_batch(self, max_frames: int, wait_s: float = 0.1) -> list[StreamFrame]:
+        """Up to ``max_frames`` frames that have arrived, waiting up to ``wait_s`` for one."""
+        if not self._ready:
+            self._pump(wait_s)
+        while self._pump(0.0) and len(self._ready) < max_frames:
+            pass
+        return [self._ready.popleft() for _ in range(min(max_frames, len(self._ready)))]
+
+    def stop(self, wait_s: float = 1.0) -> None:
+        """Ask the device to stop and account for the frames it sent before END."""
+        try:
+            self.port.write(encode_control(Kind.STOP))
+        except (serial.SerialException, OSError):
+            return
+        deadline = time.perf_counter() + wait_s
+        while not self.ended and time.perf_counter() < deadline:
+            self._pump(min(0.05, wait_s))
+
+    def close(self) -> None:
+        self.port.close()
+
+    def __enter__(self) -> StreamReader:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
