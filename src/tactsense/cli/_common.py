@@ -3,6 +3,9 @@ an error into a one-line message and an exit code."""
 
 from __future__ import annotations
 
+import os
+from contextlib import contextmanager
+from pathlib import Path
 from typing import Annotated, NoReturn
 
 import typer
@@ -30,3 +33,37 @@ def fail(message: str) -> NoReturn:
     """Print ``error: message`` and leave with exit status 2 (bad input)."""
     console.print(f"[bold red]error:[/] {message}")
     raise typer.Exit(code=2)
+
+
+def check_output(path: Path, force: bool, *, what: str = "output") -> Path:
+    """Refuse an output path that cannot be written, before any work starts.
+
+    The rule for every command: the parent folder must exist (it is never created, so a
+    typo does not scatter folders), an existing directory is never an output file, and
+    an existing file is replaced only with ``--force``.
+    """
+    path = Path(path)
+    parent = path.parent if str(path.parent) else Path(".")
+    if path.is_dir():
+        fail(f"{what} {path} is a directory; expected a file name")
+    if not parent.is_dir():
+        fail(f"folder {parent} of {what} {path} does not exist; create it first")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        fail(f"cannot write {what} {path}: folder {parent} is not writable")
+    if path.exists() and not force:
+        fail(f"{path} exists; pass --force to replace it, or choose another name")
+    return path
+
+
+@contextmanager
+def atomic_output(path: Path):
+    """Yield a temporary name beside ``path``; move it into place only if the block ends
+    without an exception (Ctrl-C included), else remove it."""
+    path = Path(path)
+    temporary = path.with_name(f".{path.name}.{os.getpid()}.partial")
+    try:
+        yield temporary
+    except BaseException:
+        temporary.unlink(missing_ok=True)
+        raise
+    os.replace(temporary, path)

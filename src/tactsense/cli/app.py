@@ -1,6 +1,6 @@
 """The ``tactsense`` command line, one module per group of commands.
 
-Each group (``model``, ``estimate``, ``design``, ``reproduce``) is a typer app of its own;
+Each group (``model``, ``estimate``, ``live``, ``design``, ``reproduce``) is a typer app of its own;
 this module mounts them. A new command is a function in its group's module.
 """
 
@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import typer
 
-from tactsense.cli import design, estimate, model, reproduce
+from tactsense.cli import design, estimate, live, model, reproduce
 
 app = typer.Typer(
     no_args_is_help=True,
@@ -19,6 +19,7 @@ app = typer.Typer(
 app.add_typer(reproduce.app)
 app.add_typer(model.app)
 app.add_typer(estimate.app)
+app.add_typer(live.app)
 app.add_typer(model.sensor_app, name="sensor")
 app.add_typer(design.app, name="design")
 

@@ -130,6 +130,7 @@ class Emulator:
         self.log = FaultLog()
         self._rng = np.random.default_rng(rng)
         self._next = 0
+        self._start = 0
         self._stop = threading.Event()
         self._lock = threading.Lock()
 
@@ -164,7 +165,11 @@ class Emulator:
 
     @property
     def exhausted(self) -> bool:
-        return not self.repeat and self._next >= len(self.frames)
+        return not self.repeat and self._next - self._start >= len(self.frames)
+
+    def rewind(self) -> None:
+        """Start the frames over at the next frame; sequence and device clock run on."""
+        self._start = self._next
 
     def next_packet(self) -> tuple[bytes, float]:
         """The next frame's bytes on the wire (faults applied) and the stall before it [s].
@@ -175,7 +180,7 @@ class Emulator:
             raise StopIteration
         k = self._next
         self._next += 1
-        counts = self.frames[k % len(self.frames)]
+        counts = self.frames[(k - self._start) % len(self.frames)]
         wire = encode_frame(k, round(k * self.scan_period_s * 1e6), counts)
         rates, rng, log = self.faults, self._rng, self.log
         log.frames += 1
@@ -264,6 +269,8 @@ class Emulator:
                     if packet.kind == Kind.IDENTIFY:
                         write(encode_control(Kind.IDENT, self.identity()))
                     elif packet.kind == Kind.START:
+                        if not streaming:
+                            self.rewind()  # each host's run starts at the first frame
                         streaming, due = True, time.perf_counter()
                         if self.exhausted:
                             write(self.end_packet())

@@ -75,6 +75,10 @@ class LiveLocator:
         self._collected: list[np.ndarray] = []
         self._locator: RealTimeLocator | None = None
         self._creep = None
+        # compile (or load from Numba's cache) now, not while frames queue up
+        RealTimeLocator(sensor, np.full(sensor.shape, 1000.0), threshold=threshold)
+        if calibration is not None:
+            locate(np.full((1, *sensor.shape), 0.05), sensor, counts=False)
         if calibration is not None:
             calibration.check_sensor(sensor)
             if calibration.viscoelastic is not None:
@@ -114,7 +118,7 @@ class LiveLocator:
             "axial_mm": axial,
             "angle_deg": angle,
             "force_n": force,
-            "force_g": newtons_to_grams(force),
+            "force_g": float(newtons_to_grams(force)),
             "skew": skew,
             "peak_deflection": peak,
             "flags": int(flags),

@@ -116,7 +116,8 @@ class StreamReader:
         A frame later than this after the previous one counts as a timeout [s].
         Default: 3 frame periods plus 50 ms.
     start : bool
-        Send START once open (a device streams only after START).
+        Send START once open (a device streams only after START); pass False to
+        prepare first (e.g. compile an estimator) and call :meth:`start` after.
     identify_timeout_s : float
         How long to wait for the device's IDENT answer [s].
 
@@ -149,6 +150,8 @@ class StreamReader:
         self._last_time_us = 0
         self._index = -1
         self._fileno = self._fileno_of(self.port)
+        self.frame_period_s = 0.0
+        self._scan_period_s = 0.0
         try:
             if sensor is None:
                 sensor = self._identify(identify_timeout_s)
@@ -157,13 +160,14 @@ class StreamReader:
             self._frame_bytes = encoded_frame_size(rows, cols) - 1
             rate = float(self.identity.get("frame_rate_hz") or sensor.electronics.scan_rate_hz)
             self.frame_period_s = 1.0 / rate if rate > 0 else 0.0
+            self._scan_period_s = sensor.scan_period_s
             self.timeout_s = (
                 float(timeout_s) if timeout_s is not None else 3 * self.frame_period_s + 0.05
             )
             if not self.timeout_s > 0:
                 raise StreamError(f"timeout_s must be positive; got {timeout_s!r}")
             if start:
-                self.port.write(encode_control(Kind.START))
+                self.start()
         except BaseException:
             self.port.close()
             raise
@@ -241,10 +245,11 @@ class StreamReader:
             return
         else:
             step = (packet.sequence - self._last_seq) % SEQUENCE_MODULUS
-            if self.frame_period_s > 0:
-                # the device clock tells how many times the counter wrapped in a long gap
+            if self._scan_period_s > 0:
+                # the device clock (one scan period per frame) tells how many times the
+                # counter wrapped in a long gap
                 elapsed = (packet.device_time_us - self._last_time_us) * 1e-6
-                wraps = round((elapsed / self.frame_period_s - step) / SEQUENCE_MODULUS)
+                wraps = round((elapsed / self._scan_period_s - step) / SEQUENCE_MODULUS)
                 step += SEQUENCE_MODULUS * max(wraps, 0)
             if step == 0:
                 self.stats.duplicates += 1
@@ -327,6 +332,13 @@ class StreamReader:
             pass
         return [self._ready.popleft() for _ in range(min(max_frames, len(self._ready)))]
 
+    def start(self) -> None:
+        """Ask the device to stream (sent by the constructor unless ``start=False``)."""
+        try:
+            self.port.write(encode_control(Kind.START))
+        except (serial.SerialException, OSError) as error:
+            raise StreamError(f"{self.url}: cannot send START: {error}") from None
+
     def stop(self, wait_s: float = 1.0) -> None:
         """Ask the device to stop and account for the frames it sent before END."""
         try:
@@ -338,7 +350,15 @@ class StreamReader:
             self._pump(min(0.05, wait_s))
 
     def close(self) -> None:
-        self.port.close()
+        """Tell the device to stop streaming (if it still is) and close the line."""
+        if self.port.is_open:
+            if not self.ended:
+                try:
+                    self.port.write(encode_control(Kind.STOP))
+                    self.port.flush()
+                except (serial.SerialException, OSError):
+                    pass
+            self.port.close()
 
     def __enter__(self) -> StreamReader:
         return self

@@ -1,0 +1,379 @@
+"""The live system on the command line: ``emulate``, ``record`` and ``live``."""
+
+from __future__ import annotations
+
+import csv
+import json
+import sys
+from enum import StrEnum
+from pathlib import Path
+from typing import Annotated
+
+import numpy as np
+import typer
+from rich.progress import Progress, TextColumn
+
+from tactsense._validation import TactsenseInputError
+from tactsense.cli._common import (
+    SensorOption,
+    atomic_output,
+    check_output,
+    console,
+    fail,
+    new_group,
+)
+from tactsense.cli._scenario import (
+    ColOption,
+    DwellOption,
+    FlawsOption,
+    ForceGOption,
+    IncrementOption,
+    LiftOption,
+    RepeatsOption,
+    RowOption,
+    ScenarioKind,
+    ScenarioOption,
+    SeedOption,
+    build_scenario,
+    run_scenario,
+)
+from tactsense.sensor import load_sensor
+
+app = new_group("The live system: an emulated finger, recording and live estimates.")
+
+RATE = dict(min=0.0, max=1.0)
+
+SourceArgument = Annotated[
+    str,
+    typer.Argument(
+        help="The device: a serial port (/dev/ttyUSB0), a pty path printed by 'tactsense "
+        "emulate', socket://127.0.0.1:PORT, or any other pyserial URL."
+    ),
+]
+StreamSensorOption = Annotated[
+    str | None,
+    typer.Option(
+        "--sensor",
+        help="The finger on the line ('initial', 'improved' or a TOML file). Default: ask "
+        "the device (IDENTIFY) for its sensor description.",
+    ),
+]
+TimeoutOption = Annotated[
+    float | None,
+    typer.Option(
+        min=0.001,
+        max=3600.0,
+        help="A frame later than this after the previous one counts as a timeout [s] "
+        "(default: 3 frame periods + 0.05 s).",
+    ),
+]
+FramesLimit = Annotated[
+    int | None, typer.Option("--frames", min=1, help="Stop after this many frames.")
+]
+DurationLimit = Annotated[
+    float | None,
+    typer.Option("--duration", min=0.0, max=1e7, help="Stop after this long [s]."),
+]
+
+
+def _open_reader(source: str, sensor: str | None, timeout: float | None, *, start: bool = True):
+    from tactsense.stream import StreamReader
+
+    spec = None if sensor is None else load_sensor(sensor)
+    return StreamReader(source, sensor=spec, timeout_s=timeout, start=start)
+
+
+def _check_finite(**values: float | None) -> None:
+    for name, value in values.items():
+        if value is not None and not np.isfinite(value):
+            fail(f"--{name.replace('_', '-')} must be a finite number; got {value}")
+
+
+@app.command()
+def emulate(
+    sensor: SensorOption = "initial",
+    scenario: ScenarioOption = ScenarioKind.sweep_axial,
+    row: RowOption = 4,
+    col: ColOption = 0,
+    force_g: ForceGOption = 50.0,
+    increment: IncrementOption = None,
+    dwell_s: DwellOption = 0.5,
+    lift_s: LiftOption = 0.0,
+    repeats: RepeatsOption = 100,
+    flaws: FlawsOption = "all",
+    seed: SeedOption = 0,
+    recording: Annotated[
+        Path | None,
+        typer.Option(help="Play the frames of this recording instead of simulating a scenario."),
+    ] = None,
+    port: Annotated[
+        int | None,
+        typer.Option(
+            min=0,
+            max=65535,
+            help="Serve on this TCP port of 127.0.0.1 (0: a free port) instead of a new "
+            "pseudo-terminal.",
+        ),
+    ] = None,
+    speed: Annotated[
+        float,
+        typer.Option(
+            min=0.0,
+            max=1e6,
+            help="Send frames at this multiple of the sensor's scan rate (0: as fast as "
+            "the line takes them).",
+        ),
+    ] = 1.0,
+    loop: Annotated[
+        bool, typer.Option("--loop", help="Start the frames over when they run out.")
+    ] = False,
+    garbage: Annotated[
+        float, typer.Option(**RATE, help="Rate of bursts of random bytes [per frame].")
+    ] = 0.0,
+    bitflip: Annotated[
+        float, typer.Option(**RATE, help="Rate of frames with one bit inverted [per frame].")
+    ] = 0.0,
+    drop: Annotated[float, typer.Option(**RATE, help="Rate of frames not sent [per frame].")] = 0.0,
+    truncate: Annotated[
+        float, typer.Option(**RATE, help="Rate of frames cut short [per frame].")
+    ] = 0.0,
+    stall: Annotated[
+        float, typer.Option(**RATE, help="Rate of pauses before a frame [per frame].")
+    ] = 0.0,
+    stall_s: Annotated[
+        float, typer.Option(min=0.0, max=60.0, help="Length of each pause [s].")
+    ] = 0.5,
+    fault_seed: Annotated[
+        int, typer.Option(min=0, help="Seed of the fault draws, for a repeatable line.")
+    ] = 0,
+) -> None:
+    """Play the finger as a device: frames of the twin in the wire protocol on a pty or TCP.
+
+    Prints where to connect on standard output (a pty path, or socket://127.0.0.1:PORT)
+    and serves until Ctrl-C. The device streams after a host sends START
+    (docs/protocol.md); 'tactsense record' and 'tactsense live' do.
+    """
+    from tactsense.io.recording import read_recording
+    from tactsense.stream import Emulator, FaultRates
+
+    _check_finite(
+        speed=speed, garbage=garbage, bitflip=bitflip, drop=drop, truncate=truncate,
+        stall=stall, stall_s=stall_s,
+    )  # fmt: skip
+    try:
+        faults = FaultRates(garbage, bitflip, drop, truncate, stall, stall_s)
+        if recording is not None:
+            source = read_recording(recording)
+        else:
+            spec = load_sensor(sensor)
+            scene = build_scenario(
+                spec, scenario, row=row, col=col, force_g=force_g, increment=increment,
+                dwell_s=dwell_s, lift_s=lift_s, repeats=repeats,
+            )  # fmt: skip
+            source = run_scenario(spec, scene, flaws=flaws, seed=seed)
+        emulator = Emulator.from_recording(
+            source, speed=speed, faults=faults, repeat=loop, rng=fault_seed
+        )
+    except TactsenseInputError as error:
+        fail(str(error))
+    try:
+        if port is None:
+            master, _slave, path = emulator.open_pty()  # the slave stays open: no EIO
+            typer.echo(path)
+            sys.stdout.flush()
+            console.print(
+                f"emulating {source.sensor.name} on {path}: {len(source)} frames at "
+                f"{emulator.frame_rate_hz or float('inf'):g} frames/s; Ctrl-C stops"
+            )
+            emulator.serve_pty(master)
+        else:
+
+            def ready(chosen: int) -> None:
+                typer.echo(f"socket://127.0.0.1:{chosen}")
+                sys.stdout.flush()
+                console.print(
+                    f"emulating {source.sensor.name} on 127.0.0.1:{chosen}: {len(source)} "
+                    f"frames at {emulator.frame_rate_hz or float('inf'):g} frames/s; "
+                    "Ctrl-C stops"
+                )
+
+            emulator.serve_tcp(port, ready=ready)
+    except KeyboardInterrupt:
+        pass
+    except OSError as error:
+        fail(f"cannot serve: {error.strerror or error}")
+    log = emulator.log
+    console.print(
+        f"sent {log.frames} frames ({log.delivered_intact} intact); injected: "
+        + ", ".join(
+            f"{k} {getattr(log, k)}" for k in ("garbage", "bitflip", "drop", "truncate", "stall")
+        )
+    )
+
+
+@app.command()
+def record(
+    source: SourceArgument,
+    out: Annotated[Path, typer.Option("--out", "-o", help="New HDF5 recording.")] = Path(
+        "recording.h5"
+    ),
+    frames: FramesLimit = None,
+    duration: DurationLimit = None,
+    sensor: StreamSensorOption = None,
+    timeout: TimeoutOption = None,
+    quiet: Annotated[bool, typer.Option("--quiet", help="No live status line.")] = False,
+    force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
+) -> None:
+    """Record a device's frames to HDF5 as they arrive, until --frames, --duration or Ctrl-C.
+
+    The file is flushed at least once a second: if the recorder is killed, every frame
+    up to the last flush is readable. Losses (bad check, gaps, timeouts...) are counted
+    and stored with the frames.
+    """
+    from tactsense.stream import StreamError
+    from tactsense.stream import record as run_record
+
+    _check_finite(duration=duration, timeout=timeout)
+    check_output(out, force)
+    try:
+        reader = _open_reader(source, sensor, timeout)
+    except TactsenseInputError as error:
+        fail(str(error))
+    with Progress(TextColumn("{task.description}"), console=console, disable=quiet) as bar:
+        task = bar.add_task(f"recording {source}")
+
+        def update(count: int, stats, rate: float) -> None:
+            bar.update(task, description=f"{out}: {rate:7.1f} frames/s, {stats.summary()}")
+
+        interrupted = False
+        try:
+            with reader:
+                run_record(
+                    reader, out, max_frames=frames, duration_s=duration, overwrite=force,
+                    progress=update,
+                )  # fmt: skip
+        except KeyboardInterrupt:
+            interrupted = True
+        except (StreamError, TactsenseInputError, FileExistsError) as error:
+            fail(str(error))
+    stopped = " (stopped by Ctrl-C)" if interrupted else ""
+    console.print(f"wrote {out}{stopped}: {reader.stats.summary()}")
+
+
+class LiveFormat(StrEnum):
+    jsonl = "jsonl"
+    csv = "csv"
+
+
+@app.command()
+def live(
+    source: SourceArgument,
+    calibration: Annotated[
+        Path | None,
+        typer.Option(
+            help="Calibration JSON from 'tactsense calibrate': baseline, gains, excluded "
+            "tactels and creep compensation apply from the first frame."
+        ),
+    ] = None,
+    output_format: Annotated[
+        LiveFormat, typer.Option("--format", help="One JSON object per line, or CSV.")
+    ] = LiveFormat.jsonl,
+    out: Annotated[
+        Path | None,
+        typer.Option("--out", "-o", help="Write the estimates here instead of standard output."),
+    ] = None,
+    frames: FramesLimit = None,
+    duration: DurationLimit = None,
+    baseline_frames: Annotated[
+        int,
+        typer.Option(
+            min=1,
+            max=10000,
+            help="Without --calibration: untouched frames at the start whose median is "
+            "the baseline V_o of eq. 4.",
+        ),
+    ] = 5,
+    threshold: Annotated[
+        float,
+        typer.Option(
+            min=1e-6,
+            max=1.0,
+            help="Smallest tactel deflection that counts as a contact, as a fraction [-].",
+        ),
+    ] = 0.005,
+    sensor: StreamSensorOption = None,
+    timeout: TimeoutOption = None,
+    force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
+) -> None:
+    """Estimate the contact of every frame as it arrives: position, force, skew, flags and
+    latency (from the frame's last byte to its estimate), until --frames, --duration,
+    the end of the stream or Ctrl-C.
+    """
+    from tactsense.estimate import Calibration
+    from tactsense.stream import LiveLocator, StreamError
+    from tactsense.stream.live import FIELDS
+
+    _check_finite(duration=duration, timeout=timeout, threshold=threshold)
+    if out is not None:
+        check_output(out, force)
+    try:
+        reader = _open_reader(source, sensor, timeout, start=False)
+        cal = None if calibration is None else Calibration.load(calibration, reader.sensor)
+        locator = LiveLocator(
+            reader.sensor,
+            calibration=cal,
+            baseline_frames=baseline_frames,
+            threshold=threshold,
+            frame_period_s=reader.frame_period_s or None,
+        )
+        reader.start()
+    except TactsenseInputError as error:
+        fail(str(error))
+    latencies: list[float] = []
+
+    def run(stream) -> None:
+        writer = None
+        if output_format is LiveFormat.csv:
+            writer = csv.DictWriter(stream, fieldnames=FIELDS, lineterminator="\n")
+            writer.writeheader()
+        for frame in reader.frames(max_frames=frames, duration_s=duration):
+            estimate = locator(frame)
+            if estimate is None:
+                continue
+            latencies.append(estimate["latency_ms"])
+            if writer is None:
+                clean = {
+                    k: (None if isinstance(v, float) and not np.isfinite(v) else v)
+                    for k, v in estimate.items()
+                }
+                stream.write(json.dumps(clean) + "\n")
+            else:
+                writer.writerow(
+                    {k: repr(v) if isinstance(v, float) else v for k, v in estimate.items()}
+                )
+            stream.flush()
+
+    interrupted = False
+    try:
+        with reader:
+            if out is None:
+                run(sys.stdout)
+            else:
+                with atomic_output(out) as temporary, open(temporary, "w", newline="") as stream:
+                    try:
+                        run(stream)
+                    except KeyboardInterrupt:
+                        interrupted = True  # what was estimated so far is complete: keep it
+    except KeyboardInterrupt:
+        interrupted = True
+    except (StreamError, TactsenseInputError) as error:
+        fail(str(error))
+    except BrokenPipeError:
+        sys.stderr.close()
+        return
+    summary = reader.stats.summary()
+    if latencies:
+        median, p99 = np.percentile(latencies, [50, 99])
+        summary += f"; latency median {median:.3f} ms, p99 {p99:.3f} ms"
+    stopped = " (stopped by Ctrl-C)" if interrupted else ""
+    console.print(f"{len(latencies)} estimates{stopped}: {summary}")
