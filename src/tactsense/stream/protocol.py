@@ -95,10 +95,9 @@ def frame_size(rows: int, cols: int) -> int:
 
 
 def encoded_frame_size(rows: int, cols: int) -> int:
-    """Bytes of a frame on the wire: COBS adds one byte per 254 (at least one), plus the
-    delimiter."""
-    raw = frame_size(rows, cols)
-    return raw + raw // 254 + 1 + 1
+    """Fewest bytes a frame takes on the wire: COBS adds at least one byte (at most one
+    per 254), plus the delimiter. Exact for frames of up to 254 bytes (10x10 tactels)."""
+    return frame_size(rows, cols) + 2
 
 
 def _seal(packet: bytes) -> bytes:

@@ -1,0 +1,5 @@
+"""``python -m tactsense.cli``: the same as the ``tactsense`` command."""
+
+from tactsense.cli.app import main
+
+main()
