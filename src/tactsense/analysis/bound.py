@@ -52,6 +52,13 @@ def fisher_information(
 ) -> np.ndarray:
     """Fisher information of (axial [mm], angle [deg], force [N]), shape (3, 3)."""
     check_positive(force_n, "force_n")
+    tip_mm = np.pi / 2 * sensor.body.diameter_mm / 2  # arc from the junction to the tip's apex
+    length_mm = sensor.body.cylinder_length_mm
+    if not -tip_mm <= float(axial_mm) <= length_mm:
+        raise TactsenseInputError(
+            f"axial position {axial_mm:g} mm is off the finger; expected {-tip_mm:.2f} mm "
+            f"(apex of the tip) to {length_mm:g} mm (base of the cylinder)"
+        )
     theta = np.array([axial_mm, angle_deg, force_n], dtype=float)
     gradients = []
     for k in range(3):

@@ -3,13 +3,18 @@ an error into a one-line message and an exit code."""
 
 from __future__ import annotations
 
+import functools
 import os
+import warnings
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated, NoReturn
 
+import numpy as np
 import typer
 from rich.console import Console
+
+from tactsense._validation import TactsenseInputError
 
 console = Console(stderr=True)
 """Messages, progress and tables meant for a person go to standard error."""
@@ -24,9 +29,50 @@ SensorOption = Annotated[
 ]
 
 
+class _Group(typer.Typer):
+    """A typer app whose every command runs under :func:`guarded`."""
+
+    def command(self, *args, **kwargs):
+        register = super().command(*args, **kwargs)
+
+        def decorator(function):
+            register(guarded(function))
+            return function
+
+        return decorator
+
+
 def new_group(help: str) -> typer.Typer:
-    """A typer app for a group of commands, with tactsense's settings."""
-    return typer.Typer(no_args_is_help=True, add_completion=False, rich_markup_mode=None, help=help)
+    """A typer app for a group of commands, with tactsense's settings and error rule."""
+    return _Group(no_args_is_help=True, add_completion=False, rich_markup_mode=None, help=help)
+
+
+def guarded(function):
+    """The one rule from errors to messages and exit codes, for every command.
+
+    Bad input (a :class:`TactsenseInputError`, an existing output, an unreadable or
+    unwritable path) is ``error: ...`` on one line and exit status 2; Ctrl-C is exit
+    status 1 (outputs are written to temporary names, so nothing is left half-written);
+    NumPy's floating-point warnings never reach the terminal: the estimates carry flags
+    and NaN where a number is meaningless.
+    """
+
+    @functools.wraps(function)
+    def run(*args, **kwargs):
+        with warnings.catch_warnings(), np.errstate(all="ignore"):
+            warnings.simplefilter("ignore", RuntimeWarning)
+            try:
+                return function(*args, **kwargs)
+            except KeyboardInterrupt:
+                console.print("[bold red]error:[/] interrupted; no output was left half-written")
+                raise typer.Exit(code=1) from None
+            except (TactsenseInputError, FileExistsError) as error:
+                fail(str(error))
+            except OSError as error:
+                where = f" ({error.filename})" if error.filename else ""
+                fail(f"{error.strerror or error}{where}")
+
+    return run
 
 
 def fail(message: str) -> NoReturn:
@@ -46,6 +92,8 @@ def check_output(path: Path, force: bool, *, what: str = "output") -> Path:
     parent = path.parent if str(path.parent) else Path(".")
     if path.is_dir():
         fail(f"{what} {path} is a directory; expected a file name")
+    if parent.exists() and not parent.is_dir():
+        fail(f"{parent} in {what} {path} is a file, not a folder")
     if not parent.is_dir():
         fail(f"folder {parent} of {what} {path} does not exist; create it first")
     if not os.access(parent, os.W_OK | os.X_OK):
@@ -60,7 +108,8 @@ def atomic_output(path: Path):
     """Yield a temporary name beside ``path``; move it into place only if the block ends
     without an exception (Ctrl-C included), else remove it."""
     path = Path(path)
-    temporary = path.with_name(f".{path.name}.{os.getpid()}.partial")
+    # hidden, unique, and with the final suffix (matplotlib picks the format from it)
+    temporary = path.with_name(f".{path.stem}.{os.getpid()}.partial{path.suffix}")
     try:
         yield temporary
     except BaseException:

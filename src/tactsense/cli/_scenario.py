@@ -37,38 +37,51 @@ ScenarioOption = Annotated[
 RowOption = Annotated[
     int,
     typer.Option(
+        min=0,
+        max=254,
         help="Row of the tactel: fixes the axial position of a sweep "
-        "around, or the tactel loaded by 'repeated' (0 = tip row)."
+        "around, or the tactel loaded by 'repeated' (0 = tip row).",
     ),
 ]
 ColOption = Annotated[
     int,
     typer.Option(
+        min=0,
+        max=254,
         help="Column of the tactel: fixes the angle of a sweep along the "
-        "finger, or the tactel loaded by 'repeated'."
+        "finger, or the tactel loaded by 'repeated'.",
     ),
 ]
 ForceGOption = Annotated[
-    float, typer.Option(help="Probe load in grams-force (the paper's unit) [g].")
+    float, typer.Option(min=1e-3, max=1e5, help="Probe load in grams-force (the paper's unit) [g].")
 ]
 IncrementOption = Annotated[
     float | None,
     typer.Option(
+        min=1e-3,
+        max=90.0,
         help="Step between probe positions: mm for sweep-axial (default 0.6), "
-        "deg for sweep-around (default 3)."
+        "deg for sweep-around (default 3).",
     ),
 ]
 DwellOption = Annotated[
-    float, typer.Option(help="Time the probe is held at each position or application [s].")
+    float,
+    typer.Option(
+        min=1e-3, max=3600.0, help="Time the probe is held at each position or application [s]."
+    ),
 ]
 LiftOption = Annotated[
     float,
     typer.Option(
+        min=0.0,
+        max=3600.0,
         help="Time the probe is lifted between positions or applications "
-        "(0 = it slides from one to the next in a sweep) [s]."
+        "(0 = it slides from one to the next in a sweep) [s].",
     ),
 ]
-RepeatsOption = Annotated[int, typer.Option(help="Applications for 'repeated'.")]
+RepeatsOption = Annotated[
+    int, typer.Option(min=1, max=1_000_000, help="Applications for 'repeated'.")
+]
 FlawsOption = Annotated[
     str,
     typer.Option(
@@ -78,7 +91,7 @@ FlawsOption = Annotated[
     ),
 ]
 SeedOption = Annotated[
-    int | None, typer.Option(help="Seed of every random draw, for a repeatable run.")
+    int | None, typer.Option(min=0, help="Seed of every random draw, for a repeatable run.")
 ]
 
 

@@ -20,13 +20,19 @@ app = new_group("Design questions: capacitor gain in the skin, aliasing, the Cra
 
 @app.command("aliasing")
 def design_aliasing(
-    depth: Annotated[float, typer.Option(help="Sensor depth d below the surface, in mm.")] = 3.8,
-    spacing: Annotated[float, typer.Option(help="Sensor spacing b, in mm.")] = 3.8,
+    depth: Annotated[
+        float, typer.Option(min=1e-3, max=1e3, help="Sensor depth d below the surface, in mm.")
+    ] = 3.8,
+    spacing: Annotated[
+        float, typer.Option(min=1e-3, max=1e3, help="Sensor spacing b, in mm.")
+    ] = 3.8,
     poisson: Annotated[
         float,
         typer.Option(
+            min=-0.999,
+            max=0.5,
             help="Poisson's ratio of the plane-stress model (the paper's fit: "
-            "0.4; the rubber: 0.5)."
+            "0.4; the rubber: 0.5).",
         ),
     ] = 0.5,
     as_json: Annotated[
@@ -73,14 +79,23 @@ def design_bound(
     axial: Annotated[
         float,
         typer.Option(
+            min=-1e3,
+            max=1e3,
             help="Probe position along the finger, arc length from the "
-            "junction of tip and cylinder, in mm."
+            "junction of tip and cylinder, in mm.",
         ),
     ] = 12.5,
-    angle: Annotated[float, typer.Option(help="Probe angle around the finger, in deg.")] = 0.0,
-    force_g: Annotated[float, typer.Option(help="Probe load in grams-force.")] = 50.0,
+    angle: Annotated[
+        float, typer.Option(min=-360.0, max=360.0, help="Probe angle around the finger, in deg.")
+    ] = 0.0,
+    force_g: Annotated[
+        float, typer.Option(min=1e-3, max=1e5, help="Probe load in grams-force.")
+    ] = 50.0,
     diameter: Annotated[
-        float, typer.Option(help="Contact diameter of the hemispherical probe, in mm.")
+        float,
+        typer.Option(
+            min=1e-3, max=100.0, help="Contact diameter of the hemispherical probe, in mm."
+        ),
     ] = 3.0,
     sensor: SensorOption = "initial",
     as_json: Annotated[
@@ -148,39 +163,53 @@ def design_strip(
     thickness: Annotated[
         float,
         typer.Option(
+            min=1e-3,
+            max=1e3,
             help="Depth of the bottom capacitor plate below the skin surface "
-            "(the skin thickness when the plate sits on the core), in mm."
+            "(the skin thickness when the plate sits on the core), in mm.",
         ),
     ] = 3.8,
     separation: Annotated[
         float,
         typer.Option(
+            min=1e-4,
+            max=1e3,
             help="Nominal plate separation d_o, in mm; the top plate lies this "
-            "far above the bottom one."
+            "far above the bottom one.",
         ),
     ] = 0.5,
     load: Annotated[
         float,
         typer.Option(
+            min=1e-6,
+            max=1e7,
             help="Load per unit length of the finger slab, in N/m (the paper: "
-            "about 200 N/m for its calibration probe)."
+            "about 200 N/m for its calibration probe).",
         ),
     ] = 200.0,
     width: Annotated[
         float,
         typer.Option(
-            help="Width of the parabolic contact pressure, in mm (the paper's probe: 3 mm)."
+            min=1e-3,
+            max=1e3,
+            help="Width of the parabolic contact pressure, in mm (the paper's probe: 3 mm).",
         ),
     ] = 3.0,
     backing: Annotated[
         float,
         typer.Option(
+            min=0.0,
+            max=1e3,
             help="Elastic layer between the bottom plate and the rigid core, "
-            "in mm (0: the plate sits on the core)."
+            "in mm (0: the plate sits on the core).",
         ),
     ] = 0.0,
-    modulus: Annotated[float, typer.Option(help="Young's modulus of the skin, in Pa.")] = 2.5e5,
-    poisson: Annotated[float, typer.Option(help="Poisson's ratio of the skin material.")] = 0.5,
+    modulus: Annotated[
+        float, typer.Option(min=1.0, max=1e12, help="Young's modulus of the skin, in Pa.")
+    ] = 2.5e5,
+    poisson: Annotated[
+        float, typer.Option(min=-0.999, max=0.5, help="Poisson's ratio of the skin material.")
+    ] = 0.5,
     model: Annotated[
         ElasticModel,
         typer.Option(

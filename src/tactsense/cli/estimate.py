@@ -11,7 +11,7 @@ from rich.console import Console
 from rich.table import Table
 
 from tactsense._validation import TactsenseInputError
-from tactsense.cli._common import console, fail, new_group
+from tactsense.cli._common import atomic_output, check_output, console, fail, new_group
 from tactsense.io.recording import read_recording
 
 app = new_group("Estimate contacts and calibrations from recordings.")
@@ -26,15 +26,19 @@ def locate(
     baseline_frames: Annotated[
         int,
         typer.Option(
+            min=1,
+            max=1_000_000,
             help="Number of untouched frames at the start of the recording "
-            "whose median is the undeflected reading V_o of eq. 4."
+            "whose median is the undeflected reading V_o of eq. 4.",
         ),
     ] = 5,
     threshold: Annotated[
         float,
         typer.Option(
+            min=1e-6,
+            max=1.0,
             help="Smallest tactel deflection that counts as a contact, as a "
-            "fraction (0.005 = 0.5 %, about 10 counts at 2000)."
+            "fraction (0.005 = 0.5 %, about 10 counts at 2000).",
         ),
     ] = 0.005,
     calibration: Annotated[
@@ -51,8 +55,7 @@ def locate(
     from tactsense.estimate import locate as run_locate
 
     try:
-        if out.exists() and not force:
-            fail(f"{out} exists; pass --force to replace it, or choose another name")
+        check_output(out, force)
         rec = read_recording(recording)
         if calibration is not None:
             from tactsense.estimate import Calibration
@@ -68,7 +71,8 @@ def locate(
         else:
             baseline = baseline_from(rec.frames, baseline_frames)
             estimates = run_locate(rec.frames, rec.sensor, baseline=baseline, threshold=threshold)
-        write_estimates_csv(out, estimates, rec.time_s, overwrite=force)
+        with atomic_output(out) as temporary:
+            write_estimates_csv(temporary, estimates, rec.time_s)
     except (TactsenseInputError, FileExistsError) as error:
         fail(str(error))
     touched = int(np.count_nonzero(np.isfinite(estimates.row)))
@@ -90,12 +94,15 @@ def calibrate(
     probe_g: Annotated[
         float,
         typer.Option(
+            min=1e-3,
+            max=1e5,
             help="Load of the sweeping probe in grams-force, for the "
-            "sensitivity thresholds of Fig. 8."
+            "sensitivity thresholds of Fig. 8.",
         ),
     ] = 50.0,
     baseline_frames: Annotated[
-        int, typer.Option(help="Untouched frames at the start of each recording.")
+        int,
+        typer.Option(min=1, max=1_000_000, help="Untouched frames at the start of each recording."),
     ] = 5,
     steps: Annotated[
         Path | None,
@@ -113,16 +120,19 @@ def calibrate(
             "for the edge positions."
         ),
     ] = None,
-    row: Annotated[int, typer.Option(help="Row of the tactel under --steps and --knife.")] = 4,
-    col: Annotated[int, typer.Option(help="Column of the tactel under --steps and --knife.")] = 0,
+    row: Annotated[
+        int, typer.Option(min=0, max=254, help="Row of the tactel under --steps and --knife.")
+    ] = 4,
+    col: Annotated[
+        int, typer.Option(min=0, max=254, help="Column of the tactel under --steps and --knife.")
+    ] = 0,
     force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
 ) -> None:
     """Build a calibration (gains, baseline, dead/weak/noisy tactels, creep, model fit)."""
     from tactsense.estimate import calibrate as cal
 
     try:
-        if out.exists() and not force:
-            fail(f"{out} exists; pass --force to replace it, or choose another name")
+        check_output(out, force)
         rec = read_recording(sweep)
         calibration = cal.calibrate_sweep(
             rec.frames, rec.sensor, baseline_frames=baseline_frames, probe_grams=probe_g
@@ -135,7 +145,8 @@ def calibrate(
             calibration.model_fit = _fit_knife(
                 read_recording(knife), rec.sensor, row, col, baseline_frames
             )
-        calibration.save(out, overwrite=force)
+        with atomic_output(out) as temporary:
+            calibration.save(temporary)
     except (TactsenseInputError, FileExistsError) as error:
         fail(str(error))
     table = Table(title=f"wrote {out}", show_header=False)

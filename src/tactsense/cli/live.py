@@ -83,12 +83,6 @@ def _open_reader(source: str, sensor: str | None, timeout: float | None, *, star
     return StreamReader(source, sensor=spec, timeout_s=timeout, start=start)
 
 
-def _check_finite(**values: float | None) -> None:
-    for name, value in values.items():
-        if value is not None and not np.isfinite(value):
-            fail(f"--{name.replace('_', '-')} must be a finite number; got {value}")
-
-
 @app.command()
 def emulate(
     sensor: SensorOption = "initial",
@@ -156,10 +150,6 @@ def emulate(
     from tactsense.io.recording import read_recording
     from tactsense.stream import Emulator, FaultRates
 
-    _check_finite(
-        speed=speed, garbage=garbage, bitflip=bitflip, drop=drop, truncate=truncate,
-        stall=stall, stall_s=stall_s,
-    )  # fmt: skip
     try:
         faults = FaultRates(garbage, bitflip, drop, truncate, stall, stall_s)
         if recording is not None:
@@ -233,7 +223,6 @@ def record(
     from tactsense.stream import StreamError
     from tactsense.stream import record as run_record
 
-    _check_finite(duration=duration, timeout=timeout)
     check_output(out, force)
     try:
         reader = _open_reader(source, sensor, timeout)
@@ -313,7 +302,6 @@ def live(
     from tactsense.stream import LiveLocator, StreamError
     from tactsense.stream.live import FIELDS
 
-    _check_finite(duration=duration, timeout=timeout, threshold=threshold)
     if out is not None:
         check_output(out, force)
     try:

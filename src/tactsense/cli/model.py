@@ -11,7 +11,14 @@ from rich.console import Console
 from rich.table import Table
 
 from tactsense._validation import TactsenseInputError
-from tactsense.cli._common import SensorOption, console, fail, new_group
+from tactsense.cli._common import (
+    SensorOption,
+    atomic_output,
+    check_output,
+    console,
+    fail,
+    new_group,
+)
 from tactsense.cli._scenario import (
     ColOption,
     DwellOption,
@@ -64,8 +71,8 @@ def simulate(
     try:
         spec = load_sensor(sensor)
         for target in (out, plot):
-            if target is not None and target.exists() and not force:
-                fail(f"{target} exists; pass --force to replace it, or choose another name")
+            if target is not None:
+                check_output(target, force)
         if plot is not None and scenario not in (
             ScenarioKind.sweep_axial,
             ScenarioKind.sweep_around,
@@ -83,13 +90,15 @@ def simulate(
             repeats=repeats,
         )
         recording = run_scenario(spec, scene, flaws=flaws, seed=seed)
-        write_recording(out, recording, overwrite=force)
+        with atomic_output(out) as temporary:
+            write_recording(temporary, recording)
         console.print(
             f"wrote {out}: {len(recording)} frames of {spec.shape[0]}x{spec.shape[1]} "
             f"counts at {spec.electronics.scan_rate_hz:g} Hz ({spec.name})"
         )
         if plot is not None:
-            plot_sweep(recording, plot, overwrite=force)
+            with atomic_output(plot) as temporary:
+                plot_sweep(recording, temporary)
             console.print(f"wrote {plot}")
     except (TactsenseInputError, FileExistsError) as error:
         fail(str(error))
@@ -108,7 +117,22 @@ def info(recording: Annotated[Path, typer.Argument(help="HDF5 recording to descr
     table.add_row("frames", f"{frames.shape[0]} x {frames.shape[1]} x {frames.shape[2]} counts")
     duration = rec.time_s[-1] + rec.sensor.scan_period_s if len(rec) else 0.0
     table.add_row("duration", f"{duration:.3f} s at {rec.sensor.electronics.scan_rate_hz:g} Hz")
-    table.add_row("counts", f"{frames.min():g} .. {frames.max():g}")
+    finite = np.isfinite(frames) if frames.dtype.kind == "f" else np.ones(frames.shape, bool)
+    if finite.any():
+        counts = f"{frames[finite].min():g} .. {frames[finite].max():g}"
+        bad = int(np.count_nonzero(~finite.all(axis=(1, 2))))
+        if bad:
+            counts += f" ({bad} frames hold NaN or infinite readings)"
+    else:
+        counts = "none (no frames)" if frames.size == 0 else "none finite"
+    table.add_row("counts", counts)
+    if rec.source:
+        table.add_row("source", rec.source)
+    if rec.losses:
+        lost = ", ".join(f"{k} {v}" for k, v in rec.losses.items() if v) or "none"
+        table.add_row("losses", lost)
+    if not rec.closed_cleanly:
+        table.add_row("state", "not closed by its writer (killed?): frames up to its last flush")
     table.add_row("scenario", str(rec.scenario.get("description", "")))
     table.add_row("flaws", ", ".join(rec.flaws) or "none")
     Console().print(table)
@@ -128,7 +152,9 @@ def sensor_show(
         if out is None:
             typer.echo(spec.to_toml_string())
         else:
-            spec.to_toml(out, overwrite=force)
+            check_output(out, force)
+            with atomic_output(out) as temporary:
+                spec.to_toml(temporary)
             console.print(f"wrote {out}")
     except (TactsenseInputError, FileExistsError) as error:
         fail(str(error))

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+import shutil
 from pathlib import Path
 from typing import Annotated
 
@@ -48,8 +50,17 @@ def reproduce(
 
     try:
         spec = load_sensor(sensor)
+        if out.exists() and not out.is_dir():
+            fail(f"{out} is a file; expected a directory for the report")
         if out.exists() and not force:
             fail(f"{out} exists; pass --force to write into it, or choose another directory")
+        parent = out.parent
+        if not parent.is_dir():
+            fail(f"folder {parent} of the report directory {out} does not exist; create it first")
+        if not os.access(parent, os.W_OK | os.X_OK):
+            fail(f"cannot write the report: folder {parent} is not writable")
+        # a new report is built in a hidden folder and renamed into place when complete
+        target = out if out.exists() else parent / f".{out.name}.{os.getpid()}.partial"
         with Progress(
             TextColumn("{task.description:<36}"),
             BarColumn(),
@@ -63,7 +74,16 @@ def reproduce(
             def update(name: str, done: int, total: int) -> None:
                 bar.update(task, description=name, completed=done, total=total)
 
-            result = run_reproduce(out, quick=quick, force=force, sensor=spec, progress=update)
+            try:
+                result = run_reproduce(
+                    target, quick=quick, force=True, sensor=spec, progress=update
+                )
+            except BaseException:
+                if target != out:
+                    shutil.rmtree(target, ignore_errors=True)
+                raise
+        if target != out:
+            target.rename(out)
     except (TactsenseInputError, FileExistsError) as error:
         fail(str(error))
     claims = result["claims"].values()

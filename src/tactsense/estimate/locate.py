@@ -225,5 +225,5 @@ def write_estimates_csv(
                     values.append(bool(item))
                 else:
                     values.append(f"{item:.6g}")
-            writer.writerow([k, f"{times[k]:.6g}", *values])
+            writer.writerow([k, repr(float(times[k])), *values])
     return path

@@ -165,6 +165,16 @@ def write_recording(path: str | Path, recording: Recording, *, overwrite: bool =
     if not path.parent.exists():
         raise RecordingError(f"folder {path.parent} does not exist")
     partial = path.with_name(path.name + ".partial")
+    try:
+        _write_file(partial, recording)
+    except BaseException:
+        partial.unlink(missing_ok=True)  # interrupted: leave nothing behind
+        raise
+    partial.replace(path)
+    return path
+
+
+def _write_file(partial: Path, recording: Recording) -> None:
     with h5py.File(partial, "w") as h5:
         h5.attrs["format"] = FORMAT
         h5.attrs["format_version"] = FORMAT_VERSION
@@ -178,7 +188,8 @@ def write_recording(path: str | Path, recording: Recording, *, overwrite: bool =
             "frames",
             data=recording.frames,
             compression="gzip",
-            chunks=(min(len(recording), 1024), *recording.sensor.shape),
+            chunks=(max(1, min(len(recording), 1024)), *recording.sensor.shape),
+            maxshape=(None, *recording.sensor.shape),
         )
         frames.attrs["units"] = "counts"
         frames.attrs["axes"] = "time, row (along the finger, 0 = tip), col (around)"
@@ -204,8 +215,6 @@ def write_recording(path: str | Path, recording: Recording, *, overwrite: bool =
                     group.attrs[key] = value
                 else:
                     group.create_dataset(key, data=value).attrs["units"] = units.get(key, "1")
-    partial.replace(path)
-    return path
 
 
 def read_recording(path: str | Path) -> Recording:
