@@ -55,6 +55,8 @@ def reproduce(
         if out.exists() and not force:
             fail(f"{out} exists; pass --force to write into it, or choose another directory")
         parent = out.parent
+        if parent.exists() and not parent.is_dir():
+            fail(f"{parent} in the report directory {out} is a file, not a folder")
         if not parent.is_dir():
             fail(f"folder {parent} of the report directory {out} does not exist; create it first")
         if not os.access(parent, os.W_OK | os.X_OK):

@@ -1,0 +1,183 @@
+"""The bad-input matrix: every command, given a bad path or a bad option value, ends
+with exit status 2, a short message naming what was wrong, no traceback, and nothing at
+the output name. A new option joins the matrix when it is added."""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+from typer.testing import CliRunner
+
+import tactsense as ts
+from tactsense.cli import app
+
+runner = CliRunner()
+
+
+@pytest.fixture(scope="module")
+def workspace(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("matrix")
+    spec = ts.fearing1990_initial()
+    ts.write_recording(folder / "rec.h5", ts.simulate(spec, ts.probe_sweep(spec), rng=0))
+    (folder / "a_file").write_text("x")
+    (folder / "a_dir").mkdir()
+    return folder
+
+
+BAD_OPTIONS = [
+    # (command line, the option or file the message must name)
+    ("design aliasing --spacing 0", "--spacing"),
+    ("design aliasing --spacing -1", "--spacing"),
+    ("design aliasing --depth nan", "--depth"),
+    ("design aliasing --poisson 0.7", "--poisson"),
+    ("design strip --modulus 0", "--modulus"),
+    ("design strip --modulus -5", "--modulus"),
+    ("design strip --thickness -1", "--thickness"),
+    ("design strip --separation 0", "--separation"),
+    ("design strip --backing -1", "--backing"),
+    ("design bound --axial 100", "axial position 100 mm is off the finger"),
+    ("design bound --force-g 0", "--force-g"),
+    ("design bound --diameter -1", "--diameter"),
+    ("simulate --seed -1 --out OUT", "--seed"),
+    ("simulate --lift-s -1 --out OUT", "--lift-s"),
+    ("simulate --dwell-s 0 --out OUT", "--dwell-s"),
+    ("simulate --force-g nan --out OUT", "--force-g"),
+    ("simulate --repeats 0 --out OUT", "--repeats"),
+    ("simulate --increment 0 --out OUT", "--increment"),
+    ("simulate --row -1 --out OUT", "--row"),
+    ("locate REC --threshold -1 --out OUT", "--threshold"),
+    ("locate REC --threshold nan --out OUT", "--threshold"),
+    ("locate REC --baseline-frames 0 --out OUT", "--baseline-frames"),
+    ("calibrate REC --probe-g 0 --out OUT", "--probe-g"),
+    ("calibrate REC --baseline-frames 0 --out OUT", "--baseline-frames"),
+    ("emulate --speed -1", "--speed"),
+    ("emulate --drop 2", "--drop"),
+    ("emulate --garbage -0.1", "--garbage"),
+    ("emulate --stall-s nan", "--stall-s"),
+    ("emulate --port 70000", "--port"),
+    ("record loop:// --frames 0 --out OUT", "--frames"),
+    ("record loop:// --duration -1 --out OUT", "--duration"),
+    ("record loop:// --timeout 0 --out OUT", "--timeout"),
+    ("live loop:// --threshold 2", "--threshold"),
+    ("live loop:// --baseline-frames 0", "--baseline-frames"),
+    ("reproduce --sensor bogus --out OUT", "bogus"),
+]
+
+BAD_OUTPUTS = {
+    "simulate": "simulate --out {out}",
+    "simulate --plot": "simulate --out {ok}/s.h5 --plot {out}",
+    "locate": "locate {rec} --out {out}",
+    "calibrate": "calibrate {rec} --out {out}",
+    "sensor show": "sensor show --out {out}",
+    "record": "record loop:// --out {out}",
+    "live": "live loop:// --out {out}",
+}
+BAD_PATHS = {
+    "missing folder": ("no_such_folder/x.out", "does not exist"),
+    "a directory": ("a_dir", "is a directory"),
+    "under a file": ("a_file/x.out", "is a file"),
+    "existing file": ("a_file", "exists; pass --force"),
+}
+
+
+def _check(result, names: str, forbidden=None):
+    message = " ".join(result.output.split())  # rich wraps long lines at the terminal width
+    assert result.exit_code == 2, message
+    assert "Traceback" not in message
+    assert names in message, message
+    if forbidden is not None:
+        assert not forbidden.exists() or forbidden.read_text() == "x"
+
+
+@pytest.mark.parametrize("line, names", BAD_OPTIONS, ids=[line for line, _ in BAD_OPTIONS])
+def test_bad_option_values(workspace, line, names):
+    out = workspace / "never_written.out"
+    args = line.replace("REC", str(workspace / "rec.h5")).replace("OUT", str(out)).split()
+    result = runner.invoke(app, args)
+    _check(result, names)
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("kind", list(BAD_PATHS))
+@pytest.mark.parametrize("command", list(BAD_OUTPUTS))
+def test_bad_output_paths_are_refused_before_any_work(workspace, command, kind):
+    path, names = BAD_PATHS[kind]
+    target = workspace / path
+    line = BAD_OUTPUTS[command].format(out=target, ok=workspace, rec=workspace / "rec.h5")
+    result = runner.invoke(app, line.split())
+    _check(result, names, forbidden=target if kind == "existing file" else None)
+    assert not (workspace / "s.h5").exists()
+    assert not [p for p in workspace.iterdir() if ".partial" in p.name]
+
+
+@pytest.mark.parametrize("kind", ["missing folder", "under a file"])
+def test_bad_report_directory(workspace, kind):
+    path, names = BAD_PATHS[kind]
+    result = runner.invoke(app, ["reproduce", "--quick", "--out", str(workspace / path)])
+    _check(result, names)
+    result = runner.invoke(app, ["reproduce", "--quick", "--out", str(workspace / "a_file")])
+    _check(result, "is a file")
+
+
+@pytest.mark.parametrize("case", ["empty", "nan"])
+def test_info_on_empty_and_nan_recordings(tmp_path, case):
+    import dataclasses
+
+    import numpy as np
+
+    spec = ts.fearing1990_initial()
+    rec = ts.simulate(spec, ts.probe_sweep(spec), rng=0)
+    if case == "empty":
+        rec = dataclasses.replace(rec, frames=rec.frames[:0], time_s=rec.time_s[:0], truth={})
+        expected = "none (no frames)"
+    else:
+        frames = rec.frames.astype(float)
+        frames[3] = np.nan
+        rec = dataclasses.replace(rec, frames=frames)
+        expected = "1 frames hold NaN"
+    ts.write_recording(tmp_path / "r.h5", rec)
+    result = runner.invoke(app, ["info", str(tmp_path / "r.h5")])
+    assert result.exit_code == 0 and "Traceback" not in result.output
+    assert expected in " ".join(result.output.split())
+
+
+def test_csv_time_keeps_full_precision(tmp_path):
+    import numpy as np
+
+    spec = ts.fearing1990_initial()
+    rec = ts.simulate(spec, ts.probe_sweep(spec), rng=0)
+    late = rec.time_s + 100_000.0  # 100,000 s in: %.6g would give equal stamps
+    est = ts.locate(rec.frames, spec, baseline=ts.baseline_from(rec.frames))
+    ts.estimate.write_estimates_csv(tmp_path / "e.csv", est, late)
+    written = np.genfromtxt(tmp_path / "e.csv", delimiter=",", skip_header=1, usecols=1)
+    np.testing.assert_array_equal(written, late)
+
+
+@pytest.mark.parametrize("command", ["simulate", "locate", "reproduce"])
+def test_interruption_leaves_nothing_and_the_rerun_works(tmp_path, command):
+    spec = ts.fearing1990_initial()
+    rec = tmp_path / "rec.h5"
+    ts.write_recording(rec, ts.simulate(spec, ts.repeated_load(spec, repeats=400), rng=0))
+    out = tmp_path / ("out" if command == "reproduce" else "out.file")
+    lines = {
+        "simulate": ["simulate", "--scenario", "repeated", "--repeats", "3000", "--out", str(out)],
+        "locate": ["locate", str(rec), "--out", str(out)],
+        "reproduce": ["reproduce", "--quick", "--out", str(out)],
+    }
+    cli = [sys.executable, "-m", "tactsense.cli", *lines[command]]
+    process = subprocess.Popen(cli, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(2.5)  # start-up is about 2 s: the work is under way
+    process.send_signal(signal.SIGINT)
+    _, err = process.communicate(timeout=60)
+    assert "Traceback" not in err
+    if process.returncode != 0:  # interrupted in time: nothing at the final name
+        assert process.returncode == 1 and "interrupted" in err
+        assert not out.exists()
+    assert not [p for p in os.listdir(tmp_path) if ".partial" in p]
+    rerun = subprocess.run(cli, capture_output=True, text=True, timeout=300)
+    if process.returncode != 0:
+        assert rerun.returncode == 0, rerun.stderr
+        assert out.exists()
