@@ -329,6 +329,8 @@ class RecordingWriter:
         Where the frames come from (a stream's URL).
     loss_kinds : sequence of str
         Names of the loss counters kept with the recording.
+    losses : callable() -> dict, optional
+        Returns the current loss counters (by kind); read at every flush.
     flush_interval_s : float
         Longest time between flushes [s].
     """
@@ -341,6 +343,7 @@ class RecordingWriter:
         *,
         source: str = "",
         loss_kinds=(),
+        losses=None,
         overwrite: bool = False,
         flush_interval_s: float = 1.0,
         chunk_frames: int = 1024,
@@ -356,9 +359,9 @@ class RecordingWriter:
             raise RecordingError(f"folder {path.parent} does not exist")
         self.path = path
         self.sensor = sensor
-        self._clock = time.monotonic
         self._interval = float(flush_interval_s)
-        self._last_flush = self._clock()
+        self._last_flush = time.monotonic()
+        self._loss_source = losses
         self._buffer: list[tuple] = []
         self._count = 0
         rows, cols = sensor.shape
@@ -415,12 +418,8 @@ class RecordingWriter:
     def append(self, counts, device_time_s: float, sequence: int, host_time_s: float) -> None:
         """Add one frame; flushes when ``flush_interval_s`` has passed since the last."""
         self._buffer.append((counts, device_time_s, sequence, host_time_s))
-        if self._clock() - self._last_flush >= self._interval:
+        if time.monotonic() - self._last_flush >= self._interval:
             self.flush()
-
-    def set_losses(self, counters: dict) -> None:
-        """Loss counters to store at the next flush."""
-        self._pending_losses = [int(counters.get(kind, 0)) for kind in self._kinds]
 
     def flush(self) -> None:
         """Write the buffered frames and the loss counters, and flush the file."""
@@ -435,11 +434,11 @@ class RecordingWriter:
             self._host[n:] = hosts
             self._count += k
             self._buffer.clear()
-        pending = getattr(self, "_pending_losses", None)
-        if pending:
-            self._losses[: len(pending)] = pending
+        if self._loss_source is not None and self._kinds:
+            counters = self._loss_source()
+            self._losses[:] = [int(counters.get(kind, 0)) for kind in self._kinds]
         self._h5.flush()
-        self._last_flush = self._clock()
+        self._last_flush = time.monotonic()
 
     def close(self) -> None:
         """Flush and close the file (idempotent)."""

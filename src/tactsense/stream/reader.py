@@ -150,8 +150,10 @@ class StreamReader:
         self._last_time_us = 0
         self._index = -1
         self._fileno = self._fileno_of(self.port)
+        self.sensor: SensorSpec | None = None
         self.frame_period_s = 0.0
         self._scan_period_s = 0.0
+        self._frame_bytes: int | None = None
         try:
             if sensor is None:
                 sensor = self._identify(identify_timeout_s)
@@ -215,7 +217,7 @@ class StreamReader:
 
     def _handle(self, raw: bytes, host_time: float, arrival: float) -> None:
         try:
-            packet = decode_packet(raw, getattr(self, "_frame_bytes", None))
+            packet = decode_packet(raw, self._frame_bytes)
         except ProtocolError as error:
             setattr(self.stats, error.reason, getattr(self.stats, error.reason) + 1)
             if error.reason == "garbage":
@@ -235,7 +237,7 @@ class StreamReader:
             self.identity = packet.body
 
     def _accept(self, packet: FramePacket, host_time: float, arrival: float) -> None:
-        if hasattr(self, "sensor") and packet.counts.shape != self.sensor.shape:
+        if self.sensor is not None and packet.counts.shape != self.sensor.shape:
             self.stats.bad_check += 1
             return
         if self._last_seq is None:

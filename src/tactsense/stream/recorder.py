@@ -52,6 +52,7 @@ def record(
         sample_offsets(sensor),
         source=str(reader.url),
         loss_kinds=LOSS_KINDS,
+        losses=lambda: reader.stats.as_dict(),
         overwrite=overwrite,
         flush_interval_s=flush_interval_s,
     ) as writer:
@@ -59,7 +60,6 @@ def record(
         reported = 0
         try:
             for frame in reader.frames(max_frames=max_frames, duration_s=duration_s):
-                writer.set_losses(reader.stats.as_dict())
                 writer.append(frame.counts, frame.device_time_s, frame.sequence, frame.host_time_s)
                 now = time.perf_counter()
                 if progress is not None and now - last_report >= progress_interval_s:
@@ -67,7 +67,6 @@ def record(
                     progress(len(writer), reader.stats, rate)
                     last_report, reported = now, len(writer)
         finally:
-            writer.set_losses(reader.stats.as_dict())
             if progress is not None:
                 elapsed = max(time.perf_counter() - start, 1e-9)
                 progress(len(writer), reader.stats, len(writer) / elapsed)
