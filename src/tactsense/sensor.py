@@ -327,20 +327,38 @@ class SensorSpec:
     def from_dict(cls, data: dict[str, Any], *, source: str = "sensor description") -> SensorSpec:
         """Build a sensor from nested dictionaries, naming every unknown key.
 
-        Sections and keys left out take the defaults of the initial finger
-        (:func:`fearing1990_initial`).
+        Every key of every section must be given, unless the description names a
+        preset to start from with ``extends = "initial"`` (or ``"improved"``): then
+        the keys it leaves out take that preset's values. A description that leaves
+        keys out without saying where their values come from is an error, so that a
+        typo or a forgotten section never silently becomes the initial finger.
         """
         if not isinstance(data, dict):
             raise SensorSpecError(
                 f"{source}: expected a table of sections, got {type(data).__name__}"
             )
         problems: list[str] = []
-        allowed_top = {"name", "description", *_SECTIONS}
+        allowed_top = {"name", "description", "extends", *_SECTIONS}
         for key in data:
             if key not in allowed_top:
                 problems.append(
                     f"unknown key {key!r} at top level; allowed: {', '.join(sorted(allowed_top))}"
                 )
+        base: dict[str, Any] | None = None
+        if "extends" in data:
+            extends = data["extends"]
+            if not isinstance(extends, str) or extends.removeprefix("fearing1990_") not in PRESETS:
+                raise SensorSpecError(
+                    f"{source}: extends = {extends!r} is not a preset; "
+                    f"available: {', '.join(PRESETS)}"
+                )
+            base = preset(extends).to_dict()
+        elif not any(section in data for section in _SECTIONS):
+            raise SensorSpecError(
+                f"{source}: no sections ({', '.join(f'[{s}]' for s in _SECTIONS)}); describe "
+                'every section, or start from a preset with extends = "initial" '
+                "(tactsense sensor show prints a complete description to edit)"
+            )
         sections: dict[str, Any] = {}
         for section, kind in _SECTIONS.items():
             values = data.get(section, {})
@@ -348,6 +366,12 @@ class SensorSpec:
                 problems.append(f"[{section}] must be a table, got {type(values).__name__}")
                 continue
             known = {f.name: f for f in dataclasses.fields(kind)}
+            if base is None:
+                missing = [key for key in known if key not in values]
+                if missing:
+                    problems.append(f"[{section}] is missing {', '.join(missing)}")
+            else:
+                values = {**base[section], **values}
             converted: dict[str, Any] = {}
             for key, value in values.items():
                 if key not in known:
@@ -361,7 +385,13 @@ class SensorSpec:
                     problems.append(f"[{section}] {key} = {value!r}: {error}")
             sections[section] = converted
         if problems:
-            raise SensorSpecError(f"{source}:\n  - " + "\n  - ".join(problems))
+            hint = ""
+            if any(" is missing " in problem for problem in problems):
+                hint = (
+                    '\n  (give every key, or add extends = "initial" at the top to take '
+                    "the keys left out from a preset)"
+                )
+            raise SensorSpecError(f"{source}:\n  - " + "\n  - ".join(problems) + hint)
         return cls(
             name=str(data.get("name", "custom")),
             description=str(data.get("description", "")),
@@ -399,7 +429,7 @@ class SensorSpec:
         """Write the description as TOML; an existing file is kept unless ``overwrite``."""
         path = Path(path)
         if path.exists() and not overwrite:
-            raise FileExistsError(f"{path} exists; pass overwrite=True (or --force) to replace it")
+            raise FileExistsError(f"{path} exists; not replacing it (overwrite=True replaces it)")
         path.write_text(self.to_toml_string(), encoding="utf-8")
         return path
 
@@ -665,4 +695,9 @@ def load_sensor(source: str | Path | SensorSpec | None = None) -> SensorSpec:
     text = str(source)
     if text.removeprefix("fearing1990_") in PRESETS:
         return preset(text)
+    if not Path(text).exists():
+        raise SensorSpecError(
+            f"no preset or sensor file named {text!r}; presets: {', '.join(PRESETS)}, "
+            "or give the path of a sensor TOML file"
+        )
     return SensorSpec.from_toml(text)

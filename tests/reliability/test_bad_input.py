@@ -181,3 +181,27 @@ def test_interruption_leaves_nothing_and_the_rerun_works(tmp_path, command):
     if process.returncode != 0:
         assert rerun.returncode == 0, rerun.stderr
         assert out.exists()
+
+
+def test_import_and_locate_without_a_writable_numba_cache():
+    """Item 11: no cache folder Numba can write (read-only install, read-only $HOME).
+
+    As root every folder is writable, so the condition is made the way Numba sees it:
+    no cache locator accepts the source file. Before the fix this was
+    ``RuntimeError: cannot cache function`` at ``import tactsense``.
+    """
+    code = (
+        "import numba.core.caching as c\n"
+        "c.CacheImpl._locator_classes = []\n"
+        "import numpy as np, tactsense as ts\n"
+        "from tactsense.simulate import repeated_load\n"
+        "spec = ts.fearing1990_initial()\n"
+        "rec = ts.simulate(spec, repeated_load(spec, repeats=2), rng=1)\n"
+        "est = ts.locate(rec.frames, spec, baseline=rec.frames[0])\n"
+        "print(int(np.count_nonzero(np.isfinite(est.force_n) & (est.force_n > 0.1))))\n"
+    )
+    result = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=300
+    )
+    assert result.returncode == 0, result.stderr
+    assert int(result.stdout.strip()) > 0

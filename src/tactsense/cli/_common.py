@@ -13,6 +13,7 @@ from typing import Annotated, NoReturn
 import numpy as np
 import typer
 from rich.console import Console
+from rich.markup import escape
 
 from tactsense._validation import TactsenseInputError
 
@@ -77,7 +78,8 @@ def guarded(function):
 
 def fail(message: str) -> NoReturn:
     """Print ``error: message`` and leave with exit status 2 (bad input)."""
-    console.print(f"[bold red]error:[/] {message}")
+    # the message is text, not markup ("[array]" must survive), and one line however long
+    console.print(f"[bold red]error:[/] {escape(message)}", soft_wrap=True)
     raise typer.Exit(code=2)
 
 

@@ -12,13 +12,13 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from tactsense._jit import jit
 
 _TAYLOR = 1e-4
 SKEW_OFFSETS = np.arange(1, 9) * 0.25  # tactel: 0.25 ... 2.0
 
 
-@njit(cache=True, inline="always")
+@jit(inline="always")
 def _axis_weights(u, n, periodic, cos_i, sin_i, k0, k1, k2):
     """Kernel weights and derivatives at fractional position u for samples 0..n-1.
 
@@ -68,14 +68,14 @@ def _axis_weights(u, n, periodic, cos_i, sin_i, k0, k1, k2):
         k2[i] = d2s * w + 2.0 * ds * dw + s * d2w
 
 
-@njit(cache=True)
+@jit()
 def _trig_table(n):
     omega = 2.0 * math.pi / (n - 1)
     index = np.arange(-n, 2 * n)
     return np.cos(omega * index), np.sin(omega * index)
 
 
-@njit(cache=True)
+@jit()
 def locate_frames(z, valid, periodic, first_row, tolerance, max_iterations, max_step):
     """Peak, Newton steps, convergence, summed deflection, skew and second maximum per frame.
 
@@ -283,7 +283,7 @@ def locate_frames(z, valid, periodic, first_row, tolerance, max_iterations, max_
     return row, col, value, iterations, converged, summed, skew, second
 
 
-@njit(cache=True)
+@jit()
 def prepare_frames(frames, baseline, unusable, full_scale, nan_flag, saturated_flag, dead_flag):
     """Eq. 4 deflection, per-frame flags and the largest tactel, in one pass.
 

@@ -10,28 +10,28 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from tactsense._jit import jit
 
 
-@njit(cache=True, inline="always", fastmath=True)
+@jit(inline="always", fastmath=True)
 def _g_normal(x, d, E, nu):
     return -((1.0 + nu) * x * d / (x * x + d * d) + (1.0 - nu) * math.atan2(x, d)) / (math.pi * E)
 
 
-@njit(cache=True, inline="always", fastmath=True)
+@jit(inline="always", fastmath=True)
 def _g_tangential(x, d, E, nu):
     r2 = x * x + d * d
     return ((1.0 + nu) * d * d / r2 + nu * math.log(r2 / (d * d))) / (math.pi * E)
 
 
-@njit(cache=True, inline="always", fastmath=True)
+@jit(inline="always", fastmath=True)
 def _ring_cumulative(s, flex):
     u = abs(s) / flex
     value = 0.5 * (1.0 - math.exp(-u) * math.cos(u))
     return value if s >= 0 else -value
 
 
-@njit(cache=True, fastmath=True)
+@jit(fastmath=True)
 def probe_frames(
     row_x,
     row_depth,
