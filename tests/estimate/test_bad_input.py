@@ -35,6 +35,14 @@ def test_saturated_and_dead_tactels_are_flagged(initial, frames):
     bad[1, 6, 6] = 0
     est = ts.locate(bad, initial, baseline=baseline)
     assert est.flags[0] & Flag.SATURATED and est.flags[1] & Flag.DEAD_TACTEL
+    # a saturated frame gives no force (a lower bound only), but still a position
+    assert np.isnan(est.force_n[0]) and np.isfinite(est.force_n[1])
+    assert np.isfinite(est.row[0]) and np.isfinite(est.axial_mm[0])
+    from tactsense.estimate.realtime import RealTimeLocator
+
+    locator = RealTimeLocator(initial, baseline)
+    contact = locator(bad[0])
+    assert contact.flags & Flag.SATURATED and np.isnan(contact.force_n)
     dead = np.zeros((8, 8), bool)
     dead[2, 2] = True
     est = ts.locate(counts[-1:], initial, baseline=baseline, dead=dead)

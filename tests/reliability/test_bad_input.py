@@ -66,6 +66,70 @@ BAD_OPTIONS = [
     ("reproduce --sensor bogus --out OUT", "bogus"),
 ]
 
+def _bad_files(folder):
+    """Files that are wrong in content, each made from a good one."""
+    import json
+
+    import h5py
+    import numpy as np
+
+    result = runner.invoke(
+        app, ["calibrate", str(folder / "rec.h5"), "--out", str(folder / "good.json")]
+    )
+    assert result.exit_code == 0, result.output
+    good = json.loads((folder / "good.json").read_text())
+    for name, value in (("nan_gain", float("nan")), ("zero_gain", 0.0)):
+        data = json.loads(json.dumps(good))
+        data["gains"][4][3] = value
+        # json writes NaN as the bare word NaN, which Python's reader accepts
+        (folder / f"{name}.json").write_text(json.dumps(data))
+    data = json.loads(json.dumps(good))
+    data["baseline_counts"][2][2] = -5.0
+    (folder / "bad_baseline.json").write_text(json.dumps(data))
+    rec = ts.read_recording(folder / "rec.h5")
+    ts.write_recording(folder / "strings.h5", rec)
+    with h5py.File(folder / "strings.h5", "r+") as h5:
+        del h5["frames"]
+        h5["frames"] = np.full(rec.frames.shape, b"12", dtype="S2")
+    (folder / "empty.toml").write_text("")
+    (folder / "partial.toml").write_text("[array]\nspacing_axial_mm = 3.0\n")
+    (folder / "unknown.toml").write_text('extends = "initial"\n[array]\ncolz = 3\n')
+
+
+BAD_FILES = [
+    # (command line, what the message must say)
+    ("locate REC --calibration REC --out OUT", "not JSON text"),
+    ("locate REC --calibration DIR/nan_gain.json --out OUT", "gains of 1 tactel(s)"),
+    ("locate REC --calibration DIR/zero_gain.json --out OUT", "at (4, 3)"),
+    ("locate REC --calibration DIR/bad_baseline.json --out OUT", "baseline_counts of 1"),
+    ("live loop:// --calibration DIR/zero_gain.json", "not a positive finite number"),
+    ("locate DIR/strings.h5 --out OUT", "/frames holds |S2 values; expected numbers"),
+    ("info DIR/strings.h5", "expected numbers"),
+    ("sensor check DIR/empty.toml", "no sections ([array]"),
+    ("sensor check DIR/partial.toml", "[elastic] is missing"),
+    ("sensor check DIR/unknown.toml", "unknown key 'colz' in [array]"),
+    ("simulate --sensor DIR/partial.toml --out OUT", "[body] is missing"),
+    ("simulate --sensor bogus --out OUT", "presets: initial, improved"),
+    ("design bound --sensor bogus", "presets: initial, improved"),
+]
+
+
+@pytest.mark.parametrize("line, names", BAD_FILES, ids=[line for line, _ in BAD_FILES])
+def test_bad_files(workspace, line, names):
+    if not (workspace / "strings.h5").exists():
+        _bad_files(workspace)
+    out = workspace / "never_written.out"
+    args = (
+        line.replace("REC", str(workspace / "rec.h5"))
+        .replace("OUT", str(out))
+        .replace("DIR", str(workspace))
+        .split()
+    )
+    result = runner.invoke(app, args)
+    _check(result, names)
+    assert not out.exists()
+
+
 BAD_OUTPUTS = {
     "simulate": "simulate --out {out}",
     "simulate --plot": "simulate --out {ok}/s.h5 --plot {out}",

@@ -305,8 +305,12 @@ def live(
     if out is not None:
         check_output(out, force)
     try:
+        # the calibration file is checked before the line is opened; whether it belongs
+        # to the device's sensor can only be checked once the device has said which
+        cal = None if calibration is None else Calibration.load(calibration)
         reader = _open_reader(source, sensor, timeout, start=False)
-        cal = None if calibration is None else Calibration.load(calibration, reader.sensor)
+        if cal is not None:
+            cal.check_sensor(reader.sensor)
         locator = LiveLocator(
             reader.sensor,
             calibration=cal,

@@ -405,6 +405,11 @@ class Calibration:
             data = json.loads(path.read_text(encoding="utf-8"))
         except OSError as error:
             raise CalibrationError(f"cannot read calibration {path}: {error.strerror}") from None
+        except UnicodeDecodeError:
+            raise CalibrationError(
+                f"{path} is not a tactsense calibration: not JSON text (a calibration is the "
+                ".json file that `tactsense calibrate` writes)"
+            ) from None
         except json.JSONDecodeError as error:
             raise CalibrationError(f"{path} is not valid JSON ({error})") from None
         if not isinstance(data, dict) or data.get("format") != FORMAT:
@@ -435,6 +440,16 @@ class Calibration:
         for name in ("gains", "baseline", "dead", "weak", "noisy"):
             if getattr(calibration, name).shape != shape:
                 raise CalibrationError(f"{path}: {name} has the wrong shape, expected {shape}")
+        used = ~calibration.excluded
+        for name, values in (("gains", calibration.gains), ("baseline_counts", calibration.baseline)):
+            bad = used & ~(np.isfinite(values) & (values > 0))
+            if bad.any():
+                where = ", ".join(f"({r}, {c})" for r, c in np.argwhere(bad)[:8])
+                raise CalibrationError(
+                    f"{path}: {name} of {int(bad.sum())} tactel(s) in use is not a positive "
+                    f"finite number, e.g. at {where}; expected > 0 (mark such tactels dead, "
+                    "or calibrate again)"
+                )
         if sensor is not None:
             calibration.check_sensor(sensor)
         return calibration

@@ -35,7 +35,8 @@ class Estimates:
     peak_deflection: np.ndarray
     """Interpolated fractional deflection at the peak [-]."""
     force_n: np.ndarray
-    """Total normal force from the integral of the deflection [N]."""
+    """Total normal force from the integral of the deflection [N]; NaN in frames flagged
+    SATURATED (a clipped reading makes the integral a lower bound only)."""
     skew: np.ndarray
     """Skew index along the finger (eq. 63) [-]."""
     iterations: np.ndarray
@@ -172,6 +173,9 @@ def locate(
         MAX_STEP,
     )
     force = force_per_deflection(sensor) * summed
+    # a clipped reading understates its tactel's deflection, so the sum is only a lower
+    # bound: no number rather than a wrong one (the position is kept, flagged)
+    force[(flags & int(Flag.SATURATED)) != 0] = np.nan
     flags[touched & ~converged] |= int(Flag.NOT_CONVERGED)
     with np.errstate(invalid="ignore"):
         edge = (row < 0.5) | (row > rows - 1.5)

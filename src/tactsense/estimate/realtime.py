@@ -148,7 +148,7 @@ class RealTimeLocator:
             self._axial(r),
             angle,
             float(value[0]),
-            self._force * float(summed[0]),
+            float("nan") if flag & int(Flag.SATURATED) else self._force * float(summed[0]),
             float(skew[0]),
             int(iterations[0]),
             bool(converged[0]),

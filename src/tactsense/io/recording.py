@@ -265,6 +265,12 @@ def read_recording(path: str | Path) -> Recording:
             sensor = SensorSpec.from_toml_string(str(h5.attrs["sensor_toml"]))
         except (KeyError, SensorSpecError) as error:
             raise RecordingError(f"{path}: sensor description unreadable: {error}") from None
+        for name in ("frames", "time", "sample_offset", "sequence", "host_time"):
+            if name in h5 and h5[name].dtype.kind not in "uif":
+                raise RecordingError(
+                    f"{path}: /{name} holds {h5[name].dtype} values; expected numbers "
+                    "(counts or fractional deflections for /frames, seconds for times)"
+                )
         per_frame = [
             h5[name].shape[0]
             for name in ("frames", "time", "sequence", "host_time")
