@@ -79,7 +79,7 @@ def test_simulate_help_explains_every_option():
 
 def test_bad_inputs_give_clear_errors(tmp_path):
     bad = tmp_path / "bad.toml"
-    bad.write_text("[array]\nspacing_axial_mm = -1\n")
+    bad.write_text('extends = "initial"\n[array]\nspacing_axial_mm = -1\n')
     result = runner.invoke(app, ["simulate", "--sensor", str(bad), "--out", str(tmp_path / "x.h5")])
     assert result.exit_code == 2 and "spacing_axial_mm must be positive" in plain(result.output)
     result = runner.invoke(

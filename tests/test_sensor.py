@@ -52,7 +52,8 @@ def test_to_toml_never_overwrites(initial, tmp_path):
 
 def test_custom_sensor_from_partial_toml():
     spec = SensorSpec.from_toml_string(
-        'name = "mine"\nextends = "initial"\n[array]\nspacing_axial_mm = 3.0\n[elastic]\neffective_depth_mm = 2.5\n'
+        'name = "mine"\nextends = "initial"\n'
+        "[array]\nspacing_axial_mm = 3.0\n[elastic]\neffective_depth_mm = 2.5\n"
     )
     assert spec.name == "mine"
     assert spec.array.spacing_axial_mm == 3.0 and spec.elastic.effective_depth_mm == 2.5
@@ -101,7 +102,9 @@ def test_missing_keys_are_an_error_unless_a_preset_is_extended(text, message):
 
 
 def test_extends_takes_the_rest_from_the_preset():
-    spec = SensorSpec.from_toml_string('extends = "improved"\n[elastic]\neffective_depth_mm = 2.0\n')
+    spec = SensorSpec.from_toml_string(
+        'extends = "improved"\n[elastic]\neffective_depth_mm = 2.0\n'
+    )
     expected = ts.fearing1990_improved().replace(elastic__effective_depth_mm=2.0)
     assert spec.array == expected.array and spec.elastic == expected.elastic
     assert spec.flaws == expected.flaws and spec.rings == expected.rings

@@ -48,6 +48,12 @@ BAD_OPTIONS = [
     ("simulate --repeats 0 --out OUT", "--repeats"),
     ("simulate --increment 0 --out OUT", "--increment"),
     ("simulate --row -1 --out OUT", "--row"),
+    ("simulate --scenario knife-edge --force-g 10 --out OUT", "--force-g does not apply"),
+    ("simulate --scenario knife-edge --dwell-s 1 --lift-s 1 --out OUT", "--dwell-s, --lift-s"),
+    ("simulate --scenario calibration --row 2 --out OUT", "--row does not apply"),
+    ("simulate --scenario sweep-around --col 2 --out OUT", "--col does not apply"),
+    ("simulate --repeats 5 --out OUT", "which uses --col, --force-g"),
+    ("emulate --scenario calibration --lift-s 1", "--lift-s does not apply"),
     ("locate REC --threshold -1 --out OUT", "--threshold"),
     ("locate REC --threshold nan --out OUT", "--threshold"),
     ("locate REC --baseline-frames 0 --out OUT", "--baseline-frames"),
@@ -65,6 +71,7 @@ BAD_OPTIONS = [
     ("live loop:// --baseline-frames 0", "--baseline-frames"),
     ("reproduce --sensor bogus --out OUT", "bogus"),
 ]
+
 
 def _bad_files(folder):
     """Files that are wrong in content, each made from a good one."""
@@ -220,31 +227,65 @@ def test_csv_time_keeps_full_precision(tmp_path):
     np.testing.assert_array_equal(written, late)
 
 
-@pytest.mark.parametrize("command", ["simulate", "locate", "reproduce"])
-def test_interruption_leaves_nothing_and_the_rerun_works(tmp_path, command):
+INTERRUPTIONS = [
+    # (command, signal, seconds after start): 0.4 s lands in the imports, 2.5 s in the work
+    ("simulate", signal.SIGINT, 2.5),
+    ("locate", signal.SIGINT, 2.5),
+    ("reproduce", signal.SIGINT, 2.5),
+    ("simulate", signal.SIGINT, 0.4),
+    ("reproduce", signal.SIGINT, 0.4),
+    ("simulate", signal.SIGKILL, 3.0),
+    ("locate", signal.SIGKILL, 2.5),
+    ("reproduce", signal.SIGKILL, 3.0),
+]
+
+
+@pytest.mark.parametrize(
+    "command, sent, delay",
+    INTERRUPTIONS,
+    ids=[f"{c}-{s.name}-{d}s" for c, s, d in INTERRUPTIONS],
+)
+def test_interruption_leaves_nothing_and_the_rerun_works(tmp_path, command, sent, delay):
+    import dataclasses
+
+    import numpy as np
+
     spec = ts.fearing1990_initial()
     rec = tmp_path / "rec.h5"
-    ts.write_recording(rec, ts.simulate(spec, ts.repeated_load(spec, repeats=400), rng=0))
+    short = ts.simulate(spec, ts.repeated_load(spec, repeats=40), rng=0)
+    # 300,000 frames: several seconds of locate, so the signal lands in its work
+    tiles = -(-300_000 // len(short.frames))
+    frames = np.tile(short.frames, (tiles, 1, 1))
+    period = spec.scan_period_s
+    long = dataclasses.replace(
+        short, frames=frames, time_s=np.arange(len(frames)) * period, truth={}
+    )
+    ts.write_recording(rec, long)
     out = tmp_path / ("out" if command == "reproduce" else "out.file")
     lines = {
         "simulate": ["simulate", "--scenario", "repeated", "--repeats", "3000", "--out", str(out)],
         "locate": ["locate", str(rec), "--out", str(out)],
         "reproduce": ["reproduce", "--quick", "--out", str(out)],
     }
-    cli = [sys.executable, "-m", "tactsense.cli", *lines[command]]
+    cli = [sys.executable, "-m", "tactsense_launcher", *lines[command]]
     process = subprocess.Popen(cli, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    time.sleep(2.5)  # start-up is about 2 s: the work is under way
-    process.send_signal(signal.SIGINT)
+    time.sleep(delay)
+    process.send_signal(sent)
     _, err = process.communicate(timeout=60)
-    assert "Traceback" not in err
+    assert "Traceback" not in err and "Exception ignored" not in err, err
     if process.returncode != 0:  # interrupted in time: nothing at the final name
-        assert process.returncode == 1 and "interrupted" in err
+        if sent == signal.SIGINT:
+            assert process.returncode == 1 and "interrupted" in err
+            assert not [p for p in os.listdir(tmp_path) if ".partial" in p]
+        else:
+            assert process.returncode == -signal.SIGKILL
         assert not out.exists()
-    assert not [p for p in os.listdir(tmp_path) if ".partial" in p]
     rerun = subprocess.run(cli, capture_output=True, text=True, timeout=300)
     if process.returncode != 0:
         assert rerun.returncode == 0, rerun.stderr
         assert out.exists()
+    # a killed run's temporary output is removed by the next run toward the same name
+    assert not [p for p in os.listdir(tmp_path) if ".partial" in p]
 
 
 def test_import_and_locate_without_a_writable_numba_cache():

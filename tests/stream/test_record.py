@@ -15,7 +15,7 @@ from tactsense.io.recording import RecordingWriter, read_recording
 from tactsense.physics.transduction import sample_offsets
 from tactsense.stream import LOSS_KINDS
 
-CLI = [sys.executable, "-m", "tactsense.cli"]
+CLI = [sys.executable, "-m", "tactsense_launcher"]
 
 
 def _emulator(*options):

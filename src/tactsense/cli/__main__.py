@@ -1,5 +1,5 @@
 """``python -m tactsense.cli``: the same as the ``tactsense`` command."""
 
-from tactsense.cli.app import main
+from tactsense_launcher import main
 
 main()

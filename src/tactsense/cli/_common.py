@@ -105,12 +105,40 @@ def check_output(path: Path, force: bool, *, what: str = "output") -> Path:
     return path
 
 
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's process
+        return True
+    return True
+
+
+def remove_stale_partials(folder: Path, prefix: str, suffix: str) -> None:
+    """Remove ``{prefix}.{pid}.partial{suffix}`` left in ``folder`` by a killed run.
+
+    A run killed outright (SIGKILL, power loss) cannot clean up its temporary output;
+    the next run toward the same name removes it, if the process that wrote it is gone.
+    """
+    import shutil
+
+    for leftover in folder.glob(f"{prefix}.*.partial{suffix}"):
+        pid = leftover.name[len(prefix) + 1 :].split(".", 1)[0]
+        if pid.isdigit() and not _alive(int(pid)):
+            if leftover.is_dir():
+                shutil.rmtree(leftover, ignore_errors=True)
+            else:
+                leftover.unlink(missing_ok=True)
+
+
 @contextmanager
 def atomic_output(path: Path):
     """Yield a temporary name beside ``path``; move it into place only if the block ends
     without an exception (Ctrl-C included), else remove it."""
     path = Path(path)
     # hidden, unique, and with the final suffix (matplotlib picks the format from it)
+    remove_stale_partials(path.parent, f".{path.stem}", path.suffix)
     temporary = path.with_name(f".{path.stem}.{os.getpid()}.partial{path.suffix}")
     try:
         yield temporary

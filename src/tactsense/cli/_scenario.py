@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
+from tactsense._validation import TactsenseInputError
 from tactsense.cli._common import console
 from tactsense.io.recording import Recording
 from tactsense.physics.contact import grams_force
@@ -35,53 +36,94 @@ ScenarioOption = Annotated[
     ),
 ]
 RowOption = Annotated[
-    int,
+    int | None,
     typer.Option(
         min=0,
         max=254,
         help="Row of the tactel: fixes the axial position of a sweep "
-        "around, or the tactel loaded by 'repeated' (0 = tip row).",
+        "around, or the tactel loaded by 'repeated' or passed by 'knife-edge' "
+        "(0 = tip row) [default: 4].",
     ),
 ]
 ColOption = Annotated[
-    int,
+    int | None,
     typer.Option(
         min=0,
         max=254,
         help="Column of the tactel: fixes the angle of a sweep along the "
-        "finger, or the tactel loaded by 'repeated'.",
+        "finger, or the tactel loaded by 'repeated' or passed by 'knife-edge' [default: 0].",
     ),
 ]
 ForceGOption = Annotated[
-    float, typer.Option(min=1e-3, max=1e5, help="Probe load in grams-force (the paper's unit) [g].")
+    float | None,
+    typer.Option(
+        min=1e-3,
+        max=1e5,
+        help="Probe load in grams-force (the paper's unit) [g] [default: 50].",
+    ),
 ]
 IncrementOption = Annotated[
     float | None,
     typer.Option(
         min=1e-3,
         max=90.0,
-        help="Step between probe positions: mm for sweep-axial (default 0.6), "
+        help="Step between probe positions: mm for sweep-axial, calibration and "
+        "knife-edge (default 0.6), "
         "deg for sweep-around (default 3).",
     ),
 ]
 DwellOption = Annotated[
-    float,
+    float | None,
     typer.Option(
-        min=1e-3, max=3600.0, help="Time the probe is held at each position or application [s]."
+        min=1e-3,
+        max=3600.0,
+        help="Time the probe is held at each position or application [s] [default: 0.5].",
     ),
 ]
 LiftOption = Annotated[
-    float,
+    float | None,
     typer.Option(
         min=0.0,
         max=3600.0,
         help="Time the probe is lifted between positions or applications "
-        "(0 = it slides from one to the next in a sweep) [s].",
+        "(0 = it slides from one to the next in a sweep) [s] [default: 0 in a sweep; "
+        "for 'repeated' the longer of this and --dwell-s].",
     ),
 ]
 RepeatsOption = Annotated[
-    int, typer.Option(min=1, max=1_000_000, help="Applications for 'repeated'.")
+    int | None,
+    typer.Option(min=1, max=1_000_000, help="Applications for 'repeated' [default: 100]."),
 ]
+
+DEFAULTS = {"row": 4, "col": 0, "force_g": 50.0, "dwell_s": 0.5, "lift_s": 0.0, "repeats": 100}
+"""The value of each scenario option the user did not give."""
+
+USES = {
+    ScenarioKind.sweep_axial: ("col", "force_g", "increment", "dwell_s", "lift_s"),
+    ScenarioKind.sweep_around: ("row", "force_g", "increment", "dwell_s", "lift_s"),
+    ScenarioKind.repeated: ("row", "col", "force_g", "dwell_s", "lift_s", "repeats"),
+    ScenarioKind.calibration: ("force_g", "increment"),
+    ScenarioKind.knife: ("row", "col", "increment"),
+}
+"""The options each scenario reads; any other scenario option given is an error."""
+
+
+def _flag(name: str) -> str:
+    return "--" + name.replace("_", "-")
+
+
+def check_scenario_options(scenario: ScenarioKind, given: dict) -> dict:
+    """Refuse options the scenario does not use; fill in the defaults of the rest."""
+    unused = [name for name, value in given.items() if value is not None]
+    unused = [name for name in unused if name not in USES[scenario]]
+    if unused:
+        raise TactsenseInputError(
+            f"{', '.join(_flag(n) for n in unused)} does not apply to --scenario "
+            f"{scenario.value}, which uses {', '.join(_flag(n) for n in USES[scenario])}"
+        )
+    return {name: DEFAULTS.get(name) if value is None else value for name, value in given.items()}
+
+
 FlawsOption = Annotated[
     str,
     typer.Option(
@@ -99,17 +141,35 @@ def build_scenario(
     spec: SensorSpec,
     scenario: ScenarioKind,
     *,
-    row: int,
-    col: int,
-    force_g: float,
+    row: int | None,
+    col: int | None,
+    force_g: float | None,
     increment: float | None,
-    dwell_s: float,
-    lift_s: float,
-    repeats: int,
+    dwell_s: float | None,
+    lift_s: float | None,
+    repeats: int | None,
 ):
-    """The :class:`~tactsense.simulate.Scenario` the command-line options describe."""
+    """The :class:`~tactsense.simulate.Scenario` the command-line options describe.
+
+    Options left as None take :data:`DEFAULTS`; an option given to a scenario that does
+    not use it (:data:`USES`) is a :class:`TactsenseInputError`.
+    """
     from tactsense.simulate import calibration_sweep, knife_edge_sweep, probe_sweep, repeated_load
 
+    values = check_scenario_options(
+        scenario,
+        dict(
+            row=row,
+            col=col,
+            force_g=force_g,
+            increment=increment,
+            dwell_s=dwell_s,
+            lift_s=lift_s,
+            repeats=repeats,
+        ),
+    )
+    row, col, force_g = values["row"], values["col"], values["force_g"]
+    dwell_s, lift_s, repeats = values["dwell_s"], values["lift_s"], values["repeats"]
     force_n = grams_force(force_g)
     if scenario is ScenarioKind.calibration:
         return calibration_sweep(spec, force_n=force_n, increment=increment or 0.6)

@@ -13,7 +13,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 
 from tactsense._validation import TactsenseInputError
-from tactsense.cli._common import SensorOption, console, fail, new_group
+from tactsense.cli._common import SensorOption, console, fail, new_group, remove_stale_partials
 from tactsense.sensor import load_sensor
 
 app = new_group("The paper's experiments on the twin.")
@@ -62,6 +62,7 @@ def reproduce(
         if not os.access(parent, os.W_OK | os.X_OK):
             fail(f"cannot write the report: folder {parent} is not writable")
         # a new report is built in a hidden folder and renamed into place when complete
+        remove_stale_partials(parent, f".{out.name}", "")
         target = out if out.exists() else parent / f".{out.name}.{os.getpid()}.partial"
         with Progress(
             TextColumn("{task.description:<36}"),

@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+
 from tactsense._jit import jit
 
 _TAYLOR = 1e-4

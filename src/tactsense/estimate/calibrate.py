@@ -441,7 +441,8 @@ class Calibration:
             if getattr(calibration, name).shape != shape:
                 raise CalibrationError(f"{path}: {name} has the wrong shape, expected {shape}")
         used = ~calibration.excluded
-        for name, values in (("gains", calibration.gains), ("baseline_counts", calibration.baseline)):
+        checked = (("gains", calibration.gains), ("baseline_counts", calibration.baseline))
+        for name, values in checked:
             bad = used & ~(np.isfinite(values) & (values > 0))
             if bad.any():
                 where = ", ".join(f"({r}, {c})" for r, c in np.argwhere(bad)[:8])

@@ -9,6 +9,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from tactsense._signals import deferred_interrupts
 from tactsense._validation import TactsenseInputError, check_frames
 from tactsense.estimate._fast import locate_frames, prepare_frames
 from tactsense.estimate.deflection import Flag
@@ -135,15 +136,16 @@ def locate(
         if dead is not None:
             unusable = unusable | np.asarray(dead, dtype=bool)
         lead = frames.shape[:-2]
-        deflection, flags, peak_tactel = prepare_frames(
-            np.ascontiguousarray(frames, dtype=np.float64).reshape(-1, *sensor.shape),
-            np.where(unusable, 1.0, baseline),
-            unusable,
-            float(2**sensor.electronics.adc_bits - 1),
-            int(Flag.NAN_INPUT),
-            int(Flag.SATURATED),
-            int(Flag.DEAD_TACTEL),
-        )
+        with deferred_interrupts():
+            deflection, flags, peak_tactel = prepare_frames(
+                np.ascontiguousarray(frames, dtype=np.float64).reshape(-1, *sensor.shape),
+                np.where(unusable, 1.0, baseline),
+                unusable,
+                float(2**sensor.electronics.adc_bits - 1),
+                int(Flag.NAN_INPUT),
+                int(Flag.SATURATED),
+                int(Flag.DEAD_TACTEL),
+            )
         deflection = deflection.reshape(*lead, *sensor.shape)
         flags = flags.reshape(lead)
     else:
@@ -163,15 +165,16 @@ def locate(
     touched = peak_tactel >= threshold
     flags[~touched] |= int(Flag.NO_CONTACT)
 
-    row, col, value, iterations, converged, summed, skew, second = locate_frames(
-        np.ascontiguousarray(flat, dtype=np.float64),
-        touched,
-        periodic,
-        1 if sensor.array.tip_row else 0,
-        TOLERANCE,
-        MAX_ITERATIONS,
-        MAX_STEP,
-    )
+    with deferred_interrupts():
+        row, col, value, iterations, converged, summed, skew, second = locate_frames(
+            np.ascontiguousarray(flat, dtype=np.float64),
+            touched,
+            periodic,
+            1 if sensor.array.tip_row else 0,
+            TOLERANCE,
+            MAX_ITERATIONS,
+            MAX_STEP,
+        )
     force = force_per_deflection(sensor) * summed
     # a clipped reading understates its tactel's deflection, so the sum is only a lower
     # bound: no number rather than a wrong one (the position is kept, flagged)

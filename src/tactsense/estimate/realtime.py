@@ -6,6 +6,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from tactsense._signals import deferred_interrupts
 from tactsense._validation import TactsenseInputError, check_frames
 from tactsense.estimate._fast import locate_frames, prepare_frames
 from tactsense.estimate.deflection import Flag
@@ -109,28 +110,30 @@ class RealTimeLocator:
             raise TactsenseInputError(
                 f"frame has shape {frame.shape}; expected {self.sensor.shape}"
             )
-        deflection, flags, peak = prepare_frames(
-            frame.reshape(self._shape),
-            self._baseline,
-            self._unusable,
-            self._full_scale,
-            int(Flag.NAN_INPUT),
-            int(Flag.SATURATED),
-            int(Flag.DEAD_TACTEL),
-        )
+        with deferred_interrupts():
+            deflection, flags, peak = prepare_frames(
+                frame.reshape(self._shape),
+                self._baseline,
+                self._unusable,
+                self._full_scale,
+                int(Flag.NAN_INPUT),
+                int(Flag.SATURATED),
+                int(Flag.DEAD_TACTEL),
+            )
         flag = int(flags[0])
         if not peak[0] >= self._threshold:
             nan = float("nan")
             return Contact(nan, nan, nan, nan, nan, nan, nan, 0, False, flag | int(Flag.NO_CONTACT))
-        row, col, value, iterations, converged, summed, skew, second = locate_frames(
-            deflection,
-            self._valid,
-            self._periodic,
-            self._first_row,
-            TOLERANCE,
-            MAX_ITERATIONS,
-            MAX_STEP,
-        )
+        with deferred_interrupts():
+            row, col, value, iterations, converged, summed, skew, second = locate_frames(
+                deflection,
+                self._valid,
+                self._periodic,
+                self._first_row,
+                TOLERANCE,
+                MAX_ITERATIONS,
+                MAX_STEP,
+            )
         r, c = float(row[0]), float(col[0])
         rows, cols = self.sensor.shape
         if not converged[0]:

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from tactsense._signals import deferred_interrupts
 from tactsense.physics._fast import probe_frames
 from tactsense.physics.contact import Patches, Probe, contacts_to_patches, profile_cdf
 from tactsense.physics.halfplane import (
@@ -263,20 +264,21 @@ def probe_response(
     )
     u = np.linspace(-1.0, 1.0, _CELLS + 1)
     latitude = np.clip(-spec.row_axial_mm / spec.radius_mm, 0.0, np.pi / 2)
-    return probe_frames(
-        spec.row_axial_mm * 1e-3,
-        spec.row_depth_mm * 1e-3,
-        spec.ring_radius_mm * np.cos(latitude),
-        np.deg2rad(spec.col_angle_deg),
-        E,
-        nu,
-        spec.ring_flexural_length_mm * 1e-3,
-        spec.radius_mm,
-        np.ascontiguousarray(axial.ravel()),
-        np.ascontiguousarray(angle.ravel()),
-        np.ascontiguousarray(force.ravel() * np.cos(alpha_rad)),
-        half,
-        np.ascontiguousarray(np.tan(alpha_rad)),
-        u,
-        np.diff(profile_cdf(u, "parabolic")),
-    )
+    with deferred_interrupts():
+        return probe_frames(
+            spec.row_axial_mm * 1e-3,
+            spec.row_depth_mm * 1e-3,
+            spec.ring_radius_mm * np.cos(latitude),
+            np.deg2rad(spec.col_angle_deg),
+            E,
+            nu,
+            spec.ring_flexural_length_mm * 1e-3,
+            spec.radius_mm,
+            np.ascontiguousarray(axial.ravel()),
+            np.ascontiguousarray(angle.ravel()),
+            np.ascontiguousarray(force.ravel() * np.cos(alpha_rad)),
+            half,
+            np.ascontiguousarray(np.tan(alpha_rad)),
+            u,
+            np.diff(profile_cdf(u, "parabolic")),
+        )
