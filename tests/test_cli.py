@@ -250,7 +250,8 @@ def test_calibration_workflow_from_the_command_line_alone(tmp_path):
     for args in (
         ["--scenario", "calibration", "--increment", "1.2", "--out", str(sweep)],
         ["--scenario", "knife-edge", "--out", str(knife)],
-        ["--scenario", "repeated", "--repeats", "3", "--dwell-s", "1", "--out", str(steps)],
+        # creep of 15 s needs steps of seconds: 3 x 1 s leaves it unidentifiable (refused)
+        ["--scenario", "repeated", "--repeats", "5", "--dwell-s", "3", "--out", str(steps)],
     ):
         result = runner.invoke(app, ["simulate", *args])
         assert result.exit_code == 0, result.output

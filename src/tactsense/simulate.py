@@ -267,11 +267,13 @@ def calibration_sweep(
     """The section 3.1 calibration: a 50-g probe swept along every column in turn.
 
     Each sweep runs the length of the cylinder at the angle of one wired
-    column; the probe is lifted for a second between columns.
+    column, starting over the tip row when the finger has one (so that every
+    tactel is reached); the probe is lifted for a second between columns.
     """
     force_n = grams_force(50.0) if force_n is None else check_positive(force_n, "force_n")
     steps = _settle(settle_s)
-    positions = np.arange(0.0, spec.body.cylinder_length_mm + 1e-9, increment)
+    start = float(spec.row_axial_mm[0]) if spec.array.tip_row else 0.0
+    positions = np.arange(start, spec.body.cylinder_length_mm + 1e-9, increment)
     for col, angle in enumerate(spec.col_angle_deg):
         steps += [
             Step((Probe(float(p), float(angle), force_n),), dwell_s, f"col {col}")

@@ -81,7 +81,8 @@ def _bad_files(folder):
     import numpy as np
 
     result = runner.invoke(
-        app, ["calibrate", str(folder / "rec.h5"), "--out", str(folder / "good.json")]
+        app,
+        ["calibrate", str(folder / "rec.h5"), "--partial", "--out", str(folder / "good.json")],
     )
     assert result.exit_code == 0, result.output
     good = json.loads((folder / "good.json").read_text())
@@ -98,6 +99,9 @@ def _bad_files(folder):
     with h5py.File(folder / "strings.h5", "r+") as h5:
         del h5["frames"]
         h5["frames"] = np.full(rec.frames.shape, b"12", dtype="S2")
+    for name, scenario in (("knife", "knife-edge"), ("steps", "repeated")):
+        args = ["simulate", "--scenario", scenario, "--out", str(folder / f"{name}.h5")]
+        assert runner.invoke(app, args).exit_code == 0
     (folder / "empty.toml").write_text("")
     (folder / "partial.toml").write_text("[array]\nspacing_axial_mm = 3.0\n")
     (folder / "unknown.toml").write_text('extends = "initial"\n[array]\ncolz = 3\n')
@@ -105,6 +109,14 @@ def _bad_files(folder):
 
 BAD_FILES = [
     # (command line, what the message must say)
+    ("calibrate REC --out OUT", "the sweep reached only 7 of 64 tactels"),
+    ("calibrate REC --partial --steps REC --out OUT", "delayed fraction stopped at its bound"),
+    ("calibrate REC --partial --knife DIR/knife.h5 --col 1 --out OUT", "nu 0.500"),
+    (
+        "calibrate REC --partial --knife DIR/steps.h5 --out OUT",
+        "distinct position(s); a knife-edge fit",
+    ),
+    ("calibrate REC --partial --steps DIR/steps.h5 --col 3 --out OUT", "residual is"),
     ("locate REC --calibration REC --out OUT", "not JSON text"),
     ("locate REC --calibration DIR/nan_gain.json --out OUT", "gains of 1 tactel(s)"),
     ("locate REC --calibration DIR/zero_gain.json --out OUT", "at (4, 3)"),

@@ -126,9 +126,22 @@ def calibrate(
     col: Annotated[
         int, typer.Option(min=0, max=254, help="Column of the tactel under --steps and --knife.")
     ] = 0,
+    partial: Annotated[
+        bool,
+        typer.Option(
+            "--partial",
+            help="Accept a sweep that leaves more than 10 % of the tactels uncalibrated "
+            "(they keep gain 1 and are listed in the JSON's notes).",
+        ),
+    ] = False,
     force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
 ) -> None:
-    """Build a calibration (gains, baseline, dead/weak/noisy tactels, creep, model fit)."""
+    """Build a calibration (gains, baseline, dead/weak/noisy tactels, creep, model fit).
+
+    A sweep that misses more than 10 % of the tactels, and a creep or knife-edge fit
+    that stops at a bound of its parameters or leaves a residual above 10 % of full
+    scale, is an error: such a calibration would be applied without anyone knowing.
+    """
     from tactsense.estimate import calibrate as cal
 
     try:
@@ -137,6 +150,15 @@ def calibrate(
         calibration = cal.calibrate_sweep(
             rec.frames, rec.sensor, baseline_frames=baseline_frames, probe_grams=probe_g
         )
+        uncalibrated = calibration.notes["uncalibrated_tactels"]
+        wired = int(np.prod(rec.sensor.shape))
+        if len(uncalibrated) > 0.1 * wired and not partial:
+            raise TactsenseInputError(
+                f"the sweep reached only {wired - len(uncalibrated)} of {wired} tactels "
+                f"({len(uncalibrated)} never deflected 1 %): sweep the probe along every "
+                "column (simulate --scenario calibration), or pass --partial to keep gain 1 "
+                "for the rest"
+            )
         if steps is not None:
             calibration.viscoelastic = _fit_steps(
                 read_recording(steps), rec.sensor, row, col, baseline_frames
@@ -160,6 +182,13 @@ def calibrate(
     table.add_row(
         "dead / weak / noisy",
         f"{calibration.dead.sum()} / {calibration.weak.sum()} / {calibration.noisy.sum()}",
+    )
+    missed = calibration.notes["uncalibrated_tactels"]
+    table.add_row(
+        "uncalibrated (gain 1)",
+        f"[bold red]{len(missed)} of {gains.size}: the sweep did not reach them[/]"
+        if missed
+        else "none",
     )
     if calibration.viscoelastic is not None:
         v = calibration.viscoelastic
@@ -194,7 +223,14 @@ def _fit_steps(rec, sensor, row, col, baseline_frames):
     if rec.sensor != sensor:
         raise TactsenseInputError("the steps recording comes from another sensor than the sweep")
     rec.sensor.check_tactel(row, col)
-    model, _, _ = cal.fit_viscoelastic_recording(rec, row, col, baseline_frames=baseline_frames)
+    model, _, rms = cal.fit_viscoelastic_recording(rec, row, col, baseline_frames=baseline_frames)
+    problems = cal.check_viscoelastic_fit(model, rms, rec.sensor.scan_period_s)
+    if problems:
+        raise TactsenseInputError(
+            f"the creep fit to tactel ({row}, {col}) of the --steps recording cannot be trusted: "
+            f"{'; '.join(problems)}. Is it a recording of force steps on that tactel "
+            "(simulate --scenario repeated)? Check --row and --col."
+        )
     return model
 
 
@@ -210,4 +246,21 @@ def _fit_knife(rec, sensor, row, col, baseline_frames):
         )
     signal = _deflection_of(rec, row, col, baseline_frames)
     last, steps = rec.last_loaded_frames(row, col)
-    return cal.fit_plane_stress(rec.truth["step_axial_mm"][steps], signal[last])
+    positions = np.asarray(rec.truth["step_axial_mm"])[steps]
+    # distinct to 0.1 mm: the positions carry the probe's placement jitter
+    distinct = np.unique(np.round(positions[np.isfinite(positions)], 1)).size
+    if distinct < 6:
+        raise TactsenseInputError(
+            f"the --knife recording loads the finger at {distinct} distinct position(s); a "
+            "knife-edge fit needs the edge stepped past the tactel (simulate --scenario "
+            "knife-edge)"
+        )
+    fit = cal.fit_plane_stress(positions, signal[last])
+    problems = cal.check_model_fit(fit)
+    if problems:
+        raise TactsenseInputError(
+            f"the knife-edge fit to tactel ({row}, {col}) cannot be trusted (depth "
+            f"{fit.depth_mm:.2f} mm, nu {fit.poisson_ratio:.3f}): {'; '.join(problems)}. "
+            "Is the edge stepped past that tactel? Check --row and --col."
+        )
+    return fit

@@ -27,6 +27,7 @@ from tactsense._validation import CalibrationError, check_frames
 from tactsense.estimate.creep import (
     Viscoelastic,
     compensate_viscoelastic,
+    creep_bounds,
     fit_viscoelastic,
     fit_viscoelastic_recording,
     load_schedule,
@@ -44,6 +45,8 @@ __all__ = [
     "Viscoelastic",
     "array_health",
     "calibrate_sweep",
+    "check_model_fit",
+    "check_viscoelastic_fit",
     "compensate_viscoelastic",
     "fit_plane_stress",
     "fit_viscoelastic",
@@ -259,11 +262,79 @@ def fit_plane_stress(positions_mm, response, *, youngs_modulus: float = 2.5e5) -
     fit = least_squares(
         lambda p: shape(p) - r,
         start,
-        bounds=([0.2, -0.99, x.min(), 0], [30.0, 0.5, x.max(), np.inf]),
+        bounds=(
+            [DEPTH_BOUNDS[0], NU_BOUNDS[0], x.min(), 0],
+            [DEPTH_BOUNDS[1], NU_BOUNDS[1], x.max(), np.inf],
+        ),
     )
     depth, nu, centre, amplitude = fit.x
     rms = 100 * float(np.sqrt(np.mean(fit.fun**2)) / r.max())
     return ModelFit(float(depth), float(nu), float(centre), float(amplitude), rms)
+
+
+DEPTH_BOUNDS = (0.2, 30.0)
+"""Depths a knife-edge fit may return [mm]."""
+NU_BOUNDS = (0.0, 0.5)
+"""Poisson's ratios a knife-edge fit may return [-]: rubber is 0 to 0.5."""
+MAX_FIT_RMS_PERCENT = 10.0
+"""A fit whose RMS residual exceeds this share of full scale describes another tactel,
+another load, or no contact at all [%]."""
+
+
+def _at(value: float, bound: float) -> bool:
+    return abs(value - bound) <= 1e-3 * max(1.0, abs(bound))
+
+
+def check_model_fit(fit: ModelFit) -> list[str]:
+    """Why a knife-edge fit cannot be trusted (empty if it can)."""
+    problems = []
+    for name, value, bounds, unit in (
+        ("depth", fit.depth_mm, DEPTH_BOUNDS, " mm"),
+        ("Poisson's ratio", fit.poisson_ratio, NU_BOUNDS, ""),
+    ):
+        for bound in bounds:
+            if _at(value, bound):
+                problems.append(f"{name} stopped at its bound {bound:g}{unit}")
+    if fit.rms_percent > MAX_FIT_RMS_PERCENT:
+        problems.append(
+            f"the residual is {fit.rms_percent:.1f} % of full scale (at most "
+            f"{MAX_FIT_RMS_PERCENT:g} % expected)"
+        )
+    return problems
+
+
+def check_viscoelastic_fit(model: Viscoelastic, rms: float, dt: float, fine: int = 16) -> list[str]:
+    """Why a creep fit cannot be trusted (empty if it can); ``rms`` as a share [-].
+
+    A fraction at its upper bound, or a time constant at a bound while its fraction is
+    more than 1 %, means the data did not hold the steps the model describes (a sweep
+    given as --steps, a tactel the load never reached). A fraction of 0 is allowed: a
+    finger may well show no creep.
+    """
+    problems = []
+    lower, upper = creep_bounds(dt, fine)
+    fractions = (
+        ("delayed fraction", model.delayed_fraction, upper[1]),
+        ("creep fraction", model.creep_fraction, upper[3]),
+    )
+    for name, value, bound in fractions:
+        if _at(value, bound):
+            problems.append(f"{name} stopped at its bound {bound:g}")
+    taus = (
+        ("delayed time constant", model.delayed_time_constant_s, model.delayed_fraction, 2),
+        ("creep time constant", model.creep_time_constant_s, model.creep_fraction, 4),
+    )
+    for name, tau, fraction, k in taus:
+        if fraction > 0.01:
+            for bound in (np.exp(lower[k]), np.exp(upper[k])):
+                if _at(np.log(tau), np.log(bound)):
+                    problems.append(f"{name} stopped at its bound {bound:.3g} s")
+    if 100 * rms > MAX_FIT_RMS_PERCENT:
+        problems.append(
+            f"the residual is {100 * rms:.1f} % of full scale "
+            f"(at most {MAX_FIT_RMS_PERCENT:g} % expected)"
+        )
+    return problems
 
 
 # ---- health of the array ------------------------------------------------------------
@@ -277,6 +348,7 @@ def array_health(
     nominal_counts: float = 2000.0,
     weak: float = 0.5,
     noisy: float = 4.0,
+    expected=None,
 ):
     """Sensitivity of every tactel and detection of dead, weak and noisy ones (Figs. 8-11).
 
@@ -292,6 +364,9 @@ def array_health(
         A tactel below this share of the median sensitivity is weak [-].
     noisy : float
         A tactel whose untouched noise exceeds this many times the median is noisy [-].
+    expected : ndarray, shape (rows, cols), optional
+        The model's peak deflection of each tactel (:func:`expected_peaks`); with it,
+        weakness is judged on measured over expected, not on the raw peak.
 
     Returns
     -------
@@ -306,7 +381,8 @@ def array_health(
         threshold = np.where(counts_change > 0, probe_grams / counts_change, np.inf)
     dead = (base.mean(axis=0) <= 0) | (peak <= 0)
     alive = ~dead
-    median_peak = np.median(peak[alive]) if alive.any() else 0.0
+    relative = peak if expected is None else peak / np.asarray(expected, dtype=float)
+    median_peak = np.median(relative[alive]) if alive.any() else 0.0
     noise = base.std(axis=0)
     # quantization alone gives 1/sqrt(12) counts; do not call a quiet array noisy
     floor = max(np.median(noise[alive]) if alive.any() else 0.0, 1 / np.sqrt(12))
@@ -314,7 +390,7 @@ def array_health(
         "threshold_g": threshold,
         "noise_counts": noise,
         "dead": dead,
-        "weak": alive & (peak < weak * median_peak),
+        "weak": alive & (relative < weak * median_peak),
         "noisy": alive & (noise > noisy * floor),
     }
 
@@ -475,6 +551,26 @@ class Calibration:
         return deflection, flags
 
 
+def expected_peaks(sensor: SensorSpec, probe_grams: float) -> np.ndarray:
+    """The model's deflection of every tactel under the probe centred on it [-].
+
+    The reference of the gains: a tactel's gain is its measured largest deflection over
+    this, so that where the finger's geometry alone makes a tactel respond less (the tip
+    row on the hemisphere, the rows at the ends of the cylinder) it is not called weak.
+    """
+    rows, cols = sensor.shape
+    force = probe_grams * 1e-3 * STANDARD_GRAVITY
+    contacts = [
+        (Probe(float(sensor.row_axial_mm[r]), float(sensor.col_angle_deg[c]), force),)
+        for r in range(rows)
+        for c in range(cols)
+    ]
+    frames = deflection_batch(sensor, contacts).reshape(rows, cols, rows, cols)
+    return frames[
+        np.arange(rows)[:, None], np.arange(cols), np.arange(rows)[:, None], np.arange(cols)
+    ]
+
+
 def calibrate_sweep(
     frames,
     sensor: SensorSpec,
@@ -516,18 +612,16 @@ def calibrate_sweep(
     base = frames[:baseline_frames]
     baseline = np.median(base, axis=0)
     deflection, _ = deflection_from_counts(frames[baseline_frames:], baseline, sensor)
-    middle = sensor.shape[0] // 2
-    probe = Probe(
-        float(sensor.row_axial_mm[middle]),
-        float(sensor.col_angle_deg[0]),
-        probe_grams * 1e-3 * STANDARD_GRAVITY,
-    )
-    reference = float(deflection_batch(sensor, [(probe,)])[0, middle, 0])
+    reference = expected_peaks(sensor, probe_grams)
     gains, peak, uncalibrated = gain_table(
         deflection, min_response=min_response, reference=reference
     )
     health = array_health(
-        peak, base, probe_grams=probe_grams, nominal_counts=float(np.median(baseline))
+        peak,
+        base,
+        probe_grams=probe_grams,
+        nominal_counts=float(np.median(baseline)),
+        expected=reference,
     )
     return Calibration(
         sensor_toml=sensor.to_toml_string(),

@@ -34,6 +34,14 @@ def _memory_response(u, dt, model: Viscoelastic):
     return y
 
 
+def creep_bounds(dt: float, fine: int = 16) -> tuple[list[float], list[float]]:
+    """Bounds of :func:`fit_viscoelastic`'s parameters (gain, a_d, log tau_d, a_c, log tau_c)."""
+    return (
+        [0.0, 0.0, float(np.log(dt / fine)), 0.0, float(np.log(0.5))],
+        [np.inf, 1.0, float(np.log(5.0)), 10.0, float(np.log(1000.0))],
+    )
+
+
 def fit_viscoelastic(signal, dt, loaded, *, fine: int = 16) -> tuple[Viscoelastic, float, float]:
     """Fit delayed elasticity and creep to a tactel's response to force steps.
 
@@ -76,14 +84,7 @@ def fit_viscoelastic(signal, dt, loaded, *, fine: int = 16) -> tuple[Viscoelasti
         return gain * _memory_response(u, dt / fine, model)[fine - 1 :: fine]
 
     start = [signal.max(), 0.3, np.log(0.05), 0.2, np.log(10.0)]
-    fit = least_squares(
-        lambda p: model_output(p) - signal,
-        start,
-        bounds=(
-            [0, 0, np.log(dt / fine), 0, np.log(0.5)],
-            [np.inf, 1, np.log(5.0), 10, np.log(1000.0)],
-        ),
-    )
+    fit = least_squares(lambda p: model_output(p) - signal, start, bounds=creep_bounds(dt, fine))
     gain, a_d, log_tau_d, a_c, log_tau_c = fit.x
     rms = float(np.sqrt(np.mean(fit.fun**2)) / np.abs(signal).max())
     return (
