@@ -111,3 +111,25 @@ def test_existing_directory_is_not_overwritten(report):
     with pytest.raises(FileExistsError, match="force"):
         reproduce(out, quick=True)
     assert (out / "results.json").read_text() == before
+
+
+def test_improved_finger_places_every_contact_on_its_array(tmp_path):
+    """Issue 10 item 12: the experiments once hard-coded the 45-deg finger's angles, so on
+    the improved finger (columns at -63..63 deg, none at 0 or 90 deg) Fig. 9's profile
+    was read off the array edge (superposition error 195 %) and Fig. 22's rod lay off the
+    array. Bounds: the same physics as on the initial finger, which gives 1-2 % (Fig. 9),
+    about 0.12 tactel (Figs. 23-25) and 6 % force error (Fig. 26)."""
+    from tactsense.reproduce._common import centre_angle, on_array
+    from tactsense.sensor import fearing1990_improved
+
+    spec = fearing1990_improved()
+    assert on_array(spec, 90.0) == centre_angle(spec) == -9.0  # nearest the middle
+    assert on_array(spec, 20.0) == 20.0
+    assert on_array(fearing1990_initial(), 90.0) == 90.0
+    out = tmp_path / "improved"
+    reproduce(out, quick=True, sensor=spec)
+    claims = json.loads((out / "results.json").read_text())["claims"]
+    assert all(np.isfinite(c["computed"]) for c in claims.values())
+    assert claims["superposition_error_pct"]["computed"] < 5.0
+    assert claims["localization_tactel"]["computed"] < 0.3
+    assert claims["force_error_pct"]["computed"] < 20.0

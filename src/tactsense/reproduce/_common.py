@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import matplotlib
+import numpy as np
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
@@ -16,6 +17,33 @@ from tactsense.estimate import calibrate as cal
 from tactsense.physics.transduction import fractional_deflection
 
 G50 = ts.grams_force(50)
+
+
+def centre_col(spec) -> int:
+    """The column the experiments load: column 0 (0 deg) on a finger whose columns close
+    the circumference, as in the paper; else the wired column nearest the middle of the
+    array, so that every contact lies on the tactels whatever the layout."""
+    if spec.closes_circumference:
+        return 0
+    angles = np.asarray(spec.col_angle_deg, dtype=float)
+    return int(np.argmin(np.abs(angles - angles.mean())))
+
+
+def centre_angle(spec) -> float:
+    """The angle of :func:`centre_col` [deg]."""
+    return float(spec.col_angle_deg[centre_col(spec)])
+
+
+def on_array(spec, angle_deg: float) -> float:
+    """``angle_deg`` if it lies on the array, else the angle of :func:`centre_col` [deg]."""
+    if spec.closes_circumference:
+        return float(angle_deg)
+    angles = np.asarray(spec.col_angle_deg, dtype=float)
+    half = 0.5 * spec.array.spacing_angle_deg
+    inside = angles.min() - half <= angle_deg <= angles.max() + half
+    return float(angle_deg) if inside else centre_angle(spec)
+
+
 MEASURED = ["gain_spread", "noise", "quantization", "jitter", "nonlinearity"]
 
 

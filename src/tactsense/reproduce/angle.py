@@ -12,6 +12,7 @@ from tactsense.physics import halfplane as hp
 from tactsense.reproduce._common import (
     Claim,
     Context,
+    centre_angle,
     recording_deflection,
 )
 
@@ -56,7 +57,9 @@ def fig27_28_angle(ctx: Context) -> None:
     fig, axes = plt.subplots(1, 2, figsize=(10, 4), constrained_layout=True)
     offsets = np.linspace(0, 2, 41)
     for ax, angle in zip(axes, (30.0, -30.0), strict=True):
-        edge = ts.knife_edge(spec.row_axial_mm[4], 0.0, ts.grams_force(100), alpha_deg=angle)
+        edge = ts.knife_edge(
+            spec.row_axial_mm[4], centre_angle(spec), ts.grams_force(100), alpha_deg=angle
+        )
         rec = ts.simulate(spec, ts.static([edge], 1.0), flaws=["noise", "quantization"], rng=9)
         est = ts.locate(rec.frames[-1:], spec, baseline=ts.baseline_from(rec.frames, 5))
         measured.append(float(est.skew[0]))

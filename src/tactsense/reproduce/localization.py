@@ -13,6 +13,7 @@ from tactsense.reproduce._common import (
     Claim,
     Context,
     calibration_of,
+    centre_angle,
 )
 
 
@@ -23,8 +24,9 @@ def fig23_24_25_localization(ctx: Context) -> None:
     step_along = 0.25 if not ctx.quick else 0.95
     along = np.arange(spec.row_axial_mm[3], spec.row_axial_mm[5] + 1e-9, step_along)
     step_around = 3.0 if not ctx.quick else 9.0
-    around = np.arange(-45.0, 45.0 + 1e-9, step_around)
-    positions = [(a, 0.0) for a in along] + [(spec.row_axial_mm[4], g) for g in around]
+    around = centre_angle(spec) + np.arange(-45.0, 45.0 + 1e-9, step_around)
+    positions = [(a, centre_angle(spec)) for a in along]
+    positions += [(spec.row_axial_mm[4], g) for g in around]
     steps = [ts.Step((), 1.0, "baseline")]
     for a, g in positions:
         steps += [ts.Step((ts.Probe(a, g, G50),), 3 / 7), ts.Step((), 2 / 7, "lifted")]

@@ -13,6 +13,7 @@ from tactsense.estimate.interpolate import surface
 from tactsense.reproduce._common import (
     Claim,
     Context,
+    on_array,
 )
 
 
@@ -95,7 +96,12 @@ def fig21_22_surface(ctx: Context) -> None:
     soft = ts.soft_object(12.0, 20.0, ts.grams_force(100), length_mm=12.0, width_mm=15.0)
     frame = ts.tactel_deflection(spec, soft)
     x = np.linspace(0, spec.shape[0] - 1, 71)
-    y = np.linspace(0, spec.shape[1], 81)
+    if spec.closes_circumference:
+        # unwrapped around the contact, so that it is one blob and the seam lies opposite
+        centre = float(np.argmax(frame.max(axis=0)))
+        y = np.linspace(centre - spec.shape[1] / 2, centre + spec.shape[1] / 2, 81)
+    else:
+        y = np.linspace(0, spec.shape[1] - 1, 81)
     values = surface(frame, x[:, None], y[None, :], periodic=spec.closes_circumference)
     fig = plt.figure(figsize=(7, 5))
     ax = fig.add_subplot(projection="3d")
@@ -113,7 +119,7 @@ def fig21_22_surface(ctx: Context) -> None:
         "A 100-g soft object 12 x 15 mm on the simulated finger, eq. 48 on 8 x 8 tactels.",
         "A smooth single-peaked surface; the low-pass response keeps it well behaved.",
     )
-    rod = ts.rod(12.0, 90.0, ts.grams_force(100), orientation_deg=45.0)
+    rod = ts.rod(12.0, on_array(spec, 90.0), ts.grams_force(100), orientation_deg=45.0)
     frame = ts.tactel_deflection(spec, rod)
     est = ts.locate(frame, spec, counts=False)
     fig, ax = plt.subplots(figsize=(6, 5), constrained_layout=True)
