@@ -225,7 +225,7 @@ def test_reproduce_quick_from_the_command_line(tmp_path):
     result = runner.invoke(app, ["reproduce", "--out", str(out), "--quick"])
     assert result.exit_code == 0, result.output
     assert (out / "report.html").exists() and (out / "results.json").exists()
-    assert "claims agree" in plain(result.output)
+    assert "predictions agree with the paper" in " ".join(plain(result.output).split())
     again = runner.invoke(app, ["reproduce", "--out", str(out), "--quick"])
     assert again.exit_code == 2 and "--force" in plain(again.output)
 

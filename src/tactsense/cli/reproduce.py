@@ -89,10 +89,11 @@ def reproduce(
             target.rename(out)
     except (TactsenseInputError, FileExistsError) as error:
         fail(str(error))
-    claims = result["claims"].values()
-    agree = sum(claim.verdict == "agrees" for claim in claims)
+    from tactsense.reproduce.report import summary
+
+    claims = list(result["claims"].values())
     table = Table(title=f"{len(result['figures'])} figures and {len(claims)} claims in {out}")
-    for column in ("claim", "paper", "tactsense", "unit", "verdict"):
+    for column in ("claim", "paper", "tactsense", "unit", "basis", "verdict"):
         table.add_column(column)
     for claim in claims:
         table.add_row(
@@ -100,10 +101,11 @@ def reproduce(
             "-" if claim.paper is None else f"{claim.paper:.4g}",
             f"{claim.computed:.4g}",
             claim.unit,
+            claim.basis,
             claim.verdict,
         )
     Console().print(table)
     console.print(
-        f"{agree} of {len(claims)} claims agree; open {out / 'report.html'} for the "
-        "figures and the reasons behind each difference"
+        f"{summary(claims)} Open {out / 'report.html'} for the figures and the reasons "
+        "behind each difference."
     )

@@ -15,6 +15,7 @@ import matplotlib.pyplot as plt
 import tactsense as ts
 from tactsense.estimate import calibrate as cal
 from tactsense.physics.transduction import fractional_deflection
+from tactsense.reproduce.basis import BY_CONSTRUCTION, FITTED, basis_of
 
 G50 = ts.grams_force(50)
 
@@ -69,16 +70,31 @@ class Claim:
         return (self.computed - self.paper) / abs(self.paper)
 
     @property
-    def verdict(self) -> str:
+    def basis(self) -> str:
+        """``predicted``, ``fitted``, ``by construction`` or ``arithmetic``."""
+        return basis_of(self.id)[0]
+
+    @property
+    def basis_note(self) -> str:
+        """How the computed value was obtained (for a fit: the constant set from it)."""
+        return basis_of(self.id)[1]
+
+    @property
+    def within_tolerance(self) -> bool:
         if self.kind == "qualitative" or self.paper is None:
-            return "agrees" if self.tolerance >= abs(self.computed) else "differs"
+            return self.tolerance >= abs(self.computed)
         if self.kind == "within":
-            return (
-                "agrees"
-                if abs(self.computed) <= abs(self.paper) * (1 + self.tolerance)
-                else ("differs")
-            )
-        return "agrees" if abs(self.relative_difference) <= self.tolerance else "differs"
+            return abs(self.computed) <= abs(self.paper) * (1 + self.tolerance)
+        return abs(self.relative_difference) <= self.tolerance
+
+    @property
+    def verdict(self) -> str:
+        """``agrees`` or ``differs`` for predictions and arithmetic; a fitted or
+        by-construction claim within tolerance is ``consistent`` (an echo of what the
+        twin was set to, not evidence)."""
+        if not self.within_tolerance:
+            return "differs"
+        return "consistent" if self.basis in (FITTED, BY_CONSTRUCTION) else "agrees"
 
     def to_dict(self) -> dict:
         return {
@@ -87,6 +103,8 @@ class Claim:
             "computed": self.computed,
             "unit": self.unit,
             "relative_difference": self.relative_difference,
+            "basis": self.basis,
+            "basis_note": self.basis_note,
             "verdict": self.verdict,
             "note": self.note,
         }

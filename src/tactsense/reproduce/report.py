@@ -8,6 +8,7 @@ import json
 from pathlib import Path
 
 from tactsense.reproduce._common import Claim, Figure
+from tactsense.reproduce.basis import ARITHMETIC, BY_CONSTRUCTION, FITTED, PREDICTED
 
 
 def _format(value: float | None) -> str:
@@ -19,8 +20,8 @@ def _format(value: float | None) -> str:
 def claims_table_markdown(claims: list[Claim]) -> str:
     """The claims table as Markdown."""
     lines = [
-        "| id | the paper says | paper | tactsense | unit | difference | verdict |",
-        "|---|---|---|---|---|---|---|",
+        "| id | the paper says | paper | tactsense | unit | difference | basis | verdict |",
+        "|---|---|---|---|---|---|---|---|",
     ]
     for claim in claims:
         diff = claim.relative_difference
@@ -28,9 +29,25 @@ def claims_table_markdown(claims: list[Claim]) -> str:
         lines.append(
             f"| `{claim.id}` | {claim.statement} | {_format(claim.paper)} "
             f"| {_format(claim.computed)} | {claim.unit} | {diff_text} "
-            f"| **{claim.verdict}** |"
+            f"| {claim.basis} | **{claim.verdict}** |"
         )
     return "\n".join(lines)
+
+
+def summary(claims: list[Claim]) -> str:
+    """One sentence: predictions that agree, and what the rest are."""
+    predicted = [c for c in claims if c.basis == PREDICTED]
+    agree = sum(c.verdict == "agrees" for c in predicted)
+    echoes = [c for c in claims if c.basis in (FITTED, BY_CONSTRUCTION)]
+    consistent = sum(c.verdict == "consistent" for c in echoes)
+    sums = [c for c in claims if c.basis == ARITHMETIC]
+    sums_agree = sum(c.verdict == "agrees" for c in sums)
+    return (
+        f"{agree} of {len(predicted)} predictions agree with the paper; "
+        f"{consistent} of {len(echoes)} claims the twin was fitted to (or holds by "
+        f"construction) are consistent, which is not evidence; {sums_agree} of {len(sums)} "
+        "arithmetic checks of the paper's formulas agree."
+    )
 
 
 def write_results(out: Path, claims: list[Claim], figures: list[Figure], meta: dict) -> Path:
@@ -54,6 +71,15 @@ def write_results(out: Path, claims: list[Claim], figures: list[Figure], meta: d
     return path
 
 
+BASIS_TEXT = (
+    "The basis column says how each value was obtained: *predicted* (computed from "
+    "parameters not set from this claim), *fitted* (a constant of the twin was chosen to "
+    "match it; the note names it), *by construction* (true of the model by definition, "
+    "e.g. a fit recovering the twin's own parameters) or *arithmetic* (a formula of the "
+    "paper evaluated, a unit conversion). Fitted and by-construction claims within "
+    "tolerance are *consistent*, never *agrees*: they are echoes, not evidence."
+)
+
 INTRO = (
     "This report runs the experiments of R. S. Fearing, *Tactile Sensing Mechanisms* "
     "(IJRR 1990) on tactsense's digital twin of the finger and puts every quantitative "
@@ -69,11 +95,15 @@ def write_markdown(out: Path, claims: list[Claim], figures: list[Figure], meta: 
         f"Sensor: `{meta['sensor']}`; run: {meta['mode']}; tactsense {meta['version']}; "
         f"{meta['seconds']:.0f} s.\n",
         "## Claims\n",
+        summary(claims) + "\n",
+        BASIS_TEXT + "\n",
         claims_table_markdown(claims),
         "\n### Notes\n",
     ]
     for claim in claims:
-        parts.append(f"- `{claim.id}` ({claim.verdict}): {claim.note}")
+        parts.append(
+            f"- `{claim.id}` ({claim.basis}, {claim.verdict}): {claim.basis_note} {claim.note}"
+        )
     parts.append("\n## Figures\n")
     for figure in sorted(figures, key=lambda f: f.number):
         parts.append(
@@ -93,13 +123,14 @@ def write_html(out: Path, claims: list[Claim], figures: list[Figure], meta: dict
     rows = []
     for claim in claims:
         diff = claim.relative_difference
-        colour = "#dff0d8" if claim.verdict == "agrees" else "#fcf8e3"
+        colour = {"agrees": "#dff0d8", "consistent": "#e8eef7"}.get(claim.verdict, "#fcf8e3")
         rows.append(
             f"<tr style='background:{colour}'><td><code>{e(claim.id)}</code></td>"
             f"<td>{e(claim.statement)}</td><td>{e(_format(claim.paper))}</td>"
             f"<td>{e(_format(claim.computed))}</td><td>{e(claim.unit)}</td>"
             f"<td>{'-' if diff is None else f'{100 * diff:+.1f} %'}</td>"
-            f"<td><b>{e(claim.verdict)}</b></td><td>{e(claim.note)}</td></tr>"
+            f"<td>{e(claim.basis)}</td><td><b>{e(claim.verdict)}</b></td>"
+            f"<td>{e(claim.basis_note)} {e(claim.note)}</td></tr>"
         )
     sections = []
     for figure in sorted(figures, key=lambda f: f.number):
@@ -125,8 +156,10 @@ img {{ max-width: 100%; }}
 <p>Sensor: <code>{e(meta["sensor"])}</code>; run: {e(meta["mode"])};
 tactsense {e(meta["version"])}; {meta["seconds"]:.0f} s.</p>
 <h2>Claims</h2>
+<p><b>{e(summary(claims))}</b></p>
+<p>{e(BASIS_TEXT)}</p>
 <table><tr><th>id</th><th>the paper says</th><th>paper</th><th>tactsense</th><th>unit</th>
-<th>difference</th><th>verdict</th><th>why</th></tr>
+<th>difference</th><th>basis</th><th>verdict</th><th>why</th></tr>
 {"".join(rows)}
 </table>
 <h2>Figures</h2>

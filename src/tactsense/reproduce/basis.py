@@ -1,0 +1,107 @@
+"""How each claim of the report was obtained: a prediction, a fit, a consequence of the
+model's definition, or arithmetic.
+
+A number the twin was tuned to is a fit, not a prediction: its agreement with the paper
+is an echo, and is reported as ``consistent``, never as ``agrees``. Only ``predicted``
+claims count as agreements in the summary.
+"""
+
+from __future__ import annotations
+
+PREDICTED = "predicted"
+FITTED = "fitted"
+BY_CONSTRUCTION = "by construction"
+ARITHMETIC = "arithmetic"
+KINDS = (PREDICTED, FITTED, BY_CONSTRUCTION, ARITHMETIC)
+
+BASIS: dict[str, tuple[str, str]] = {
+    "nonlinearity_1N_pct": (
+        FITTED,
+        "[flaws] nonlinear_saturation was chosen so that 1 N reads 6 % low.",
+    ),
+    "sensitivity_bits_50g": (
+        ARITHMETIC,
+        "log2 of 6 % of 2000 A/D units through eqs. 1-2: a unit conversion.",
+    ),
+    "counts_50g": (
+        PREDICTED,
+        "From the rubber's measured modulus (2.5e5 N/m^2), the fitted depth 3.8 mm, the "
+        "ring mechanics and eqs. 1-2; no constant was set from this sentence.",
+    ),
+    "threshold_mean_g": (
+        PREDICTED,
+        "From the same chain as counts_50g and the gain spread, over the calibrated "
+        "cylinder tactels; no constant was set from Fig. 8.",
+    ),
+    "superposition_error_pct": (
+        PREDICTED,
+        "Only the fitted stiffening law breaks linearity; the joint profile is computed, not set.",
+    ),
+    "creep_decay_time_s": (
+        FITTED,
+        "[flaws] delayed_fraction and delayed_time_constant_s were chosen from Fig. 12.",
+    ),
+    "creep_residual_pct": (
+        FITTED,
+        "[flaws] creep_fraction and creep_time_constant_s were chosen from Fig. 12.",
+    ),
+    "creep_error_25Hz_pct": (
+        FITTED,
+        "The delayed-elastic constants chosen from Fig. 12 fix this error at 25 Hz.",
+    ),
+    "fit_depth_mm": (
+        BY_CONSTRUCTION,
+        "The twin's effective depth is 3.8 mm; the fit recovers its own parameter.",
+    ),
+    "fit_nu": (
+        BY_CONSTRUCTION,
+        "The twin's effective Poisson's ratio is 0.4; the fit recovers its own parameter.",
+    ),
+    "fit_rms_pct": (
+        PREDICTED,
+        "The residual comes from the twin's noise, jitter and stiffening, whose sizes were "
+        "set from other sentences; the twin is eq. 7, so this is a floor, not a test of "
+        "eq. 7.",
+    ),
+    "planestress_equivalent_nu": (ARITHMETIC, "Eq. 10: nu / (1 + nu) at nu = 0.5."),
+    "strip_gain_d0_0.5mm": (
+        PREDICTED,
+        "The strip model with the paper's stated sizes; the unstated ones from the "
+        "finger's description.",
+    ),
+    "strip_gain_increase_backing": (PREDICTED, "The strip model with and without backing."),
+    "frequency_peak_per_mm": (
+        ARITHMETIC,
+        "The maximum of eq. 39's closed form, evaluated numerically.",
+    ),
+    "aliasing_xi": (ARITHMETIC, "Eq. 45 evaluated by quadrature at the paper's sizes."),
+    "newton_iterations": (PREDICTED, "Counted while locating the simulated sweep."),
+    "localization_length_mm": (
+        PREDICTED,
+        "Simulated frames estimated with the same model the twin uses (inverse crime): "
+        "see the robustness study in docs/accuracy.md.",
+    ),
+    "localization_circumference_deg": (
+        PREDICTED,
+        "As localization_length_mm, around the finger.",
+    ),
+    "localization_tactel": (PREDICTED, "As localization_length_mm, in tactels."),
+    "force_error_pct": (
+        PREDICTED,
+        "Simulated frames with the measured flaws, estimated after calibration.",
+    ),
+    "skew_slope": (ARITHMETIC, "Eq. 67's closed form for a line load."),
+    "skew_odd_peak_x_over_z": (ARITHMETIC, "Eq. 65 solved in closed form."),
+    "skew_measured_30deg": (PREDICTED, "A simulated 30-deg knife edge, estimated."),
+}
+"""Claim id -> (basis, how it was obtained)."""
+
+
+def basis_of(claim_id: str) -> tuple[str, str]:
+    """The basis of a claim; every claim of the report must have one."""
+    try:
+        return BASIS[claim_id]
+    except KeyError:
+        raise KeyError(
+            f"claim {claim_id!r} has no basis: add it to tactsense.reproduce.basis.BASIS"
+        ) from None
