@@ -120,6 +120,15 @@ class Figure:
     simulated: str
     came_out: str
     path: Path
+    label: str = ""
+    """How the report names it: ``Fig. N`` for the paper's figures; the studies that go
+    beyond the paper have their own label (and a number after the paper's last)."""
+    table: str = ""
+    """A Markdown table printed under the figure (studies beyond the paper)."""
+
+    @property
+    def name(self) -> str:
+        return self.label or f"Fig. {self.number}"
 
 
 @dataclass
@@ -135,13 +144,25 @@ class Context:
         return quick if self.quick else full
 
     def save(
-        self, fig, number: int, title: str, paper_did: str, simulated: str, came_out: str
+        self,
+        fig,
+        number: int,
+        title: str,
+        paper_did: str,
+        simulated: str,
+        came_out: str,
+        *,
+        label: str = "",
+        stem: str = "",
+        table: str = "",
     ) -> None:
-        path = self.out / f"fig{number:02d}.png"
-        fig.suptitle(f"Fig. {number}: {title}", fontsize=11)
+        path = self.out / f"{stem or f'fig{number:02d}'}.png"
+        fig.suptitle(f"{label or f'Fig. {number}'}: {title}", fontsize=11)
         fig.savefig(path, dpi=100)
         plt.close(fig)
-        self.figures.append(Figure(number, title, paper_did, simulated, came_out, path))
+        self.figures.append(
+            Figure(number, title, paper_did, simulated, came_out, path, label, table)
+        )
 
 
 def recording_deflection(rec):

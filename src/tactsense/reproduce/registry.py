@@ -16,6 +16,7 @@ from tactsense.reproduce.array import fig13_around, fig14_tip
 from tactsense.reproduce.force import fig26_force
 from tactsense.reproduce.halfplane import fig16_fit
 from tactsense.reproduce.localization import fig23_24_25_localization
+from tactsense.reproduce.robustness import robustness
 from tactsense.reproduce.sampling import fig19_20_aliasing, fig21_22_surface
 from tactsense.reproduce.strip import fig17_strip_gain, fig18_strip_impulse
 from tactsense.reproduce.transduction import (
@@ -42,4 +43,5 @@ EXPERIMENTS: list[tuple[str, Callable[[Context], None]]] = [
     ("Figs. 23-25: localization", fig23_24_25_localization),
     ("Fig. 26: total force", fig26_force),
     ("Figs. 27-28: force angle", fig27_28_angle),
+    ("Beyond the paper: a finger unlike its description", robustness),
 ]

@@ -57,6 +57,7 @@ def write_results(out: Path, claims: list[Claim], figures: list[Figure], meta: d
         "figures": [
             {
                 "number": f.number,
+                "label": f.name,
                 "title": f.title,
                 "file": f.path.name,
                 "paper": f.paper_did,
@@ -107,11 +108,11 @@ def write_markdown(out: Path, claims: list[Claim], figures: list[Figure], meta: 
     parts.append("\n## Figures\n")
     for figure in sorted(figures, key=lambda f: f.number):
         parts.append(
-            f"### Fig. {figure.number}: {figure.title}\n\n"
-            f"![Fig. {figure.number}]({figure.path.name})\n\n"
+            f"### {figure.name}: {figure.title}\n\n"
+            f"![{figure.name}]({figure.path.name})\n\n"
             f"- **The paper:** {figure.paper_did}\n"
             f"- **Simulated:** {figure.simulated}\n"
-            f"- **Result:** {figure.came_out}\n"
+            f"- **Result:** {figure.came_out}\n" + (f"\n{figure.table}\n" if figure.table else "")
         )
     path = out / "report.md"
     path.write_text("\n".join(parts), encoding="utf-8")
@@ -136,11 +137,12 @@ def write_html(out: Path, claims: list[Claim], figures: list[Figure], meta: dict
     for figure in sorted(figures, key=lambda f: f.number):
         data = base64.b64encode(figure.path.read_bytes()).decode("ascii")
         sections.append(
-            f"<h3>Fig. {figure.number}: {e(figure.title)}</h3>"
-            f"<img alt='Fig. {figure.number}' src='data:image/png;base64,{data}'>"
+            f"<h3>{e(figure.name)}: {e(figure.title)}</h3>"
+            f"<img alt='{e(figure.name)}' src='data:image/png;base64,{data}'>"
             f"<ul><li><b>The paper:</b> {e(figure.paper_did)}</li>"
             f"<li><b>Simulated:</b> {e(figure.simulated)}</li>"
             f"<li><b>Result:</b> {e(figure.came_out)}</li></ul>"
+            + (f"<pre>{e(figure.table)}</pre>" if figure.table else "")
         )
     page = f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8">

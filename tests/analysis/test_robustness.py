@@ -1,0 +1,62 @@
+"""The inverse-crime study (tactsense.analysis.robustness): the properties docs/accuracy.md
+states, each with the reason for its bound."""
+
+import pytest
+
+import tactsense as ts
+from tactsense.analysis.robustness import markdown_table, perturbations, robustness_study
+
+
+@pytest.fixture(scope="module")
+def rows():
+    spec = ts.fearing1990_initial()
+    fingers = ["as assumed", "depth +15 %", "modulus +20 %", "gain spread"]
+    found = robustness_study(spec, n_positions=16, seed=3, fingers=fingers)
+    return spec, {(r.finger, r.estimator, r.calibrated): r for r in found}
+
+
+def test_knife_fit_recovers_the_true_depth(rows):
+    # the paper's fit residual is 1.3 % of full scale; with read noise alone the depth is
+    # determined to about 1 %: 3 % allows three standard deviations
+    spec, by = rows
+    assert by[("depth +15 %", "model", True)].fitted_depth_mm == pytest.approx(
+        1.15 * spec.elastic.effective_depth_mm, rel=0.03
+    )
+    assert by[("as assumed", "model", True)].fitted_depth_mm == pytest.approx(
+        spec.elastic.effective_depth_mm, rel=0.03
+    )
+
+
+def test_a_wrong_depth_or_modulus_biases_the_force_and_calibration_removes_it(rows):
+    # deflection scales about as 1/E and, for a probe small against the depth, as
+    # 1/depth: a 15-20 % error must show as more than half of itself in the worst force
+    # error, and after calibration the model fit must be back within 5 % (its error on
+    # the exact finger is 1-2 %, the gain sweep adds about as much)
+    _, by = rows
+    for finger in ("depth +15 %", "modulus +20 %"):
+        assert by[(finger, "model", False)].force_pct > 7.5
+        assert by[(finger, "model", True)].force_pct < 5.0
+
+
+def test_an_uncalibrated_gain_spread_is_the_largest_error(rows):
+    # gain spread SD 0.35: the worst of 16 contacts is off by far more than 20 %; the
+    # calibrated sweep measures each gain to the noise and sampling of the sweep
+    _, by = rows
+    raw, fixed = by[("gain spread", "model", False)], by[("gain spread", "model", True)]
+    assert raw.force_pct > 20.0 and fixed.force_pct < 5.0
+    assert raw.along_mm > 3 * fixed.along_mm
+
+
+def test_position_of_the_interpolation_does_not_depend_on_the_model(rows):
+    # the interpolation uses the model only for the force conversion: its positions on a
+    # stiffer finger are those of the exact finger, up to the noise (0.1 mm)
+    _, by = rows
+    exact = by[("as assumed", "interpolation", False)].along_mm
+    assert by[("modulus +20 %", "interpolation", False)].along_mm == pytest.approx(exact, abs=0.1)
+
+
+def test_table_has_one_line_per_finger_and_estimator(rows):
+    spec, by = rows
+    text = markdown_table(list(by.values()), spec)
+    assert text.count("\n") == 2 + 4 * 2 - 1
+    assert set(perturbations(spec)) >= {"depth +15 %", "nu -15 %", "ring stiffness +20 %"}
