@@ -44,10 +44,14 @@ def fig23_24_25_localization(ctx: Context) -> None:
     peaks = est.peak_deflection[last]
     iterations = est.iterations[last]
     fig, ax = plt.subplots(figsize=(7, 4), constrained_layout=True)
-    ax.plot(true_axial[:n_along] / b, est.axial_mm[last][:n_along] / b, ".-", label="estimated")
-    ax.plot(true_axial[:n_along] / b, true_axial[:n_along] / b, "k:", label="true")
-    ax.set_xlabel("probe position [tactel]")
-    ax.set_ylabel("estimated position [tactel]")
+    ax.plot(true_axial[:n_along], est.axial_mm[last][:n_along], ".-", label="estimated")
+    ax.plot(true_axial[:n_along], true_axial[:n_along], "k:", label="true")
+    for k, ring in enumerate(spec.row_axial_mm):
+        if true_axial[:n_along].min() <= ring <= true_axial[:n_along].max():
+            ax.axvline(ring, color="0.6", lw=0.8)
+            ax.text(ring, ax.get_ylim()[1], f" row {k}", fontsize=7, va="top")
+    ax.set_xlabel("probe position along the finger [mm] (grey: rings)")
+    ax.set_ylabel("estimated position [mm]")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     worst_along = float(np.abs(d_axial[:n_along]).max())
@@ -62,8 +66,11 @@ def fig23_24_25_localization(ctx: Context) -> None:
         f"took a median of {np.median(iterations):.0f} steps.",
     )
     fig, ax = plt.subplots(figsize=(7, 4), constrained_layout=True)
-    ax.plot(true_axial[:n_along] / b, 100 * peaks[:n_along], ".-")
-    ax.set_xlabel("probe position [tactel]")
+    ax.plot(true_axial[:n_along], 100 * peaks[:n_along], ".-")
+    for ring in spec.row_axial_mm:
+        if true_axial[:n_along].min() <= ring <= true_axial[:n_along].max():
+            ax.axvline(ring, color="0.6", lw=0.8)
+    ax.set_xlabel("probe position along the finger [mm] (grey: rings)")
     ax.set_ylabel("peak deflection [%]")
     ax.grid(alpha=0.3)
     ripple = 100 * np.ptp(peaks[:n_along]) / (2 * np.mean(peaks[:n_along]))

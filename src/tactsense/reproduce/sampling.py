@@ -139,6 +139,11 @@ def fig21_22_surface(ctx: Context) -> None:
         lines.append(line)
         ax.plot(line.angle_deg, line.axial_mm, ".", ms=1.5, label=f"{100 * share:.0f} % of peak")
     ax.plot(est.angle_deg, est.axial_mm, "k+", ms=10, label="peak")
+    open_levels = ", ".join(
+        f"{100 * line.level / float(est.peak_deflection):.0f} %"
+        for line in lines
+        if not line.closed
+    )
     ax.set_xlabel("angle around the finger [deg]")
     ax.set_ylabel("position along the finger [mm]")
     ax.grid(alpha=0.3)
@@ -150,6 +155,8 @@ def fig21_22_surface(ctx: Context) -> None:
         "Contour tracking (eqs. 49-51) for a rod at 45 deg to the cylinder axis on the "
         "45-deg, 3.8-mm finger.",
         "A 100-g rod at 45 deg on the simulated finger; contours tracked at four levels.",
-        f"{len(lines)} closed contours elongated along the rod; around the finger the "
-        "45-deg strips resolve the rod's tilt only coarsely, as the paper found.",
+        f"{sum(line.closed for line in lines)} of {len(lines)} contours close "
+        f"({open_levels or 'none'} open: they leave the array); they are elongated along "
+        "the rod, and around the "
+        "finger the strips resolve the rod's tilt only coarsely, as the paper found.",
     )

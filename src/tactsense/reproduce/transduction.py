@@ -14,6 +14,7 @@ from tactsense.physics.transduction import (
 )
 from tactsense.reproduce._common import (
     G50,
+    MEASURED,
     Claim,
     Context,
     calibration_of,
@@ -104,22 +105,27 @@ def fig06_nonlinearity(ctx: Context) -> None:
 def fig07_08_calibration(ctx: Context) -> None:
     spec = ctx.spec
     calibration = calibration_of(ctx)
-    sweep = ctx.cache["sweep"]
-    fixed, _ = calibration.apply(sweep.frames, spec)
-    step = sweep.truth["frame_step"]
-    params = sweep.truth["step_axial_mm"][step]
-    col_of_step = np.array(
-        [
-            int(s["label"].split()[1]) if s["label"].startswith("col") else -1
-            for s in sweep.scenario["steps"]
-        ]
+    column = 2 if spec.closes_circumference else centre_col(spec)
+    # Fig. 7 itself: one column swept with creep on (the elastic set the paper points
+    # out cannot appear without it), every tactel plotted at the probe position at the
+    # instant it was read (a frame's scan takes 1/7 s: rows read before the probe moved
+    # belong to the previous position)
+    one = ts.simulate(
+        spec,
+        ts.probe_sweep(spec, along="axial", col=column, dwell_s=0.3),
+        flaws=[*MEASURED, "viscoelastic"],
+        rng=12,
     )
-    column = 2
-    rows = (col_of_step[step] == column) & np.isfinite(params)
+    one_fixed, _ = calibration.apply(one.frames, spec)
     fig, ax = plt.subplots(figsize=(8, 4), constrained_layout=True)
+    set_pct = []
     for r in range(1, spec.shape[0]):
-        ax.plot(params[rows], 100 * fixed[rows, r, column], lw=1, label=f"row {r}")
-    ax.set_xlabel("probe position along the finger [mm]")
+        at = one.truth["step_axial_mm"][one.sample_step(r, column)]
+        shown = np.isfinite(at)
+        ax.plot(at[shown], 100 * one_fixed[shown, r, column], lw=1, label=f"row {r}")
+        response = one_fixed[shown, r, column]
+        set_pct.append(100 * response[-1] / response.max())
+    ax.set_xlabel("probe position along the finger when the tactel was read [mm]")
     ax.set_ylabel("calibrated fractional deflection [%]")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7, ncol=4)
@@ -131,10 +137,14 @@ def fig07_08_calibration(ctx: Context) -> None:
         "responses along the cylinder for a moving probe, after calibration",
         "A 50-g probe applied at 0.6-mm increments along the cylinder, equal times at each "
         "place; each cell's largest deflection stored as its gain.",
-        "The same sweep along every column of the simulated finger with its gain spread, "
-        "jitter, noise and stiffening; gains calibrated, column 2 shown.",
+        "The sweep of section 3.1 along every column (gain spread, jitter, noise, "
+        f"stiffening) for the gains; shown, column {column} swept again with creep on and "
+        "calibrated.",
         f"Neighbouring rings overlap; the gains are recovered within "
-        f"{100 * error.max():.1f} % (true spread {truth[1:].max() / truth[1:].min():.1f}:1).",
+        f"{100 * error.max():.1f} % (true spread {truth[1:].max() / truth[1:].min():.1f}:1). "
+        f"Elastic set: when the probe reaches the base, the ring nearest the tip still reads "
+        f"{set_pct[0]:.1f} % of its peak (a prediction of the creep constants fitted to "
+        "Fig. 12; the paper shows it but gives no number).",
     )
     thresholds = calibration.threshold_g[1:].ravel()
     thresholds = thresholds[np.isfinite(thresholds)]
@@ -259,8 +269,12 @@ def fig10_11_jitter(ctx: Context) -> None:
         f"The reading under the probe varies by {under.std(ddof=1):.2f} units, {std_g:.2f} g.",
     )
     fig, ax = plt.subplots(figsize=(6, 3.5), constrained_layout=True)
-    ax.hist(under - under.mean(), bins=15, edgecolor="k")
-    ax.set_xlabel("reading minus mean [A/D units]")
+    # one bin per A/D unit, centred on the integers: quantized readings leave no comb
+    edges = np.arange(np.floor(under.min()) - 0.5, np.ceil(under.max()) + 1.0)
+    ax.hist(under, bins=edges, edgecolor="k")
+    ax.axvline(under.mean(), color="k", ls=":", label=f"mean {under.mean():.1f}")
+    ax.legend(fontsize=8)
+    ax.set_xlabel("reading [A/D units]")
     ax.set_ylabel("applications")
     ctx.save(
         fig,
