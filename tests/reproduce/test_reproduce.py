@@ -170,6 +170,7 @@ def test_fits_and_echoes_never_count_as_agreement(report):
     assert "1 of 1 claims the twin was fitted to" in summary(claims)
     text = (out / "report.md").read_text()
     assert "| basis | verdict |" in text and "predictions agree" in text
+    assert "Hold-out checks of the fitted constants" in text and "none held out" in text
 
 
 def test_readme_table_lists_every_claim_with_its_basis():

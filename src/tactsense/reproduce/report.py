@@ -8,7 +8,7 @@ import json
 from pathlib import Path
 
 from tactsense.reproduce._common import Claim, Figure
-from tactsense.reproduce.basis import ARITHMETIC, BY_CONSTRUCTION, FITTED, PREDICTED
+from tactsense.reproduce.basis import ARITHMETIC, BY_CONSTRUCTION, FITTED, HOLDOUTS, PREDICTED
 
 
 def _format(value: float | None) -> str:
@@ -105,6 +105,8 @@ def write_markdown(out: Path, claims: list[Claim], figures: list[Figure], meta: 
         parts.append(
             f"- `{claim.id}` ({claim.basis}, {claim.verdict}): {claim.basis_note} {claim.note}"
         )
+    parts.append("\n### Hold-out checks of the fitted constants\n")
+    parts.extend(f"- **{constant}:** {text}" for constant, text in HOLDOUTS)
     parts.append("\n## Figures\n")
     for figure in sorted(figures, key=lambda f: f.number):
         parts.append(
@@ -164,6 +166,8 @@ tactsense {e(meta["version"])}; {meta["seconds"]:.0f} s.</p>
 <th>difference</th><th>basis</th><th>verdict</th><th>why</th></tr>
 {"".join(rows)}
 </table>
+<h3>Hold-out checks of the fitted constants</h3>
+<ul>{"".join(f"<li><b>{e(c)}:</b> {e(t)}</li>" for c, t in HOLDOUTS)}</ul>
 <h2>Figures</h2>
 {"".join(sections)}
 </body></html>
