@@ -1,5 +1,6 @@
 import re
 
+import numpy as np
 import pytest
 from typer.testing import CliRunner
 
@@ -210,7 +211,17 @@ def test_calibrate_then_locate_with_the_calibration(tmp_path):
         app, ["locate", str(steps), "--calibration", str(out), "--out", str(estimates)]
     )
     assert result.exit_code == 0, result.output
-    assert estimates.exists()
+    # what the CLI wrote is what the API computes with that calibration, and on the
+    # frames where the steps' load is on, the force is the applied load to within the
+    # paper's 20 % (section 8)
+    table = np.genfromtxt(estimates, delimiter=",", names=True)
+    rec = ts.read_recording(steps)
+    api = ts.locate(rec.frames, spec, calibration=calibration, frame_period_s=spec.scan_period_s)
+    np.testing.assert_allclose(table["force_N"], api.force_n, rtol=1e-5, equal_nan=True)
+    applied = rec.truth["step_force_n"][rec.truth["frame_step"]]
+    loaded = applied > 0
+    assert loaded.sum() > 10
+    assert np.all(np.abs(table["force_N"][loaded] / applied[loaded] - 1) < 0.2)
     other = tmp_path / "other.h5"
     improved = ts.fearing1990_improved()
     ts.write_recording(other, ts.simulate(improved, ts.force_steps(improved, repeats=1)))

@@ -7,6 +7,9 @@ from tactsense.sensor import VACUUM_PERMITTIVITY, SensorSpec, SensorSpecError
 
 
 def test_presets_match_the_paper(initial, improved):
+    """The presets against the paper's text (sections 2.3, 3, 4.1), not against the code:
+    3.8 mm x 45 deg and 3.3 mm x 18 deg spacings, 12 strips and 7 rings on the improved
+    cylinder, the 1-inch finger on a 17.7-mm core, the 3.8-mm / nu = 0.4 fit, V_o = 2000."""
     assert initial.shape == (8, 8) and improved.shape == (8, 8)
     assert initial.array.spacing_axial_mm == 3.8 and initial.array.spacing_angle_deg == 45
     assert improved.array.spacing_axial_mm == 3.3 and improved.array.spacing_angle_deg == 18
@@ -25,12 +28,36 @@ def test_junction_capacitance_is_about_one_picofarad(initial):
     assert 0.8e-12 < initial.junction_capacitance_f < 1.2e-12
 
 
-def test_ring_flexural_length_formula(initial):
-    # Hetenyi: lambda = (k / 4EI)^(1/4), k = E_d b / t_d, I = b t^3 / 12
-    b, t = 2.5e-3, 0.07e-3
-    k = 7e4 * b / 0.5e-3
-    ei = 1.2e11 * b * t**3 / 12
-    assert initial.ring_flexural_length_mm == pytest.approx(1e3 * (4 * ei / k) ** 0.25, rel=1e-12)
+def test_ring_flexural_length_from_a_beam_on_an_elastic_foundation(initial):
+    """The ring is a copper beam on the dielectric (a Winkler foundation): solve
+    EI d4w/dx4 + k w = P delta(x) by finite differences and find the flexural length from
+    where the deflection first crosses zero (beta x = 3 pi / 4 for the exact solution
+    e^{-beta x} (cos beta x + sin beta x)), independently of the closed form the code uses.
+    Foundation modulus k = E_d b / t_d, I = b t^3 / 12 (their definitions)."""
+    import numpy as np
+
+    rings = initial.rings
+    b, t = rings.ring_width_mm * 1e-3, rings.ring_thickness_mm * 1e-3
+    k = rings.dielectric_modulus_pa * b / (rings.dielectric_thickness_mm * 1e-3)
+    ei = rings.copper_modulus_pa * b * t**3 / 12
+    n, length = 4001, 0.04  # a beam much longer than the flexural length (about 1.4 mm)
+    h = length / (n - 1)
+    matrix = np.zeros((n, n))
+    stencil = np.array([1.0, -4.0, 6.0, -4.0, 1.0]) * ei / h**4
+    for i in range(2, n - 2):
+        matrix[i, i - 2 : i + 3] = stencil
+        matrix[i, i] += k
+    for i in (0, 1, n - 2, n - 1):  # far ends: clamped at zero deflection
+        matrix[i, :] = 0.0
+        matrix[i, i] = 1.0
+    load = np.zeros(n)
+    load[n // 2] = 1.0 / h
+    w = np.linalg.solve(matrix, load)
+    right = w[n // 2 :]
+    first_zero = np.flatnonzero(right < 0)[0] * h
+    flexural_mm = 1e3 * first_zero / (3 * np.pi / 4)
+    # the zero is located to one grid step (10 um of about 1.4 mm): 1 %
+    assert initial.ring_flexural_length_mm == pytest.approx(flexural_mm, rel=0.01)
 
 
 def test_wired_columns_of_improved_finger_are_central(improved):
