@@ -67,7 +67,11 @@ def track_contour(
     start_row, start_col : float
         A point inside the contour, usually the peak [tactel].
     sensor : SensorSpec, optional
-        For surface coordinates; without it those are NaN.
+        For surface coordinates; without it those are NaN. On a finger with a tip row
+        the contour is tracked on the cylinder only: the tip row's samples lie about
+        11 mm (three spacings) before the first ring, not one spacing, so they are left
+        out of the interpolation (treated as beyond the array, zero) and a contour that
+        reaches the first ring ends there, open.
     step : float
         Delta r of eq. 51 [tactel].
 
@@ -77,6 +81,11 @@ def track_contour(
     """
     z = np.asarray(deflection, float)
     rows, cols = z.shape
+    first = 0
+    if sensor is not None and sensor.array.tip_row:
+        z = z.copy()
+        z[0, :] = 0.0
+        first = 1
     x, y = float(start_row), float(start_col)
     if surface(z, x, y, periodic=periodic) <= level:
         raise ValueError("the start point must lie inside the contour (above its level)")
@@ -93,28 +102,43 @@ def track_contour(
         else:
             high = mid
     x = 0.5 * (low + high)
-    xs, ys = [x], [y]
-    closed = False
-    for k in range(max_steps):
-        _, fx, fy = surface(z, x, y, periodic=periodic, derivatives=1)
-        norm = np.hypot(fx, fy)
-        if norm == 0:
-            break
-        x, y = _correct(z, x - step * fy / norm, y + step * fx / norm, level, periodic)
-        if periodic:
-            y = y % cols
-        if not (0 <= x <= rows - 1) or (not periodic and not 0 <= y <= cols - 1):
-            break
-        xs.append(x)
-        ys.append(y)
-        d_col = ys[-1] - ys[0]
-        if periodic:
-            d_col = (d_col + cols / 2) % cols - cols / 2
-        if k > 10 and np.hypot(xs[-1] - xs[0], d_col) < 0.75 * step:
-            closed = True
-            xs.append(xs[0])
-            ys.append(ys[0])
-            break
+
+    def walk(direction: float):
+        """Points from the start along the contour; whether it came back to the start."""
+        px, py = x, y
+        xs, ys = [px], [py]
+        for k in range(max_steps):
+            _, fx, fy = surface(z, px, py, periodic=periodic, derivatives=1)
+            norm = np.hypot(fx, fy)
+            if norm == 0:
+                break
+            px, py = _correct(
+                z,
+                px - direction * step * fy / norm,
+                py + direction * step * fx / norm,
+                level,
+                periodic,
+            )
+            if periodic:
+                py = py % cols
+            if not (first <= px <= rows - 1) or (not periodic and not 0 <= py <= cols - 1):
+                break
+            xs.append(px)
+            ys.append(py)
+            d_col = ys[-1] - ys[0]
+            if periodic:
+                d_col = (d_col + cols / 2) % cols - cols / 2
+            if k > 10 and np.hypot(xs[-1] - xs[0], d_col) < 0.75 * step:
+                xs.append(xs[0])
+                ys.append(ys[0])
+                return xs, ys, True
+        return xs, ys, False
+
+    xs, ys, closed = walk(1.0)
+    if not closed:
+        # it left the array (or the cylinder): follow the other branch from the start too
+        back_x, back_y, _ = walk(-1.0)
+        xs, ys = back_x[::-1] + xs[1:], back_y[::-1] + ys[1:]
     row, col = np.array(xs), np.array(ys)
     if sensor is not None:
         axial, angle = tactel_to_surface(sensor, row, col)
