@@ -57,6 +57,8 @@ BAD_OPTIONS = [
     ("locate REC --threshold -1 --out OUT", "--threshold"),
     ("locate REC --threshold nan --out OUT", "--threshold"),
     ("locate REC --baseline-frames 0 --out OUT", "--baseline-frames"),
+    ("locate REC --chunk-frames 0 --out OUT", "--chunk-frames"),
+    ("locate REC --out OUT.txt", "use the extension .csv, .parquet or .h5"),
     ("calibrate REC --probe-g 0 --out OUT", "--probe-g"),
     ("calibrate REC --baseline-frames 0 --out OUT", "--baseline-frames"),
     ("emulate --speed -1", "--speed"),
@@ -137,7 +139,7 @@ BAD_FILES = [
 def test_bad_files(workspace, line, names):
     if not (workspace / "strings.h5").exists():
         _bad_files(workspace)
-    out = workspace / "never_written.out"
+    out = workspace / "never_written.csv"
     args = (
         line.replace("REC", str(workspace / "rec.h5"))
         .replace("OUT", str(out))
@@ -177,7 +179,7 @@ def _check(result, names: str, forbidden=None):
 
 @pytest.mark.parametrize("line, names", BAD_OPTIONS, ids=[line for line, _ in BAD_OPTIONS])
 def test_bad_option_values(workspace, line, names):
-    out = workspace / "never_written.out"
+    out = workspace / "never_written.csv"
     args = line.replace("REC", str(workspace / "rec.h5")).replace("OUT", str(out)).split()
     result = runner.invoke(app, args)
     _check(result, names)
@@ -273,7 +275,7 @@ def test_interruption_leaves_nothing_and_the_rerun_works(tmp_path, command, sent
         short, frames=frames, time_s=np.arange(len(frames)) * period, truth={}
     )
     ts.write_recording(rec, long)
-    out = tmp_path / ("out" if command == "reproduce" else "out.file")
+    out = tmp_path / {"reproduce": "out", "simulate": "out.h5", "locate": "out.csv"}[command]
     lines = {
         "simulate": ["simulate", "--scenario", "repeated", "--repeats", "3000", "--out", str(out)],
         "locate": ["locate", str(rec), "--out", str(out)],

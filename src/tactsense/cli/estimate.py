@@ -21,7 +21,13 @@ app = new_group("Estimate contacts and calibrations from recordings.")
 def locate(
     recording: Annotated[Path, typer.Argument(help="HDF5 recording to analyse.")],
     out: Annotated[
-        Path, typer.Option("--out", "-o", help="CSV file to write, one row per frame.")
+        Path,
+        typer.Option(
+            "--out",
+            "-o",
+            help="File to write, one row per frame; the extension sets the format: .csv "
+            "(units in the header, flags by name), .parquet or .h5 (flags as bits).",
+        ),
     ] = Path("estimates.csv"),
     baseline_frames: Annotated[
         int,
@@ -48,35 +54,74 @@ def locate(
             "excluded tactels and creep model are applied."
         ),
     ] = None,
+    chunk_frames: Annotated[
+        int | None,
+        typer.Option(
+            min=1,
+            max=10_000_000,
+            help="Frames read and estimated at a time (memory is about 1 kB per frame "
+            "of 8 x 8) [default: the recording's HDF5 chunk, near 65,536].",
+        ),
+    ] = None,
+    quiet: Annotated[
+        bool, typer.Option("--quiet", "-q", help="No progress bar, only the summary line.")
+    ] = False,
     force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
 ) -> None:
-    """Locate the contact in every frame: position, force, skew and quality flags to CSV."""
-    from tactsense.estimate import baseline_from, write_estimates_csv
-    from tactsense.estimate import locate as run_locate
+    """Locate the contact in every frame: position, force, skew and quality flags.
+
+    The recording is read and the estimates written piece by piece, so memory stays
+    bounded whatever its length; a progress bar shows on a terminal.
+    """
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeRemainingColumn,
+    )
+
+    from tactsense.batch import locate_file, output_format
 
     try:
         check_output(out, force)
-        rec = read_recording(recording)
+        output_format(out)
+        calibrated = None
         if calibration is not None:
             from tactsense.estimate import Calibration
+            from tactsense.io.recording import RecordingReader
 
-            calibrated = Calibration.load(calibration, rec.sensor)
-            estimates = run_locate(
-                rec.frames,
-                rec.sensor,
+            with RecordingReader(recording) as reader:
+                sensor = reader.sensor
+            calibrated = Calibration.load(calibration, sensor)
+        with (
+            Progress(
+                TextColumn("locating"),
+                BarColumn(),
+                MofNCompleteColumn(),
+                TextColumn("frames"),
+                TimeRemainingColumn(),
+                console=console,
+                disable=quiet or None,
+            ) as bar,
+            atomic_output(out) as temporary,
+        ):
+            task = bar.add_task("frames", total=None)
+            summary = locate_file(
+                recording,
+                temporary,
+                baseline_frames=baseline_frames,
                 calibration=calibrated,
-                frame_period_s=rec.sensor.scan_period_s,
                 threshold=threshold,
+                chunk_frames=chunk_frames,
+                progress=lambda done, total: bar.update(task, completed=done, total=total),
             )
-        else:
-            baseline = baseline_from(rec.frames, baseline_frames)
-            estimates = run_locate(rec.frames, rec.sensor, baseline=baseline, threshold=threshold)
-        with atomic_output(out) as temporary:
-            write_estimates_csv(temporary, estimates, rec.time_s)
     except (TactsenseInputError, FileExistsError) as error:
         fail(str(error))
-    touched = int(np.count_nonzero(np.isfinite(estimates.row)))
-    console.print(f"wrote {out}: {len(estimates)} frames, {touched} with a contact")
+    note = f", {summary['saturated']} saturated (force NaN)" if summary["saturated"] else ""
+    console.print(
+        f"wrote {out}: {summary['frames']} frames, {summary['contacts']} with a contact{note}"
+    )
 
 
 @app.command()

@@ -76,7 +76,7 @@ def _trig_table(n):
     return np.cos(omega * index), np.sin(omega * index)
 
 
-@jit()
+@jit(nogil=True)
 def locate_frames(z, valid, periodic, first_row, tolerance, max_iterations, max_step):
     """Peak, Newton steps, convergence, summed deflection, skew and second maximum per frame.
 
@@ -284,7 +284,7 @@ def locate_frames(z, valid, periodic, first_row, tolerance, max_iterations, max_
     return row, col, value, iterations, converged, summed, skew, second
 
 
-@jit()
+@jit(nogil=True)
 def prepare_frames(frames, baseline, unusable, full_scale, nan_flag, saturated_flag, dead_flag):
     """Eq. 4 deflection, per-frame flags and the largest tactel, in one pass.
 
@@ -292,14 +292,15 @@ def prepare_frames(frames, baseline, unusable, full_scale, nan_flag, saturated_f
 
     Parameters
     ----------
-    frames : float64 array (N, rows, cols)
+    frames : array (N, rows, cols), any integer or float type
         Readings [counts].
     baseline : float64 array (rows, cols)
     unusable : bool array (rows, cols)
         Tactels known dead or excluded (a non-positive baseline included).
     """
     n_frames, rows, cols = frames.shape
-    deflection = np.empty_like(frames)
+    # any numeric input (uint16 counts straight from a recording: no float64 copy)
+    deflection = np.empty((n_frames, rows, cols), np.float64)
     flags = np.zeros(n_frames, np.int64)
     peak = np.full(n_frames, -np.inf)
     any_unusable = False
@@ -312,7 +313,7 @@ def prepare_frames(frames, baseline, unusable, full_scale, nan_flag, saturated_f
         best = -np.inf
         for r in range(rows):
             for c in range(cols):
-                v = frames[f, r, c]
+                v = float(frames[f, r, c])
                 d = 0.0
                 if not math.isfinite(v):
                     flag |= nan_flag

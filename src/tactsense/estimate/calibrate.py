@@ -25,6 +25,7 @@ from scipy.optimize import least_squares
 
 from tactsense._validation import CalibrationError, check_frames
 from tactsense.estimate.creep import (
+    CreepCompensator,
     Viscoelastic,
     compensate_viscoelastic,
     creep_bounds,
@@ -531,11 +532,27 @@ class Calibration:
             calibration.check_sensor(sensor)
         return calibration
 
-    def apply(self, frames, sensor: SensorSpec, *, frame_period_s: float | None = None):
+    def compensator(self, frame_period_s: float, shape: tuple[int, ...]):
+        """A :class:`CreepCompensator` for this calibration's creep model (None without
+        one): pass it to :meth:`apply` so that consecutive pieces of one recording are
+        compensated as one sequence."""
+        if self.viscoelastic is None:
+            return None
+        return CreepCompensator(self.viscoelastic, frame_period_s, tuple(shape))
+
+    def apply(
+        self,
+        frames,
+        sensor: SensorSpec,
+        *,
+        frame_period_s: float | None = None,
+        compensator=None,
+    ):
         """Calibrated fractional deflection of a sequence of frames, and their flags.
 
         Order: eq. 4 against the stored baseline -> nonlinearity table ->
-        creep compensation (frames in time order, needs ``frame_period_s``) ->
+        creep compensation (frames in time order, needs ``frame_period_s``, or a
+        ``compensator`` from :meth:`compensator` carried from the previous piece) ->
         division by the gains; excluded tactels are zeroed and flagged.
         """
         self.check_sensor(sensor)
@@ -545,7 +562,9 @@ class Calibration:
         if self.nonlinearity is not None:
             measured, linear = (np.asarray(v, float) for v in self.nonlinearity)
             deflection = apply_nonlinearity(deflection, measured, linear)
-        if self.viscoelastic is not None and frame_period_s is not None and deflection.ndim == 3:
+        if compensator is not None and deflection.ndim == 3:
+            deflection = np.stack([compensator(frame) for frame in deflection])
+        elif self.viscoelastic is not None and frame_period_s is not None and deflection.ndim == 3:
             deflection = compensate_viscoelastic(deflection, frame_period_s, self.viscoelastic)
         deflection = np.where(self.excluded, 0.0, deflection / self.gains)
         return deflection, flags

@@ -81,6 +81,8 @@ def locate(
     second_contact: float = 0.3,
     calibration=None,
     frame_period_s: float | None = None,
+    compensator=None,
+    workers: int = 1,
 ) -> Estimates:
     """Locate the contact in every frame of a batch.
 
@@ -105,6 +107,12 @@ def locate(
         Applied to counts before estimation (its baseline replaces
         ``baseline``; gains, nonlinearity, excluded tactels, and creep
         compensation when ``frame_period_s`` is given for frames in time order).
+    workers : int
+        Threads for the compiled passes (the frames are split among them; the
+        kernels release the GIL). 1 (the default) runs in the calling thread.
+    compensator : CreepCompensator, optional
+        With ``calibration``: the creep state carried from the previous piece of the
+        same recording (:meth:`Calibration.compensator`), for chunked processing.
 
     Returns
     -------
@@ -116,12 +124,11 @@ def locate(
     if not isinstance(sensor, SensorSpec):
         raise TactsenseInputError(f"sensor must be a SensorSpec; got {type(sensor).__name__}")
     frames = check_frames(frames, sensor.shape)
-    peak_tactel = None
-    if calibration is not None:
-        if not counts:
-            raise TactsenseInputError("a calibration applies to counts, not to deflections")
-        deflection, flags = calibration.apply(frames, sensor, frame_period_s=frame_period_s)
-    elif counts:
+    if calibration is not None and not counts:
+        raise TactsenseInputError("a calibration applies to counts, not to deflections")
+    if workers < 1:
+        raise TactsenseInputError(f"workers must be at least 1; got {workers}")
+    if calibration is None and counts:
         if baseline is None:
             raise TactsenseInputError(
                 "counts need a baseline (the untouched readings): pass baseline=, e.g. "
@@ -136,44 +143,61 @@ def locate(
         if dead is not None:
             unusable = unusable | np.asarray(dead, dtype=bool)
         lead = frames.shape[:-2]
-        with deferred_interrupts():
-            deflection, flags, peak_tactel = prepare_frames(
-                np.ascontiguousarray(frames, dtype=np.float64).reshape(-1, *sensor.shape),
-                np.where(unusable, 1.0, baseline),
-                unusable,
-                float(2**sensor.electronics.adc_bits - 1),
-                int(Flag.NAN_INPUT),
-                int(Flag.SATURATED),
-                int(Flag.DEAD_TACTEL),
-            )
-        deflection = deflection.reshape(*lead, *sensor.shape)
-        flags = flags.reshape(lead)
-    else:
-        deflection = np.asarray(frames, dtype=float)
-        bad = ~np.isfinite(deflection)
-        flags = np.where(bad.any(axis=(-2, -1)), int(Flag.NAN_INPUT), 0).astype(np.int64)
-        deflection = np.where(bad, 0.0, deflection)
-        if dead is not None:
-            deflection = np.where(np.asarray(dead, bool), 0.0, deflection)
-    lead = deflection.shape[:-2]
-    rows, cols = sensor.shape
-    flat = deflection.reshape(-1, rows, cols)
-    flags = flags.reshape(-1).copy()
-    periodic = sensor.closes_circumference
-    if peak_tactel is None:
-        peak_tactel = flat.reshape(flat.shape[0], -1).max(axis=1)
-    touched = peak_tactel >= threshold
-    flags[~touched] |= int(Flag.NO_CONTACT)
-
-    with deferred_interrupts():
-        row, col, value, iterations, converged, summed, skew, second = locate_frames(
-            np.ascontiguousarray(flat, dtype=np.float64),
-            touched,
-            periodic,
+        # counts as recorded (uint16, or float with NaN): no float64 copy of the input
+        source = _as_kernel_input(frames).reshape(-1, *sensor.shape)
+        shared = (
+            np.where(unusable, 1.0, baseline),
+            unusable,
+            float(2**sensor.electronics.adc_bits - 1),
+            int(Flag.NAN_INPUT),
+            int(Flag.SATURATED),
+            int(Flag.DEAD_TACTEL),
+        )
+        geometry = (
+            sensor.closes_circumference,
             1 if sensor.array.tip_row else 0,
             TOLERANCE,
             MAX_ITERATIONS,
             MAX_STEP,
+        )
+
+        def block(lo: int, hi: int):
+            # eq. 4 and Newton on one cache-sized block: the deflection of BLOCK frames
+            # (4 MB) is made and used while it is hot, never for the whole recording
+            deflection, flags, peak = prepare_frames(source[lo:hi], *shared)
+            touched = peak >= threshold
+            return (flags, touched, *locate_frames(deflection, touched, *geometry))
+
+        flags, touched, row, col, value, iterations, converged, summed, skew, second = _run_blocks(
+            block, source.shape[0], workers
+        )
+        periodic = sensor.closes_circumference
+        rows, cols = sensor.shape
+        flags[~touched] |= int(Flag.NO_CONTACT)
+    else:
+        if calibration is not None:
+            deflection, flags = calibration.apply(
+                frames, sensor, frame_period_s=frame_period_s, compensator=compensator
+            )
+        else:
+            deflection = np.asarray(frames, dtype=float)
+            bad = ~np.isfinite(deflection)
+            flags = np.where(bad.any(axis=(-2, -1)), int(Flag.NAN_INPUT), 0).astype(np.int64)
+            deflection = np.where(bad, 0.0, deflection)
+            if dead is not None:
+                deflection = np.where(np.asarray(dead, bool), 0.0, deflection)
+        lead = deflection.shape[:-2]
+        rows, cols = sensor.shape
+        flat = np.ascontiguousarray(deflection.reshape(-1, rows, cols), dtype=np.float64)
+        flags = flags.reshape(-1).copy()
+        periodic = sensor.closes_circumference
+        touched = flat.reshape(flat.shape[0], -1).max(axis=1) >= threshold
+        flags[~touched] |= int(Flag.NO_CONTACT)
+        geometry = (periodic, 1 if sensor.array.tip_row else 0, TOLERANCE, MAX_ITERATIONS, MAX_STEP)
+        row, col, value, iterations, converged, summed, skew, second = _run_blocks(
+            lambda lo, hi: locate_frames(flat[lo:hi], touched[lo:hi], *geometry),
+            flat.shape[0],
+            workers,
         )
     force = force_per_deflection(sensor) * summed
     # a clipped reading understates its tactel's deflection, so the sum is only a lower
@@ -196,6 +220,40 @@ def locate(
         for a in (row, col, axial, angle, value, force, skew, iterations, converged, flags)
     ]
     return Estimates(*shaped)
+
+
+def _as_kernel_input(frames: np.ndarray) -> np.ndarray:
+    """Frames in a type the compiled pass takes without copying (uint16, int, float64)."""
+    if frames.dtype in (np.uint16, np.int32, np.int64, np.float64):
+        return np.ascontiguousarray(frames)
+    return np.ascontiguousarray(frames, dtype=np.float64)
+
+
+BLOCK = 8192
+"""Frames per block of the compiled passes: the deflection of a block (4 MB for 8 x 8)
+stays in cache between the two passes."""
+
+
+def _run_blocks(work, n: int, workers: int):
+    """``work(lo, hi)`` over consecutive blocks of ``n`` frames, on ``workers`` threads;
+    the per-frame outputs of the blocks joined in order.
+
+    SIGINT is held back meanwhile (:mod:`tactsense._signals`: a Ctrl-C inside compiled
+    code can crash the interpreter); threads started here inherit that mask, so a Ctrl-C
+    reaches only the main thread, once the blocks are done.
+    """
+    spans = [(lo, min(lo + BLOCK, n)) for lo in range(0, n, BLOCK)] or [(0, 0)]
+    with deferred_interrupts():
+        if workers == 1 or len(spans) == 1:
+            parts = [work(lo, hi) for lo, hi in spans]
+        else:
+            from concurrent.futures import ThreadPoolExecutor
+
+            with ThreadPoolExecutor(max_workers=workers) as pool:
+                parts = list(pool.map(lambda span: work(*span), spans))
+    if len(parts) == 1:
+        return parts[0]
+    return tuple(np.concatenate([part[i] for part in parts]) for i in range(len(parts[0])))
 
 
 def write_estimates_csv(

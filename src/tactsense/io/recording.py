@@ -217,14 +217,11 @@ def _write_file(partial: Path, recording: Recording) -> None:
                     group.create_dataset(key, data=value).attrs["units"] = units.get(key, "1")
 
 
-def read_recording(path: str | Path) -> Recording:
-    """Open and validate a recording written by :func:`write_recording`.
+def _open_validated(path: str | Path):
+    """Open a recording and check it: (h5 file, sensor, number of frames, closed cleanly).
 
-    Raises
-    ------
-    RecordingError
-        If the file is missing, not HDF5, not a tactsense recording, lacks a
-        dataset, or has shapes that disagree with its sensor.
+    The caller closes the file. Raises :class:`RecordingError` for everything
+    :func:`read_recording` refuses.
     """
     path = Path(path)
     if not path.exists():
@@ -241,7 +238,7 @@ def read_recording(path: str | Path) -> Recording:
             h5 = h5py.File(path, "r", swmr=True)
         except OSError as again:
             raise RecordingError(f"{path} is not a readable HDF5 file ({again})") from None
-    with h5:
+    try:
         if h5.attrs.get("format") != FORMAT:
             raise RecordingError(
                 f"{path} is not a tactsense recording (format attribute "
@@ -277,12 +274,31 @@ def read_recording(path: str | Path) -> Recording:
             if name in h5 and h5[name].ndim >= 1
         ]
         n = min(per_frame)  # a killed writer may have flushed one dataset further
-        frames = h5["frames"][:n]
-        if frames.ndim != 3 or frames.shape[1:] != sensor.shape:
+        shape = h5["frames"].shape
+        if len(shape) != 3 or shape[1:] != sensor.shape:
             raise RecordingError(
-                f"{path}: /frames has shape {frames.shape}; expected (T, {sensor.shape[0]}, "
+                f"{path}: /frames has shape {shape}; expected (T, {sensor.shape[0]}, "
                 f"{sensor.shape[1]}) for its sensor {sensor.name!r}"
             )
+    except BaseException:
+        h5.close()
+        raise
+    return h5, sensor, n, closed_cleanly
+
+
+def read_recording(path: str | Path) -> Recording:
+    """Open and validate a recording written by :func:`write_recording`.
+
+    Raises
+    ------
+    RecordingError
+        If the file is missing, not HDF5, not a tactsense recording, lacks a
+        dataset, or has shapes that disagree with its sensor.
+    """
+    path = Path(path)
+    h5, sensor, n, closed_cleanly = _open_validated(path)
+    with h5:
+        frames = h5["frames"][:n]
         truth: dict = {}
         if "truth" in h5:
             group = h5["truth"]
@@ -312,6 +328,57 @@ def read_recording(path: str | Path) -> Recording:
             source=str(h5.attrs.get("source", "")),
             closed_cleanly=closed_cleanly,
         )
+
+
+class RecordingReader:
+    """A recording read in pieces, for recordings larger than memory.
+
+    Validated as :func:`read_recording` validates, but nothing but the metadata is read
+    until asked for. Use as a context manager.
+
+    Examples
+    --------
+    >>> with RecordingReader("long.h5") as reader:  # doctest: +SKIP
+    ...     for start, frames, time_s in reader.chunks():
+    ...         ...
+    """
+
+    def __init__(self, path: str | Path):
+        self.path = Path(path)
+        self._h5, self.sensor, self.n_frames, self.closed_cleanly = _open_validated(self.path)
+
+    def __enter__(self) -> RecordingReader:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def close(self) -> None:
+        self._h5.close()
+
+    @property
+    def chunk_frames(self) -> int:
+        """Frames per piece: the HDF5 chunk length (a multiple of it near 65,536)."""
+        chunks = self._h5["frames"].chunks
+        if not chunks:
+            return 65_536
+        return max(chunks[0], (65_536 // chunks[0]) * chunks[0])
+
+    def frames(self, start: int, stop: int) -> np.ndarray:
+        """Frames ``start`` to ``stop`` (exclusive) [counts]."""
+        return self._h5["frames"][start : min(stop, self.n_frames)]
+
+    def time_s(self, start: int, stop: int) -> np.ndarray:
+        """Their times [s]."""
+        return self._h5["time"][start : min(stop, self.n_frames)]
+
+    def chunks(self, chunk_frames: int | None = None):
+        """Yield ``(start, frames, time_s)`` for consecutive pieces of the recording."""
+        size = int(chunk_frames or self.chunk_frames)
+        if size < 1:
+            raise TactsenseInputError(f"chunk_frames must be at least 1; got {size}")
+        for start in range(0, self.n_frames, size):
+            yield start, self.frames(start, start + size), self.time_s(start, start + size)
 
 
 class RecordingWriter:
