@@ -45,6 +45,12 @@ def main() -> None:
         run()
     except KeyboardInterrupt:
         _interrupted()
+    except SystemExit as done:
+        if done.code == 130:  # typer's code for a Ctrl-C outside the command's own guard
+            _interrupted()
+        # the command is over and its output complete: a Ctrl-C now changes nothing
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        raise
 
 
 if __name__ == "__main__":

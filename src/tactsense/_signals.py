@@ -1,11 +1,17 @@
 """Ctrl-C and compiled code.
 
-A SIGINT that arrives while a Numba-compiled function runs can crash the interpreter
+A Ctrl-C (SIGINT) handled while a Numba-compiled function runs can crash the
+interpreter or leave it in a broken state: Python raises KeyboardInterrupt at the next
+Python code it runs, and inside a compiled call that is one of Numba's own helpers
 (numba/numba#2324: "interrupting ... sometimes gives a segmentation fault"; observed
-here in ``locate`` on 300,000 frames). :func:`deferred_interrupts` blocks SIGINT in the
-calling thread for the length of a compiled call; a Ctrl-C pressed meanwhile stays
-pending and is delivered, as an ordinary KeyboardInterrupt, when the call returns.
-Callers keep each call short (chunks of frames) so that Ctrl-C stays prompt.
+here as a segfault in ``locate`` on 300,000 frames, and as ``SystemError:
+_numba_unpickle returned a result with an exception set``).
+
+:func:`deferred_interrupts` swaps Python's SIGINT handler for one that only notes the
+press, for the length of the compiled calls, and raises the KeyboardInterrupt after
+them, in ordinary Python code. (Blocking the signal with ``pthread_sigmask`` is not
+enough: any other thread, e.g. a progress bar's, can receive it.) Callers keep each
+block of compiled work short, so that Ctrl-C stays prompt.
 """
 
 from __future__ import annotations
@@ -14,17 +20,25 @@ import signal
 import threading
 from contextlib import contextmanager
 
-_BLOCKABLE = hasattr(signal, "pthread_sigmask")
-
 
 @contextmanager
 def deferred_interrupts():
-    """Hold SIGINT back while the block runs (main thread, POSIX); elsewhere a no-op."""
-    if not _BLOCKABLE or threading.current_thread() is not threading.main_thread():
+    """Hold a Ctrl-C back while the block runs; raise it when the block ends.
+
+    Only the main thread can install signal handlers; elsewhere this does nothing (the
+    handler runs in the main thread anyway).
+    """
+    if threading.current_thread() is not threading.main_thread():
         yield
         return
-    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    pressed: list[int] = []
+    previous = signal.signal(signal.SIGINT, lambda number, frame: pressed.append(number))
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+        signal.signal(signal.SIGINT, previous)
+    if pressed:
+        if callable(previous):
+            previous(signal.SIGINT, None)
+        elif previous == signal.SIG_DFL:
+            raise KeyboardInterrupt

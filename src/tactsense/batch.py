@@ -54,6 +54,7 @@ def iter_locate(
     calibration=None,
     threshold: float = CONTACT_THRESHOLD,
     chunk_frames: int | None = None,
+    workers: int = 1,
 ) -> Iterator[tuple[int, np.ndarray, Estimates]]:
     """Estimates of a recording, one piece at a time: ``(first frame, time_s, estimates)``.
 
@@ -81,9 +82,12 @@ def iter_locate(
                 calibration=calibration,
                 compensator=compensator,
                 threshold=threshold,
+                workers=workers,
             )
         else:
-            estimates = locate(frames, sensor, baseline=baseline, threshold=threshold)
+            estimates = locate(
+                frames, sensor, baseline=baseline, threshold=threshold, workers=workers
+            )
         yield start, time_s, estimates
 
 
@@ -199,6 +203,7 @@ def locate_file(
     calibration=None,
     threshold: float = CONTACT_THRESHOLD,
     chunk_frames: int | None = None,
+    workers: int = 1,
     progress: Callable[[int, int], None] | None = None,
 ) -> dict:
     """Locate every frame of a recording file and write the estimates to ``out``.
@@ -225,6 +230,7 @@ def locate_file(
             calibration=calibration,
             threshold=threshold,
             chunk_frames=chunk_frames,
+            workers=workers,
         ):
             writer.write(start, time_s, estimates)
             contacts += int(np.count_nonzero(np.isfinite(estimates.row)))

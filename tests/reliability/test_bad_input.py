@@ -58,6 +58,7 @@ BAD_OPTIONS = [
     ("locate REC --threshold nan --out OUT", "--threshold"),
     ("locate REC --baseline-frames 0 --out OUT", "--baseline-frames"),
     ("locate REC --chunk-frames 0 --out OUT", "--chunk-frames"),
+    ("locate REC --workers 0 --out OUT", "--workers"),
     ("locate REC --out OUT.txt", "use the extension .csv, .parquet or .h5"),
     ("calibrate REC --probe-g 0 --out OUT", "--probe-g"),
     ("calibrate REC --baseline-frames 0 --out OUT", "--baseline-frames"),

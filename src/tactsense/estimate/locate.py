@@ -238,9 +238,8 @@ def _run_blocks(work, n: int, workers: int):
     """``work(lo, hi)`` over consecutive blocks of ``n`` frames, on ``workers`` threads;
     the per-frame outputs of the blocks joined in order.
 
-    SIGINT is held back meanwhile (:mod:`tactsense._signals`: a Ctrl-C inside compiled
-    code can crash the interpreter); threads started here inherit that mask, so a Ctrl-C
-    reaches only the main thread, once the blocks are done.
+    A Ctrl-C is held back meanwhile and raised once the blocks are done
+    (:mod:`tactsense._signals`: a Ctrl-C inside compiled code can crash the interpreter).
     """
     spans = [(lo, min(lo + BLOCK, n)) for lo in range(0, n, BLOCK)] or [(0, 0)]
     with deferred_interrupts():
