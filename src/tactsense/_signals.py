@@ -18,27 +18,42 @@ from __future__ import annotations
 
 import signal
 import threading
-from contextlib import contextmanager
 
 
-@contextmanager
-def deferred_interrupts():
+class _Hold:
+    """The context manager behind :func:`deferred_interrupts` (a class: a generator-based
+    one costs more than the compiled call it guards in a real-time loop)."""
+
+    __slots__ = ("pressed", "previous")
+
+    def __init__(self) -> None:
+        self.pressed = False
+        self.previous = None
+
+    def _note(self, number, frame) -> None:
+        self.pressed = True
+
+    def __enter__(self) -> None:
+        if threading.current_thread() is threading.main_thread():
+            self.previous = signal.signal(signal.SIGINT, self._note)
+
+    def __exit__(self, *exc) -> None:
+        previous, self.previous = self.previous, None
+        if previous is None:
+            return
+        signal.signal(signal.SIGINT, previous)
+        if self.pressed:
+            self.pressed = False
+            if callable(previous):
+                previous(signal.SIGINT, None)
+            elif previous == signal.SIG_DFL:
+                raise KeyboardInterrupt
+
+
+def deferred_interrupts() -> _Hold:
     """Hold a Ctrl-C back while the block runs; raise it when the block ends.
 
     Only the main thread can install signal handlers; elsewhere this does nothing (the
     handler runs in the main thread anyway).
     """
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    pressed: list[int] = []
-    previous = signal.signal(signal.SIGINT, lambda number, frame: pressed.append(number))
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGINT, previous)
-    if pressed:
-        if callable(previous):
-            previous(signal.SIGINT, None)
-        elif previous == signal.SIG_DFL:
-            raise KeyboardInterrupt
+    return _Hold()
