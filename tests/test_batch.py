@@ -121,3 +121,15 @@ def test_workers_give_the_same_numbers(recording):
     two = ts.locate(frames, rec.sensor, baseline=base, workers=2)
     for name in [*FIELDS, "flags"]:
         np.testing.assert_array_equal(getattr(two, name), getattr(one, name), err_msg=name)
+
+
+def test_calibration_from_pieces_equals_the_whole_sweep():
+    spec = ts.fearing1990_initial()
+    sweep = ts.simulate(spec, ts.calibration_sweep(spec, increment=1.2), rng=1)
+    whole = cal.calibrate_sweep(sweep.frames, spec)
+    # pieces of 3 frames: the 5 baseline frames span two pieces
+    pieces = cal.calibrate_sweep(
+        (sweep.frames[k : k + 3] for k in range(0, len(sweep.frames), 3)), spec
+    )
+    for name in ("gains", "baseline", "dead", "weak", "noisy", "threshold_g"):
+        np.testing.assert_array_equal(getattr(pieces, name), getattr(whole, name), err_msg=name)

@@ -201,12 +201,19 @@ def calibrate(
 
     try:
         check_output(out, force)
-        rec = read_recording(sweep)
-        calibration = cal.calibrate_sweep(
-            rec.frames, rec.sensor, baseline_frames=baseline_frames, probe_grams=probe_g
-        )
+        from tactsense.io.recording import RecordingReader
+
+        # the sweep is read in pieces: any length fits in memory
+        with RecordingReader(sweep) as reader:
+            sensor = reader.sensor
+            calibration = cal.calibrate_sweep(
+                (frames for _, frames, _ in reader.chunks()),
+                sensor,
+                baseline_frames=baseline_frames,
+                probe_grams=probe_g,
+            )
         uncalibrated = calibration.notes["uncalibrated_tactels"]
-        wired = int(np.prod(rec.sensor.shape))
+        wired = int(np.prod(sensor.shape))
         if len(uncalibrated) > 0.1 * wired and not partial:
             raise TactsenseInputError(
                 f"the sweep reached only {wired - len(uncalibrated)} of {wired} tactels "
@@ -216,11 +223,11 @@ def calibrate(
             )
         if steps is not None:
             calibration.viscoelastic = _fit_steps(
-                read_recording(steps), rec.sensor, row, col, baseline_frames
+                read_recording(steps), sensor, row, col, baseline_frames
             )
         if knife is not None:
             calibration.model_fit = _fit_knife(
-                read_recording(knife), rec.sensor, row, col, baseline_frames
+                read_recording(knife), sensor, row, col, baseline_frames
             )
         with atomic_output(out) as temporary:
             calibration.save(temporary)

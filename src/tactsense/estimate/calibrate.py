@@ -96,7 +96,12 @@ def gain_table(deflection, *, min_response: float = 0.01, reference: float | Non
         raise CalibrationError(
             f"a gain calibration needs a sweep of frames (T, rows, cols); got {deflection.shape}"
         )
-    peak = deflection.max(axis=0)
+    return gains_from_peak(deflection.max(axis=0), min_response=min_response, reference=reference)
+
+
+def gains_from_peak(peak, *, min_response: float = 0.01, reference=None):
+    """:func:`gain_table` from each tactel's largest deflection (for sweeps read in pieces)."""
+    peak = np.asarray(peak, dtype=float)
     calibrated = peak >= min_response
     if not calibrated.any():
         raise CalibrationError(
@@ -602,8 +607,10 @@ def calibrate_sweep(
 
     Parameters
     ----------
-    frames : ndarray, shape (T, rows, cols)
-        Readings [counts]; the first ``baseline_frames`` untouched.
+    frames : ndarray, shape (T, rows, cols), or an iterable of such pieces
+        Readings [counts]; the first ``baseline_frames`` untouched. Pieces (consecutive
+        parts of one recording, e.g. ``(f for _, f, _ in reader.chunks())``) are read
+        one at a time, so a sweep of any length fits in memory.
     probe_grams : float
         Load of the sweeping probe, for the sensitivity thresholds [g].
 
@@ -613,27 +620,53 @@ def calibrate_sweep(
         Gains (relative to the model's deflection for the probe centred on a
         tactel), baseline, health masks and thresholds; no fitted models yet.
     """
-    frames = check_frames(frames, sensor.shape).astype(float)
-    if frames.ndim != 3:
-        raise CalibrationError(f"frames has shape {frames.shape}; expected (T, rows, cols)")
-    if frames.shape[0] <= baseline_frames + 1:
+    nested = isinstance(frames, list | tuple) and not all(hasattr(p, "shape") for p in frames)
+    if hasattr(frames, "shape") or nested:
+        whole = check_frames(frames, sensor.shape)
+        if whole.ndim != 3:
+            raise CalibrationError(f"frames has shape {whole.shape}; expected (T, rows, cols)")
+        pieces = (whole[k : k + 65_536] for k in range(0, max(whole.shape[0], 1), 65_536))
+    else:
+        pieces = iter(frames)
+    full_scale = 2**sensor.electronics.adc_bits - 1
+    base_parts: list[np.ndarray] = []
+    have_base = 0
+    baseline = None
+    peak = None
+    total = saturated_count = 0
+    for piece in pieces:
+        piece = check_frames(piece, sensor.shape).astype(float)
+        if piece.ndim != 3:
+            raise CalibrationError(f"a piece has shape {piece.shape}; expected (T, rows, cols)")
+        total += piece.shape[0]
+        saturated_count += int(np.count_nonzero(piece >= full_scale))
+        if have_base < baseline_frames:
+            take = piece[: baseline_frames - have_base]
+            base_parts.append(take)
+            have_base += take.shape[0]
+            piece = piece[take.shape[0] :]
+            if have_base == baseline_frames:
+                baseline = np.median(np.concatenate(base_parts), axis=0)
+        if baseline is None or piece.shape[0] == 0:
+            continue
+        deflection, _ = deflection_from_counts(piece, baseline, sensor)
+        most = deflection.max(axis=0)
+        peak = most if peak is None else np.maximum(peak, most)
+    if total <= baseline_frames + 1 or peak is None:
         raise CalibrationError(
-            f"the recording has {frames.shape[0]} frames: too short for a baseline of "
+            f"the recording has {total} frames: too short for a baseline of "
             f"{baseline_frames} frames and a sweep"
         )
-    full_scale = 2**sensor.electronics.adc_bits - 1
-    saturated = np.mean(frames >= full_scale)
+    saturated = saturated_count / (total * np.prod(sensor.shape))
     if saturated > 0.001:
         raise CalibrationError(
             f"{100 * saturated:.2g} % of the readings are saturated at {full_scale} counts: "
             "lighten the probe or lower the amplifier gain and record again"
         )
-    base = frames[:baseline_frames]
-    baseline = np.median(base, axis=0)
-    deflection, _ = deflection_from_counts(frames[baseline_frames:], baseline, sensor)
+    base = np.concatenate(base_parts)
     reference = expected_peaks(sensor, probe_grams)
-    gains, peak, uncalibrated = gain_table(
-        deflection, min_response=min_response, reference=reference
+    gains, peak, uncalibrated = gains_from_peak(
+        peak, min_response=min_response, reference=reference
     )
     health = array_health(
         peak,
