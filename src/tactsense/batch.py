@@ -216,10 +216,11 @@ def locate_file(
     -------
     dict
         ``frames``, ``contacts`` (frames with a contact), ``saturated`` (frames flagged
-        SATURATED).
+        SATURATED), ``force_mean_n`` and ``force_max_n`` over the contacts [N].
     """
     output_format(out)
     contacts = saturated = 0
+    force_sum, force_max = 0.0, float("nan")
     with RecordingReader(recording) as reader, EstimatesWriter(out) as writer:
         total = reader.n_frames
         if progress is not None:
@@ -234,6 +235,10 @@ def locate_file(
         ):
             writer.write(start, time_s, estimates)
             contacts += int(np.count_nonzero(np.isfinite(estimates.row)))
+            finite = estimates.force_n[np.isfinite(estimates.force_n)]
+            if finite.size:
+                force_sum += float(finite.sum())
+                force_max = float(np.fmax(force_max, finite.max()))
             saturated += int(np.count_nonzero(estimates.flags & int(Flag.SATURATED)))
             if progress is not None:
                 progress(start + len(estimates), total)
@@ -241,4 +246,10 @@ def locate_file(
             empty = Estimates(*(np.zeros(0) for _ in _NAMES))
             writer.write(0, np.zeros(0), empty)
             writer.rows = 0
-    return {"frames": total, "contacts": contacts, "saturated": saturated}
+    return {
+        "frames": total,
+        "contacts": contacts,
+        "saturated": saturated,
+        "force_mean_n": force_sum / contacts if contacts else float("nan"),
+        "force_max_n": force_max,
+    }
