@@ -73,6 +73,13 @@ BAD_OPTIONS = [
     ("live loop:// --threshold 2", "--threshold"),
     ("live loop:// --baseline-frames 0", "--baseline-frames"),
     ("reproduce --sensor bogus --out OUT", "bogus"),
+    ("design sweep --depth 0:3:4 --out OUT", "--depth"),
+    ("design sweep --spacing x --out OUT", "--spacing"),
+    ("design sweep --poisson 0.6 --out OUT", "--poisson"),
+    ("design sweep --workers -1 --out OUT", "--workers"),
+    ("batch REC --workers 0 --out OUT", "--workers"),
+    ("batch REC --format xml --out OUT", "--format"),
+    ("batch REC --threshold 0 --out OUT", "--threshold"),
 ]
 
 
@@ -160,6 +167,7 @@ BAD_OUTPUTS = {
     "sensor show": "sensor show --out {out}",
     "record": "record loop:// --out {out}",
     "live": "live loop:// --out {out}",
+    "design sweep": "design sweep --depth 3.8 --spacing 3.8 --out {out}",
 }
 BAD_PATHS = {
     "missing folder": ("no_such_folder/x.out", "does not exist"),

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from enum import StrEnum
+from pathlib import Path
 from typing import Annotated
 
 import numpy as np
@@ -268,3 +269,117 @@ def design_strip(
     table.add_row("bottom plate deflection", f"{1e6 * values['bottom_plate_deflection']:.2f} um")
     table.add_row("surface deflection", f"{1e6 * values['surface_deflection']:.2f} um")
     Console().print(table)
+
+
+def _grid(text: str, option: str, *, low: float, high: float) -> list[float]:
+    """'START:STOP:COUNT' (evenly spaced, inclusive) or 'A,B,C' -> values within range."""
+    try:
+        if ":" in text:
+            start, stop, count = text.split(":")
+            n = int(count)
+            if n < 1 or n > 10_000:
+                raise ValueError
+            values = np.linspace(float(start), float(stop), n).tolist()
+        else:
+            values = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        fail(f"{option} {text!r}: expected START:STOP:COUNT (COUNT 1-10000) or A,B,C")
+    if not values or not all(np.isfinite(v) and low <= v <= high for v in values):
+        fail(f"{option} {text!r}: every value must lie in [{low:g}, {high:g}]")
+    return values
+
+
+@app.command("sweep")
+def design_sweep_command(
+    out: Annotated[
+        Path,
+        typer.Option(
+            "--out", "-o", help="The map as NetCDF (an xarray Dataset; open with xarray)."
+        ),
+    ] = Path("design_map.nc"),
+    depth: Annotated[
+        str, typer.Option(help="Effective depths [mm]: START:STOP:COUNT or A,B,C (0.5-20).")
+    ] = "2:6:9",
+    spacing: Annotated[
+        str,
+        typer.Option(help="Tactel spacings along the finger [mm]: as --depth (0.5-20)."),
+    ] = "2:3.8:7",
+    poisson: Annotated[
+        str, typer.Option(help="Effective Poisson's ratios: A,B,C (0-0.5).")
+    ] = "0.4",
+    force_g: Annotated[str, typer.Option(help="Probe loads [g]: A,B,C (0.1-10000).")] = "50",
+    sensor: SensorOption = "initial",
+    plot: Annotated[
+        Path | None, typer.Option(help="Also draw the map (first ratio and load) to this PNG.")
+    ] = None,
+    workers: Annotated[
+        int,
+        typer.Option(
+            min=0, max=256, help="Local Dask worker processes (0: compute here, one core)."
+        ),
+    ] = 0,
+    force: Annotated[bool, typer.Option("--force", help="Replace OUT and PLOT.")] = False,
+) -> None:
+    """Map what section 6 trades off over a grid of designs: sensitivity, aliasing,
+    interpolation ripple and the Cramer-Rao bound on position and force. The paper's
+    two fingers are marked on the plot."""
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
+
+    from tactsense.analysis.sweep import design_sweep, plot_map
+    from tactsense.cli._common import atomic_output, check_output, console
+
+    check_output(out, force)
+    if plot is not None:
+        check_output(plot, force, what="plot")
+    depths = _grid(depth, "--depth", low=0.5, high=20.0)
+    spacings = _grid(spacing, "--spacing", low=0.5, high=20.0)
+    ratios = _grid(poisson, "--poisson", low=0.0, high=0.5)
+    loads = _grid(force_g, "--force-g", low=0.1, high=10_000.0)
+    spec = load_sensor(sensor)
+    client = cluster = None
+    if workers > 0:
+        import logging
+
+        from dask.distributed import Client, LocalCluster
+
+        cluster = LocalCluster(
+            n_workers=workers,
+            threads_per_worker=1,
+            dashboard_address="127.0.0.1:0",
+            silence_logs=logging.ERROR,
+        )
+        client = Client(cluster)
+        console.print(f"Dask dashboard: {client.dashboard_link}")
+    try:
+        with Progress(
+            TextColumn("depths"), BarColumn(), MofNCompleteColumn(), console=console, disable=None
+        ) as bar:
+            task = bar.add_task("sweep", total=len(depths))
+            dataset = design_sweep(
+                spec,
+                depths,
+                spacings,
+                poisson_ratios=ratios,
+                grams=loads,
+                client=client,
+                progress=lambda done, total: bar.update(task, completed=done, total=total),
+            )
+    finally:
+        if client is not None:
+            client.close()
+            cluster.close()
+    with atomic_output(out) as temporary:
+        dataset.to_netcdf(temporary, engine="scipy")
+    if plot is not None:
+        designs = {
+            "initial": (3.8, 3.8),
+            "improved": (
+                load_sensor("improved").elastic.effective_depth_mm,
+                load_sensor("improved").array.spacing_axial_mm,
+            ),
+        }
+        with atomic_output(plot) as temporary:
+            plot_map(dataset, temporary, designs=designs)
+    n = len(depths) * len(spacings) * len(ratios) * len(loads)
+    fits = int(np.isfinite(dataset["xi"].values).sum())
+    console.print(f"wrote {out}: {n} designs ({n - fits} do not fit the finger: NaN)")

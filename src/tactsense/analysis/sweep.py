@@ -1,0 +1,199 @@
+"""Design maps: what section 6 of the paper trades off, over a grid of designs.
+
+For every depth x spacing (x Poisson's ratio x load) of a finger otherwise like the
+given one, :func:`design_sweep` computes
+
+* ``counts_per_gram``: sensitivity, the A/D units a 50-g probe centred on a tactel moves
+  the reading, per gram (eqs. 1-4 and the elastic model) [1/g];
+* ``xi``: the aliasing of eq. 45, energy beyond the Nyquist rate [-];
+* ``ripple_tactel``: the worst position error of the paper's interpolation for a line
+  load (Fig. 20) [tactel];
+* ``crb_axial_mm`` and ``crb_force_pct``: the Cramer-Rao bound on position along the
+  finger and on force for a probe at the middle of the cylinder, with the finger's read
+  noise (what any estimator can reach) [mm], [%];
+
+as an :class:`xarray.Dataset` with units in the attributes. A design that does not fit
+the finger (rings beyond the cylinder) is NaN. Each depth is one task, so a grid runs
+on a Dask client (``client=``) as well as here.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+import numpy as np
+
+from tactsense._validation import TactsenseInputError
+from tactsense.analysis.aliasing import interpolation_errors, reconstruction_error
+from tactsense.analysis.bound import cramer_rao_bound
+from tactsense.physics.array_response import tactel_deflection
+from tactsense.physics.contact import Probe, grams_force
+from tactsense.physics.transduction import deflection_to_counts
+from tactsense.sensor import SensorSpec, SensorSpecError
+
+VARIABLES = {
+    "counts_per_gram": ("1/g", "A/D units per gram of a probe centred on a tactel"),
+    "xi": ("1", "aliasing: share of eq. 45's energy beyond the Nyquist rate"),
+    "ripple_tactel": ("tactel", "worst position error of the interpolation, line load"),
+    "crb_axial_mm": ("mm", "Cramer-Rao bound on position along the finger"),
+    "crb_force_pct": ("%", "Cramer-Rao bound on force"),
+}
+
+
+def design_point(
+    sensor: SensorSpec, depth_mm: float, spacing_mm: float, poisson_ratio: float, grams: float
+) -> dict[str, float]:
+    """The map's variables for one design (NaN where the design does not fit)."""
+    try:
+        spec = sensor.replace(
+            elastic__effective_depth_mm=depth_mm,
+            elastic__effective_poisson_ratio=poisson_ratio,
+            array__spacing_axial_mm=spacing_mm,
+        )
+    except SensorSpecError:
+        return dict.fromkeys(VARIABLES, float("nan"))
+    middle = spec.shape[0] // 2
+    axial, angle = float(spec.row_axial_mm[middle]), float(spec.col_angle_deg[0])
+    force = grams_force(grams)
+    peak = float(tactel_deflection(spec, [Probe(axial, angle, force)])[middle, 0])
+    counts = float(deflection_to_counts(spec, peak, quantize=False)) - float(
+        deflection_to_counts(spec, 0.0, quantize=False)
+    )
+    positions = np.linspace(-0.5, 0.5, 41)
+    ripple, _ = interpolation_errors(positions, depth_mm, spacing_mm, poisson_ratio)
+    try:
+        bound = cramer_rao_bound(spec, axial, angle, force)
+        crb_axial, crb_force = bound["axial_mm"], 100 * bound["force_relative"]
+    except TactsenseInputError:
+        crb_axial = crb_force = float("nan")
+    return {
+        "counts_per_gram": counts / grams,
+        "xi": float(reconstruction_error(depth_mm, spacing_mm, poisson_ratio)),
+        "ripple_tactel": float(np.abs(ripple).max()),
+        "crb_axial_mm": crb_axial,
+        "crb_force_pct": crb_force,
+    }
+
+
+def _depth_slice(sensor_toml: str, depth, spacings, poissons, grams) -> np.ndarray:
+    """All designs of one depth: array (spacing, poisson, grams, variable)."""
+    sensor = SensorSpec.from_toml_string(sensor_toml)
+    out = np.full((len(spacings), len(poissons), len(grams), len(VARIABLES)), np.nan)
+    for i, spacing in enumerate(spacings):
+        for j, nu in enumerate(poissons):
+            for k, g in enumerate(grams):
+                point = design_point(sensor, depth, spacing, nu, g)
+                out[i, j, k] = [point[name] for name in VARIABLES]
+    return out
+
+
+def design_sweep(
+    sensor: SensorSpec,
+    depths_mm: Sequence[float],
+    spacings_mm: Sequence[float],
+    *,
+    poisson_ratios: Sequence[float] = (0.4,),
+    grams: Sequence[float] = (50.0,),
+    client=None,
+    progress: Callable[[int, int], None] | None = None,
+):
+    """The design map over a grid; an :class:`xarray.Dataset` (see the module).
+
+    Parameters
+    ----------
+    sensor : SensorSpec
+        Everything but depth, axial spacing and Poisson's ratio comes from it.
+    depths_mm, spacings_mm : sequence of float
+        Effective depth and axial tactel spacing [mm].
+    poisson_ratios : sequence of float
+        Effective Poisson's ratio [-].
+    grams : sequence of float
+        Probe load [g].
+    client : dask.distributed.Client, optional
+        Run one task per depth on it; default here, one depth after the other.
+    """
+    import xarray as xr
+
+    depths = [float(d) for d in depths_mm]
+    spacings = [float(s) for s in spacings_mm]
+    poissons = [float(p) for p in poisson_ratios]
+    loads = [float(g) for g in grams]
+    for name, values in (("depth", depths), ("spacing", spacings), ("load", loads)):
+        if not values or min(values) <= 0 or not np.all(np.isfinite(values)):
+            raise TactsenseInputError(f"every {name} must be a positive number; got {values}")
+    if not poissons or not all(0.0 <= p < 0.5 + 1e-12 for p in poissons):
+        raise TactsenseInputError(f"Poisson's ratios must lie in [0, 0.5]; got {poissons}")
+    toml = sensor.to_toml_string()
+    if client is None:
+        slices = []
+        for n, depth in enumerate(depths):
+            slices.append(_depth_slice(toml, depth, spacings, poissons, loads))
+            if progress is not None:
+                progress(n + 1, len(depths))
+    else:
+        futures = client.map(
+            _depth_slice,
+            [toml] * len(depths),
+            depths,
+            [spacings] * len(depths),
+            [poissons] * len(depths),
+            [loads] * len(depths),
+            pure=False,
+        )
+        slices = client.gather(futures)
+    cube = np.stack(slices)  # depth, spacing, poisson, grams, variable
+    coords = {
+        "depth_mm": ("depth_mm", depths, {"units": "mm"}),
+        "spacing_mm": ("spacing_mm", spacings, {"units": "mm"}),
+        "poisson_ratio": ("poisson_ratio", poissons, {"units": "1"}),
+        "load_g": ("load_g", loads, {"units": "g"}),
+    }
+    data = {
+        name: (
+            ("depth_mm", "spacing_mm", "poisson_ratio", "load_g"),
+            cube[..., k],
+            {"units": unit, "long_name": text},
+        )
+        for k, (name, (unit, text)) in enumerate(VARIABLES.items())
+    }
+    return xr.Dataset(
+        data,
+        coords=coords,
+        attrs={"sensor": sensor.name, "sensor_toml": toml, "source": "tactsense design sweep"},
+    )
+
+
+def plot_map(dataset, path, *, designs: dict[str, tuple[float, float]]) -> None:
+    """Sensitivity, aliasing and the position bound over depth x spacing, with the named
+    designs (name -> (depth, spacing)) marked; first Poisson's ratio and load."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    view = dataset.isel(poisson_ratio=0, load_g=0)
+    d, s = view["depth_mm"].values, view["spacing_mm"].values
+    fig, axes = plt.subplots(1, 3, figsize=(14, 4.2), constrained_layout=True)
+    for ax, (name, title) in zip(
+        axes,
+        (
+            ("counts_per_gram", "sensitivity [A/D units per g]"),
+            ("xi", "aliasing xi (eq. 45)"),
+            ("crb_axial_mm", "best possible position sd [mm] (CRB)"),
+        ),
+        strict=True,
+    ):
+        mesh = ax.pcolormesh(s, d, view[name].values, shading="nearest", cmap="viridis")
+        fig.colorbar(mesh, ax=ax)
+        for label, (depth, spacing) in designs.items():
+            ax.plot(spacing, depth, "r*", ms=12)
+            ax.annotate(
+                label, (spacing, depth), color="r", xytext=(4, 4), textcoords="offset points"
+            )
+        ax.set_xlabel("tactel spacing along the finger [mm]")
+        ax.set_ylabel("effective depth [mm]")
+        ax.set_title(title, fontsize=10)
+    nu, load = float(view["poisson_ratio"]), float(view["load_g"])
+    fig.suptitle(f"Design map (nu = {nu:g}, {load:g}-g probe)")
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
