@@ -52,7 +52,8 @@ if mode == "reference":
 else:
     frames = locate_file(path, out, workers=workers)["frames"]
 seconds = time.perf_counter() - start
-peak_kb = [int(line.split()[1]) for line in open("/proc/self/status") if line.startswith("VmHWM")][0]
+status = open("/proc/self/status").read().splitlines()
+peak_kb = [int(line.split()[1]) for line in status if line.startswith("VmHWM")][0]
 print(json.dumps({"frames": frames, "seconds": seconds, "peak_mb": peak_kb / 1024}))
 """
 
@@ -88,12 +89,15 @@ def main() -> None:
         print("| what | workers | frames/s | peak memory [MB] |")
         print("|---|---|---|---|")
         results = {}
-        for mode, suffix, workers in (
+        runs = [
             ("reference", ".csv", 1),
             ("batch", ".csv", 1),
             ("batch", ".parquet", 1),
             ("batch", ".parquet", 2),
-        ):
+        ]
+        if n > 3_000_000:  # the reference holds everything in memory: skip it
+            runs = runs[1:]
+        for mode, suffix, workers in runs:
             out = folder / f"out{suffix}"
             out.unlink(missing_ok=True)
             r = child(path, out, mode, workers)
@@ -105,13 +109,16 @@ def main() -> None:
             )
             rate = r["frames"] / r["seconds"]
             print(f"| {label} | {workers} | {rate:,.0f} | {r['peak_mb']:.0f} |")
-        ref = results[("reference", ".csv", 1)]
-        new = results[("batch", ".csv", 1)]
-        print(
-            f"\nCSV end to end: {ref['seconds'] / new['seconds']:.1f}x the reference, "
-            f"{ref['peak_mb'] / new['peak_mb']:.1f}x less memory"
-        )
+        if ("reference", ".csv", 1) in results:
+            ref = results[("reference", ".csv", 1)]
+            new = results[("batch", ".csv", 1)]
+            print(
+                f"\nCSV end to end: {ref['seconds'] / new['seconds']:.1f}x the reference, "
+                f"{ref['peak_mb'] / new['peak_mb']:.1f}x less memory"
+            )
         spec = ts.fearing1990_initial()
+        if n > 3_000_000:
+            return
         rec = ts.read_recording(path)
         frames, baseline = rec.frames, ts.baseline_from(rec.frames, 5)
         print("\nFrom uint16 counts in memory (ts.locate):\n")
