@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import csv
 from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import ClassVar
@@ -258,36 +257,14 @@ def _run_blocks(work, n: int, workers: int):
 def write_estimates_csv(
     path: str | Path, estimates: Estimates, time_s=None, *, overwrite: bool = False
 ) -> Path:
-    """Write one row per frame, with the units in the header."""
+    """Write one row per frame, with the units in the header (full precision)."""
+    from tactsense.estimate.output import EstimatesWriter
+
     path = Path(path)
     if path.exists() and not overwrite:
         raise FileExistsError(f"{path} exists; pass --force to replace it")
-    names = [f.name for f in fields(Estimates)]
-    labels = {
-        "axial_mm": "axial",
-        "angle_deg": "angle",
-        "force_n": "force",
-        "peak_deflection": "peak deflection",
-    }
-    header = ["frame", "time [s]"] + [
-        f"{labels.get(name, name)} [{Estimates.UNITS[name]}]" for name in names
-    ]
-    columns = [np.ravel(getattr(estimates, name)) for name in names]
     times = np.full(len(estimates), np.nan) if time_s is None else np.ravel(time_s)
-    with path.open("w", newline="", encoding="utf-8") as handle:
-        writer = csv.writer(handle)
-        writer.writerow(header)
-        for k in range(len(estimates)):
-            values = []
-            for name, column in zip(names, columns, strict=True):
-                item = column[k]
-                if name == "flags":
-                    values.append(Flag.describe(int(item)))
-                elif name in ("iterations",):
-                    values.append(int(item))
-                elif name == "converged":
-                    values.append(bool(item))
-                else:
-                    values.append(f"{item:.6g}")
-            writer.writerow([k, repr(float(times[k])), *values])
+    flat = Estimates(*(np.ravel(getattr(estimates, f.name)) for f in fields(Estimates)))
+    with EstimatesWriter(path, format="csv") as out:
+        out.write(0, times, flat)
     return path
