@@ -88,6 +88,43 @@ def test_batch_survives_a_killed_worker_with_identical_results(recordings, tmp_p
     assert not [p for p in out.iterdir() if ".partial" in p.name]
 
 
+def test_one_recording_split_across_workers_gives_the_same_output(recordings, tmp_path):
+    """A recording larger than --split-frames runs as ranges on both workers, joined in
+    order: the file must equal one process's, column by column."""
+    _, paths = recordings
+    alone = tmp_path / "alone.h5"
+    summary = locate_file(paths[0], alone)
+    out = tmp_path / "split"
+    result = runner.invoke(
+        app,
+        [
+            "batch",
+            str(paths[0]),
+            "--out",
+            str(out),
+            "--format",
+            "h5",
+            "--split-frames",
+            "40000",
+            "--workers",
+            "2",
+            "--quiet",
+        ],
+    )
+    assert result.exit_code == 0, result.output
+    import h5py
+    import pyarrow.csv as pa_csv
+
+    with h5py.File(out / f"{paths[0].stem}.h5") as split, h5py.File(alone) as whole:
+        assert sorted(split) == sorted(whole)
+        for name in whole:
+            np.testing.assert_array_equal(split[name][()], whole[name][()], err_msg=name)
+    row = pa_csv.read_csv(out / "summary.csv").to_pylist()[0]
+    assert row["frames"] == summary["frames"] and row["contacts"] == summary["contacts"]
+    assert row["force_mean_n"] == pytest.approx(summary["force_mean_n"], rel=1e-9)
+    assert not [p for p in out.iterdir() if p.name.startswith(".")]  # parts removed
+
+
 def test_batch_command_lists_failures_and_resumes(tmp_path):
     small = tmp_path / "in"
     small.mkdir()

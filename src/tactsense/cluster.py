@@ -16,6 +16,7 @@ import glob
 import os
 import time
 from collections.abc import Callable
+from dataclasses import fields
 from pathlib import Path
 
 from tactsense._validation import TactsenseInputError
@@ -92,6 +93,94 @@ def process_recording(
     return summary
 
 
+def process_range(recording: str, part: str, lo: int, hi: int, threshold: float = 0.005) -> dict:
+    """One piece of a split recording: frames ``lo`` to ``hi`` into the Parquet file
+    ``part`` (the same numbers as the whole recording: the baseline is the median of the
+    recording's first 5 frames, and without creep compensation every frame is
+    independent)."""
+    import numpy as np
+
+    from tactsense.estimate import locate
+    from tactsense.estimate.output import EstimatesWriter
+    from tactsense.io.recording import RecordingReader
+
+    force_sum, force_max, contacts, saturated = 0.0, float("nan"), 0, 0
+    from tactsense.estimate.deflection import Flag
+
+    with RecordingReader(recording) as reader, EstimatesWriter(part) as writer:
+        baseline = np.median(reader.frames(0, 5).astype(float), axis=0)
+        step = reader.chunk_frames
+        for start in range(lo, hi, step):
+            stop = min(hi, start + step)
+            estimates = locate(
+                reader.frames(start, stop), reader.sensor, baseline=baseline, threshold=threshold
+            )
+            writer.write(start, reader.time_s(start, stop), estimates)
+            contacts += int(np.count_nonzero(np.isfinite(estimates.row)))
+            saturated += int(np.count_nonzero(estimates.flags & int(Flag.SATURATED)))
+            finite = estimates.force_n[np.isfinite(estimates.force_n)]
+            if finite.size:
+                force_sum += float(finite.sum())
+                force_max = float(np.fmax(force_max, finite.max()))
+    return {
+        "part": part,
+        "frames": hi - lo,
+        "contacts": contacts,
+        "saturated": saturated,
+        "force_sum": force_sum,
+        "force_max_n": force_max,
+    }
+
+
+def combine_parts(parts: list[dict], recording: str, output: str) -> dict:
+    """Join the parts of a split recording, in order, into ``output`` (any format); the
+    recording's summary. Reads one part at a time."""
+    import numpy as np
+    import pyarrow.parquet as pq
+
+    from tactsense.estimate.locate import Estimates
+    from tactsense.estimate.output import EstimatesWriter
+    from tactsense.io.recording import RecordingReader
+
+    start_time = time.perf_counter()
+    output = Path(output)
+    temporary = output.with_name(f".{output.stem}.{os.getpid()}.partial{output.suffix}")
+    names = [f.name for f in fields(Estimates)]
+    try:
+        with EstimatesWriter(temporary) as writer:
+            for part in parts:
+                table = pq.read_table(part["part"])
+                estimates = Estimates(*(table[name].to_numpy() for name in names))
+                writer.write(int(table["frame"][0].as_py()), table["time_s"].to_numpy(), estimates)
+        os.replace(temporary, output)
+    finally:
+        temporary.unlink(missing_ok=True)
+        for part in parts:
+            Path(part["part"]).unlink(missing_ok=True)
+    contacts = sum(p["contacts"] for p in parts)
+    with RecordingReader(recording) as reader:
+        losses = reader._h5["losses"][()].sum() if "losses" in reader._h5 else 0
+    return {
+        "frames": sum(p["frames"] for p in parts),
+        "contacts": contacts,
+        "saturated": sum(p["saturated"] for p in parts),
+        "force_mean_n": sum(p["force_sum"] for p in parts) / contacts if contacts else np.nan,
+        "force_max_n": float(np.nanmax([p["force_max_n"] for p in parts])),
+        "losses": int(losses),
+        "seconds": time.perf_counter() - start_time,
+    }
+
+
+def _frames_of(recording: Path) -> int | None:
+    from tactsense.io.recording import RecordingReader
+
+    try:
+        with RecordingReader(recording) as reader:
+            return reader.n_frames
+    except TactsenseInputError:
+        return None  # the task itself will fail and say why
+
+
 def run_batch(
     recordings: list[Path],
     out_dir: Path,
@@ -100,9 +189,15 @@ def run_batch(
     calibration: Path | None = None,
     threshold: float = 0.005,
     client=None,
+    split_frames: int | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> list[dict]:
     """Process every recording on ``client`` (a :class:`dask.distributed.Client`).
+
+    A recording of more than ``split_frames`` frames is split into ranges of that many
+    frames, one task each, joined in order by a last task: the same output as one
+    process (not with a calibration, whose creep compensation runs through the whole
+    recording in order).
 
     Returns one summary row per recording (:data:`SUMMARY_FIELDS`), in the order given:
     status ``done``, ``skipped`` (its output is complete and newer) or ``failed`` (with
@@ -120,6 +215,34 @@ def run_batch(
                 "output": str(output),
                 "status": "skipped",
             }
+            continue
+        n = _frames_of(recording) if split_frames and calibration is None else None
+        if n is not None and n > split_frames:
+            stamp = recording.stat().st_mtime_ns
+            parts = [
+                client.submit(
+                    process_range,
+                    str(recording),
+                    str(out_dir / f".{recording.stem}.part{k:05d}.parquet"),
+                    lo,
+                    min(n, lo + split_frames),
+                    threshold,
+                    key=f"tactsense-{recording.stem}-{stamp}-range{k}",
+                    pure=False,
+                    retries=1,
+                )
+                for k, lo in enumerate(range(0, n, split_frames))
+            ]
+            future = client.submit(
+                combine_parts,
+                parts,
+                str(recording),
+                str(output),
+                key=f"tactsense-{recording.stem}-{stamp}-join",
+                pure=False,
+                retries=1,
+            )
+            futures[future] = (recording, output)
             continue
         future = client.submit(
             process_recording,

@@ -80,6 +80,7 @@ BAD_OPTIONS = [
     ("batch REC --workers 0 --out OUT", "--workers"),
     ("batch REC --format xml --out OUT", "--format"),
     ("batch REC --threshold 0 --out OUT", "--threshold"),
+    ("batch REC --split-frames 10 --out OUT", "--split-frames"),
 ]
 
 

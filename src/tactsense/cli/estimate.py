@@ -374,6 +374,16 @@ def batch(
             "local cluster; its workers must see the same files and have tactsense."
         ),
     ] = None,
+    split_frames: Annotated[
+        int | None,
+        typer.Option(
+            min=1000,
+            max=10**9,
+            help="Split a recording of more frames than this into ranges of this many, "
+            "one task each, joined in order (same output; not with --calibration, whose "
+            "creep compensation runs through the recording in order).",
+        ),
+    ] = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,
 ) -> None:
     """Locate every frame of many recordings on a Dask cluster, one task per recording.
@@ -430,6 +440,7 @@ def batch(
                     calibration=calibration,
                     threshold=threshold,
                     client=client,
+                    split_frames=split_frames,
                     progress=lambda done, total: bar.update(task, completed=done, total=total),
                 )
         finally:
