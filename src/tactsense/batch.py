@@ -75,6 +75,38 @@ def iter_locate(
         yield start, time_s, estimates
 
 
+class Tally:
+    """Running counts of a recording's estimates, piece by piece: contacts, saturated
+    frames, and the sum and largest of the force over the contacts."""
+
+    def __init__(self) -> None:
+        self.contacts = self.saturated = 0
+        self.force_sum, self.force_max = 0.0, float("nan")
+
+    def add(self, estimates: Estimates) -> None:
+        self.contacts += int(np.count_nonzero(np.isfinite(estimates.row)))
+        self.saturated += int(np.count_nonzero(estimates.flags & int(Flag.SATURATED)))
+        finite = estimates.force_n[np.isfinite(estimates.force_n)]
+        if finite.size:
+            self.force_sum += float(finite.sum())
+            self.force_max = float(np.fmax(self.force_max, finite.max()))
+
+    def merge(self, other: Tally) -> None:
+        self.contacts += other.contacts
+        self.saturated += other.saturated
+        self.force_sum += other.force_sum
+        self.force_max = float(np.fmax(self.force_max, other.force_max))
+
+    def summary(self) -> dict:
+        mean = self.force_sum / self.contacts if self.contacts else float("nan")
+        return {
+            "contacts": self.contacts,
+            "saturated": self.saturated,
+            "force_mean_n": mean,
+            "force_max_n": self.force_max,
+        }
+
+
 def locate_file(
     recording: str | Path,
     out: str | Path,
@@ -99,8 +131,7 @@ def locate_file(
         SATURATED), ``force_mean_n`` and ``force_max_n`` over the contacts [N].
     """
     output_format(out)
-    contacts = saturated = 0
-    force_sum, force_max = 0.0, float("nan")
+    tally = Tally()
     with RecordingReader(recording) as reader, EstimatesWriter(out) as writer:
         total = reader.n_frames
         if progress is not None:
@@ -114,22 +145,11 @@ def locate_file(
             workers=workers,
         ):
             writer.write(start, time_s, estimates)
-            contacts += int(np.count_nonzero(np.isfinite(estimates.row)))
-            finite = estimates.force_n[np.isfinite(estimates.force_n)]
-            if finite.size:
-                force_sum += float(finite.sum())
-                force_max = float(np.fmax(force_max, finite.max()))
-            saturated += int(np.count_nonzero(estimates.flags & int(Flag.SATURATED)))
+            tally.add(estimates)
             if progress is not None:
                 progress(start + len(estimates), total)
         if writer.rows == 0:  # an empty recording still gets its (empty) file
             empty = Estimates(*(np.zeros(0) for _ in fields(Estimates)))
             writer.write(0, np.zeros(0), empty)
             writer.rows = 0
-    return {
-        "frames": total,
-        "contacts": contacts,
-        "saturated": saturated,
-        "force_mean_n": force_sum / contacts if contacts else float("nan"),
-        "force_max_n": force_max,
-    }
+    return {"frames": total, **tally.summary()}

@@ -87,9 +87,7 @@ def process_recording(
         os.replace(temporary, output)
     finally:
         temporary.unlink(missing_ok=True)
-    with RecordingReader(recording) as reader:
-        losses = reader._h5["losses"][()].sum() if "losses" in reader._h5 else 0
-    summary.update(losses=int(losses), seconds=time.perf_counter() - start)
+    summary.update(losses=_losses(recording), seconds=time.perf_counter() - start)
     return summary
 
 
@@ -100,13 +98,12 @@ def process_range(recording: str, part: str, lo: int, hi: int, threshold: float 
     independent)."""
     import numpy as np
 
+    from tactsense.batch import Tally
     from tactsense.estimate import locate
     from tactsense.estimate.output import EstimatesWriter
     from tactsense.io.recording import RecordingReader
 
-    force_sum, force_max, contacts, saturated = 0.0, float("nan"), 0, 0
-    from tactsense.estimate.deflection import Flag
-
+    tally = Tally()
     with RecordingReader(recording) as reader, EstimatesWriter(part) as writer:
         baseline = np.median(reader.frames(0, 5).astype(float), axis=0)
         step = reader.chunk_frames
@@ -116,31 +113,17 @@ def process_range(recording: str, part: str, lo: int, hi: int, threshold: float 
                 reader.frames(start, stop), reader.sensor, baseline=baseline, threshold=threshold
             )
             writer.write(start, reader.time_s(start, stop), estimates)
-            contacts += int(np.count_nonzero(np.isfinite(estimates.row)))
-            saturated += int(np.count_nonzero(estimates.flags & int(Flag.SATURATED)))
-            finite = estimates.force_n[np.isfinite(estimates.force_n)]
-            if finite.size:
-                force_sum += float(finite.sum())
-                force_max = float(np.fmax(force_max, finite.max()))
-    return {
-        "part": part,
-        "frames": hi - lo,
-        "contacts": contacts,
-        "saturated": saturated,
-        "force_sum": force_sum,
-        "force_max_n": force_max,
-    }
+            tally.add(estimates)
+    return {"part": part, "frames": hi - lo, "tally": tally}
 
 
 def combine_parts(parts: list[dict], recording: str, output: str) -> dict:
     """Join the parts of a split recording, in order, into ``output`` (any format); the
     recording's summary. Reads one part at a time."""
-    import numpy as np
     import pyarrow.parquet as pq
 
     from tactsense.estimate.locate import Estimates
     from tactsense.estimate.output import EstimatesWriter
-    from tactsense.io.recording import RecordingReader
 
     start_time = time.perf_counter()
     output = Path(output)
@@ -157,18 +140,24 @@ def combine_parts(parts: list[dict], recording: str, output: str) -> dict:
         temporary.unlink(missing_ok=True)
         for part in parts:
             Path(part["part"]).unlink(missing_ok=True)
-    contacts = sum(p["contacts"] for p in parts)
-    with RecordingReader(recording) as reader:
-        losses = reader._h5["losses"][()].sum() if "losses" in reader._h5 else 0
+    from tactsense.batch import Tally
+
+    tally = Tally()
+    for part in parts:
+        tally.merge(part["tally"])
     return {
         "frames": sum(p["frames"] for p in parts),
-        "contacts": contacts,
-        "saturated": sum(p["saturated"] for p in parts),
-        "force_mean_n": sum(p["force_sum"] for p in parts) / contacts if contacts else np.nan,
-        "force_max_n": float(np.nanmax([p["force_max_n"] for p in parts])),
-        "losses": int(losses),
+        **tally.summary(),
+        "losses": _losses(recording),
         "seconds": time.perf_counter() - start_time,
     }
+
+
+def _losses(recording: str) -> int:
+    """Frames the recording's writer counted as lost (0 for a simulated recording)."""
+    from tactsense.io.recording import read_losses
+
+    return sum(read_losses(recording).values())
 
 
 def _frames_of(recording: Path) -> int | None:

@@ -372,6 +372,14 @@ class RecordingReader:
         """Their times [s]."""
         return self._h5["time"][start : min(stop, self.n_frames)]
 
+    @property
+    def losses(self) -> dict[str, int]:
+        """Frames lost by kind, as the recorder counted them (empty if none recorded)."""
+        if "losses" not in self._h5:
+            return {}
+        kinds = str(self._h5["losses"].attrs.get("kinds", "")).split(",")
+        return {k: int(v) for k, v in zip(kinds, self._h5["losses"][()], strict=False) if k}
+
     def chunks(self, chunk_frames: int | None = None):
         """Yield ``(start, frames, time_s)`` for consecutive pieces of the recording."""
         size = int(chunk_frames or self.chunk_frames)
@@ -379,6 +387,12 @@ class RecordingReader:
             raise TactsenseInputError(f"chunk_frames must be at least 1; got {size}")
         for start in range(0, self.n_frames, size):
             yield start, self.frames(start, start + size), self.time_s(start, start + size)
+
+
+def read_losses(path: str | Path) -> dict[str, int]:
+    """A recording's loss counters alone, without reading its frames."""
+    with RecordingReader(path) as reader:
+        return reader.losses
 
 
 class RecordingWriter:
