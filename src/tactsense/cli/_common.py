@@ -76,6 +76,28 @@ def guarded(function):
     return run
 
 
+def progress_bar(label: str, *, unit: str = "", quiet: bool = False, eta: bool = True):
+    """The progress bar of every long command: ``label ━━━ done/total unit eta``.
+
+    Shown on a terminal only: quiet when standard error is a file or a pipe (logs stay
+    clean), and with ``--quiet``.
+    """
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeRemainingColumn,
+    )
+
+    columns = [TextColumn(label), BarColumn(), MofNCompleteColumn()]
+    if unit:
+        columns.append(TextColumn(unit))
+    if eta:
+        columns.append(TimeRemainingColumn())
+    return Progress(*columns, console=console, disable=quiet or not console.is_terminal)
+
+
 def fail(message: str) -> NoReturn:
     """Print ``error: message`` and leave with exit status 2 (bad input)."""
     # the message is text, not markup ("[array]" must survive), and one line however long

@@ -6,10 +6,9 @@ from enum import StrEnum
 from typing import Annotated
 
 import typer
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
 from tactsense._validation import TactsenseInputError
-from tactsense.cli._common import console
+from tactsense.cli._common import progress_bar
 from tactsense.io.recording import Recording
 from tactsense.physics.contact import grams_force
 from tactsense.physics.flaws import FLAW_NAMES
@@ -202,15 +201,7 @@ def run_scenario(spec: SensorSpec, scene, *, flaws: str, seed: int | None) -> Re
     """Simulate ``scene`` with a progress bar on the terminal."""
     from tactsense.simulate import simulate
 
-    with Progress(
-        TextColumn("simulating"),
-        BarColumn(),
-        MofNCompleteColumn(),
-        TextColumn("frames"),
-        TimeRemainingColumn(),
-        console=console,
-        disable=None,
-    ) as bar:
+    with progress_bar("simulating", unit="frames") as bar:
         task = bar.add_task("frames", total=None)
 
         def update(done: int, total: int) -> None:

@@ -12,7 +12,7 @@ from rich.console import Console
 from rich.table import Table
 
 from tactsense._validation import TactsenseInputError
-from tactsense.cli._common import SensorOption, fail, new_group
+from tactsense.cli._common import SensorOption, fail, new_group, progress_bar
 from tactsense.physics.contact import grams_force
 from tactsense.sensor import load_sensor
 
@@ -323,7 +323,6 @@ def design_sweep_command(
     """Map what section 6 trades off over a grid of designs: sensitivity, aliasing,
     interpolation ripple and the Cramer-Rao bound on position and force. The paper's
     two fingers are marked on the plot."""
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
 
     from tactsense.analysis.sweep import design_sweep, plot_map
     from tactsense.cli._common import atomic_output, check_output, console
@@ -351,9 +350,7 @@ def design_sweep_command(
         client = Client(cluster)
         console.print(f"Dask dashboard: {client.dashboard_link}")
     try:
-        with Progress(
-            TextColumn("depths"), BarColumn(), MofNCompleteColumn(), console=console, disable=None
-        ) as bar:
+        with progress_bar("depths", eta=False) as bar:
             task = bar.add_task("sweep", total=len(depths))
             dataset = design_sweep(
                 spec,

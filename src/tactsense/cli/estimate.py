@@ -12,7 +12,14 @@ from rich.console import Console
 from rich.table import Table
 
 from tactsense._validation import TactsenseInputError
-from tactsense.cli._common import atomic_output, check_output, console, fail, new_group
+from tactsense.cli._common import (
+    atomic_output,
+    check_output,
+    console,
+    fail,
+    new_group,
+    progress_bar,
+)
 from tactsense.io.recording import read_recording
 
 app = new_group("Estimate contacts and calibrations from recordings.")
@@ -83,13 +90,6 @@ def locate(
     The recording is read and the estimates written piece by piece, so memory stays
     bounded whatever its length; a progress bar shows on a terminal.
     """
-    from rich.progress import (
-        BarColumn,
-        MofNCompleteColumn,
-        Progress,
-        TextColumn,
-        TimeRemainingColumn,
-    )
 
     from tactsense.batch import locate_file, output_format
 
@@ -105,15 +105,7 @@ def locate(
                 sensor = reader.sensor
             calibrated = Calibration.load(calibration, sensor)
         with (
-            Progress(
-                TextColumn("locating"),
-                BarColumn(),
-                MofNCompleteColumn(),
-                TextColumn("frames"),
-                TimeRemainingColumn(),
-                console=console,
-                disable=quiet or None,
-            ) as bar,
+            progress_bar("locating", unit="frames", quiet=quiet) as bar,
             atomic_output(out) as temporary,
         ):
             task = bar.add_task("frames", total=None)
@@ -394,8 +386,6 @@ def batch(
     """
     import logging
 
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
-
     from tactsense import cluster
 
     try:
@@ -425,13 +415,7 @@ def batch(
             client = Client(scheduler, timeout=10)
         try:
             console.print(f"Dask dashboard: {client.dashboard_link}")
-            with Progress(
-                TextColumn("recordings"),
-                BarColumn(),
-                MofNCompleteColumn(),
-                console=console,
-                disable=quiet or None,
-            ) as bar:
+            with progress_bar("recordings", eta=False, quiet=quiet) as bar:
                 task = bar.add_task("batch", total=len(paths))
                 rows = cluster.run_batch(
                     paths,

@@ -228,7 +228,11 @@ def record(
         reader = _open_reader(source, sensor, timeout)
     except TactsenseInputError as error:
         fail(str(error))
-    with Progress(TextColumn("{task.description}"), console=console, disable=quiet) as bar:
+    with Progress(
+        TextColumn("{task.description}"),
+        console=console,
+        disable=quiet or not console.is_terminal,
+    ) as bar:
         task = bar.add_task(f"recording {source}")
 
         def update(count: int, stats, rate: float) -> None:

@@ -9,11 +9,17 @@ from typing import Annotated
 
 import typer
 from rich.console import Console
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
 from tactsense._validation import TactsenseInputError
-from tactsense.cli._common import SensorOption, console, fail, new_group, remove_stale_partials
+from tactsense.cli._common import (
+    SensorOption,
+    console,
+    fail,
+    new_group,
+    progress_bar,
+    remove_stale_partials,
+)
 from tactsense.sensor import load_sensor
 
 app = new_group("The paper's experiments on the twin.")
@@ -64,14 +70,7 @@ def reproduce(
         # a new report is built in a hidden folder and renamed into place when complete
         remove_stale_partials(parent, f".{out.name}", "")
         target = out if out.exists() else parent / f".{out.name}.{os.getpid()}.partial"
-        with Progress(
-            TextColumn("{task.description:<36}"),
-            BarColumn(),
-            MofNCompleteColumn(),
-            TimeRemainingColumn(),
-            console=console,
-            disable=None,
-        ) as bar:
+        with progress_bar("{task.description:<36}") as bar:
             task = bar.add_task("experiments", total=None)
 
             def update(name: str, done: int, total: int) -> None:

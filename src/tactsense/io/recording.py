@@ -286,6 +286,14 @@ def _open_validated(path: str | Path):
     return h5, sensor, n, closed_cleanly
 
 
+def _losses(h5) -> dict[str, int]:
+    """The /losses counters by kind (empty if the recording has none)."""
+    if "losses" not in h5:
+        return {}
+    kinds = str(h5["losses"].attrs.get("kinds", "")).split(",")
+    return {k: int(v) for k, v in zip(kinds, h5["losses"][()], strict=False) if k}
+
+
 def read_recording(path: str | Path) -> Recording:
     """Open and validate a recording written by :func:`write_recording`.
 
@@ -309,10 +317,7 @@ def read_recording(path: str | Path) -> Recording:
         except json.JSONDecodeError as error:
             raise RecordingError(f"{path}: scenario metadata is not valid JSON ({error})") from None
         flaws = tuple(f for f in str(h5.attrs.get("flaws", "")).split(",") if f)
-        losses = {}
-        if "losses" in h5:
-            kinds = str(h5["losses"].attrs.get("kinds", "")).split(",")
-            losses = {k: int(v) for k, v in zip(kinds, h5["losses"][()], strict=False) if k}
+        losses = _losses(h5)
         return Recording(
             frames=frames,
             time_s=h5["time"][:n],
@@ -375,10 +380,7 @@ class RecordingReader:
     @property
     def losses(self) -> dict[str, int]:
         """Frames lost by kind, as the recorder counted them (empty if none recorded)."""
-        if "losses" not in self._h5:
-            return {}
-        kinds = str(self._h5["losses"].attrs.get("kinds", "")).split(",")
-        return {k: int(v) for k, v in zip(kinds, self._h5["losses"][()], strict=False) if k}
+        return _losses(self._h5)
 
     def chunks(self, chunk_frames: int | None = None):
         """Yield ``(start, frames, time_s)`` for consecutive pieces of the recording."""
