@@ -373,3 +373,145 @@ def live(
         summary += f"; latency median {median:.3f} ms, p99 {p99:.3f} ms"
     stopped = " (stopped by Ctrl-C)" if interrupted else ""
     console.print(f"{len(latencies)} estimates{stopped}: {summary}")
+
+
+RECORDING_SUFFIXES = (".h5", ".hdf5")
+
+
+@app.command()
+def view(
+    source: Annotated[
+        str,
+        typer.Argument(
+            help="A recording (.h5 from 'tactsense record' or 'simulate') to play back, or "
+            "a device: a serial port, a pty path, socket://127.0.0.1:PORT or any pyserial URL."
+        ),
+    ],
+    port: Annotated[
+        int,
+        typer.Option(min=0, max=65535, help="TCP port of the page (0: a free port)."),
+    ] = 0,
+    host: Annotated[
+        str | None,
+        typer.Option(
+            help="Listen on this address instead of 127.0.0.1. Anyone who reaches it sees "
+            "the finger and can control playback: there is no login."
+        ),
+    ] = None,
+    open_browser: Annotated[
+        bool, typer.Option("--open", help="Open the page in the default web browser.")
+    ] = False,
+    calibration: Annotated[
+        Path | None,
+        typer.Option(help="Calibration JSON from 'tactsense calibrate' (as for 'live')."),
+    ] = None,
+    baseline_frames: Annotated[
+        int,
+        typer.Option(
+            min=1,
+            max=10000,
+            help="Without --calibration: untouched frames at the start whose median is "
+            "the baseline V_o of eq. 4.",
+        ),
+    ] = 5,
+    threshold: Annotated[
+        float,
+        typer.Option(
+            min=1e-6,
+            max=1.0,
+            help="Smallest tactel deflection that counts as a contact, as a fraction [-].",
+        ),
+    ] = 0.005,
+    speed: Annotated[
+        float,
+        typer.Option(
+            min=0.01,
+            max=1000.0,
+            help="Recordings: start playing at this multiple of the recorded frame rate "
+            "(the page changes it).",
+        ),
+    ] = 1.0,
+    sensor: StreamSensorOption = None,
+    timeout: TimeoutOption = None,
+) -> None:
+    """Show the finger in a web browser: a live stream as it arrives, or a recording played
+    back (play, pause, step, seek, speed).
+
+    The page shows the array unwrapped (length across, circumference down, the tip row
+    apart, the seam marked), the interpolated surface, the contact with its trail,
+    force and tactel time traces, and the stream's health (frame rate, losses by kind,
+    latency). The server listens on 127.0.0.1 only unless --host says otherwise; it
+    prints the address and serves until Ctrl-C.
+    """
+    import webbrowser
+
+    from tactsense.estimate import Calibration
+    from tactsense.estimate.deflection import baseline_from
+    from tactsense.stream import LiveLocator
+    from tactsense.view import LiveFeed, RecordingFeed, ViewServer
+    from tactsense.view.server import is_loopback
+
+    listen = "127.0.0.1" if host is None else host.strip()
+    if not listen:
+        fail("--host is empty; give an address such as 127.0.0.1 or 0.0.0.0")
+    path = Path(source)
+    is_recording = path.is_file() or path.suffix.lower() in RECORDING_SUFFIXES
+    if is_recording and not path.is_file():
+        fail(f"no recording at {source}")
+    if is_recording and sensor is not None:
+        fail("--sensor applies to a device; a recording names its own sensor")
+    if is_recording and timeout is not None:
+        fail("--timeout applies to a device, not to a recording")
+    if not is_recording and speed != 1.0:
+        fail("--speed applies to recordings; a device sends at its own rate")
+    try:
+        cal = None if calibration is None else Calibration.load(calibration)
+        if is_recording:
+
+            def locator_for(spec, file):
+                if cal is not None:
+                    cal.check_sensor(spec)
+                    return LiveLocator(spec, calibration=cal, threshold=threshold,
+                                       keep_deflection=True)  # fmt: skip
+                start = file.frames(0, baseline_frames)
+                base = baseline_from(start, min(baseline_frames, len(start)))
+                return LiveLocator(spec, baseline=base, threshold=threshold,
+                                   keep_deflection=True)  # fmt: skip
+
+            feed = RecordingFeed(path, locator_for, speed=speed)
+        else:
+            reader = _open_reader(source, sensor, timeout, start=False)
+            if cal is not None:
+                cal.check_sensor(reader.sensor)
+            locator = LiveLocator(
+                reader.sensor,
+                calibration=cal,
+                baseline_frames=baseline_frames,
+                threshold=threshold,
+                frame_period_s=reader.frame_period_s or None,
+                keep_deflection=True,
+            )
+            feed = LiveFeed(reader, locator)
+    except TactsenseInputError as error:
+        fail(str(error))
+    try:
+        server = ViewServer(feed, host=listen, port=port)
+    except OSError as error:
+        feed.stop()
+        fail(f"cannot listen on {listen}:{port}: {error.strerror or error}")
+    if not is_loopback(listen):
+        console.print(
+            f"[bold red]warning:[/] listening on {listen}, not only on this machine: anyone "
+            "who can reach it sees the finger and can control playback (there is no login)."
+        )
+    typer.echo(server.url)
+    sys.stdout.flush()
+    what = f"recording {source} ({feed.n_frames} frames)" if is_recording else source
+    console.print(f"showing {what} at {server.url}; Ctrl-C stops", soft_wrap=True)
+    if open_browser:
+        webbrowser.open(server.url)
+    try:
+        server.run()
+    except KeyboardInterrupt:
+        pass
+    console.print(f"stopped: {feed.frames_in} frames shown")

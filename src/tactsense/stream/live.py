@@ -8,6 +8,7 @@ import numpy as np
 
 from tactsense.estimate import Flag, locate
 from tactsense.estimate.creep import CreepCompensator
+from tactsense.estimate.deflection import deflection_from_counts
 from tactsense.estimate.locate import CONTACT_THRESHOLD
 from tactsense.estimate.realtime import RealTimeLocator
 from tactsense.physics.contact import newtons_to_grams
@@ -57,6 +58,12 @@ class LiveLocator:
         Smallest tactel deflection that counts as a contact [-].
     frame_period_s : float, optional
         Time between frames [s], for the creep compensation; default the sensor's.
+    baseline : array_like, shape (rows, cols), optional
+        Without a calibration: the undeflected readings [counts], known in advance
+        (e.g. from the start of a recording); no frames are spent collecting one.
+    keep_deflection : bool
+        Keep the fractional deflection of the last frame in :attr:`last_deflection`
+        (for a display; costs a few microseconds a frame).
     """
 
     def __init__(
@@ -67,6 +74,8 @@ class LiveLocator:
         baseline_frames: int = 5,
         threshold: float = CONTACT_THRESHOLD,
         frame_period_s: float | None = None,
+        baseline=None,
+        keep_deflection: bool = False,
     ):
         self.sensor = sensor
         self.calibration = calibration
@@ -75,6 +84,10 @@ class LiveLocator:
         self._collected: list[np.ndarray] = []
         self._locator: RealTimeLocator | None = None
         self._creep = None
+        self._keep = bool(keep_deflection)
+        self._baseline = None
+        self.last_deflection: np.ndarray | None = None
+        """Fractional deflection of the last frame [-] (with ``keep_deflection``)."""
         # compile (or load from Numba's cache) now, not while frames queue up
         RealTimeLocator(sensor, np.full(sensor.shape, 1000.0), threshold=threshold)
         if calibration is not None:
@@ -82,8 +95,21 @@ class LiveLocator:
         if calibration is not None:
             calibration.check_sensor(sensor)
             if calibration.viscoelastic is not None:
-                period = frame_period_s or sensor.scan_period_s
-                self._creep = CreepCompensator(calibration.viscoelastic, period, sensor.shape)
+                self._period = frame_period_s or sensor.scan_period_s
+                self._creep = CreepCompensator(calibration.viscoelastic, self._period, sensor.shape)
+        elif baseline is not None:
+            self._set_baseline(np.asarray(baseline, dtype=float))
+
+    def _set_baseline(self, baseline: np.ndarray) -> None:
+        self._baseline = baseline
+        self._locator = RealTimeLocator(self.sensor, baseline, threshold=self.threshold)
+
+    def reset(self) -> None:
+        """Forget the creep history (after a jump in time, e.g. a seek in a recording)."""
+        if self._creep is not None:
+            self._creep = CreepCompensator(
+                self.calibration.viscoelastic, self._period, self.sensor.shape
+            )
 
     @property
     def ready(self) -> bool:
@@ -100,10 +126,14 @@ class LiveLocator:
                 self._collected.append(frame.counts)
                 if len(self._collected) < self._baseline_frames:
                     return None
-                baseline = np.median(np.stack(self._collected), axis=0)
-                self._locator = RealTimeLocator(self.sensor, baseline, threshold=self.threshold)
+                self._set_baseline(np.median(np.stack(self._collected), axis=0))
+                self._collected = []
                 return None
             c = self._locator(frame.counts)
+            if self._keep:
+                self.last_deflection = deflection_from_counts(
+                    frame.counts, self._baseline, self.sensor
+                )[0]
             contact = (
                 c.row, c.col, c.axial_mm, c.angle_deg, c.force_n, c.skew,
                 c.peak_deflection, c.flags,
@@ -130,6 +160,8 @@ class LiveLocator:
         deflection, apply_flags = self.calibration.apply(counts[None], self.sensor)
         if self._creep is not None:
             deflection = self._creep(deflection[0])[None]
+        if self._keep:
+            self.last_deflection = deflection[0]
         est = locate(deflection, self.sensor, counts=False, threshold=self.threshold)
         flags = int(est.flags[0]) | int(np.bitwise_or.reduce(np.ravel(apply_flags)))
         return (

@@ -1,0 +1,421 @@
+"""What the browser view shows, frame by frame: the layout once, then one message a frame.
+
+A *feed* runs in a thread of its own. It reads frames (from a live stream or from a
+recording), estimates the contact of each, and hands every frame's message (JSON
+text) to a ``publish`` callable. The server (:mod:`tactsense.view.server`) passes the
+messages on to the pages. Nothing here knows about HTTP.
+
+The page draws the interpolated surface itself from weights sent once in the layout:
+``surface = W_rows @ deflection[cylinder rows] @ W_cols.T`` is the windowed-sinc
+reconstruction of eq. 48 (:func:`tactsense.estimate.interpolate.surface`) on a grid
+``SURFACE_STEPS`` times finer than the tactels, periodic around a closed finger.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import threading
+import time
+from collections import deque
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+from matplotlib import colormaps
+
+from tactsense.estimate import Flag
+from tactsense.estimate.interpolate import col_weights, row_weights
+from tactsense.io.recording import RecordingReader
+from tactsense.sensor import SensorSpec
+from tactsense.stream.live import LiveLocator
+from tactsense.stream.reader import LOSS_KINDS, StreamError, StreamFrame, StreamReader
+
+SURFACE_STEPS = 9
+"""Points of the interpolated surface per tactel spacing, along and around: the centres
+of bands 1/9 of a tactel wide (odd, so that one band is centred on each tactel)."""
+
+HISTORY_S = 20.0
+"""Seconds of recent frames a page receives when it connects (for its time traces)."""
+
+MAX_HISTORY = 2000
+"""At most this many recent frames are kept for new pages, whatever the frame rate."""
+
+COLORMAP = "viridis"
+"""Matplotlib colour map of the heat map: its lightness rises monotonically."""
+
+Publish = Callable[[str], None]
+
+
+def _finite(value):
+    """JSON has no NaN: None stands for a value that does not exist."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+def layout_message(sensor: SensorSpec, source: dict) -> dict:
+    """Everything a page needs once: geometry, surface weights, colour map, source."""
+    rows, cols = sensor.shape
+    first = 1 if sensor.array.tip_row else 0
+    cylinder = rows - first
+    periodic = bool(sensor.closes_circumference)
+    # fine rows over the cylinder rows' span, fine columns over the tactels' span (one
+    # whole turn, seam included, when the finger closes)
+    # (beyond the first and last rows the surface is held flat, not extrapolated)
+    fine_rows = (np.arange(cylinder * SURFACE_STEPS) + 0.5) / SURFACE_STEPS - 0.5
+    fine_rows = np.clip(fine_rows, 0.0, cylinder - 1.0)
+    fine_cols = (np.arange(cols * SURFACE_STEPS) + 0.5) / SURFACE_STEPS - 0.5
+    w_rows = row_weights(fine_rows, cylinder, derivatives=0)
+    w_cols = col_weights(fine_cols, cols, periodic, derivatives=0)
+    lut = (colormaps[COLORMAP](np.linspace(0.0, 1.0, 256))[:, :3] * 255).round().astype(int)
+    return {
+        "type": "layout",
+        "sensor": sensor.name,
+        "rows": rows,
+        "cols": cols,
+        "first_row": first,
+        "tip_row": bool(sensor.array.tip_row),
+        "closes": periodic,
+        "row_axial_mm": [float(v) for v in sensor.row_axial_mm],
+        "col_angle_deg": [float(v) for v in sensor.col_angle_deg],
+        "spacing_mm": float(sensor.array.spacing_axial_mm),
+        "spacing_deg": float(sensor.array.spacing_angle_deg),
+        "full_scale": int(2**sensor.electronics.adc_bits - 1),
+        "surface": {
+            "row": fine_rows.tolist(),
+            "col": fine_cols.tolist(),
+            "w_rows": np.round(w_rows, 6).tolist(),
+            "w_cols": np.round(w_cols, 6).tolist(),
+        },
+        "colormap": {"name": COLORMAP, "lut": lut.tolist()},
+        "loss_kinds": list(LOSS_KINDS),
+        "flags": {flag.name: int(flag) for flag in Flag if flag},
+        "source": source,
+    }
+
+
+class _Rate:
+    """Frames per second over the last second of arrivals."""
+
+    def __init__(self) -> None:
+        self._times: deque[float] = deque(maxlen=4096)
+
+    def __call__(self, now: float) -> float:
+        self._times.append(now)
+        while self._times and now - self._times[0] > 1.0:
+            self._times.popleft()
+        if len(self._times) < 2:
+            return 0.0
+        span = self._times[-1] - self._times[0]
+        return (len(self._times) - 1) / span if span > 0 else 0.0
+
+
+class Feed:
+    """Base of the two feeds: frame messages, a thread, a bounded history for new pages."""
+
+    kind = "feed"
+
+    def __init__(self, sensor: SensorSpec, locator: LiveLocator, name: str):
+        self.sensor = sensor
+        self.locator = locator
+        self.name = name
+        self.frames_in = 0
+        self.status = "starting"
+        self.error: str | None = None
+        self._publish: Publish = lambda text: None
+        self._history: deque[tuple[float, str]] = deque(maxlen=MAX_HISTORY)
+        self._history_s = HISTORY_S
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._rate = _Rate()
+        self._lock = threading.Lock()
+
+    # ---- what pages receive --------------------------------------------------------
+
+    def source_info(self) -> dict:
+        return {"kind": self.kind, "name": self.name}
+
+    def layout(self) -> dict:
+        message = layout_message(self.sensor, self.source_info())
+        with self._lock:
+            message["history"] = [json.loads(text) for _, text in self._history]
+        message["status"] = self.status_message()
+        return message
+
+    def status_message(self) -> dict:
+        return {"type": "status", "status": self.status, "error": self.error}
+
+    def frame_message(self, frame: StreamFrame, estimate: dict | None, health: dict) -> dict:
+        deflection = self.locator.last_deflection
+        message = {
+            "type": "frame",
+            "serial": self.frames_in,
+            "index": int(frame.index),
+            "sequence": int(frame.sequence),
+            "time_s": float(frame.device_time_s),
+            "host_time_s": float(frame.host_time_s),
+            "counts": np.asarray(frame.counts).astype(int).tolist(),
+            "deflection": None if deflection is None else np.round(deflection, 6).tolist(),
+            "estimate": None
+            if estimate is None
+            else {k: _finite(v) for k, v in estimate.items() if k != "sequence"},
+            "health": health,
+        }
+        return message
+
+    def _emit(self, message: dict, *, keep: bool = True) -> None:
+        text = json.dumps(message, allow_nan=False)
+        if keep:
+            t = message["time_s"]
+            with self._lock:
+                if self._history and t < self._history[-1][0]:
+                    self._history.clear()  # a seek back: the traces start over
+                self._history.append((t, text))
+                while self._history and self._history[0][0] < t - self._history_s:
+                    self._history.popleft()
+        self._publish(text)
+
+    def _set_status(self, status: str, error: str | None = None) -> None:
+        self.status, self.error = status, error
+        self._publish(json.dumps(self.status_message()))
+
+    # ---- the thread ----------------------------------------------------------------
+
+    def start(self, publish: Publish) -> None:
+        """Run the feed in a thread; every message goes to ``publish`` (thread-safe)."""
+        self._publish = publish
+        self._thread = threading.Thread(target=self._guarded, name=f"tactsense-{self.kind}")
+        self._thread.daemon = True
+        self._thread.start()
+
+    def stop(self, wait_s: float = 2.0) -> None:
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join(wait_s)
+
+    def _guarded(self) -> None:
+        try:
+            self._run()
+        except StreamError as error:
+            self._set_status("error", str(error))
+        except Exception as error:  # shown on the page and by /api/health, not lost
+            self._set_status("error", f"{type(error).__name__}: {error}")
+
+    def _run(self) -> None:
+        raise NotImplementedError
+
+    def command(self, message: dict) -> None:
+        """A control message from a page (playback); live streams ignore them."""
+
+    def health(self) -> dict:
+        return {"frames_in": self.frames_in, "status": self.status, "error": self.error}
+
+
+class LiveFeed(Feed):
+    """Frames of a device as they arrive (:class:`~tactsense.stream.StreamReader`)."""
+
+    kind = "live"
+
+    def __init__(self, reader: StreamReader, locator: LiveLocator):
+        super().__init__(reader.sensor, locator, str(reader.url))
+        self.reader = reader
+        self._last_latency = float("nan")
+
+    def source_info(self) -> dict:
+        info = super().source_info()
+        info["rate_hz"] = 1.0 / self.reader.frame_period_s if self.reader.frame_period_s else 0
+        info["identity"] = {k: v for k, v in self.reader.identity.items() if k != "sensor_toml"}
+        return info
+
+    def _health(self, rate: float, latency: float) -> dict:
+        stats = self.reader.stats
+        health = {"rate_hz": round(rate, 3), "received": stats.frames}
+        health.update({kind: getattr(stats, kind) for kind in LOSS_KINDS})
+        health["latency_ms"] = _finite(round(latency, 4))
+        return health
+
+    def _run(self) -> None:
+        reader = self.reader
+        reader.start()
+        self._set_status("streaming")
+        last = time.perf_counter()
+        while not self._stop.is_set():
+            batch = reader.read_batch(256, wait_s=0.1)
+            now = time.perf_counter()
+            if not batch:
+                if reader.ended:
+                    self._set_status("ended", reader.stats.summary())
+                    return
+                if now - last > reader.timeout_s:
+                    reader.stats.timeouts += 1  # as StreamReader.frames counts them
+                    last = now
+                continue
+            last = now
+            for frame in batch:
+                self.frames_in += 1
+                rate = self._rate(frame.arrival)
+                estimate = self.locator(frame)
+                latency = estimate["latency_ms"] if estimate else float("nan")
+                self._emit(self.frame_message(frame, estimate, self._health(rate, latency)))
+
+    def stop(self, wait_s: float = 2.0) -> None:
+        super().stop(wait_s)
+        self.reader.close()
+
+    def health(self) -> dict:
+        health = super().health()
+        health["stream"] = self.reader.stats.as_dict()
+        return health
+
+
+class RecordingFeed(Feed):
+    """Frames of a recording played back: play, pause, step, seek and speed from the page.
+
+    The playback state is shared by every page (one recording, one position). Frames
+    are read from the file a block at a time, so memory does not grow with its length.
+    With a creep calibration the compensation restarts at every seek or backward step
+    (its state is the recent past, which a jump skips).
+    """
+
+    kind = "recording"
+    BLOCK = 1024
+
+    def __init__(self, path: str | Path, locator_factory, *, speed: float = 1.0):
+        self.file = RecordingReader(path)
+        sensor = self.file.sensor
+        super().__init__(sensor, locator_factory(sensor, self.file), str(path))
+        self.n_frames = self.file.n_frames
+        self.losses = self.file.losses
+        self.speed = float(speed)
+        self.position = 0
+        self.playing = True
+        self._block_start = -1
+        self._block: np.ndarray | None = None
+        self._times: np.ndarray | None = None
+        self._wake = threading.Event()
+        self._jumped = False
+        times = self.file.time_s(0, min(self.n_frames, 2))
+        self.period_s = float(np.diff(times)[0]) if len(times) > 1 else sensor.scan_period_s
+        if not self.period_s > 0:
+            self.period_s = sensor.scan_period_s
+
+    def source_info(self) -> dict:
+        info = super().source_info()
+        info.update(n_frames=self.n_frames, rate_hz=1.0 / self.period_s, losses=self.losses)
+        return info
+
+    def _frame(self, index: int) -> tuple[np.ndarray, float]:
+        if self._block is None or not self._block_start <= index < self._block_start + self.BLOCK:
+            self._block_start = (index // self.BLOCK) * self.BLOCK
+            stop = self._block_start + self.BLOCK
+            self._block = self.file.frames(self._block_start, stop)
+            self._times = self.file.time_s(self._block_start, stop)
+        offset = index - self._block_start
+        return self._block[offset], float(self._times[offset])
+
+    def _playback(self) -> dict:
+        return {
+            "position": self.position,
+            "n_frames": self.n_frames,
+            "playing": self.playing,
+            "speed": self.speed,
+        }
+
+    def _show(self, index: int, rate: float) -> None:
+        counts, t = self._frame(index)
+        frame = StreamFrame(
+            index % 65536, index, t, time.time(), time.perf_counter(), np.asarray(counts)
+        )
+        self.frames_in += 1
+        estimate = self.locator(frame)
+        health = {"rate_hz": round(rate, 3), "received": self.n_frames}
+        health.update({kind: int(self.losses.get(kind, 0)) for kind in LOSS_KINDS})
+        health["latency_ms"] = _finite(round(estimate["latency_ms"], 4)) if estimate else None
+        message = self.frame_message(frame, estimate, health)
+        message["playback"] = self._playback()
+        self._emit(message)
+
+    def command(self, message: dict) -> None:
+        """``{"command": "play"|"pause"|"step"|"seek"|"speed", "value": ...}``."""
+        command = message.get("command")
+        value = message.get("value")
+        with self._lock:
+            if command == "play":
+                if self.position >= self.n_frames - 1:
+                    self.position, self._jumped = 0, True
+                self.playing = True
+            elif command == "pause":
+                self.playing = False
+            elif command == "step":
+                step = int(value) if isinstance(value, int | float) else 1
+                self.playing = False
+                self._jumped = step < 0
+                self.position = min(max(self.position + step, 0), self.n_frames - 1)
+                self._pending_show = True
+            elif command == "seek":
+                if not isinstance(value, int | float) or not math.isfinite(value):
+                    return
+                self.position = min(max(int(value), 0), self.n_frames - 1)
+                self._jumped = True
+                self._pending_show = True
+            elif command == "speed":
+                if isinstance(value, int | float) and 0 < value <= 1000:
+                    self.speed = float(value)
+            else:
+                return
+        self._wake.set()
+
+    _pending_show = True
+
+    def _run(self) -> None:
+        self._set_status("playing")
+        next_due = time.perf_counter()
+        while not self._stop.is_set():
+            with self._lock:
+                show_now = self._pending_show
+                self._pending_show = False
+                if self._jumped:
+                    self.locator.reset()
+                    self._jumped = False
+                playing, position = self.playing, self.position
+            now = time.perf_counter()
+            if show_now:
+                self._show(position, 0.0 if not playing else self._rate(now))
+                next_due = now + self.period_s / self.speed
+                if playing and position < self.n_frames - 1:
+                    with self._lock:
+                        self.position += 1
+                continue
+            if not playing:
+                self._status_if("paused")
+                self._wake.wait(0.25)
+                self._wake.clear()
+                continue
+            if now < next_due:
+                self._wake.wait(min(next_due - now, 0.25))
+                self._wake.clear()
+                continue
+            self._status_if("playing")
+            self._show(position, self._rate(now))
+            next_due = max(next_due + self.period_s / self.speed, now - 0.5)
+            with self._lock:
+                if self.position == position:  # not moved by a command meanwhile
+                    if position >= self.n_frames - 1:
+                        self.playing = False
+                    else:
+                        self.position = position + 1
+
+    def _status_if(self, status: str) -> None:
+        if self.status != status:
+            self._set_status(status)
+
+    def stop(self, wait_s: float = 2.0) -> None:
+        super().stop(wait_s)
+        self._wake.set()
+        self.file.close()
+
+    def health(self) -> dict:
+        health = super().health()
+        health["playback"] = self._playback()
+        return health

@@ -1,0 +1,500 @@
+// tactsense view: the finger's frames as they arrive over a websocket.
+// The server sends a layout message once, then one message per frame (see
+// src/tactsense/view/feed.py for their fields). Drawing happens at most once per
+// animation frame, with the latest frame; every frame still feeds the time traces.
+"use strict";
+
+const CELL = 48;          // pixels per tactel spacing, along and around
+const GAP = 34;           // pixels between the tip row and the cylinder
+const MARGIN = { left: 56, top: 14, bottom: 40, bar: 70 };
+const TRAIL = 24;         // estimates kept in the contact's trail
+const TRACE_S = 20;       // seconds shown by the time traces
+
+const state = {
+  layout: null,
+  latest: null,
+  units: "deflection",
+  showSurface: true,
+  showMarker: true,
+  centre: 0,              // display angle at the middle of the map [deg]
+  touching: false,
+  trail: [],
+  selected: null,         // [row, col] followed by the tactel trace
+  vmax: 0.01,             // deflection colour scale, decaying running maximum
+  framesReceived: 0,
+  skipped: 0,
+  lastIndex: null,
+  lastSerial: null,
+  marker: null,           // canvas pixels of the marker, for tests and people alike
+  dirty: false,
+  traces: { t: [], force: [], tactel: [] },
+};
+window.tactsenseView = state;
+
+const canvas = document.getElementById("map");
+const ctx = canvas.getContext("2d");
+const $ = (id) => document.getElementById(id);
+
+// ---- geometry -------------------------------------------------------------------
+
+function wrap360(a) { return ((a % 360) + 360) % 360; }
+// (-180, 180], the convention of the estimates
+function signedAngle(a) { const w = wrap360(a); return w > 180 ? w - 360 : w; }
+
+function angleSpan() {
+  const L = state.layout;
+  const n = L.cols;
+  if (L.closes) return [state.centre - 180, state.centre + 180];
+  const a0 = L.col_angle_deg[0], s = L.spacing_deg;
+  return [a0 - s / 2, a0 + (n - 0.5) * s];
+}
+
+function mapHeight() { return state.layout.cols * CELL; }
+function cylinderLeft() { return MARGIN.left + (state.layout.tip_row ? CELL + GAP : 0); }
+function cylinderRows() { return state.layout.rows - state.layout.first_row; }
+
+// vertical pixel of an angle [deg]
+function yOfAngle(angle) {
+  const [lo, hi] = angleSpan();
+  const off = state.layout.closes ? wrap360(angle - lo) : angle - lo;
+  return MARGIN.top + (off / (hi - lo)) * mapHeight();
+}
+
+function angleOfCol(col) {
+  const L = state.layout;
+  return L.col_angle_deg[0] + col * L.spacing_deg;
+}
+
+// canvas pixels of the centre of tactel (row, col); fractional row/col allowed
+function cellCentre(row, col) {
+  const L = state.layout;
+  const y = yOfAngle(angleOfCol(col));
+  if (L.tip_row && row < L.first_row - 0.5) return [MARGIN.left + CELL / 2, y];
+  return [cylinderLeft() + (row - L.first_row + 0.5) * CELL, y];
+}
+state.cellCentre = cellCentre;
+
+function tactelAt(px, py) {
+  const L = state.layout;
+  const [lo, hi] = angleSpan();
+  const frac = (py - MARGIN.top) / mapHeight();
+  if (frac < 0 || frac >= 1) return null;
+  let angle = lo + frac * (hi - lo);
+  let col = Math.round((angle - L.col_angle_deg[0]) / L.spacing_deg);
+  if (L.closes) col = ((col % L.cols) + L.cols) % L.cols;
+  if (col < 0 || col >= L.cols) return null;
+  if (L.tip_row && px >= MARGIN.left && px < MARGIN.left + CELL) return [0, col];
+  const k = Math.floor((px - cylinderLeft()) / CELL);
+  if (k < 0 || k >= cylinderRows()) return null;
+  return [k + L.first_row, col];
+}
+
+// ---- values and colours -----------------------------------------------------------
+
+function values(frame) {
+  if (state.units === "counts" || !frame.deflection) return frame.counts;
+  return frame.deflection;
+}
+
+// what the tactel trace shows: nothing in deflection while the baseline is collected
+function traceValues(frame) {
+  if (state.units === "counts") return frame.counts;
+  return frame.deflection;
+}
+
+function scale(frame) {
+  if (state.units === "counts" || !frame.deflection) {
+    let lo = Infinity, hi = -Infinity;
+    for (const row of frame.counts) for (const v of row) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
+    if (hi - lo < 1) hi = lo + 1;
+    return [lo, hi, "counts"];
+  }
+  return [0, state.vmax, "deflection [-]"];
+}
+
+function colour(value, lo, hi) {
+  const lut = state.layout.colormap.lut;
+  let t = (value - lo) / (hi - lo);
+  if (!Number.isFinite(t)) t = 0;
+  const i = Math.max(0, Math.min(lut.length - 1, Math.round(t * (lut.length - 1))));
+  return lut[i];
+}
+
+function rgb(c) { return `rgb(${c[0]},${c[1]},${c[2]})`; }
+
+// the windowed-sinc surface of eq. 48 on the fine grid: W_rows @ Z @ W_cols^T
+function surfaceOf(z) {
+  const S = state.layout.surface, first = state.layout.first_row;
+  const nr = S.w_rows.length, nc = S.w_cols.length, R = cylinderRows(), C = state.layout.cols;
+  const zc = new Float64Array(R * nc);           // Z @ W_cols^T
+  for (let r = 0; r < R; r++) {
+    const zr = z[r + first];
+    for (let j = 0; j < nc; j++) {
+      const w = S.w_cols[j];
+      let s = 0;
+      for (let c = 0; c < C; c++) s += zr[c] * w[c];
+      zc[r * nc + j] = s;
+    }
+  }
+  const out = new Float64Array(nr * nc);
+  for (let i = 0; i < nr; i++) {
+    const w = S.w_rows[i];
+    for (let j = 0; j < nc; j++) {
+      let s = 0;
+      for (let r = 0; r < R; r++) s += w[r] * zc[r * nc + j];
+      out[i * nc + j] = s;
+    }
+  }
+  return out;
+}
+
+const offscreen = document.createElement("canvas");
+
+function drawSurface(z, lo, hi) {
+  const L = state.layout, S = L.surface;
+  const nr = S.w_rows.length, nc = S.w_cols.length;
+  const f = surfaceOf(z);
+  offscreen.width = nr; offscreen.height = nc;
+  const octx = offscreen.getContext("2d");
+  const image = octx.createImageData(nr, nc);
+  // fine columns in display order (rotated so the map starts at the top of the span)
+  const order = [...Array(nc).keys()].map((j) => [yOfAngle(angleOfCol(S.col[j])), j]);
+  order.sort((a, b) => a[0] - b[0]);
+  order.forEach(([, j], y) => {
+    for (let i = 0; i < nr; i++) {
+      const c = colour(f[i * nc + j], lo, hi);
+      const p = 4 * (y * nr + i);
+      image.data[p] = c[0]; image.data[p + 1] = c[1]; image.data[p + 2] = c[2]; image.data[p + 3] = 255;
+    }
+  });
+  octx.putImageData(image, 0, 0);
+  ctx.imageSmoothingEnabled = true;
+  ctx.drawImage(offscreen, cylinderLeft(), MARGIN.top, cylinderRows() * CELL, mapHeight());
+}
+
+// ---- drawing ----------------------------------------------------------------------
+
+function draw() {
+  state.dirty = false;
+  const L = state.layout, frame = state.latest;
+  if (!L) return;
+  ctx.clearRect(0, 0, canvas.width, canvas.height);
+  const H = mapHeight(), left = cylinderLeft(), W = cylinderRows() * CELL;
+  ctx.fillStyle = "#eceff1";
+  ctx.fillRect(left, MARGIN.top, W, H);
+  if (L.tip_row) ctx.fillRect(MARGIN.left, MARGIN.top, CELL, H);
+  drawAxes();
+  if (!frame) return;
+  const z = values(frame);
+  const [lo, hi, unit] = scale(frame);
+  if (state.showSurface) drawSurface(z, lo, hi);
+  // tactels: dots in the colour of their value, over the surface
+  for (let r = 0; r < L.rows; r++) {
+    for (let c = 0; c < L.cols; c++) {
+      const [x, y] = cellCentre(r, c);
+      ctx.beginPath();
+      ctx.arc(x, y, CELL * 0.32, 0, 2 * Math.PI);
+      ctx.fillStyle = rgb(colour(z[r][c], lo, hi));
+      ctx.fill();
+      const sel = state.selected && state.selected[0] === r && state.selected[1] === c;
+      ctx.lineWidth = sel ? 3 : 1;
+      ctx.strokeStyle = sel ? "#e91e63" : "rgba(0,0,0,0.35)";
+      ctx.stroke();
+    }
+  }
+  drawSeam();
+  drawColourBar(lo, hi, unit);
+  if (state.showMarker) drawContact();
+}
+
+function drawAxes() {
+  const L = state.layout, H = mapHeight(), left = cylinderLeft();
+  ctx.fillStyle = "#333"; ctx.font = "12px system-ui, sans-serif"; ctx.textAlign = "center";
+  for (let r = L.first_row; r < L.rows; r++) {
+    const [x] = cellCentre(r, 0);
+    ctx.fillText(L.row_axial_mm[r].toFixed(1), x, MARGIN.top + H + 14);
+  }
+  ctx.fillText("along the finger [mm]", left + (cylinderRows() * CELL) / 2, MARGIN.top + H + 30);
+  if (L.tip_row) {
+    ctx.fillText("tip", MARGIN.left + CELL / 2, MARGIN.top + H + 14);
+  }
+  ctx.textAlign = "right";
+  for (let c = 0; c < L.cols; c++) {
+    const y = yOfAngle(angleOfCol(c));
+    ctx.fillText(`${signedAngle(L.col_angle_deg[c]).toFixed(0)}°`, MARGIN.left - 6, y + 4);
+  }
+  ctx.save();
+  ctx.translate(14, MARGIN.top + H / 2); ctx.rotate(-Math.PI / 2); ctx.textAlign = "center";
+  ctx.fillText("around [deg]", 0, 0);
+  ctx.restore();
+}
+
+function drawSeam() {
+  const L = state.layout;
+  if (!L.closes) return;
+  const y = yOfAngle(L.col_angle_deg[0] - L.spacing_deg / 2);
+  ctx.save();
+  ctx.setLineDash([6, 4]); ctx.strokeStyle = "#b71c1c"; ctx.lineWidth = 1.5;
+  ctx.beginPath();
+  const x0 = L.tip_row ? MARGIN.left : cylinderLeft();
+  ctx.moveTo(x0, y); ctx.lineTo(cylinderLeft() + cylinderRows() * CELL, y); ctx.stroke();
+  ctx.fillStyle = "#b71c1c"; ctx.textAlign = "left"; ctx.font = "11px system-ui, sans-serif";
+  ctx.fillText("seam", cylinderLeft() + cylinderRows() * CELL + 4, y + 4);
+  ctx.restore();
+}
+
+function drawColourBar(lo, hi, unit) {
+  const x = cylinderLeft() + cylinderRows() * CELL + 36, H = mapHeight();
+  for (let i = 0; i < H; i++) {
+    ctx.fillStyle = rgb(colour(hi - (i / (H - 1)) * (hi - lo), lo, hi));
+    ctx.fillRect(x, MARGIN.top + i, 12, 1);
+  }
+  ctx.fillStyle = "#333"; ctx.textAlign = "left"; ctx.font = "11px system-ui, sans-serif";
+  const fmt = (v) => (unit === "counts" ? v.toFixed(0) : v.toPrecision(2));
+  ctx.fillText(fmt(hi), x + 15, MARGIN.top + 9);
+  ctx.fillText(fmt(lo), x + 15, MARGIN.top + H);
+  ctx.save();
+  ctx.translate(x + 26, MARGIN.top + H / 2); ctx.rotate(Math.PI / 2); ctx.textAlign = "center";
+  ctx.fillText(unit, 0, 0);
+  ctx.restore();
+}
+
+function drawContact() {
+  state.marker = null;
+  ctx.save();
+  // trail: older points fainter; no line across the wrap
+  let prev = null;
+  state.trail.forEach((p, k) => {
+    const [x, y] = cellCentre(p.row, p.col);
+    const alpha = (k + 1) / state.trail.length;
+    ctx.fillStyle = `rgba(255,255,255,${0.8 * alpha})`;
+    ctx.beginPath(); ctx.arc(x, y, 2.5, 0, 2 * Math.PI); ctx.fill();
+    if (prev && Math.abs(prev[1] - y) < mapHeight() / 2 && Math.abs(prev[0] - x) < 3 * CELL) {
+      ctx.strokeStyle = `rgba(255,255,255,${0.6 * alpha})`; ctx.lineWidth = 1.5;
+      ctx.beginPath(); ctx.moveTo(prev[0], prev[1]); ctx.lineTo(x, y); ctx.stroke();
+    }
+    prev = [x, y];
+  });
+  const est = state.latest && state.latest.estimate;
+  if (est && isContact(est)) {
+    const [x, y] = cellCentre(est.row, est.col);
+    ctx.lineWidth = 4; ctx.strokeStyle = "#000";
+    ctx.beginPath(); ctx.arc(x, y, 6, 0, 2 * Math.PI); ctx.stroke();
+    ctx.lineWidth = 2; ctx.strokeStyle = "#fff";
+    ctx.beginPath(); ctx.arc(x, y, 6, 0, 2 * Math.PI); ctx.stroke();
+    state.marker = { x, y };
+  }
+  ctx.restore();
+}
+
+// ---- readouts -----------------------------------------------------------------------
+
+function isContact(est) {
+  const noContact = state.layout.flags.NO_CONTACT;
+  return est && !(est.flags & noContact) && Number.isFinite(est.row) && Number.isFinite(est.col);
+}
+
+const fixed = (v, d) => (v === null || v === undefined || !Number.isFinite(v) ? "–" : v.toFixed(d));
+
+function showEstimate(est) {
+  const touching = est && isContact(est);
+  $("axial").textContent = touching ? fixed(est.axial_mm, 2) : "–";
+  $("angle").textContent = touching ? fixed(est.angle_deg, 1) : "–";
+  $("force-n").textContent = touching ? fixed(est.force_n, 4) : "–";
+  $("force-g").textContent = touching ? fixed(est.force_g, 1) : "–";
+  $("skew").textContent = touching ? fixed(est.skew, 3) : "–";
+  $("peak").textContent = est ? fixed(est.peak_deflection, 4) : "–";
+  $("flags").textContent = est ? est.flag_names || "none" : "baseline…";
+}
+
+function showHealth(frame) {
+  const h = frame.health || {};
+  $("frame-index").textContent = frame.index;
+  $("rate").textContent = h.rate_hz !== undefined ? `${h.rate_hz.toFixed(1)} /s` : "–";
+  $("received").textContent = h.received ?? "–";
+  for (const kind of state.layout.loss_kinds) {
+    const cell = $(kind);
+    if (!cell) continue;
+    cell.textContent = h[kind] ?? 0;
+    cell.classList.toggle("bad", (h[kind] ?? 0) > 0);
+  }
+  $("latency").textContent = h.latency_ms === null || h.latency_ms === undefined ? "–" : `${h.latency_ms.toFixed(2)} ms`;
+  $("display-latency").textContent = `${Math.max(0, Date.now() - 1000 * frame.host_time_s).toFixed(0)} ms`;
+  $("skipped").textContent = state.skipped;
+}
+
+function showPlayback(p) {
+  if (!p) return;
+  $("playback").hidden = false;
+  const seek = $("seek");
+  seek.max = p.n_frames - 1;
+  if (document.activeElement !== seek) seek.value = p.position;
+  $("play").textContent = p.playing ? "pause" : "play";
+  $("position").textContent = `frame ${state.latest.index + 1} of ${p.n_frames} · ${state.latest.time_s.toFixed(2)} s`;
+}
+
+// ---- time traces (uPlot) --------------------------------------------------------------
+
+let forcePlot = null, tactelPlot = null, lastTraceDraw = 0;
+
+function makePlots() {
+  const opts = (title, label) => ({
+    title, width: 520, height: 200,
+    scales: { x: { time: false } },
+    axes: [{ label: "time [s]" }, { label }],
+    series: [{}, { label, stroke: "#1565c0", width: 1.5, spanGaps: false }],
+  });
+  forcePlot = new uPlot(opts("force", "force [g]"), [[], []], $("force-trace"));
+  tactelPlot = new uPlot(opts("tactel", "value"), [[], []], $("tactel-trace"));
+}
+
+function tactelValue(frame) {
+  if (!state.selected) return null;
+  const [r, c] = state.selected;
+  const v = traceValues(frame);
+  return v ? v[r][c] : null;
+}
+
+function pushTrace(frame) {
+  const T = state.traces, est = frame.estimate;
+  T.t.push(frame.time_s);
+  T.force.push(est && isContact(est) && est.force_g !== null ? est.force_g : 0);
+  T.tactel.push(tactelValue(frame));
+  while (T.t.length && T.t[0] < frame.time_s - TRACE_S) { T.t.shift(); T.force.shift(); T.tactel.shift(); }
+  if (T.t.length > 4000) { T.t.shift(); T.force.shift(); T.tactel.shift(); }
+}
+
+function refillTactelTrace() {
+  // the selected tactel or the units changed: recompute from the frames kept
+  state.traces.tactel = state.history.map((f) => tactelValue(f));
+}
+
+function drawTraces(now) {
+  if (!forcePlot || now - lastTraceDraw < 100) return;
+  lastTraceDraw = now;
+  const T = state.traces;
+  forcePlot.setData([T.t, T.force]);
+  const title = state.selected ? `tactel (${state.selected[0]}, ${state.selected[1]}) [${state.units}]` : "tactel: click one on the map";
+  tactelPlot.root.querySelector(".u-title").textContent = title;
+  tactelPlot.setData([T.t, T.tactel]);
+}
+
+// ---- messages -------------------------------------------------------------------------
+
+state.history = [];   // the frames behind the traces (bounded like the traces)
+
+function onLayout(L) {
+  state.layout = L;
+  state.centre = L.closes ? L.col_angle_deg[0] + ((L.cols - 1) / 2) * L.spacing_deg : 0;
+  $("sensor").textContent = L.sensor;
+  $("source").textContent = `${L.source.kind}: ${L.source.name}`;
+  const width = cylinderLeft() + cylinderRows() * CELL + MARGIN.bar + 40;
+  canvas.width = width;
+  canvas.height = MARGIN.top + mapHeight() + MARGIN.bottom;
+  state.selected = [L.first_row + Math.floor(cylinderRows() / 2), 0];
+  state.history = []; state.traces = { t: [], force: [], tactel: [] }; state.trail = [];
+  if (!forcePlot) makePlots();
+  onStatus(L.status);
+  for (const f of L.history || []) onFrame(f, true);
+  state.dirty = true;
+}
+
+function onStatus(s) {
+  if (!s) return;
+  const el = $("status");
+  el.textContent = s.error ? `${s.status}: ${s.error}` : s.status;
+  el.className = `status ${s.status}`;
+}
+
+function onFrame(f, fromHistory) {
+  if (!fromHistory) {
+    state.framesReceived += 1;
+    // frames the server had but this page did not get (not those lost on the line)
+    if (state.lastSerial !== null && f.serial > state.lastSerial + 1) {
+      state.skipped += f.serial - state.lastSerial - 1;
+    }
+    state.lastSerial = f.serial;
+  }
+  if (state.lastIndex !== null && f.index < state.lastIndex) {   // a seek back
+    state.history = []; state.traces = { t: [], force: [], tactel: [] }; state.trail = [];
+  }
+  state.lastIndex = f.index;
+  state.latest = f;
+  if (f.deflection) {
+    let peak = 0;
+    for (const row of f.deflection) for (const v of row) peak = Math.max(peak, v);
+    state.vmax = Math.max(0.01, peak, state.vmax * 0.995);
+  }
+  const est = f.estimate;
+  const touching = est && isContact(est);
+  if (touching) {
+    const L = state.layout;
+    if (L.closes && !state.touching) {
+      // a new touch near the top or bottom edge: centre the map on it, so a contact
+      // on the seam is one blob
+      const angle = angleOfCol(est.col);
+      const off = wrap360(angle - state.centre + 180) - 180;
+      if (Math.abs(off) > 180 - L.spacing_deg) state.centre = angle;
+    }
+    state.trail.push({ row: est.row, col: est.col });
+    if (state.trail.length > TRAIL) state.trail.shift();
+  }
+  state.touching = touching;
+  state.history.push(f);
+  while (state.history.length && state.history[0].time_s < f.time_s - TRACE_S) state.history.shift();
+  if (state.history.length > 4000) state.history.shift();
+  pushTrace(f);
+  showEstimate(est);
+  showHealth(f);
+  showPlayback(f.playback);
+  state.dirty = true;
+}
+
+function connect() {
+  const scheme = location.protocol === "https:" ? "wss" : "ws";
+  const ws = new WebSocket(`${scheme}://${location.host}/ws`);
+  state.socket = ws;
+  ws.onmessage = (event) => {
+    const m = JSON.parse(event.data);
+    if (m.type === "layout") onLayout(m);
+    else if (m.type === "frame") onFrame(m, false);
+    else if (m.type === "status") onStatus(m);
+  };
+  ws.onclose = () => {
+    onStatus({ status: "disconnected", error: "the server closed the connection; retrying" });
+    setTimeout(connect, 1000);
+  };
+}
+
+function send(command, value) {
+  if (state.socket && state.socket.readyState === WebSocket.OPEN) {
+    state.socket.send(JSON.stringify({ command, value }));
+  }
+}
+
+function loop(now) {
+  if (state.dirty) draw();
+  drawTraces(now);
+  requestAnimationFrame(loop);
+}
+
+// ---- controls -----------------------------------------------------------------------
+
+document.querySelectorAll('input[name="units"]').forEach((el) =>
+  el.addEventListener("change", () => { state.units = el.value; refillTactelTrace(); state.dirty = true; }));
+$("show-surface").addEventListener("change", (e) => { state.showSurface = e.target.checked; state.dirty = true; });
+$("show-marker").addEventListener("change", (e) => { state.showMarker = e.target.checked; state.dirty = true; });
+canvas.addEventListener("click", (e) => {
+  if (!state.layout) return;
+  const rect = canvas.getBoundingClientRect();
+  const t = tactelAt(e.clientX - rect.left, e.clientY - rect.top);
+  if (t) { state.selected = t; refillTactelTrace(); state.dirty = true; }
+});
+$("play").addEventListener("click", () => send($("play").textContent === "pause" ? "pause" : "play"));
+$("step-back").addEventListener("click", () => send("step", -1));
+$("step-fwd").addEventListener("click", () => send("step", 1));
+$("seek").addEventListener("change", (e) => send("seek", Number(e.target.value)));
+$("speed").addEventListener("change", (e) => send("speed", Number(e.target.value)));
+
+connect();
+requestAnimationFrame(loop);
