@@ -364,6 +364,9 @@ class RecordingFeed(Feed):
                     self.speed = float(value)
             else:
                 return
+            playback = self._playback()
+        # every page shows the new state at once, even while paused
+        self._publish(json.dumps({"type": "playback", **playback}))
         self._wake.set()
 
     _pending_show = True

@@ -278,10 +278,11 @@ function drawContact() {
   const est = state.latest && state.latest.estimate;
   if (est && isContact(est)) {
     const [x, y] = cellCentre(est.row, est.col);
-    ctx.lineWidth = 4; ctx.strokeStyle = "#000";
-    ctx.beginPath(); ctx.arc(x, y, 6, 0, 2 * Math.PI); ctx.stroke();
-    ctx.lineWidth = 2; ctx.strokeStyle = "#fff";
-    ctx.beginPath(); ctx.arc(x, y, 6, 0, 2 * Math.PI); ctx.stroke();
+    // a white ring (radius 7 px) edged in black: visible on any colour of the map
+    ctx.lineWidth = 5; ctx.strokeStyle = "#000";
+    ctx.beginPath(); ctx.arc(x, y, 7, 0, 2 * Math.PI); ctx.stroke();
+    ctx.lineWidth = 3; ctx.strokeStyle = "#fff";
+    ctx.beginPath(); ctx.arc(x, y, 7, 0, 2 * Math.PI); ctx.stroke();
     state.marker = { x, y };
   }
   ctx.restore();
@@ -330,7 +331,8 @@ function showPlayback(p) {
   seek.max = p.n_frames - 1;
   if (document.activeElement !== seek) seek.value = p.position;
   $("play").textContent = p.playing ? "pause" : "play";
-  $("position").textContent = `frame ${state.latest.index + 1} of ${p.n_frames} · ${state.latest.time_s.toFixed(2)} s`;
+  const f = state.latest;
+  if (f) $("position").textContent = `frame ${f.index + 1} of ${p.n_frames} · ${f.time_s.toFixed(2)} s`;
 }
 
 // ---- time traces (uPlot) --------------------------------------------------------------
@@ -459,6 +461,7 @@ function connect() {
     if (m.type === "layout") onLayout(m);
     else if (m.type === "frame") onFrame(m, false);
     else if (m.type === "status") onStatus(m);
+    else if (m.type === "playback") showPlayback(m);
   };
   ws.onclose = () => {
     onStatus({ status: "disconnected", error: "the server closed the connection; retrying" });
