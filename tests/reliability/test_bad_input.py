@@ -81,6 +81,17 @@ BAD_OPTIONS = [
     ("batch REC --format xml --out OUT", "--format"),
     ("batch REC --threshold 0 --out OUT", "--threshold"),
     ("batch REC --split-frames 10 --out OUT", "--split-frames"),
+    ("view REC --port 70000", "--port"),
+    ("view REC --port -1", "--port"),
+    ("view REC --speed 0", "--speed"),
+    ("view REC --speed nan", "--speed"),
+    ("view REC --threshold 2", "--threshold"),
+    ("view REC --baseline-frames 0", "--baseline-frames"),
+    ("view REC --sensor improved", "--sensor applies to a device"),
+    ("view REC --timeout 1", "--timeout applies to a device"),
+    ("view loop:// --speed 2", "--speed applies to recordings"),
+    ("view no_such_recording.h5", "no recording at no_such_recording.h5"),
+    ("view REC --host 203.0.113.9", "cannot listen on 203.0.113.9"),
 ]
 
 
@@ -141,6 +152,9 @@ BAD_FILES = [
     ("simulate --sensor DIR/partial.toml --out OUT", "[body] is missing"),
     ("simulate --sensor bogus --out OUT", "presets: initial, improved"),
     ("design bound --sensor bogus", "presets: initial, improved"),
+    ("view REC --calibration REC", "not JSON text"),
+    ("view DIR/strings.h5", "/frames holds |S2 values; expected numbers"),
+    ("view loop:// --calibration DIR/zero_gain.json", "not a positive finite number"),
 ]
 
 
@@ -334,3 +348,14 @@ def test_import_and_locate_without_a_writable_numba_cache():
     )
     assert result.returncode == 0, result.stderr
     assert int(result.stdout.strip()) > 0
+
+
+def test_view_port_in_use(workspace):
+    import socket
+
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen(1)
+        port = taken.getsockname()[1]
+        result = runner.invoke(app, ["view", str(workspace / "rec.h5"), "--port", str(port)])
+    _check(result, f"cannot listen on 127.0.0.1:{port}")
