@@ -10,7 +10,6 @@ import os
 import shutil
 import subprocess
 import sys
-import time
 
 import numpy as np
 import pytest
@@ -140,7 +139,10 @@ def test_hottest_cell_is_the_tactel_the_scenario_touches(page, initial, row, col
         # the readout says where, in the finger's own units
         axial = float(page.text_content("#axial"))
         assert axial == pytest.approx(initial.row_axial_mm[row], abs=0.5)
-        assert float(page.text_content("#force-g")) == pytest.approx(50.0, rel=0.3)
+        # uncalibrated, the force carries the tactel's gain (the finger's spread is up to
+        # x2): the page says so rather than pass it off as the load
+        assert page.text_content("#calibration").startswith("uncalibrated")
+        assert 20.0 < float(page.text_content("#force-g")) < 120.0
         # the counts toggle: the tactel trace says what it shows
         page.check('input[value="counts"]')
         page.wait_for_timeout(300)
@@ -256,7 +258,8 @@ def test_seek_and_step_on_a_recording(page, sweep_file):
             timeout=5000,
         )
         page.wait_for_timeout(150)
-        deflection, _ = deflection_from_counts(rec.frames[target], baseline_from(rec.frames), rec.sensor)
+        baseline = baseline_from(rec.frames)
+        deflection, _ = deflection_from_counts(rec.frames[target], baseline, rec.sensor)
         expected = np.unravel_index(np.argmax(deflection), deflection.shape)
         assert _hottest(page) == tuple(int(v) for v in expected)
         assert int(page.text_content("#frame-index")) == target

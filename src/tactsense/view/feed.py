@@ -134,7 +134,11 @@ class Feed:
     # ---- what pages receive --------------------------------------------------------
 
     def source_info(self) -> dict:
-        return {"kind": self.kind, "name": self.name}
+        return {
+            "kind": self.kind,
+            "name": self.name,
+            "calibrated": self.locator.calibration is not None,
+        }
 
     def layout(self) -> dict:
         message = layout_message(self.sensor, self.source_info())

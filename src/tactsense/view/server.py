@@ -38,7 +38,7 @@ from starlette.websockets import WebSocket, WebSocketDisconnect
 
 from tactsense.view.feed import Feed
 
-QUEUE = 64
+QUEUE = 256
 """Messages waiting for one page at most; older ones are dropped first."""
 
 PENDING = 1024

@@ -25,6 +25,7 @@ const state = {
   skipped: 0,
   lastIndex: null,
   lastSerial: null,
+  firstSerial: null,     // the first frame this page received (server's numbering)
   marker: null,           // canvas pixels of the marker, for tests and people alike
   dirty: false,
   traces: { t: [], force: [], tactel: [] },
@@ -390,6 +391,9 @@ function onLayout(L) {
   state.centre = L.closes ? L.col_angle_deg[0] + ((L.cols - 1) / 2) * L.spacing_deg : 0;
   $("sensor").textContent = L.sensor;
   $("source").textContent = `${L.source.kind}: ${L.source.name}`;
+  $("calibration").textContent = L.source.calibrated
+    ? "calibrated"
+    : "uncalibrated: per-tactel gains not corrected (tactsense calibrate)";
   const width = cylinderLeft() + cylinderRows() * CELL + MARGIN.bar + 40;
   canvas.width = width;
   canvas.height = MARGIN.top + mapHeight() + MARGIN.bottom;
@@ -416,6 +420,7 @@ function onFrame(f, fromHistory) {
       state.skipped += f.serial - state.lastSerial - 1;
     }
     state.lastSerial = f.serial;
+    if (state.firstSerial === null) state.firstSerial = f.serial;
   }
   if (state.lastIndex !== null && f.index < state.lastIndex) {   // a seek back
     state.history = []; state.traces = { t: [], force: [], tactel: [] }; state.trail = [];
