@@ -47,7 +47,8 @@ SourceArgument = Annotated[
     str,
     typer.Argument(
         help="The device: a serial port (/dev/ttyUSB0), a pty path printed by 'tactsense "
-        "emulate', socket://127.0.0.1:PORT, or any other pyserial URL."
+        "emulate', socket://127.0.0.1:PORT, or any other pyserial URL; or lsl:NAME, a Lab "
+        "Streaming Layer frames outlet (its name or source_id)."
     ),
 ]
 StreamSensorOption = Annotated[
@@ -76,10 +77,20 @@ DurationLimit = Annotated[
 ]
 
 
+LSL_PREFIX = "lsl:"
+
+
 def _open_reader(source: str, sensor: str | None, timeout: float | None, *, start: bool = True):
     from tactsense.stream import StreamReader
 
     spec = None if sensor is None else load_sensor(sensor)
+    if source.startswith(LSL_PREFIX):
+        from tactsense.interop.lsl import LslReader
+
+        name = source[len(LSL_PREFIX) :].strip()
+        if not name:
+            fail("lsl: needs an outlet name or source_id, e.g. lsl:fearing1990_initial-frames")
+        return LslReader(name, sensor=spec, timeout_s=timeout or 5.0)
     return StreamReader(source, sensor=spec, timeout_s=timeout, start=start)
 
 
@@ -204,9 +215,15 @@ def emulate(
 @app.command()
 def record(
     source: SourceArgument,
-    out: Annotated[Path, typer.Option("--out", "-o", help="New HDF5 recording.")] = Path(
-        "recording.h5"
-    ),
+    out: Annotated[
+        Path,
+        typer.Option(
+            "--out",
+            "-o",
+            help="New recording: HDF5 (.h5, crash-safe) or MCAP (.mcap: TactileState "
+            "messages for ROS 2 and Foxglove).",
+        ),
+    ] = Path("recording.h5"),
     frames: FramesLimit = None,
     duration: DurationLimit = None,
     sensor: StreamSensorOption = None,
@@ -223,6 +240,17 @@ def record(
     from tactsense.stream import StreamError
     from tactsense.stream import record as run_record
 
+    mcap = out.suffix.lower() == ".mcap"
+    if mcap:
+        from tactsense.interop.mcap import _writer_class
+        from tactsense.interop.mcap import record_mcap as run_record
+
+        try:
+            _writer_class()
+        except TactsenseInputError as error:
+            fail(str(error))
+    elif out.suffix.lower() not in (".h5", ".hdf5"):
+        fail(f"{out}: use the extension .h5 (HDF5) or .mcap (MCAP)")
     check_output(out, force)
     try:
         reader = _open_reader(source, sensor, timeout)
@@ -296,6 +324,14 @@ def live(
     ] = 0.005,
     sensor: StreamSensorOption = None,
     timeout: TimeoutOption = None,
+    lsl: Annotated[
+        bool,
+        typer.Option(
+            "--lsl",
+            help="Also publish the frames and the estimates on two Lab Streaming Layer "
+            "outlets (<sensor>-frames, <sensor>-contacts; docs/interop.md).",
+        ),
+    ] = False,
     force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
 ) -> None:
     """Estimate the contact of every frame as it arrives: position, force, skew, flags and
@@ -322,6 +358,12 @@ def live(
             threshold=threshold,
             frame_period_s=reader.frame_period_s or None,
         )
+        outlets = None
+        if lsl:
+            from tactsense.interop.lsl import LslOutlets
+
+            rate = 1.0 / reader.frame_period_s if reader.frame_period_s else 0.0
+            outlets = LslOutlets(reader.sensor, reader.identity, rate)
         reader.start()
     except TactsenseInputError as error:
         fail(str(error))
@@ -334,6 +376,8 @@ def live(
             writer.writeheader()
         for frame in reader.frames(max_frames=frames, duration_s=duration):
             estimate = locator(frame)
+            if outlets is not None:
+                outlets.push(frame, estimate)
             if estimate is None:
                 continue
             latencies.append(estimate["latency_ms"])

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from enum import StrEnum
 from pathlib import Path
 from typing import Annotated
 
@@ -175,3 +176,98 @@ def sensor_check(
     table.add_row("junction capacitance", f"{spec.junction_capacitance_f * 1e12:.3f} pF")
     table.add_row("ring flexural length", f"{spec.ring_flexural_length_mm:.3f} mm")
     Console().print(table)
+
+
+class BasePreset(StrEnum):
+    initial = "initial"
+    improved = "improved"
+
+
+@sensor_app.command("import")
+def sensor_import(
+    path: Annotated[
+        Path, typer.Argument(help="URDF file with a tactile toolbox <sensor><tactile><array>.")
+    ],
+    out: Annotated[
+        Path | None,
+        typer.Option("--out", "-o", help="Write the sensor TOML here instead of printing it."),
+    ] = None,
+    name: Annotated[
+        str | None,
+        typer.Option(help="The <sensor name=...> to take when the file describes several."),
+    ] = None,
+    extends: Annotated[
+        BasePreset,
+        typer.Option(
+            help="Preset giving what the array does not say: body, skin, electronics, flaws, "
+            "and whether data row 0 is a tip row."
+        ),
+    ] = BasePreset.initial,
+    force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
+) -> None:
+    """Read a URDF tactile array (ROS tactile toolbox) into a sensor description (TOML).
+
+    The array gives rows, columns, both spacings (along the finger; around it as the arc
+    at the skin's surface), the taxel size and the update rate; the rest comes from the
+    preset named by --extends.
+    """
+    from tactsense.interop.urdf import sensor_from_urdf
+
+    if out is not None:
+        check_output(out, force)
+    try:
+        spec = sensor_from_urdf(path, name=name, extends=extends.value)
+        if out is None:
+            typer.echo(spec.to_toml_string())
+        else:
+            with atomic_output(out) as temporary:
+                spec.to_toml(temporary)
+            console.print(
+                f"wrote {out}: {spec.name}, {spec.shape[0]} x {spec.shape[1]} tactels, "
+                f"{spec.array.spacing_axial_mm:g} mm x {spec.array.spacing_angle_deg:.4g} deg"
+            )
+    except (TactsenseInputError, FileExistsError) as error:
+        fail(str(error))
+
+
+@sensor_app.command("export")
+def sensor_export(
+    sensor: SensorOption = "initial",
+    urdf: Annotated[
+        bool,
+        typer.Option(
+            "--urdf", help="Write the URDF tactile array (the only format so far; required)."
+        ),
+    ] = False,
+    out: Annotated[
+        Path | None,
+        typer.Option("--out", "-o", help="Write the URDF here instead of printing it."),
+    ] = None,
+    link: Annotated[str, typer.Option(help="Name of the link the sensor is mounted on.")] = (
+        "finger"
+    ),
+    force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
+) -> None:
+    """Write a sensor's array as a URDF tactile description for ROS (RViz's tactile display).
+
+    Rows along the finger, columns around it, spacings and sizes in metres (the arc at
+    the skin's surface around); the data vector is a tactsense frame, row-major.
+    """
+    from tactsense.interop.urdf import sensor_to_urdf
+
+    if not urdf:
+        fail("say which format: --urdf (for TOML use 'tactsense sensor show')")
+    if not link.strip():
+        fail("--link is empty; give the name of the link the sensor is mounted on")
+    if out is not None:
+        check_output(out, force)
+    try:
+        text = sensor_to_urdf(load_sensor(sensor), link=link.strip())
+        if out is None:
+            typer.echo(text, nl=False)
+        else:
+            with atomic_output(out) as temporary:
+                Path(temporary).write_text(text, encoding="utf-8")
+            console.print(f"wrote {out}")
+    except (TactsenseInputError, FileExistsError) as error:
+        fail(str(error))

@@ -1,0 +1,117 @@
+"""Other tools' formats on the command line: ``export`` (MCAP for ROS 2 and Foxglove, Rerun)."""
+
+from __future__ import annotations
+
+from enum import StrEnum
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from tactsense._validation import TactsenseInputError
+from tactsense.cli._common import (
+    atomic_output,
+    check_output,
+    console,
+    fail,
+    new_group,
+    progress_bar,
+)
+
+app = new_group("Other tools' formats: MCAP (ROS 2, Foxglove) and Rerun.")
+
+
+class ExportFormat(StrEnum):
+    mcap = "mcap"
+    rerun = "rerun"
+
+
+SUFFIXES = {ExportFormat.mcap: ".mcap", ExportFormat.rerun: ".rrd"}
+
+
+@app.command()
+def export(
+    recording: Annotated[Path, typer.Argument(help="HDF5 recording to export.")],
+    out: Annotated[
+        Path,
+        typer.Option(
+            "--out", "-o", help="New file: .mcap for --format mcap, .rrd for --format rerun."
+        ),
+    ],
+    export_format: Annotated[
+        ExportFormat | None,
+        typer.Option(
+            "--format",
+            help="mcap: tactile_msgs/TactileState and TactileContact messages (ROS 2 CDR) for "
+            "ROS 2 and Foxglove; rerun: heat map, contact and force for the Rerun viewer. "
+            "Default: from the extension of OUT.",
+        ),
+    ] = None,
+    calibration: Annotated[
+        Path | None,
+        typer.Option(help="Calibration JSON applied to the contacts (as for 'locate')."),
+    ] = None,
+    baseline_frames: Annotated[
+        int,
+        typer.Option(
+            min=1,
+            max=10000,
+            help="Without --calibration: untouched frames at the start whose median is "
+            "the baseline V_o of eq. 4.",
+        ),
+    ] = 5,
+    threshold: Annotated[
+        float,
+        typer.Option(
+            min=1e-6,
+            max=1.0,
+            help="Smallest tactel deflection that counts as a contact, as a fraction [-].",
+        ),
+    ] = 0.005,
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,
+    force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
+) -> None:
+    """Export a recording's frames and contacts to another tool's format (docs/interop.md).
+
+    Frames and contacts are estimated a piece at a time, as 'locate' does; the file is
+    written to a temporary name and moved into place when complete.
+    """
+    from tactsense.estimate import Calibration
+
+    if export_format is None:
+        by_suffix = {suffix: kind for kind, suffix in SUFFIXES.items()}
+        export_format = by_suffix.get(out.suffix.lower())
+        if export_format is None:
+            fail(f"{out}: say --format mcap or rerun, or use the extension .mcap or .rrd")
+    elif out.suffix.lower() != SUFFIXES[export_format]:
+        fail(f"{out}: a {export_format.value} file takes the extension {SUFFIXES[export_format]}")
+    check_output(out, force)
+    try:
+        cal = None if calibration is None else Calibration.load(calibration)
+        if export_format is ExportFormat.mcap:
+            from tactsense.interop.mcap import _writer_class
+            from tactsense.interop.mcap import export_mcap as run
+
+            _writer_class()
+        else:
+            from tactsense.interop.rerun import _rerun
+            from tactsense.interop.rerun import export_rerun as run
+
+            _rerun()
+        with progress_bar("exporting", unit="frames", quiet=quiet) as bar:
+            task = bar.add_task("frames", total=None)
+
+            def update(done: int, total: int) -> None:
+                bar.update(task, completed=done, total=total)
+
+            with atomic_output(out) as temporary:
+                counts = run(
+                    recording, temporary, calibration=cal, baseline_frames=baseline_frames,
+                    threshold=threshold, progress=update,
+                )  # fmt: skip
+    except (TactsenseInputError, FileExistsError) as error:
+        fail(str(error))
+    console.print(
+        f"wrote {out}: {counts['frames']} frames, {counts['contacts']} with a contact "
+        f"({export_format.value})"
+    )

@@ -1,0 +1,252 @@
+"""The finger on the Lab Streaming Layer: two outlets (frames, contacts) and an inlet.
+
+Outlets (``tactsense live SOURCE --lsl``):
+
+* **frames**: name ``<sensor>-frames``, type ``Tactile``, one float32 channel per
+  tactel (rows x cols, row-major: channel ``r * cols + c``), at the sensor's nominal
+  rate. Each channel's metadata gives its label (``r3c5``), unit (counts), row,
+  column, axial position [mm] and angle [deg]; the stream's metadata holds the whole
+  sensor description (TOML) under ``tactsense/sensor_toml``, so an inlet knows the
+  finger without asking.
+* **contacts**: name ``<sensor>-contacts``, type ``TactileContact``, double channels
+  ``axial_mm, angle_deg, force_n, skew, peak_deflection, flags, row, col, latency_ms``
+  (NaN without a contact), one sample per frame.
+
+Both carry a ``source_id`` made from the device's serial number (``tactsense:<serial>:
+frames``), so a consumer recovers the stream after the device or tactsense restarts.
+Sample timestamps are LSL's clock at the frame's arrival.
+
+The inlet (:class:`LslReader`, ``tactsense record lsl:NAME``) resolves a frames outlet
+by name or source_id and reads it like a device.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+import time
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+
+from tactsense._validation import TactsenseInputError
+from tactsense.sensor import SensorSpec, SensorSpecError
+from tactsense.stream.reader import LossCounters, StreamError, StreamFrame
+
+CONTACT_CHANNELS = (
+    "axial_mm",
+    "angle_deg",
+    "force_n",
+    "skew",
+    "peak_deflection",
+    "flags",
+    "row",
+    "col",
+    "latency_ms",
+)
+CONTACT_UNITS = ("mm", "deg", "N", "", "", "", "tactel", "tactel", "ms")
+
+
+def _pylsl():
+    """pylsl, with liblsl's log kept to errors (its INFO lines would fill a terminal)."""
+    if "LSLAPICFG" not in os.environ:
+        config = Path(tempfile.gettempdir()) / "tactsense-lsl_api.cfg"
+        if not config.exists():
+            try:
+                config.write_text("[log]\nlevel = -3\n")
+            except OSError:
+                pass
+        if config.exists():
+            os.environ["LSLAPICFG"] = str(config)
+    try:
+        import pylsl
+    except ImportError:
+        raise TactsenseInputError(
+            'the Lab Streaming Layer needs the lsl extra: pip install "tactsense[lsl]"'
+        ) from None
+    return pylsl
+
+
+def source_id(identity: dict, sensor: SensorSpec, kind: str) -> str:
+    """A stable id for a stream: the device's serial number, else the sensor's name."""
+    serial = identity.get("serial") or sensor.name
+    return f"tactsense:{serial}:{kind}"
+
+
+def frames_info(sensor: SensorSpec, identity: dict, rate_hz: float):
+    """The ``StreamInfo`` of the frames outlet, with per-channel metadata."""
+    pylsl = _pylsl()
+    rows, cols = sensor.shape
+    info = pylsl.StreamInfo(
+        f"{sensor.name}-frames",
+        "Tactile",
+        rows * cols,
+        float(rate_hz),
+        pylsl.cf_float32,
+        source_id(identity, sensor, "frames"),
+    )
+    desc = info.desc()
+    desc.append_child_value("manufacturer", str(identity.get("device", "tactsense")))
+    channels = desc.append_child("channels")
+    axial = sensor.row_axial_mm
+    angle = sensor.col_angle_deg
+    for r in range(rows):
+        for c in range(cols):
+            channel = channels.append_child("channel")
+            channel.append_child_value("label", f"r{r}c{c}")
+            channel.append_child_value("unit", "counts")
+            channel.append_child_value("type", "Tactile")
+            channel.append_child_value("row", str(r))
+            channel.append_child_value("col", str(c))
+            channel.append_child_value("axial_mm", f"{axial[r]:.6g}")
+            channel.append_child_value("angle_deg", f"{angle[c]:.6g}")
+    meta = desc.append_child("tactsense")
+    meta.append_child_value("sensor_toml", sensor.to_toml_string())
+    meta.append_child_value("layout", "row-major: channel = row * cols + col")
+    return info
+
+
+def contacts_info(sensor: SensorSpec, identity: dict, rate_hz: float):
+    """The ``StreamInfo`` of the contacts outlet."""
+    pylsl = _pylsl()
+    info = pylsl.StreamInfo(
+        f"{sensor.name}-contacts",
+        "TactileContact",
+        len(CONTACT_CHANNELS),
+        float(rate_hz),
+        pylsl.cf_double64,
+        source_id(identity, sensor, "contacts"),
+    )
+    channels = info.desc().append_child("channels")
+    for name, unit in zip(CONTACT_CHANNELS, CONTACT_UNITS, strict=True):
+        channel = channels.append_child("channel")
+        channel.append_child_value("label", name)
+        channel.append_child_value("unit", unit)
+    return info
+
+
+class LslOutlets:
+    """Publish frames and contact estimates of one finger on two LSL outlets."""
+
+    def __init__(self, sensor: SensorSpec, identity: dict | None = None, rate_hz: float = 0.0):
+        pylsl = _pylsl()
+        identity = identity or {}
+        rate = float(rate_hz or sensor.electronics.scan_rate_hz)
+        self.sensor = sensor
+        self.frames = pylsl.StreamOutlet(frames_info(sensor, identity, rate))
+        self.contacts = pylsl.StreamOutlet(contacts_info(sensor, identity, rate))
+        self._clock = pylsl.local_clock
+        self._offset = pylsl.local_clock() - time.perf_counter()
+
+    def push(self, frame: StreamFrame, estimate: dict | None) -> None:
+        """One frame (and its estimate, if any), stamped with its arrival on LSL's clock."""
+        stamp = frame.arrival + self._offset
+        self.frames.push_sample(np.asarray(frame.counts, dtype=np.float32).ravel(), stamp)
+        if estimate is not None:
+            sample = [float(estimate[name]) for name in CONTACT_CHANNELS]
+            self.contacts.push_sample(sample, stamp)
+
+    def close(self) -> None:
+        del self.frames, self.contacts
+
+
+class LslReader:
+    """Frames from an LSL frames outlet, with the interface :func:`~tactsense.stream.record`
+    uses (``sensor``, ``url``, ``stats``, ``frames()``).
+
+    Parameters
+    ----------
+    name : str
+        The outlet's name (``fearing1990_initial-frames``) or source_id.
+    timeout_s : float
+        How long to look for the outlet [s].
+    """
+
+    def __init__(self, name: str, *, sensor: SensorSpec | None = None, timeout_s: float = 5.0):
+        pylsl = _pylsl()
+        self.url = f"lsl:{name}"
+        self.stats = LossCounters()
+        self.identity: dict = {}
+        self.ended = False
+        found = pylsl.resolve_byprop("name", name, timeout=timeout_s) or pylsl.resolve_byprop(
+            "source_id", name, timeout=0.5
+        )
+        if not found:
+            raise StreamError(
+                f"no Lab Streaming Layer outlet named {name!r} (name or source_id) within "
+                f"{timeout_s:g} s"
+            )
+        self.inlet = pylsl.StreamInlet(found[0], max_buflen=60, recover=True)
+        info = self.inlet.info(timeout=timeout_s)
+        if sensor is None:
+            toml = info.desc().child("tactsense").child_value("sensor_toml")
+            if not toml:
+                raise StreamError(
+                    f"{self.url}: the outlet does not describe its sensor (not tactsense's); "
+                    "pass the sensor"
+                )
+            try:
+                sensor = SensorSpec.from_toml_string(toml)
+            except SensorSpecError as error:
+                raise StreamError(f"{self.url}: its sensor description: {error}") from None
+        if info.channel_count() != sensor.shape[0] * sensor.shape[1]:
+            raise StreamError(
+                f"{self.url} has {info.channel_count()} channels; the sensor has "
+                f"{sensor.shape[0]} x {sensor.shape[1]} tactels"
+            )
+        self.sensor = sensor
+        rate = info.nominal_srate()
+        self.frame_period_s = 1.0 / rate if rate > 0 else 0.0
+        self.timeout_s = 3 * self.frame_period_s + 0.05 if rate > 0 else 1.0
+        self._index = -1
+        self._first_stamp: float | None = None
+        self._offset = time.perf_counter() - pylsl.local_clock()
+        self.inlet.open_stream(timeout=timeout_s)
+
+    def frames(
+        self, *, max_frames: int | None = None, duration_s: float | None = None
+    ) -> Iterator[StreamFrame]:
+        """Yield frames as they arrive, until ``max_frames`` or ``duration_s``."""
+        deadline = None if duration_s is None else time.perf_counter() + duration_s
+        delivered = 0
+        shape = self.sensor.shape
+        while max_frames is None or delivered < max_frames:
+            wait = self.timeout_s
+            if deadline is not None:
+                wait = min(wait, deadline - time.perf_counter())
+                if wait <= 0:
+                    return
+            samples, stamps = self.inlet.pull_chunk(timeout=wait, max_samples=1024)
+            if not stamps:
+                self.stats.timeouts += 1
+                continue
+            for sample, stamp in zip(samples, stamps, strict=True):
+                if self._first_stamp is None:
+                    self._first_stamp = stamp
+                self._index += 1
+                self.stats.frames += 1
+                counts = np.asarray(sample, dtype=np.float64).reshape(shape)
+                yield StreamFrame(
+                    self._index % 65536,
+                    self._index,
+                    stamp - self._first_stamp,
+                    time.time(),
+                    stamp + self._offset,
+                    np.rint(counts).astype(np.uint16),
+                )
+                delivered += 1
+                if max_frames is not None and delivered >= max_frames:
+                    return
+
+    def start(self) -> None:
+        """An outlet streams by itself: nothing to ask (for the interface of a device)."""
+
+    def close(self) -> None:
+        self.inlet.close_stream()
+
+    def __enter__(self) -> LslReader:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()

@@ -1,0 +1,122 @@
+"""ROS 2 message layouts of the ROS tactile toolbox (``tactile_msgs``), as tactsense fills them.
+
+No ROS 2 tactile message is standard; the toolbox's are the de-facto layouts:
+
+``tactile_msgs/msg/TactileState`` (modelled on ``sensor_msgs/JointState``)::
+
+    std_msgs/Header header
+    sensor_msgs/ChannelFloat32[] sensors      # one per sensor: name, float32[] values
+
+``tactile_msgs/msg/TactileContact``::
+
+    std_msgs/Header header
+    string name
+    geometry_msgs/Point position
+    geometry_msgs/Vector3 normal
+    geometry_msgs/Wrench wrench
+
+tactsense fills one ``TactileState`` per frame (one sensor: the finger's name and its
+counts, rows x cols row-major, as float32) and one ``TactileContact`` per frame with a
+contact: the point on the skin [m] in the finger's frame (x along the finger from the
+junction of tip and cylinder toward the base, angle 0 along +y, as
+:func:`tactsense.geometry.surface_to_xyz`), the outward normal there, and the force
+the object applies (-force x normal [N]; torque zero about the point). The header's
+``frame_id`` is the link of the URDF description (``finger``) and its stamp the
+frame's time on the device clock.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from tactsense.geometry import surface_to_xyz
+from tactsense.sensor import SensorSpec
+
+SEPARATOR = "=" * 80
+
+_DEPENDENCIES = {
+    "std_msgs/Header": "builtin_interfaces/Time stamp\nstring frame_id",
+    "builtin_interfaces/Time": "int32 sec\nuint32 nanosec",
+    "sensor_msgs/ChannelFloat32": "string name\nfloat32[] values",
+    "geometry_msgs/Point": "float64 x\nfloat64 y\nfloat64 z",
+    "geometry_msgs/Vector3": "float64 x\nfloat64 y\nfloat64 z",
+    "geometry_msgs/Wrench": "geometry_msgs/Vector3 force\ngeometry_msgs/Vector3 torque",
+}
+
+TACTILE_STATE = "tactile_msgs/msg/TactileState"
+TACTILE_CONTACT = "tactile_msgs/msg/TactileContact"
+
+
+def _msgdef(body: str, dependencies: list[str]) -> str:
+    parts = [body]
+    for name in dependencies:
+        parts.append(f"{SEPARATOR}\nMSG: {name}\n{_DEPENDENCIES[name]}")
+    return "\n".join(parts) + "\n"
+
+
+TACTILE_STATE_MSGDEF = _msgdef(
+    "std_msgs/Header header\nsensor_msgs/ChannelFloat32[] sensors",
+    ["std_msgs/Header", "builtin_interfaces/Time", "sensor_msgs/ChannelFloat32"],
+)
+"""ROS 2 message definition of ``TactileState`` with its dependencies (the ``ros2msg``
+schema encoding of MCAP)."""
+
+TACTILE_CONTACT_MSGDEF = _msgdef(
+    "std_msgs/Header header\nstring name\ngeometry_msgs/Point position\n"
+    "geometry_msgs/Vector3 normal\ngeometry_msgs/Wrench wrench",
+    [
+        "std_msgs/Header",
+        "builtin_interfaces/Time",
+        "geometry_msgs/Point",
+        "geometry_msgs/Vector3",
+        "geometry_msgs/Wrench",
+    ],
+)
+"""ROS 2 message definition of ``TactileContact`` with its dependencies."""
+
+
+def stamp(time_s: float) -> dict:
+    """``builtin_interfaces/Time`` of a time in seconds."""
+    ns = round(float(time_s) * 1e9)
+    return {"sec": ns // 1_000_000_000, "nanosec": ns % 1_000_000_000}
+
+
+def tactile_state(sensor: SensorSpec, counts, time_s: float, frame_id: str = "finger") -> dict:
+    """One ``TactileState`` of one frame: the finger's counts, row-major."""
+    return {
+        "header": {"stamp": stamp(time_s), "frame_id": frame_id},
+        "sensors": [
+            {"name": sensor.name, "values": np.asarray(counts, dtype=np.float32).ravel().tolist()}
+        ],
+    }
+
+
+def contact_geometry(sensor: SensorSpec, axial_mm, angle_deg) -> tuple[np.ndarray, np.ndarray]:
+    """Points on the skin [m] and outward unit normals there, shape (..., 3) each."""
+    outside = surface_to_xyz(sensor, axial_mm, angle_deg)
+    inside = surface_to_xyz(sensor, axial_mm, angle_deg, depth_mm=1.0)
+    normal = outside - inside
+    normal /= np.linalg.norm(normal, axis=-1, keepdims=True)
+    return outside * 1e-3, normal
+
+
+def tactile_contact(
+    sensor: SensorSpec,
+    time_s: float,
+    point_m,
+    normal,
+    force_n: float,
+    frame_id: str = "finger",
+) -> dict:
+    """One ``TactileContact``: where, the normal, and the force the object applies."""
+    force = -float(force_n) * np.asarray(normal, dtype=float)
+    return {
+        "header": {"stamp": stamp(time_s), "frame_id": frame_id},
+        "name": sensor.name,
+        "position": dict(zip("xyz", map(float, point_m), strict=True)),
+        "normal": dict(zip("xyz", map(float, normal), strict=True)),
+        "wrench": {
+            "force": dict(zip("xyz", map(float, force), strict=True)),
+            "torque": {"x": 0.0, "y": 0.0, "z": 0.0},
+        },
+    }
