@@ -1,0 +1,133 @@
+"""The Lab Streaming Layer: tactsense's outlets read by pylsl's own inlet, and tactsense's
+inlet recording an outlet, in one process (pylsl's wheel bundles liblsl)."""
+
+import threading
+import time
+import uuid
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+import tactsense as ts
+from tactsense.cli import app
+from tactsense.interop.lsl import CONTACT_CHANNELS, LslOutlets, LslReader, _pylsl
+from tactsense.stream import LiveLocator
+from tactsense.stream.reader import StreamError, StreamFrame
+
+runner = CliRunner()
+
+
+@pytest.fixture(scope="module")
+def sweep(initial):
+    return ts.simulate(initial, ts.probe_sweep(initial, along="axial", dwell_s=0.3), rng=9)
+
+
+def _frames(rec):
+    for k, counts in enumerate(rec.frames):
+        yield StreamFrame(k, k, float(rec.time_s[k]), time.time(), time.perf_counter(), counts)
+
+
+def _unique_sensor(rec):
+    """The sensor under a name of its own: outlets of other tests never answer."""
+    import dataclasses
+
+    return dataclasses.replace(rec.sensor, name=f"lsltest{uuid.uuid4().hex[:8]}")
+
+
+def test_outlets_are_read_by_pylsl_frame_by_frame(sweep):
+    pylsl = _pylsl()
+    sensor = _unique_sensor(sweep)
+    identity = {"serial": f"twin-{uuid.uuid4().hex[:6]}", "device": "tactsense twin"}
+    outlets = LslOutlets(sensor, identity, 7.0)
+    try:
+        (found,) = pylsl.resolve_byprop("source_id", f"tactsense:{identity['serial']}:frames", 1, 5)
+        (found_c,) = pylsl.resolve_byprop(
+            "source_id", f"tactsense:{identity['serial']}:contacts", 1, 5
+        )
+        inlet = pylsl.StreamInlet(found)
+        inlet_c = pylsl.StreamInlet(found_c)
+        info = inlet.info(timeout=5)
+        assert info.name() == f"{sensor.name}-frames" and info.type() == "Tactile"
+        assert info.channel_count() == 64 and info.nominal_srate() == 7.0
+        channel = info.desc().child("channels").child("channel")
+        labels = []
+        while not channel.empty():
+            labels.append(
+                (channel.child_value("label"), int(channel.child_value("row")),
+                 int(channel.child_value("col")), float(channel.child_value("axial_mm")),
+                 float(channel.child_value("angle_deg")))
+            )  # fmt: skip
+            channel = channel.next_sibling()
+        assert len(labels) == 64
+        assert labels[13] == ("r1c5", 1, 5, pytest.approx(sensor.row_axial_mm[1], abs=1e-5),
+                              pytest.approx(sensor.col_angle_deg[5]))  # fmt: skip
+        toml = info.desc().child("tactsense").child_value("sensor_toml")
+        assert ts.SensorSpec.from_toml_string(toml) == sensor
+        contact_labels = []
+        ch = inlet_c.info(timeout=5).desc().child("channels").child("channel")
+        while not ch.empty():
+            contact_labels.append(ch.child_value("label"))
+            ch = ch.next_sibling()
+        assert tuple(contact_labels) == CONTACT_CHANNELS
+        inlet.open_stream(timeout=5)
+        inlet_c.open_stream(timeout=5)
+        time.sleep(0.3)
+        locator = LiveLocator(sensor, baseline=ts.baseline_from(sweep.frames, 5))
+        estimates = []
+        for frame in _frames(sweep):
+            estimate = locator(frame)
+            estimates.append(estimate)
+            outlets.push(frame, estimate)
+        got, got_c = [], []
+        deadline = time.time() + 10
+        while (len(got) < len(sweep) or len(got_c) < len(sweep)) and time.time() < deadline:
+            samples, _ = inlet.pull_chunk(timeout=0.2)
+            got.extend(samples)
+            samples, _ = inlet_c.pull_chunk(timeout=0.2)
+            got_c.extend(samples)
+        assert len(got) == len(sweep)
+        np.testing.assert_array_equal(np.asarray(got).reshape(-1, 8, 8), sweep.frames)
+        assert len(got_c) == len(sweep)
+        expected = np.array([[e[name] for name in CONTACT_CHANNELS] for e in estimates], float)
+        np.testing.assert_allclose(np.asarray(got_c), expected, rtol=1e-12, equal_nan=True)
+    finally:
+        outlets.close()
+
+
+def test_record_from_an_lsl_outlet(tmp_path, sweep):
+    sensor = _unique_sensor(sweep)
+    outlets = LslOutlets(sensor, {"serial": uuid.uuid4().hex[:6]}, 70.0)
+    stop = threading.Event()
+
+    def push():
+        time.sleep(1.0)  # the recorder resolves and opens the inlet first
+        for frame in _frames(sweep):
+            if stop.is_set():
+                return
+            outlets.push(frame, None)
+            time.sleep(1 / 200)
+
+    pusher = threading.Thread(target=push, daemon=True)
+    pusher.start()
+    out = tmp_path / "from_lsl.h5"
+    try:
+        result = runner.invoke(
+            app,
+            ["record", f"lsl:{sensor.name}-frames", "--frames", str(len(sweep)),
+             "--out", str(out), "--duration", "30"],
+        )  # fmt: skip
+    finally:
+        stop.set()
+        pusher.join(5)
+        outlets.close()
+    assert result.exit_code == 0, result.output
+    rec = ts.read_recording(out)
+    assert rec.sensor.name == sensor.name  # from the outlet's own description
+    np.testing.assert_array_equal(rec.frames, sweep.frames)
+    assert rec.source == f"lsl:{sensor.name}-frames"
+
+
+def test_no_such_outlet_is_a_clear_error():
+    with pytest.raises(StreamError, match="no Lab Streaming Layer outlet named"):
+        LslReader(f"nothing-{uuid.uuid4().hex}", timeout_s=0.5)

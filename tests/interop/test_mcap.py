@@ -1,0 +1,105 @@
+"""MCAP for ROS 2 and Foxglove: written by tactsense, read back by mcap's own ROS 2 reader
+(``mcap_ros2``, CDR decoding from the schema in the file), compared field by field."""
+
+import math
+
+import numpy as np
+import pytest
+from mcap.reader import make_reader
+from mcap_ros2.decoder import DecoderFactory
+from typer.testing import CliRunner
+
+import tactsense as ts
+from tactsense.cli import app
+from tactsense.estimate import Flag
+from tactsense.io.recording import write_recording
+from tactsense.stream import Emulator
+
+runner = CliRunner()
+
+
+@pytest.fixture(scope="module")
+def sweep(tmp_path_factory, initial):
+    rec = ts.simulate(initial, ts.probe_sweep(initial, along="around", dwell_s=0.3), rng=4)
+    path = tmp_path_factory.mktemp("mcap") / "sweep.h5"
+    write_recording(path, rec)
+    return path, rec
+
+
+class _Message:
+    def __init__(self, schema, channel, message, decoded):
+        self.schema, self.channel, self.message, self.ros_msg = schema, channel, message, decoded
+        self.log_time_ns = message.log_time
+
+
+def _messages(path):
+    states, contacts = [], []
+    with open(path, "rb") as stream:
+        reader = make_reader(stream, decoder_factories=[DecoderFactory()])
+        for m in map(lambda args: _Message(*args), reader.iter_decoded_messages()):
+            (states if m.channel.topic == "/tactile_states" else contacts).append(m)
+    return states, contacts
+
+
+def test_export_frames_and_contacts_field_by_field(tmp_path, sweep):
+    path, rec = sweep
+    out = tmp_path / "sweep.mcap"
+    result = runner.invoke(app, ["export", str(path), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    states, contacts = _messages(out)
+    assert len(states) == len(rec)
+    assert states[0].schema.name == "tactile_msgs/msg/TactileState"
+    for k, m in enumerate(states):
+        msg = m.ros_msg
+        (channel,) = msg.sensors
+        assert channel.name == rec.sensor.name
+        np.testing.assert_array_equal(np.asarray(channel.values).reshape(8, 8), rec.frames[k])
+        stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+        assert stamp == pytest.approx(rec.time_s[k], abs=1e-9)
+        assert m.log_time_ns == round(rec.time_s[k] * 1e9)
+        assert msg.header.frame_id == "finger"
+
+    est = ts.locate(rec.frames, rec.sensor, baseline=ts.baseline_from(rec.frames, 5))
+    touching = np.flatnonzero(((est.flags & int(Flag.NO_CONTACT)) == 0) & np.isfinite(est.force_n))
+    assert len(contacts) == len(touching) > 100
+    radius_m = rec.sensor.body.diameter_mm / 2 * 1e-3
+    for m, i in zip(contacts, touching, strict=True):
+        msg = m.ros_msg
+        assert m.schema.name == "tactile_msgs/msg/TactileContact"
+        assert m.log_time_ns == round(rec.time_s[i] * 1e9)
+        # the cylinder by hand: x along the finger, the angle from +y toward +z
+        angle = math.radians(est.angle_deg[i])
+        assert est.axial_mm[i] >= 0  # a sweep around row 4: on the cylinder
+        expected = (est.axial_mm[i] * 1e-3, radius_m * math.cos(angle), radius_m * math.sin(angle))
+        got = (msg.position.x, msg.position.y, msg.position.z)
+        np.testing.assert_allclose(got, expected, atol=1e-12)
+        normal = (msg.normal.x, msg.normal.y, msg.normal.z)
+        np.testing.assert_allclose(normal, (0.0, math.cos(angle), math.sin(angle)), atol=1e-12)
+        force = (msg.wrench.force.x, msg.wrench.force.y, msg.wrench.force.z)
+        np.testing.assert_allclose(force, -est.force_n[i] * np.asarray(normal), rtol=1e-12)
+        assert (msg.wrench.torque.x, msg.wrench.torque.y, msg.wrench.torque.z) == (0, 0, 0)
+
+
+def test_record_writes_mcap_as_frames_arrive(tmp_path, sweep):
+    _, rec = sweep
+    emulator = Emulator.from_recording(rec, speed=0)
+    _, port = emulator.start_tcp()
+    out = tmp_path / "live.mcap"
+    try:
+        result = runner.invoke(
+            app, ["record", f"socket://127.0.0.1:{port}", "--frames", "60", "--out", str(out)]
+        )
+    finally:
+        emulator.stop()
+    assert result.exit_code == 0, result.output
+    states, contacts = _messages(out)
+    assert contacts == []  # record keeps frames; 'export' adds the contacts
+    got = np.stack([np.asarray(m.ros_msg.sensors[0].values).reshape(8, 8) for m in states])
+    np.testing.assert_array_equal(got, rec.frames[:60])
+    assert [m.message.sequence for m in states] == list(range(60))
+
+
+def test_record_refuses_other_extensions(tmp_path):
+    result = runner.invoke(app, ["record", "loop://", "--out", str(tmp_path / "x.csv")])
+    assert result.exit_code == 2
+    assert "use the extension .h5 (HDF5) or .mcap" in result.output

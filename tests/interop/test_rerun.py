@@ -1,0 +1,66 @@
+"""Rerun: written by tactsense, read back with Rerun's own reader (rerun.chunk.RrdReader),
+compared frame by frame with the recording and its estimates."""
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+import tactsense as ts
+from tactsense.cli import app
+from tactsense.estimate import Flag
+from tactsense.estimate.deflection import deflection_from_counts
+from tactsense.io.recording import write_recording
+from tactsense.physics.contact import newtons_to_grams
+
+runner = CliRunner()
+
+
+def _columns(path):
+    from rerun.chunk import RrdReader
+
+    found = {}
+    for chunk in RrdReader(str(path)).stream().to_chunks():
+        batch = chunk.to_record_batch()
+        names = batch.schema.names
+        if "time" not in names:
+            continue
+        times = [t.total_seconds() for t in batch.column("time").to_pylist()]
+        for name in names:
+            if ":" in name:
+                key = (str(chunk.entity_path), name)
+                found.setdefault(key, []).extend(
+                    zip(times, batch.column(name).to_pylist(), strict=True)
+                )
+    return {key: sorted(rows, key=lambda row: row[0]) for key, rows in found.items()}
+
+
+def test_export_heat_map_contact_and_force(tmp_path, initial):
+    rec = ts.simulate(initial, ts.probe_sweep(initial, along="axial", dwell_s=0.3), rng=8)
+    path, out = tmp_path / "rec.h5", tmp_path / "rec.rrd"
+    write_recording(path, rec)
+    result = runner.invoke(app, ["export", str(path), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    columns = _columns(out)
+    baseline = ts.baseline_from(rec.frames, 5)
+    deflection, _ = deflection_from_counts(rec.frames, baseline, rec.sensor)
+    est = ts.locate(rec.frames, rec.sensor, baseline=baseline)
+    touching = ((est.flags & int(Flag.NO_CONTACT)) == 0) & np.isfinite(est.force_n)
+
+    images = columns[("/finger/deflection", "DepthImage:buffer")]
+    assert len(images) == len(rec)
+    for k, (t, buffer) in enumerate(images):
+        assert t == pytest.approx(rec.time_s[k], abs=1e-9)
+        image = np.frombuffer(bytes(buffer[0]), dtype=np.float32).reshape(8, 8)
+        np.testing.assert_array_equal(image, deflection[k].T.astype(np.float32))
+
+    forces = columns[("/finger/force_g", "Scalars:scalars")]
+    expected = np.where(touching, newtons_to_grams(np.nan_to_num(est.force_n)), 0.0)
+    np.testing.assert_allclose([row[1][0] for row in forces], expected, rtol=1e-12)
+
+    points = columns[("/finger/deflection/contact", "Points2D:positions")]
+    assert len(points) == int(touching.sum())
+    index = {round(t, 9): i for i, t in enumerate(rec.time_s)}
+    for t, value in points:
+        i = index[round(t, 9)]
+        assert touching[i]
+        np.testing.assert_allclose(value[0], [est.row[i] + 0.5, est.col[i] + 0.5], atol=1e-5)
