@@ -97,9 +97,3 @@ def test_record_writes_mcap_as_frames_arrive(tmp_path, sweep):
     got = np.stack([np.asarray(m.ros_msg.sensors[0].values).reshape(8, 8) for m in states])
     np.testing.assert_array_equal(got, rec.frames[:60])
     assert [m.message.sequence for m in states] == list(range(60))
-
-
-def test_record_refuses_other_extensions(tmp_path):
-    result = runner.invoke(app, ["record", "loop://", "--out", str(tmp_path / "x.csv")])
-    assert result.exit_code == 2
-    assert "use the extension .h5 (HDF5) or .mcap" in result.output

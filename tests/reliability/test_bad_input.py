@@ -92,6 +92,18 @@ BAD_OPTIONS = [
     ("view loop:// --speed 2", "--speed applies to recordings"),
     ("view no_such_recording.h5", "no recording at no_such_recording.h5"),
     ("view REC --host 203.0.113.9", "cannot listen on 203.0.113.9"),
+    ("export REC --out OUT", "say --format mcap or rerun"),
+    ("export REC --format xml --out OUT", "--format"),
+    ("export REC --threshold 0 --out OUT", "--threshold"),
+    ("export REC --baseline-frames 0 --out OUT", "--baseline-frames"),
+    ("export no_such.h5 --out OUT.mcap", "no_such.h5"),
+    ("sensor import no_such.urdf", "cannot read no_such.urdf"),
+    ("sensor import REC", "not XML"),
+    ("sensor import REC --extends bogus", "--extends"),
+    ("sensor export", "say which format: --urdf"),
+    ("sensor export --urdf --sensor bogus", "presets: initial, improved"),
+    ("record lsl: --out OUT.h5", "lsl: needs an outlet name"),
+    ("live lsl:", "lsl: needs an outlet name"),
 ]
 
 
@@ -155,6 +167,8 @@ BAD_FILES = [
     ("view REC --calibration REC", "not JSON text"),
     ("view DIR/strings.h5", "/frames holds |S2 values; expected numbers"),
     ("view loop:// --calibration DIR/zero_gain.json", "not a positive finite number"),
+    ("export REC --calibration DIR/zero_gain.json --out DIR/x.mcap", "at (4, 3)"),
+    ("sensor import DIR/empty.toml", "not XML"),
 ]
 
 
@@ -183,6 +197,8 @@ BAD_OUTPUTS = {
     "record": "record loop:// --out {out}",
     "live": "live loop:// --out {out}",
     "design sweep": "design sweep --depth 3.8 --spacing 3.8 --out {out}",
+    "export": "export {rec} --format mcap --out {out}",
+    "sensor export": "sensor export --urdf --out {out}",
 }
 BAD_PATHS = {
     "missing folder": ("no_such_folder/x.out", "does not exist"),

@@ -83,8 +83,6 @@ def export(
         export_format = by_suffix.get(out.suffix.lower())
         if export_format is None:
             fail(f"{out}: say --format mcap or rerun, or use the extension .mcap or .rrd")
-    elif out.suffix.lower() != SUFFIXES[export_format]:
-        fail(f"{out}: a {export_format.value} file takes the extension {SUFFIXES[export_format]}")
     check_output(out, force)
     try:
         cal = None if calibration is None else Calibration.load(calibration)

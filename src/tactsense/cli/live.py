@@ -220,8 +220,8 @@ def record(
         typer.Option(
             "--out",
             "-o",
-            help="New recording: HDF5 (.h5, crash-safe) or MCAP (.mcap: TactileState "
-            "messages for ROS 2 and Foxglove).",
+            help="New recording: HDF5 (crash-safe), or MCAP when the name ends in .mcap "
+            "(TactileState messages for ROS 2 and Foxglove).",
         ),
     ] = Path("recording.h5"),
     frames: FramesLimit = None,
@@ -249,8 +249,6 @@ def record(
             _writer_class()
         except TactsenseInputError as error:
             fail(str(error))
-    elif out.suffix.lower() not in (".h5", ".hdf5"):
-        fail(f"{out}: use the extension .h5 (HDF5) or .mcap (MCAP)")
     check_output(out, force)
     try:
         reader = _open_reader(source, sensor, timeout)
