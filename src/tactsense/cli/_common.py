@@ -30,6 +30,26 @@ SensorOption = Annotated[
 ]
 
 
+BaselineFramesOption = Annotated[
+    int,
+    typer.Option(
+        min=1,
+        max=1_000_000,
+        help="Without --calibration: untouched frames at the start whose median is the "
+        "undeflected reading V_o of eq. 4.",
+    ),
+]
+ThresholdOption = Annotated[
+    float,
+    typer.Option(
+        min=1e-6,
+        max=1.0,
+        help="Smallest tactel deflection that counts as a contact, as a fraction (0.005 = "
+        "0.5 %, about 10 counts at 2000).",
+    ),
+]
+
+
 class _Group(typer.Typer):
     """A typer app whose every command runs under :func:`guarded`."""
 

@@ -13,6 +13,8 @@ from rich.table import Table
 
 from tactsense._validation import TactsenseInputError
 from tactsense.cli._common import (
+    BaselineFramesOption,
+    ThresholdOption,
     atomic_output,
     check_output,
     console,
@@ -37,24 +39,8 @@ def locate(
             "(units in the header, flags by name), .parquet or .h5 (flags as bits).",
         ),
     ] = Path("estimates.csv"),
-    baseline_frames: Annotated[
-        int,
-        typer.Option(
-            min=1,
-            max=1_000_000,
-            help="Number of untouched frames at the start of the recording "
-            "whose median is the undeflected reading V_o of eq. 4.",
-        ),
-    ] = 5,
-    threshold: Annotated[
-        float,
-        typer.Option(
-            min=1e-6,
-            max=1.0,
-            help="Smallest tactel deflection that counts as a contact, as a "
-            "fraction (0.005 = 0.5 %, about 10 counts at 2000).",
-        ),
-    ] = 0.005,
+    baseline_frames: BaselineFramesOption = 5,
+    threshold: ThresholdOption = 0.005,
     calibration: Annotated[
         Path | None,
         typer.Option(
@@ -349,10 +335,7 @@ def batch(
         Path | None,
         typer.Option(help="Calibration JSON applied to every recording (same finger)."),
     ] = None,
-    threshold: Annotated[
-        float,
-        typer.Option(min=1e-6, max=1.0, help="Contact threshold, as for 'locate' [fraction]."),
-    ] = 0.005,
+    threshold: ThresholdOption = 0.005,
     workers: Annotated[
         int,
         typer.Option(

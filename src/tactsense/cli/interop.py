@@ -10,6 +10,8 @@ import typer
 
 from tactsense._validation import TactsenseInputError
 from tactsense.cli._common import (
+    BaselineFramesOption,
+    ThresholdOption,
     atomic_output,
     check_output,
     console,
@@ -51,23 +53,8 @@ def export(
         Path | None,
         typer.Option(help="Calibration JSON applied to the contacts (as for 'locate')."),
     ] = None,
-    baseline_frames: Annotated[
-        int,
-        typer.Option(
-            min=1,
-            max=10000,
-            help="Without --calibration: untouched frames at the start whose median is "
-            "the baseline V_o of eq. 4.",
-        ),
-    ] = 5,
-    threshold: Annotated[
-        float,
-        typer.Option(
-            min=1e-6,
-            max=1.0,
-            help="Smallest tactel deflection that counts as a contact, as a fraction [-].",
-        ),
-    ] = 0.005,
+    baseline_frames: BaselineFramesOption = 5,
+    threshold: ThresholdOption = 0.005,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,
     force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
 ) -> None:

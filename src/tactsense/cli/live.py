@@ -15,7 +15,9 @@ from rich.progress import Progress, TextColumn
 
 from tactsense._validation import TactsenseInputError
 from tactsense.cli._common import (
+    BaselineFramesOption,
     SensorOption,
+    ThresholdOption,
     atomic_output,
     check_output,
     console,
@@ -303,23 +305,8 @@ def live(
     ] = None,
     frames: FramesLimit = None,
     duration: DurationLimit = None,
-    baseline_frames: Annotated[
-        int,
-        typer.Option(
-            min=1,
-            max=10000,
-            help="Without --calibration: untouched frames at the start whose median is "
-            "the baseline V_o of eq. 4.",
-        ),
-    ] = 5,
-    threshold: Annotated[
-        float,
-        typer.Option(
-            min=1e-6,
-            max=1.0,
-            help="Smallest tactel deflection that counts as a contact, as a fraction [-].",
-        ),
-    ] = 0.005,
+    baseline_frames: BaselineFramesOption = 5,
+    threshold: ThresholdOption = 0.005,
     sensor: StreamSensorOption = None,
     timeout: TimeoutOption = None,
     lsl: Annotated[
@@ -447,23 +434,8 @@ def view(
         Path | None,
         typer.Option(help="Calibration JSON from 'tactsense calibrate' (as for 'live')."),
     ] = None,
-    baseline_frames: Annotated[
-        int,
-        typer.Option(
-            min=1,
-            max=10000,
-            help="Without --calibration: untouched frames at the start whose median is "
-            "the baseline V_o of eq. 4.",
-        ),
-    ] = 5,
-    threshold: Annotated[
-        float,
-        typer.Option(
-            min=1e-6,
-            max=1.0,
-            help="Smallest tactel deflection that counts as a contact, as a fraction [-].",
-        ),
-    ] = 0.005,
+    baseline_frames: BaselineFramesOption = 5,
+    threshold: ThresholdOption = 0.005,
     speed: Annotated[
         float,
         typer.Option(
