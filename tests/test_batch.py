@@ -133,3 +133,27 @@ def test_calibration_from_pieces_equals_the_whole_sweep():
     )
     for name in ("gains", "baseline", "dead", "weak", "noisy", "threshold_g"):
         np.testing.assert_array_equal(getattr(pieces, name), getattr(whole, name), err_msg=name)
+
+
+def test_creep_memories_carry_linearly():
+    """Memories after a range = A^L (memories before) + (the range's own, from zero): the
+    identity that lets split ranges start where the whole recording is."""
+    from tactsense.estimate.creep import CreepCompensator
+
+    model = cal.Viscoelastic(0.5, 0.05, 0.3, 10.0)
+    y = np.random.default_rng(0).random((700, 2, 3))
+    whole = CreepCompensator(model, 1 / 7, (2, 3))
+    first = CreepCompensator(model, 1 / 7, (2, 3))
+    second = CreepCompensator(model, 1 / 7, (2, 3))
+    for k, frame in enumerate(y):
+        whole(frame)
+        (first if k < 300 else second)(frame)
+    carried = second.carry(first.state, 400) + second.state
+    np.testing.assert_allclose(carried, whole.state, rtol=1e-12, atol=1e-15)
+    assert not np.allclose(second.state, whole.state)  # the carry matters
+    # and a compensator started from the carried memories continues the whole one
+    resumed = CreepCompensator(model, 1 / 7, (2, 3))
+    resumed.state = first.state
+    for frame in y[300:]:
+        resumed(frame)
+    np.testing.assert_allclose(resumed.state, whole.state, rtol=1e-12, atol=1e-15)

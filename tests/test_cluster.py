@@ -176,3 +176,55 @@ def test_batch_bad_input(recordings, tmp_path, args, message):
     result = runner.invoke(app, line)
     assert result.exit_code == 2, result.output
     assert message in " ".join(result.output.split())
+
+
+def test_split_with_a_creep_calibration_equals_one_process(tmp_path):
+    """Ranges start from the creep memories the whole recording has there (pass 1 finds
+    each range's end memories, A^L carries them on): the estimates equal one process's to
+    rounding (the memories are summed in another order: tolerance 1e-9 relative), and
+    restarting the memories at each range would differ (the test can fail)."""
+    from tactsense.estimate import calibrate as cal
+
+    spec = ts.fearing1990_initial()
+    rec = ts.simulate(spec, ts.repeated_load(spec, row=4, col=3, repeats=260), rng=3)
+    path = tmp_path / "steps.h5"
+    ts.write_recording(path, rec)
+    calibration = cal.Calibration(
+        sensor_toml=spec.to_toml_string(),
+        gains=np.ones(spec.shape),
+        baseline=ts.baseline_from(rec.frames, 5),
+        dead=np.zeros(spec.shape, bool),
+        weak=np.zeros(spec.shape, bool),
+        noisy=np.zeros(spec.shape, bool),
+        threshold_g=np.ones(spec.shape),
+        viscoelastic=cal.Viscoelastic(0.5, 0.05, 0.3, 10.0),
+    )
+    cal_path = calibration.save(tmp_path / "cal.json")
+    alone = tmp_path / "alone.parquet"
+    locate_file(path, alone, calibration=calibration)
+    out = tmp_path / "split"
+    n = len(rec)
+    result = runner.invoke(
+        app,
+        ["batch", str(path), "--out", str(out), "--calibration", str(cal_path),
+         "--split-frames", "1000", "--workers", "2", "--quiet"],
+    )  # fmt: skip
+    assert n > 3000  # at least four ranges
+    assert result.exit_code == 0, result.output
+    split = pq.read_table(out / "steps.parquet")
+    whole = pq.read_table(alone)
+    assert split.num_rows == whole.num_rows == n
+    for name in ("force_n", "axial_mm", "angle_deg", "peak_deflection"):
+        np.testing.assert_allclose(
+            split[name].to_numpy(), whole[name].to_numpy(), rtol=1e-9, atol=1e-12,
+            equal_nan=True, err_msg=name,
+        )  # fmt: skip
+    np.testing.assert_array_equal(split["flags"].to_numpy(), whole["flags"].to_numpy())
+    restarted = np.concatenate(
+        [
+            ts.locate(rec.frames[k : k + 1000], spec, calibration=calibration,
+                      frame_period_s=spec.scan_period_s).force_n
+            for k in range(0, n, 1000)
+        ]
+    )  # fmt: skip
+    assert not np.allclose(restarted, whole["force_n"].to_numpy(), equal_nan=True)

@@ -72,17 +72,12 @@ def process_recording(
 ) -> dict:
     """One task: locate every frame of ``recording`` into ``output``; its summary."""
     from tactsense.batch import locate_file
-    from tactsense.estimate import Calibration
-    from tactsense.io.recording import RecordingReader
 
     start = time.perf_counter()
     output = Path(output)
     temporary = output.with_name(f".{output.stem}.{os.getpid()}.partial{output.suffix}")
     try:
-        cal = None
-        if calibration is not None:
-            with RecordingReader(recording) as reader:
-                cal = Calibration.load(calibration, reader.sensor)
+        cal = _calibration(recording, calibration)
         summary = locate_file(recording, temporary, calibration=cal, threshold=threshold)
         os.replace(temporary, output)
     finally:
@@ -91,11 +86,53 @@ def process_recording(
     return summary
 
 
-def process_range(recording: str, part: str, lo: int, hi: int, threshold: float = 0.005) -> dict:
+def _calibration(recording: str, calibration: str | None):
+    """The calibration file checked against the recording's sensor (None without one)."""
+    if calibration is None:
+        return None
+    from tactsense.estimate import Calibration
+    from tactsense.io.recording import RecordingReader
+
+    with RecordingReader(recording) as reader:
+        return Calibration.load(calibration, reader.sensor)
+
+
+def range_end_state(recording: str, calibration: str, lo: int, hi: int):
+    """Pass 1 of a split with creep compensation: the compensator's memories at the end
+    of frames ``lo`` to ``hi``, started from zero (array (2, rows, cols)).
+
+    The memories follow a linear recursion (``CreepCompensator.transition``): from
+    memories ``s0`` the range ends in ``A^L s0`` plus this, so the start of every range
+    follows from the ranges before it, and pass 2 (:func:`process_range`) runs all
+    ranges at once with the memories the whole recording would have had there.
+    """
+    from tactsense.io.recording import RecordingReader
+
+    cal = _calibration(recording, calibration)
+    with RecordingReader(recording) as reader:
+        compensator = cal.compensator(reader.sensor.scan_period_s, reader.sensor.shape)
+        step = reader.chunk_frames
+        for start in range(lo, hi, step):
+            frames = reader.frames(start, min(hi, start + step))
+            cal.apply(frames, reader.sensor, compensator=compensator)
+    return compensator.state
+
+
+def process_range(
+    recording: str,
+    part: str,
+    lo: int,
+    hi: int,
+    threshold: float = 0.005,
+    calibration: str | None = None,
+    before: list | None = None,
+) -> dict:
     """One piece of a split recording: frames ``lo`` to ``hi`` into the Parquet file
-    ``part`` (the same numbers as the whole recording: the baseline is the median of the
-    recording's first 5 frames, and without creep compensation every frame is
-    independent)."""
+    ``part``, with the numbers of the whole recording. Without a calibration the
+    baseline is the median of the recording's first 5 frames and every frame is
+    independent. With one, its creep compensation starts from the memories the
+    recording has at ``lo``: ``before`` lists, for every earlier range, its
+    :func:`range_end_state` and its length."""
     import numpy as np
 
     from tactsense.batch import Tally
@@ -103,15 +140,26 @@ def process_range(recording: str, part: str, lo: int, hi: int, threshold: float 
     from tactsense.estimate.output import EstimatesWriter
     from tactsense.io.recording import RecordingReader
 
+    cal = _calibration(recording, calibration)
     tally = Tally()
     with RecordingReader(recording) as reader, EstimatesWriter(part) as writer:
-        baseline = np.median(reader.frames(0, 5).astype(float), axis=0)
+        sensor = reader.sensor
+        options: dict = {"threshold": threshold}
+        if cal is None:
+            options["baseline"] = np.median(reader.frames(0, 5).astype(float), axis=0)
+        else:
+            options["calibration"] = cal
+            compensator = cal.compensator(sensor.scan_period_s, sensor.shape)
+            if compensator is not None:
+                state = np.zeros((2, *sensor.shape))
+                for end_state, length in before or []:
+                    state = compensator.carry(state, length) + end_state
+                compensator.state = state
+                options["compensator"] = compensator
         step = reader.chunk_frames
         for start in range(lo, hi, step):
             stop = min(hi, start + step)
-            estimates = locate(
-                reader.frames(start, stop), reader.sensor, baseline=baseline, threshold=threshold
-            )
+            estimates = locate(reader.frames(start, stop), sensor, **options)
             writer.write(start, reader.time_s(start, stop), estimates)
             tally.add(estimates)
     return {"part": part, "frames": hi - lo, "tally": tally}
@@ -160,6 +208,15 @@ def _losses(recording: str) -> int:
     return sum(read_losses(recording).values())
 
 
+def _has_creep(recording: Path, calibration: str) -> bool:
+    """Whether the calibration compensates creep (False if it cannot be read: the task
+    will fail and say why)."""
+    try:
+        return _calibration(str(recording), calibration).viscoelastic is not None
+    except TactsenseInputError:
+        return False
+
+
 def _frames_of(recording: Path) -> int | None:
     from tactsense.io.recording import RecordingReader
 
@@ -185,8 +242,9 @@ def run_batch(
 
     A recording of more than ``split_frames`` frames is split into ranges of that many
     frames, one task each, joined in order by a last task: the same output as one
-    process (not with a calibration, whose creep compensation runs through the whole
-    recording in order).
+    process. With a creep calibration a first pass finds each range's end memories
+    (:func:`range_end_state`, without estimation), so that every range starts from the
+    memories the whole recording has there (equal to one process's to rounding).
 
     Returns one summary row per recording (:data:`SUMMARY_FIELDS`), in the order given:
     status ``done``, ``skipped`` (its output is complete and newer) or ``failed`` (with
@@ -205,22 +263,42 @@ def run_batch(
                 "status": "skipped",
             }
             continue
-        n = _frames_of(recording) if split_frames and calibration is None else None
+        n = _frames_of(recording) if split_frames else None
         if n is not None and n > split_frames:
             stamp = recording.stat().st_mtime_ns
+            cal = None if calibration is None else str(calibration)
+            ranges = [(lo, min(n, lo + split_frames)) for lo in range(0, n, split_frames)]
+            # with a creep calibration, pass 1: each range's end memories from zero
+            states = []
+            if cal is not None and _has_creep(recording, cal):
+                states = [
+                    client.submit(
+                        range_end_state,
+                        str(recording),
+                        cal,
+                        lo,
+                        hi,
+                        key=f"tactsense-{recording.stem}-{stamp}-state{k}",
+                        pure=False,
+                        retries=1,
+                    )
+                    for k, (lo, hi) in enumerate(ranges[:-1])
+                ]
             parts = [
                 client.submit(
                     process_range,
                     str(recording),
                     str(out_dir / f".{recording.stem}.part{k:05d}.parquet"),
                     lo,
-                    min(n, lo + split_frames),
+                    hi,
                     threshold,
+                    cal,
+                    [(states[j], ranges[j][1] - ranges[j][0]) for j in range(min(k, len(states)))],
                     key=f"tactsense-{recording.stem}-{stamp}-range{k}",
                     pure=False,
                     retries=1,
                 )
-                for k, lo in enumerate(range(0, n, split_frames))
+                for k, (lo, hi) in enumerate(ranges)
             ]
             future = client.submit(
                 combine_parts,

@@ -355,8 +355,8 @@ def batch(
             min=1000,
             max=10**9,
             help="Split a recording of more frames than this into ranges of this many, "
-            "one task each, joined in order (same output; not with --calibration, whose "
-            "creep compensation runs through the recording in order).",
+            "one task each, joined in order: the same output (with a creep calibration, "
+            "a first pass finds the compensation's memories at the start of each range).",
         ),
     ] = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,

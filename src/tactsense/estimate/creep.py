@@ -9,7 +9,7 @@ import numpy as np
 from scipy.optimize import least_squares
 from scipy.signal import lfilter
 
-from tactsense._validation import CalibrationError
+from tactsense._validation import CalibrationError, TactsenseInputError
 
 
 @dataclass(frozen=True)
@@ -182,6 +182,43 @@ class CreepCompensator:
         self._c = (1 - self._a_d) + self._a_d * (1 - self._e_d) + self._a_c * (1 - self._e_c)
         self._m_d = np.zeros(shape)
         self._m_c = np.zeros(shape)
+
+    @property
+    def state(self) -> np.ndarray:
+        """The two memories (delayed, creep) per tactel: array (2, *shape) [-]."""
+        return np.stack([self._m_d, self._m_c])
+
+    @state.setter
+    def state(self, value) -> None:
+        value = np.asarray(value, dtype=float)
+        if value.shape != (2, *self._m_d.shape):
+            raise TactsenseInputError(
+                f"creep state has shape {value.shape}; expected {(2, *self._m_d.shape)}"
+            )
+        self._m_d, self._m_c = value[0].copy(), value[1].copy()
+
+    def transition(self) -> np.ndarray:
+        """The 2x2 matrix A of the memories' recursion ``s[n] = A s[n-1] + b y[n]``.
+
+        With ``u = (y - a_d e_d m_d - a_c e_c m_c) / c`` substituted into the memory
+        updates; the same for every tactel. A range of frames compensated from zero
+        memories ends in ``z``; from memories ``s0`` it ends in ``A^L s0 + z``
+        (:meth:`carry`), which lets the ranges of one recording run in parallel.
+        """
+        e_d, e_c, a_d, a_c, c = self._e_d, self._e_c, self._a_d, self._a_c, self._c
+        return np.array(
+            [
+                [e_d - (1 - e_d) * a_d * e_d / c, -(1 - e_d) * a_c * e_c / c],
+                [-(1 - e_c) * a_d * e_d / c, e_c - (1 - e_c) * a_c * e_c / c],
+            ]
+        )
+
+    def carry(self, state, n_frames: int) -> np.ndarray:
+        """Memories ``state`` (2, *shape) after ``n_frames`` frames of zero readings:
+        ``A^n_frames`` applied to each tactel's pair."""
+        state = np.asarray(state, dtype=float)
+        power = np.linalg.matrix_power(self.transition(), int(n_frames))
+        return np.tensordot(power, state, axes=(1, 0))
 
     def __call__(self, reading) -> np.ndarray:
         """The elastic deflection of one frame of readings [-]."""
