@@ -228,8 +228,8 @@ def _as_kernel_input(frames: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(frames, dtype=np.float64)
 
 
-BLOCK = 8192
-"""Frames per block of the compiled passes: the deflection of a block (4 MB for 8 x 8)
+BLOCK = 4096
+"""Frames per block of the compiled passes: the deflection of a block (2 MB for 8 x 8)
 stays in cache between the two passes."""
 
 
