@@ -413,7 +413,8 @@ def view(
         str,
         typer.Argument(
             help="A recording (.h5 from 'tactsense record' or 'simulate') to play back, or "
-            "a device: a serial port, a pty path, socket://127.0.0.1:PORT or any pyserial URL."
+            "a device: a serial port, a pty path, socket://127.0.0.1:PORT or any pyserial "
+            "URL; or lsl:NAME, a Lab Streaming Layer frames outlet."
         ),
     ],
     port: Annotated[

@@ -204,40 +204,48 @@ class LslReader:
         self._offset = time.perf_counter() - pylsl.local_clock()
         self.inlet.open_stream(timeout=timeout_s)
 
+    def read_batch(self, max_frames: int, wait_s: float = 0.1) -> list[StreamFrame]:
+        """Up to ``max_frames`` frames that have arrived, waiting up to ``wait_s`` for one."""
+        samples, stamps = self.inlet.pull_chunk(timeout=wait_s, max_samples=max_frames)
+        shape = self.sensor.shape
+        batch = []
+        for sample, stamp in zip(samples, stamps, strict=True):
+            if self._first_stamp is None:
+                self._first_stamp = stamp
+            self._index += 1
+            self.stats.frames += 1
+            counts = np.rint(np.asarray(sample, dtype=np.float64)).reshape(shape)
+            batch.append(
+                StreamFrame(
+                    self._index % 65536,
+                    self._index,
+                    stamp - self._first_stamp,
+                    time.time(),
+                    stamp + self._offset,
+                    counts.astype(np.uint16),
+                )
+            )
+        return batch
+
     def frames(
         self, *, max_frames: int | None = None, duration_s: float | None = None
     ) -> Iterator[StreamFrame]:
         """Yield frames as they arrive, until ``max_frames`` or ``duration_s``."""
         deadline = None if duration_s is None else time.perf_counter() + duration_s
         delivered = 0
-        shape = self.sensor.shape
         while max_frames is None or delivered < max_frames:
             wait = self.timeout_s
             if deadline is not None:
                 wait = min(wait, deadline - time.perf_counter())
                 if wait <= 0:
                     return
-            samples, stamps = self.inlet.pull_chunk(timeout=wait, max_samples=1024)
-            if not stamps:
+            want = 1024 if max_frames is None else min(1024, max_frames - delivered)
+            batch = self.read_batch(want, wait)
+            if not batch:
                 self.stats.timeouts += 1
                 continue
-            for sample, stamp in zip(samples, stamps, strict=True):
-                if self._first_stamp is None:
-                    self._first_stamp = stamp
-                self._index += 1
-                self.stats.frames += 1
-                counts = np.asarray(sample, dtype=np.float64).reshape(shape)
-                yield StreamFrame(
-                    self._index % 65536,
-                    self._index,
-                    stamp - self._first_stamp,
-                    time.time(),
-                    stamp + self._offset,
-                    np.rint(counts).astype(np.uint16),
-                )
-                delivered += 1
-                if max_frames is not None and delivered >= max_frames:
-                    return
+            yield from batch
+            delivered += len(batch)
 
     def start(self) -> None:
         """An outlet streams by itself: nothing to ask (for the interface of a device)."""
