@@ -92,7 +92,7 @@ def _trig_table(n):
     return np.cos(omega * index), np.sin(omega * index)
 
 
-@jit(nogil=True, fastmath=FASTMATH, error_model="numpy")
+@jit(nogil=True)
 def locate_frames(z, valid, periodic, first_row, tolerance, max_iterations, max_step):
     """Peak, Newton steps, convergence, summed deflection, skew and second maximum per frame.
 
@@ -109,15 +109,39 @@ def locate_frames(z, valid, periodic, first_row, tolerance, max_iterations, max_
         ``summed`` is the sum of the cylinder rows; ``second`` the largest separate
         local tactel maximum as a share of the largest.
     """
+    n_frames = z.shape[0]
+    row = np.empty(n_frames)
+    col = np.empty(n_frames)
+    value = np.empty(n_frames)
+    iterations = np.empty(n_frames, np.int64)
+    converged = np.empty(n_frames, np.bool_)
+    summed = np.empty(n_frames)
+    skew = np.empty(n_frames)
+    second = np.empty(n_frames)
+    locate_into(
+        z, valid, periodic, first_row, tolerance, max_iterations, max_step,
+        row, col, value, iterations, converged, summed, skew, second,
+    )  # fmt: skip
+    return row, col, value, iterations, converged, summed, skew, second
+
+
+@jit(nogil=True, fastmath=FASTMATH, error_model="numpy")
+def locate_into(
+    z, valid, periodic, first_row, tolerance, max_iterations, max_step,
+    row, col, value, iterations, converged, summed, skew, second,
+):  # fmt: skip
+    """:func:`locate_frames` writing into given arrays (N,) (e.g. slices of a recording's
+    outputs: no per-block result to join)."""
     n_frames, rows, cols = z.shape
-    row = np.full(n_frames, np.nan)
-    col = np.full(n_frames, np.nan)
-    value = np.full(n_frames, np.nan)
-    iterations = np.zeros(n_frames, np.int64)
-    converged = np.zeros(n_frames, np.bool_)
-    summed = np.full(n_frames, np.nan)
-    skew = np.full(n_frames, np.nan)
-    second = np.zeros(n_frames)
+    for f in range(n_frames):
+        row[f] = np.nan
+        col[f] = np.nan
+        value[f] = np.nan
+        iterations[f] = 0
+        converged[f] = False
+        summed[f] = np.nan
+        skew[f] = np.nan
+        second[f] = 0.0
     kx0 = np.empty(rows)
     kx1 = np.empty(rows)
     kx2 = np.empty(rows)
@@ -304,7 +328,6 @@ def locate_frames(z, valid, periodic, first_row, tolerance, max_iterations, max_
             if abs(odd) > abs(best_odd):
                 best_odd = odd
         skew[f] = best_odd / best_even if best_even > 0 else np.nan
-    return row, col, value, iterations, converged, summed, skew, second
 
 
 @jit(nogil=True)

@@ -10,7 +10,7 @@ import numpy as np
 
 from tactsense._signals import deferred_interrupts
 from tactsense._validation import TactsenseInputError, check_frames
-from tactsense.estimate._fast import locate_frames, prepare_frames
+from tactsense.estimate._fast import locate_into, prepare_frames
 from tactsense.estimate.deflection import Flag
 from tactsense.estimate.force import force_per_deflection
 from tactsense.estimate.localize import MAX_ITERATIONS, MAX_STEP, TOLERANCE
@@ -160,16 +160,21 @@ def locate(
             MAX_STEP,
         )
 
-        def block(lo: int, hi: int):
-            # eq. 4 and Newton on one cache-sized block: the deflection of BLOCK frames
-            # (4 MB) is made and used while it is hot, never for the whole recording
-            deflection, flags, peak = prepare_frames(source[lo:hi], *shared)
-            touched = peak >= threshold
-            return (flags, touched, *locate_frames(deflection, touched, *geometry))
+        n = source.shape[0]
+        flags = np.empty(n, np.int64)
+        touched = np.empty(n, np.bool_)
+        outputs = _kernel_outputs(n)
 
-        flags, touched, row, col, value, iterations, converged, summed, skew, second = _run_blocks(
-            block, source.shape[0], workers
-        )
+        def block(lo: int, hi: int) -> None:
+            # eq. 4 and Newton on one cache-sized block: the deflection of BLOCK frames
+            # is made and used while it is hot, never for the whole recording; the
+            # results go straight into the recording's outputs
+            deflection, flags[lo:hi], peak = prepare_frames(source[lo:hi], *shared)
+            touched[lo:hi] = peak >= threshold
+            locate_into(deflection, touched[lo:hi], *geometry, *(a[lo:hi] for a in outputs))
+
+        _for_blocks(block, n, workers)
+        row, col, value, iterations, converged, summed, skew, second = outputs
         periodic = sensor.closes_circumference
         rows, cols = sensor.shape
         flags[~touched] |= int(Flag.NO_CONTACT)
@@ -193,11 +198,15 @@ def locate(
         touched = flat.reshape(flat.shape[0], -1).max(axis=1) >= threshold
         flags[~touched] |= int(Flag.NO_CONTACT)
         geometry = (periodic, 1 if sensor.array.tip_row else 0, TOLERANCE, MAX_ITERATIONS, MAX_STEP)
-        row, col, value, iterations, converged, summed, skew, second = _run_blocks(
-            lambda lo, hi: locate_frames(flat[lo:hi], touched[lo:hi], *geometry),
+        outputs = _kernel_outputs(flat.shape[0])
+        _for_blocks(
+            lambda lo, hi: locate_into(
+                flat[lo:hi], touched[lo:hi], *geometry, *(a[lo:hi] for a in outputs)
+            ),
             flat.shape[0],
             workers,
         )
+        row, col, value, iterations, converged, summed, skew, second = outputs
     force = force_per_deflection(sensor) * summed
     # a clipped reading understates its tactel's deflection, so the sum is only a lower
     # bound: no number rather than a wrong one (the position is kept, flagged)
@@ -233,9 +242,20 @@ BLOCK = 4096
 stays in cache between the two passes."""
 
 
-def _run_blocks(work, n: int, workers: int):
-    """``work(lo, hi)`` over consecutive blocks of ``n`` frames, on ``workers`` threads;
-    the per-frame outputs of the blocks joined in order.
+def _kernel_outputs(n: int) -> tuple[np.ndarray, ...]:
+    """The per-frame arrays :func:`locate_into` fills: row, col, value, iterations,
+    converged, summed, skew, second."""
+    return (
+        *(np.empty(n) for _ in range(3)),
+        np.empty(n, np.int64),
+        np.empty(n, np.bool_),
+        *(np.empty(n) for _ in range(3)),
+    )
+
+
+def _for_blocks(work, n: int, workers: int) -> None:
+    """``work(lo, hi)`` over consecutive blocks of ``n`` frames, on ``workers`` threads
+    (each block writes its own slice of the outputs).
 
     A Ctrl-C is held back meanwhile and raised once the blocks are done
     (:mod:`tactsense._signals`: a Ctrl-C inside compiled code can crash the interpreter).
@@ -243,15 +263,13 @@ def _run_blocks(work, n: int, workers: int):
     spans = [(lo, min(lo + BLOCK, n)) for lo in range(0, n, BLOCK)] or [(0, 0)]
     with deferred_interrupts():
         if workers == 1 or len(spans) == 1:
-            parts = [work(lo, hi) for lo, hi in spans]
+            for lo, hi in spans:
+                work(lo, hi)
         else:
             from concurrent.futures import ThreadPoolExecutor
 
             with ThreadPoolExecutor(max_workers=workers) as pool:
-                parts = list(pool.map(lambda span: work(*span), spans))
-    if len(parts) == 1:
-        return parts[0]
-    return tuple(np.concatenate([part[i] for part in parts]) for i in range(len(parts[0])))
+                list(pool.map(lambda span: work(*span), spans))
 
 
 def write_estimates_csv(
