@@ -80,15 +80,18 @@ def test_export_frames_and_contacts_field_by_field(tmp_path, sweep):
         assert (msg.wrench.torque.x, msg.wrench.torque.y, msg.wrench.torque.z) == (0, 0, 0)
 
 
-def test_record_writes_mcap_as_frames_arrive(tmp_path, sweep):
+@pytest.mark.parametrize("name, options", [("live.mcap", []), ("live.bag", ["--format", "mcap"])])
+def test_record_writes_mcap_as_frames_arrive(tmp_path, sweep, name, options):
     _, rec = sweep
     emulator = Emulator.from_recording(rec, speed=0)
     _, port = emulator.start_tcp()
-    out = tmp_path / "live.mcap"
+    out = tmp_path / name  # by the extension, or any name with --format
     try:
         result = runner.invoke(
-            app, ["record", f"socket://127.0.0.1:{port}", "--frames", "60", "--out", str(out)]
-        )
+            app,
+            ["record", f"socket://127.0.0.1:{port}", "--frames", "60", *options,
+             "--out", str(out)],
+        )  # fmt: skip
     finally:
         emulator.stop()
     assert result.exit_code == 0, result.output

@@ -103,6 +103,7 @@ BAD_OPTIONS = [
     ("sensor export", "say which format: --urdf"),
     ("sensor export --urdf --sensor bogus", "presets: initial, improved"),
     ("record lsl: --out OUT.h5", "lsl: needs an outlet name"),
+    ("record loop:// --format xml --out OUT", "--format"),
     ("live lsl:", "lsl: needs an outlet name"),
 ]
 

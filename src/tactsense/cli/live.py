@@ -82,6 +82,11 @@ DurationLimit = Annotated[
 LSL_PREFIX = "lsl:"
 
 
+class RecordFormat(StrEnum):
+    h5 = "h5"
+    mcap = "mcap"
+
+
 def _open_reader(source: str, sensor: str | None, timeout: float | None, *, start: bool = True):
     from tactsense.stream import StreamReader
 
@@ -222,10 +227,18 @@ def record(
         typer.Option(
             "--out",
             "-o",
-            help="New recording: HDF5 (crash-safe), or MCAP when the name ends in .mcap "
-            "(TactileState messages for ROS 2 and Foxglove).",
+            help="New recording: HDF5 (crash-safe), or MCAP (see --format).",
         ),
     ] = Path("recording.h5"),
+    record_format: Annotated[
+        RecordFormat | None,
+        typer.Option(
+            "--format",
+            help="h5: HDF5, crash-safe, losses stored; mcap: tactile_msgs/TactileState "
+            "messages for ROS 2 and Foxglove (docs/interop.md). Default: mcap if OUT ends "
+            "in .mcap, else h5.",
+        ),
+    ] = None,
     frames: FramesLimit = None,
     duration: DurationLimit = None,
     sensor: StreamSensorOption = None,
@@ -233,16 +246,19 @@ def record(
     quiet: Annotated[bool, typer.Option("--quiet", help="No live status line.")] = False,
     force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
 ) -> None:
-    """Record a device's frames to HDF5 as they arrive, until --frames, --duration or Ctrl-C.
+    """Record a device's frames as they arrive, until --frames, --duration or Ctrl-C.
 
-    The file is flushed at least once a second: if the recorder is killed, every frame
-    up to the last flush is readable. Losses (bad check, gaps, timeouts...) are counted
+    HDF5 is flushed at least once a second: if the recorder is killed, every frame up
+    to the last flush is readable. Losses (bad check, gaps, timeouts...) are counted
     and stored with the frames.
     """
     from tactsense.stream import StreamError
     from tactsense.stream import record as run_record
 
-    mcap = out.suffix.lower() == ".mcap"
+    if record_format is None:
+        mcap = out.suffix.lower() == ".mcap"
+    else:
+        mcap = record_format is RecordFormat.mcap
     if mcap:
         from tactsense.interop.mcap import _writer_class
         from tactsense.interop.mcap import record_mcap as run_record
