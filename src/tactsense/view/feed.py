@@ -299,6 +299,7 @@ class RecordingFeed(Feed):
         self._times: np.ndarray | None = None
         self._wake = threading.Event()
         self._jumped = False
+        self._pending_show = True  # show the frame at the position now (start, seek, step)
         times = self.file.time_s(0, min(self.n_frames, 2))
         self.period_s = float(np.diff(times)[0]) if len(times) > 1 else sensor.scan_period_s
         if not self.period_s > 0:
@@ -372,8 +373,6 @@ class RecordingFeed(Feed):
         # every page shows the new state at once, even while paused
         self._publish(json.dumps({"type": "playback", **playback}))
         self._wake.set()
-
-    _pending_show = True
 
     def _run(self) -> None:
         self._set_status("playing")
