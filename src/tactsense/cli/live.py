@@ -101,6 +101,30 @@ def _open_reader(source: str, sensor: str | None, timeout: float | None, *, star
     return StreamReader(source, sensor=spec, timeout_s=timeout, start=start)
 
 
+def _stream_and_locator(
+    source, sensor, timeout, calibration, baseline_frames, threshold, *, keep_deflection=False
+):
+    """The device, opened but not started, and a compiled :class:`LiveLocator` for it.
+
+    The calibration was checked before the line was opened; whether it belongs to the
+    device's sensor can only be checked once the device has said which.
+    """
+    from tactsense.stream import LiveLocator
+
+    reader = _open_reader(source, sensor, timeout, start=False)
+    if calibration is not None:
+        calibration.check_sensor(reader.sensor)
+    locator = LiveLocator(
+        reader.sensor,
+        calibration=calibration,
+        baseline_frames=baseline_frames,
+        threshold=threshold,
+        frame_period_s=reader.frame_period_s or None,
+        keep_deflection=keep_deflection,
+    )
+    return reader, locator
+
+
 @app.command()
 def emulate(
     sensor: SensorOption = "initial",
@@ -340,24 +364,15 @@ def live(
     the end of the stream or Ctrl-C.
     """
     from tactsense.estimate import Calibration
-    from tactsense.stream import LiveLocator, StreamError
+    from tactsense.stream import StreamError
     from tactsense.stream.live import FIELDS
 
     if out is not None:
         check_output(out, force)
     try:
-        # the calibration file is checked before the line is opened; whether it belongs
-        # to the device's sensor can only be checked once the device has said which
         cal = None if calibration is None else Calibration.load(calibration)
-        reader = _open_reader(source, sensor, timeout, start=False)
-        if cal is not None:
-            cal.check_sensor(reader.sensor)
-        locator = LiveLocator(
-            reader.sensor,
-            calibration=cal,
-            baseline_frames=baseline_frames,
-            threshold=threshold,
-            frame_period_s=reader.frame_period_s or None,
+        reader, locator = _stream_and_locator(
+            source, sensor, timeout, cal, baseline_frames, threshold
         )
         outlets = None
         if lsl:
@@ -511,16 +526,8 @@ def view(
 
             feed = RecordingFeed(path, locator_for, speed=speed)
         else:
-            reader = _open_reader(source, sensor, timeout, start=False)
-            if cal is not None:
-                cal.check_sensor(reader.sensor)
-            locator = LiveLocator(
-                reader.sensor,
-                calibration=cal,
-                baseline_frames=baseline_frames,
-                threshold=threshold,
-                frame_period_s=reader.frame_period_s or None,
-                keep_deflection=True,
+            reader, locator = _stream_and_locator(
+                source, sensor, timeout, cal, baseline_frames, threshold, keep_deflection=True
             )
             feed = LiveFeed(reader, locator)
     except TactsenseInputError as error:
