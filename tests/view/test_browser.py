@@ -143,10 +143,22 @@ def test_hottest_cell_is_the_tactel_the_scenario_touches(page, initial, row, col
         # x2): the page says so rather than pass it off as the load
         assert page.text_content("#calibration").startswith("uncalibrated")
         assert 20.0 < float(page.text_content("#force-g")) < 120.0
-        # the counts toggle: the tactel trace says what it shows
+        # click the touched tactel: the lower trace follows it, and its line rises to the
+        # tactel's deflection (read from the trace's own data, as uPlot draws it)
+        box = page.locator("#map").bounding_box()
+        x, y = page.evaluate(f"() => window.tactsenseView.cellCentre({row}, {col})")
+        page.mouse.click(box["x"] + x, box["y"] + y)
+        page.wait_for_timeout(400)
+        assert page.text_content("#tactel-trace .u-title") == f"tactel ({row}, {col}) [deflection]"
+        assert page.evaluate("() => window.tactsenseView.selected") == [row, col]
+        trace = page.evaluate("() => window.tactsenseView.traces.tactel.filter(v => v !== null)")
+        assert max(trace) > 0.02 and min(trace) < 0.005  # untouched at first, then loaded
+        # the counts toggle: the tactel trace says what it shows, in counts
         page.check('input[value="counts"]')
         page.wait_for_timeout(300)
-        assert "[counts]" in page.text_content("#tactel-trace .u-title")
+        assert page.text_content("#tactel-trace .u-title") == f"tactel ({row}, {col}) [counts]"
+        counts = page.evaluate("() => window.tactsenseView.traces.tactel")
+        assert min(counts) > 1000  # raw readings (about 2000), not fractions
     finally:
         _stop(server, emulator)
 
