@@ -106,6 +106,10 @@ SEEN_JS = """() => {
 }"""
 
 TOUCHING_JS = "() => window.tactsenseView.touching === true"
+# the marker as drawn and the readout beside it, read in one go (one frame's)
+SNAPSHOT_JS = (
+    "() => [window.tactsenseView.marker, Number(document.getElementById('axial').textContent)]"
+)
 
 
 def _seen(page) -> np.ndarray:
@@ -117,13 +121,25 @@ def _hottest(page) -> tuple[int, int]:
     return tuple(int(v) for v in np.unravel_index(np.argmax(seen), seen.shape))
 
 
+def _click_tactel(page, row: int, col: int) -> None:
+    """Click the dot of tactel (row, col) on the map, as a person would."""
+    box = page.locator("#map").bounding_box()
+    x, y = page.evaluate(f"() => window.tactsenseView.cellCentre({row}, {col})")
+    page.mouse.click(box["x"] + x, box["y"] + y)
+
+
 def _frame_after(page, frames: int, timeout_s: float = 10.0) -> None:
+    """Wait for ``frames`` more frames, and until the map shows the latest one received
+    (drawing happens on animation frames, which a loaded machine delays)."""
     start = page.evaluate("() => window.tactsenseView.framesReceived")
     page.wait_for_function(
         f"() => window.tactsenseView.framesReceived >= {start + frames}",
         timeout=1000 * timeout_s,
     )
-    page.wait_for_timeout(100)  # one animation frame to draw it
+    page.wait_for_function(
+        "() => window.tactsenseView.drawnIndex === window.tactsenseView.lastIndex",
+        timeout=1000 * timeout_s,
+    )
 
 
 @pytest.mark.parametrize("row, col", [(3, 5), (6, 1)])
@@ -143,20 +159,27 @@ def test_hottest_cell_is_the_tactel_the_scenario_touches(page, initial, row, col
         # x2): the page says so rather than pass it off as the load
         assert page.text_content("#calibration").startswith("uncalibrated")
         assert 20.0 < float(page.text_content("#force-g")) < 120.0
-        # click the touched tactel: the lower trace follows it, and its line rises to the
-        # tactel's deflection (read from the trace's own data, as uPlot draws it)
-        box = page.locator("#map").bounding_box()
-        x, y = page.evaluate(f"() => window.tactsenseView.cellCentre({row}, {col})")
-        page.mouse.click(box["x"] + x, box["y"] + y)
-        page.wait_for_timeout(400)
-        assert page.text_content("#tactel-trace .u-title") == f"tactel ({row}, {col}) [deflection]"
-        assert page.evaluate("() => window.tactsenseView.selected") == [row, col]
-        trace = page.evaluate("() => window.tactsenseView.traces.tactel.filter(v => v !== null)")
-        assert max(trace) > 0.02 and min(trace) < 0.005  # untouched at first, then loaded
+        # click the touched tactel: the lower trace follows it (its title, and its values
+        # read from the trace's own data, as uPlot draws it)
+        _click_tactel(page, row, col)
+        title = f"tactel ({row}, {col}) [deflection]"
+        page.wait_for_function(
+            f"() => document.querySelector('#tactel-trace .u-title').textContent === '{title}'",
+            timeout=5000,
+        )
+        assert page.evaluate("() => window.tactsenseView.traces.tactel.at(-1)") > 0.02
+        far = (col + 4) % 8  # half a turn away: followed, and not loaded
+        _click_tactel(page, row, far)
+        page.wait_for_function(f"() => window.tactsenseView.selected[1] === {far}")
+        assert abs(page.evaluate("() => window.tactsenseView.traces.tactel.at(-1)")) < 0.005
+        _click_tactel(page, row, col)
         # the counts toggle: the tactel trace says what it shows, in counts
         page.check('input[value="counts"]')
-        page.wait_for_timeout(300)
-        assert page.text_content("#tactel-trace .u-title") == f"tactel ({row}, {col}) [counts]"
+        title = f"tactel ({row}, {col}) [counts]"
+        page.wait_for_function(
+            f"() => document.querySelector('#tactel-trace .u-title').textContent === '{title}'",
+            timeout=5000,
+        )
         counts = page.evaluate("() => window.tactsenseView.traces.tactel")
         assert min(counts) > 1000  # raw readings (about 2000), not fractions
     finally:
@@ -171,13 +194,11 @@ def test_marker_moves_when_the_contact_moves(page, initial):
         page.goto(server.url)
         page.wait_for_function(TOUCHING_JS, timeout=15000)
         _frame_after(page, 2)
-        first = page.evaluate("() => window.tactsenseView.marker")
-        axial_first = float(page.text_content("#axial"))
+        first, axial_first = page.evaluate(SNAPSHOT_JS)
         page.wait_for_timeout(2500)  # about 10 mm further at 4x the paper's rate
         page.wait_for_function(TOUCHING_JS, timeout=5000)
         _frame_after(page, 1)
-        second = page.evaluate("() => window.tactsenseView.marker")
-        axial_second = float(page.text_content("#axial"))
+        second, axial_second = page.evaluate(SNAPSHOT_JS)
         assert axial_second > axial_first + 3.0
         assert second["x"] > first["x"] + 40  # along the finger is across the map
         assert abs(second["y"] - first["y"]) < 12  # at the angle of column 2 all along
@@ -269,7 +290,7 @@ def test_seek_and_step_on_a_recording(page, sweep_file):
             f"'frame {target + 1} of {len(rec)}')",
             timeout=5000,
         )
-        page.wait_for_timeout(150)
+        page.wait_for_function(f"() => window.tactsenseView.drawnIndex === {target}", timeout=5000)
         baseline = baseline_from(rec.frames)
         deflection, _ = deflection_from_counts(rec.frames[target], baseline, rec.sensor)
         expected = np.unravel_index(np.argmax(deflection), deflection.shape)

@@ -27,6 +27,7 @@ const state = {
   lastSerial: null,
   firstSerial: null,     // the first frame this page received (server's numbering)
   marker: null,           // canvas pixels of the marker, for tests and people alike
+  drawnIndex: null,       // index of the frame the map shows
   dirty: false,
   traces: { t: [], force: [], tactel: [] },
 };
@@ -206,6 +207,7 @@ function draw() {
   drawSeam();
   drawColourBar(lo, hi, unit);
   if (state.showMarker) drawContact();
+  state.drawnIndex = frame.index;   // what the map shows now (tests wait for it)
 }
 
 function drawAxes() {
@@ -399,6 +401,7 @@ function onLayout(L) {
   canvas.height = MARGIN.top + mapHeight() + MARGIN.bottom;
   state.selected = [L.first_row + Math.floor(cylinderRows() / 2), 0];
   state.history = []; state.traces = { t: [], force: [], tactel: [] }; state.trail = [];
+  state.lastIndex = null; state.lastSerial = null;   // a (re)connection starts afresh
   if (!forcePlot) makePlots();
   onStatus(L.status);
   for (const f of L.history || []) onFrame(f, true);
