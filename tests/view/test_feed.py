@@ -119,30 +119,40 @@ def _recording_locator(spec, file):
     return LiveLocator(spec, baseline=baseline_from(file.frames(0, 5)), keep_deflection=True)
 
 
+def _until(condition, timeout_s: float = 10.0) -> None:
+    """Wait until ``condition()`` holds (the feed runs in its own thread)."""
+    deadline = time.monotonic() + timeout_s
+    while not condition():
+        assert time.monotonic() < deadline, "timed out"
+        time.sleep(0.01)
+
+
 def test_recording_feed_plays_seeks_and_steps(axial_recording):
     path, rec = axial_recording
     feed = RecordingFeed(path, _recording_locator, speed=50.0)
     messages = []
     feed.start(lambda text: messages.append(json.loads(text)))
+
+    def frames():
+        return [m for m in messages if m["type"] == "frame"]
+
     try:
-        time.sleep(0.6)
-        frames = [m for m in messages if m["type"] == "frame"]
-        assert len(frames) > 10
-        assert [m["index"] for m in frames] == list(range(len(frames)))  # in order, none skipped
+        _until(lambda: len(frames()) > 10)
+        assert [m["index"] for m in frames()] == list(range(len(frames())))  # none skipped
         feed.command({"command": "pause"})
-        time.sleep(0.2)
+        _until(lambda: feed.status == "paused")
         feed.command({"command": "seek", "value": 150})
-        time.sleep(0.3)
-        last = [m for m in messages if m["type"] == "frame"][-1]
-        assert last["index"] == 150 and last["playback"]["playing"] is False
+        _until(lambda: frames()[-1]["index"] == 150)
+        last = frames()[-1]
+        assert last["playback"]["playing"] is False
         np.testing.assert_array_equal(last["counts"], rec.frames[150])
         assert last["time_s"] == pytest.approx(rec.time_s[150])
+        time.sleep(0.3)
+        assert frames()[-1]["index"] == 150  # paused: it stays
         feed.command({"command": "step", "value": -1})
-        time.sleep(0.3)
-        assert [m for m in messages if m["type"] == "frame"][-1]["index"] == 149
+        _until(lambda: frames()[-1]["index"] == 149)
         feed.command({"command": "seek", "value": 10**9})  # clamped to the last frame
-        time.sleep(0.3)
-        assert [m for m in messages if m["type"] == "frame"][-1]["index"] == len(rec) - 1
+        _until(lambda: frames()[-1]["index"] == len(rec) - 1)
         before = len(messages)
         feed.command({"command": "no such thing"})
         feed.command({"command": "seek", "value": "x"})
