@@ -21,12 +21,14 @@ import json
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
 
 import tactsense as ts
+
+# run as a script (python benchmarks/bench_batch.py): its folder is on the path
+from bench_counts import frames_per_second
 
 CHILD = r"""
 import json, sys, time
@@ -123,13 +125,8 @@ def main() -> None:
         frames, baseline = rec.frames, ts.baseline_from(rec.frames, 5)
         print("\nFrom uint16 counts in memory (ts.locate):\n")
         for workers in (1, 2):
-            ts.locate(frames[:20_000], spec, baseline=baseline, workers=workers)
-            best = np.inf
-            for _ in range(3):
-                start = time.perf_counter()
-                ts.locate(frames, spec, baseline=baseline, workers=workers)
-                best = min(best, time.perf_counter() - start)
-            print(f"- workers={workers}: {n / best:,.0f} frames/s (best of 3)")
+            rate = frames_per_second(frames, spec, baseline, workers, calls=3)
+            print(f"- workers={workers}: {rate:,.0f} frames/s (best of 3)")
 
 
 if __name__ == "__main__":

@@ -11,6 +11,7 @@ from tactsense._validation import TactsenseInputError
 from tactsense.batch import EstimatesWriter, iter_locate, locate_file
 from tactsense.estimate import calibrate as cal
 from tactsense.io.recording import RecordingReader
+from tests._calibrations import creep_calibration
 
 FIELDS = ["row", "col", "axial_mm", "angle_deg", "peak_deflection", "force_n", "skew"]
 
@@ -40,16 +41,7 @@ def test_creep_compensation_carries_across_pieces(recording, tmp_path):
     """The causal creep filter has memory: pieces must continue it, not restart it."""
     path, rec = recording
     spec = rec.sensor
-    calibration = cal.Calibration(
-        sensor_toml=spec.to_toml_string(),
-        gains=np.ones(spec.shape),
-        baseline=ts.baseline_from(rec.frames, 5),
-        dead=np.zeros(spec.shape, bool),
-        weak=np.zeros(spec.shape, bool),
-        noisy=np.zeros(spec.shape, bool),
-        threshold_g=np.ones(spec.shape),
-        viscoelastic=cal.Viscoelastic(0.5, 0.05, 0.3, 10.0),
-    )
+    calibration = creep_calibration(spec, ts.baseline_from(rec.frames, 5))
     whole = ts.locate(rec.frames, spec, calibration=calibration, frame_period_s=spec.scan_period_s)
     with RecordingReader(path) as reader:
         pieces = list(iter_locate(reader, calibration=calibration, chunk_frames=50))

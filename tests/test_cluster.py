@@ -15,6 +15,7 @@ from typer.testing import CliRunner
 import tactsense as ts
 from tactsense.batch import locate_file
 from tactsense.cli import app
+from tests._calibrations import creep_calibration
 
 runner = CliRunner()
 
@@ -183,22 +184,12 @@ def test_split_with_a_creep_calibration_equals_one_process(tmp_path):
     each range's end memories, A^L carries them on): the estimates equal one process's to
     rounding (the memories are summed in another order: tolerance 1e-9 relative), and
     restarting the memories at each range would differ (the test can fail)."""
-    from tactsense.estimate import calibrate as cal
 
     spec = ts.fearing1990_initial()
     rec = ts.simulate(spec, ts.repeated_load(spec, row=4, col=3, repeats=260), rng=3)
     path = tmp_path / "steps.h5"
     ts.write_recording(path, rec)
-    calibration = cal.Calibration(
-        sensor_toml=spec.to_toml_string(),
-        gains=np.ones(spec.shape),
-        baseline=ts.baseline_from(rec.frames, 5),
-        dead=np.zeros(spec.shape, bool),
-        weak=np.zeros(spec.shape, bool),
-        noisy=np.zeros(spec.shape, bool),
-        threshold_g=np.ones(spec.shape),
-        viscoelastic=cal.Viscoelastic(0.5, 0.05, 0.3, 10.0),
-    )
+    calibration = creep_calibration(spec, ts.baseline_from(rec.frames, 5))
     cal_path = calibration.save(tmp_path / "cal.json")
     alone = tmp_path / "alone.parquet"
     locate_file(path, alone, calibration=calibration)

@@ -30,6 +30,13 @@ SensorOption = Annotated[
 ]
 
 
+CalibrationOption = Annotated[
+    Path | None,
+    typer.Option(
+        help="Calibration JSON from 'tactsense calibrate': its baseline, gains, excluded "
+        "tactels and creep compensation apply from the first frame."
+    ),
+]
 BaselineFramesOption = Annotated[
     int,
     typer.Option(

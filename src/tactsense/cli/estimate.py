@@ -14,6 +14,7 @@ from rich.table import Table
 from tactsense._validation import TactsenseInputError
 from tactsense.cli._common import (
     BaselineFramesOption,
+    CalibrationOption,
     ThresholdOption,
     atomic_output,
     check_output,
@@ -41,13 +42,7 @@ def locate(
     ] = Path("estimates.csv"),
     baseline_frames: BaselineFramesOption = 5,
     threshold: ThresholdOption = 0.005,
-    calibration: Annotated[
-        Path | None,
-        typer.Option(
-            help="Calibration JSON from 'tactsense calibrate': its baseline, gains, "
-            "excluded tactels and creep model are applied."
-        ),
-    ] = None,
+    calibration: CalibrationOption = None,
     chunk_frames: Annotated[
         int | None,
         typer.Option(

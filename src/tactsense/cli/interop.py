@@ -11,6 +11,7 @@ import typer
 from tactsense._validation import TactsenseInputError
 from tactsense.cli._common import (
     BaselineFramesOption,
+    CalibrationOption,
     ThresholdOption,
     atomic_output,
     check_output,
@@ -49,10 +50,7 @@ def export(
             "Default: from the extension of OUT.",
         ),
     ] = None,
-    calibration: Annotated[
-        Path | None,
-        typer.Option(help="Calibration JSON applied to the contacts (as for 'locate')."),
-    ] = None,
+    calibration: CalibrationOption = None,
     baseline_frames: BaselineFramesOption = 5,
     threshold: ThresholdOption = 0.005,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,

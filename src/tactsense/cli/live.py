@@ -16,6 +16,7 @@ from rich.progress import Progress, TextColumn
 from tactsense._validation import TactsenseInputError
 from tactsense.cli._common import (
     BaselineFramesOption,
+    CalibrationOption,
     SensorOption,
     ThresholdOption,
     atomic_output,
@@ -329,13 +330,7 @@ class LiveFormat(StrEnum):
 @app.command()
 def live(
     source: SourceArgument,
-    calibration: Annotated[
-        Path | None,
-        typer.Option(
-            help="Calibration JSON from 'tactsense calibrate': baseline, gains, excluded "
-            "tactels and creep compensation apply from the first frame."
-        ),
-    ] = None,
+    calibration: CalibrationOption = None,
     output_format: Annotated[
         LiveFormat, typer.Option("--format", help="One JSON object per line, or CSV.")
     ] = LiveFormat.jsonl,
@@ -462,10 +457,7 @@ def view(
     open_browser: Annotated[
         bool, typer.Option("--open", help="Open the page in the default web browser.")
     ] = False,
-    calibration: Annotated[
-        Path | None,
-        typer.Option(help="Calibration JSON from 'tactsense calibrate' (as for 'live')."),
-    ] = None,
+    calibration: CalibrationOption = None,
     baseline_frames: BaselineFramesOption = 5,
     threshold: ThresholdOption = 0.005,
     speed: Annotated[
