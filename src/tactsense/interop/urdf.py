@@ -100,8 +100,10 @@ def read_tactile_arrays(path: str | Path) -> list[TactileArray]:
         name = sensor.get("name") or f"sensor {len(arrays)}"
         source = f"{path}: sensor {name!r}"
         order = array.get("order", "row-major")
-        if order not in ("row-major", "column-major"):
-            raise UrdfError(f"{source}: order={order!r}; expected row-major or column-major")
+        if order == "column-major":  # written by tactsense before 0.2; upstream: col-major
+            order = "col-major"
+        if order not in ("row-major", "col-major"):
+            raise UrdfError(f"{source}: order={order!r}; expected row-major or col-major")
         size = _pair(array, "size", None, source)
         if size is None:
             raise UrdfError(f"{source}: the array has no size (x y) [m]")
@@ -237,5 +239,260 @@ def sensor_to_urdf(spec: SensorSpec, *, link: str = "finger", robot: str | None 
         spacing=f"{m(spec.array.spacing_axial_mm)} {m(arc_mm)}",
         offset="0 0",
     )
+    ET.indent(root)
+    return '<?xml version="1.0" encoding="utf-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+
+
+# ---- pads and point sets ---------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class TactileTaxels:
+    """One ``<sensor>`` with a ``<tactile>`` list of ``<taxel idx xyz rpy>`` elements [m]."""
+
+    name: str
+    idx: tuple[int, ...]
+    xyz_m: tuple[tuple[float, float, float], ...]
+    rpy: tuple[tuple[float, float, float], ...]
+    area_m2: tuple[float | None, ...]
+    update_rate_hz: float | None
+
+
+def _triple(element, attribute: str, source: str) -> tuple[float, float, float]:
+    text = element.get(attribute, "0 0 0")
+    try:
+        values = tuple(float(v) for v in text.split())
+    except ValueError:
+        values = ()
+    if len(values) != 3 or not all(math.isfinite(v) for v in values):
+        raise UrdfError(f"{source}: {attribute}={text!r} must be three numbers")
+    return values
+
+
+def _local(element) -> str:
+    return element.tag.rsplit("}", 1)[-1]
+
+
+def _taxel_area(taxel, source: str) -> float | None:
+    """Area of a taxel's ``<geometry>`` seen along its normal (box x*y, cylinder pi r^2) [m^2]."""
+    geometry = next((c for c in taxel if _local(c) == "geometry"), None)
+    if geometry is None:
+        raise UrdfError(f"{source}: a <taxel> has no <geometry> (the toolbox's parser needs one)")
+    shape = next(iter(geometry), None)
+    if shape is None:
+        return None
+    kind = _local(shape)
+    try:
+        if kind == "box":
+            x, y, _ = (float(v) for v in shape.get("size", "").split())
+            return abs(x * y) or None
+        if kind == "cylinder":
+            return math.pi * float(shape.get("radius")) ** 2 or None
+    except (TypeError, ValueError):
+        raise UrdfError(f"{source}: a taxel's <{kind}> has no usable size") from None
+    return None  # a mesh or a sphere: no area to read
+
+
+def read_tactile_taxels(path: str | Path) -> list[TactileTaxels]:
+    """Every tactile sensor of a URDF file given as a ``<taxel>`` list."""
+    path = Path(path)
+    try:
+        root = ET.parse(path).getroot()
+    except ET.ParseError as error:
+        raise UrdfError(f"{path}: not XML ({error})") from None
+    except OSError as error:
+        raise UrdfError(f"cannot read {path}: {error.strerror or error}") from None
+    found = []
+    for sensor in root.iter():
+        if _local(sensor) != "sensor":
+            continue
+        tactile = next((c for c in sensor if _local(c) == "tactile"), None)
+        if tactile is None:
+            continue
+        taxels = [c for c in tactile if _local(c) == "taxel"]
+        if not taxels:
+            continue
+        name = sensor.get("name") or f"sensor {len(found)}"
+        source = f"{path}: sensor {name!r}"
+        idx, xyz, rpy, area = [], [], [], []
+        for taxel in taxels:
+            try:
+                idx.append(int(taxel.get("idx")))
+            except (TypeError, ValueError):
+                raise UrdfError(f"{source}: a <taxel> has no whole-number idx") from None
+            xyz.append(_triple(taxel, "xyz", source))
+            rpy.append(_triple(taxel, "rpy", source))
+            area.append(_taxel_area(taxel, source))
+        rate = sensor.get("update_rate")
+        try:
+            rate_hz = None if rate is None else float(rate)
+        except ValueError:
+            raise UrdfError(f"{source}: update_rate={rate!r} is not a number [Hz]") from None
+        found.append(TactileTaxels(name, tuple(idx), tuple(xyz), tuple(rpy), tuple(area), rate_hz))
+    return found
+
+
+def _rpy_to_matrix(roll: float, pitch: float, yaw: float):
+    """URDF's fixed-axis roll-pitch-yaw: R = Rz(yaw) Ry(pitch) Rx(roll)."""
+    import numpy as np
+
+    cr, sr, cp, sp, cy, sy = (
+        math.cos(roll), math.sin(roll), math.cos(pitch),
+        math.sin(pitch), math.cos(yaw), math.sin(yaw),
+    )  # fmt: skip
+    return np.array(
+        [
+            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr],
+        ]
+    )
+
+
+def _normal_to_rpy(normal) -> tuple[float, float, float]:
+    """A roll-pitch-yaw whose rotation takes +z to ``normal`` (roll 0)."""
+    nx, ny, nz = normal
+    pitch = math.atan2(math.hypot(nx, ny), nz)
+    yaw = math.atan2(ny, nx) if math.hypot(nx, ny) > 1e-12 else 0.0
+    return 0.0, pitch, yaw
+
+
+def sensor_from_urdf_any(path: str | Path, *, name: str | None = None, extends: str | None = None):
+    """A sensor of any kind from a URDF tactile sensor.
+
+    An ``<array>`` becomes a finger (``extends`` a finger preset, the default ``initial``)
+    or a pad (``extends`` a pad preset); a ``<taxel>`` list becomes a point set
+    (``extends`` a point-set preset, default ``dome12``) with each taxel at its ``xyz``
+    and its normal the ``rpy`` rotation of +z, as upstream's ``TaxelInfoIterator`` reads
+    them; the taxel area comes from a ``<box>`` (x * y) or ``<cylinder>`` geometry, else
+    from the preset.
+    """
+    from tactsense.sensor import PadSpec, PointsSpec, preset, sensor_from_dict
+
+    lists = read_tactile_taxels(path)
+    arrays = read_tactile_arrays(path)
+    names = [t.name for t in lists] + [a.name for a in arrays]
+    if not names:
+        raise UrdfError(f"{path}: no <sensor> with a <tactile> <array> or <taxel> list")
+    if name is None and len(names) > 1:
+        listed = ", ".join(repr(n) for n in names)
+        raise UrdfError(f"{path} describes {len(names)} tactile sensors ({listed}); pick one")
+    wanted = name if name is not None else names[0]
+    if wanted not in names:
+        listed = ", ".join(repr(n) for n in names)
+        raise UrdfError(f"{path}: no tactile sensor named {wanted!r}; it has {listed}")
+    taxels = next((t for t in lists if t.name == wanted), None)
+    if taxels is None:
+        base = preset(extends or "initial")
+        if base.kind == "finger":
+            return sensor_from_urdf(path, name=wanted, extends=extends or "initial")
+        if not isinstance(base, PadSpec):
+            raise UrdfError(f"{path}: sensor {wanted!r} is an <array>; extend a finger or a pad")
+        array = next(a for a in arrays if a.name == wanted)
+        data = base.to_dict()
+        data["name"] = array.name
+        data["description"] = (
+            f"imported from {Path(path).name} (URDF tactile array), on {base.name}"
+        )
+        data["grid"].update(
+            rows=array.rows,
+            cols=array.cols,
+            row_pitch_mm=abs(array.spacing_m[0]) * 1e3,
+            col_pitch_mm=abs(array.spacing_m[1]) * 1e3,
+            electrode_x_mm=abs(array.size_m[0]) * 1e3,
+            electrode_y_mm=abs(array.size_m[1]) * 1e3,
+        )
+        if array.update_rate_hz is not None:
+            data["electronics"]["scan_rate_hz"] = array.update_rate_hz
+        try:
+            return sensor_from_dict(data, source=str(path))
+        except TactsenseInputError as error:
+            raise UrdfError(f"{path}: the array does not fit {base.name!r}: {error}") from None
+    base = preset(extends or "dome12")
+    if not isinstance(base, PointsSpec):
+        raise UrdfError(
+            f"{path}: sensor {wanted!r} is a <taxel> list, a point set; --extends must name a "
+            "point-set preset (dome12)"
+        )
+    order = sorted(range(len(taxels.idx)), key=lambda k: taxels.idx[k])
+    if sorted(taxels.idx) != list(range(len(taxels.idx))):
+        raise UrdfError(
+            f"{path}: sensor {wanted!r}: taxel idx must be 0..{len(taxels.idx) - 1}, each once; "
+            f"got {sorted(taxels.idx)[:8]}..."
+        )
+    default_area = float(base.areas_mm2[0])
+    positions, normals, areas = [], [], []
+    for k in order:
+        positions.append(tuple(v * 1e3 for v in taxels.xyz_m[k]))
+        normal = _rpy_to_matrix(*taxels.rpy[k])[:, 2]
+        normals.append(tuple(float(v) for v in normal))
+        area = taxels.area_m2[k]
+        areas.append(area * 1e6 if area else default_area)
+    data = base.to_dict()
+    data["name"] = taxels.name
+    data["description"] = f"imported from {Path(path).name} (URDF taxel list), on {base.name}"
+    data["taxels"] = {
+        "positions_mm": [list(p) for p in positions],
+        "normals": [list(n) for n in normals],
+        "area_mm2": areas,
+    }
+    if taxels.update_rate_hz is not None:
+        data["electronics"]["scan_rate_hz"] = taxels.update_rate_hz
+    try:
+        return sensor_from_dict(data, source=str(path))
+    except TactsenseInputError as error:
+        raise UrdfError(f"{path}: the taxels do not fit {base.name!r}: {error}") from None
+
+
+def sensor_to_urdf_any(spec, *, link: str = "finger", robot: str | None = None) -> str:
+    """Any sensor as a URDF tactile description the toolbox's parser accepts.
+
+    A finger: :func:`sensor_to_urdf`. A pad: an ``<array>`` (x along rows, y along
+    columns, as upstream's iterator places taxel (row, col) at (row * spacing.x,
+    col * spacing.y)). A point set: a ``<taxel idx xyz rpy>`` list with a ``<box>``
+    geometry of the taxel's area (a square) and its normal as the rotated +z. Every
+    ``<tactile>`` carries the ``channel`` attribute upstream's parser requires (the
+    sensor's name: the ``TactileState`` channel that holds its data).
+    """
+    if spec.kind == "finger":
+        return sensor_to_urdf(spec, link=link, robot=robot)
+    m = lambda value_mm: f"{value_mm * 1e-3:.15g}"  # noqa: E731
+    root = ET.Element("robot", name=robot or f"{spec.name}_robot")
+    ET.SubElement(root, "link", name=link)
+    sensor = ET.SubElement(
+        root, "sensor", name=spec.name, update_rate=f"{spec.electronics.scan_rate_hz:g}"
+    )
+    ET.SubElement(sensor, "parent", link=link)
+    ET.SubElement(sensor, "origin", xyz="0 0 0", rpy="0 0 0")
+    tactile = ET.SubElement(sensor, "tactile", channel=spec.name)
+    if spec.kind == "pad":
+        g = spec.grid
+        ET.SubElement(
+            tactile,
+            "array",
+            rows=str(g.rows),
+            cols=str(g.cols),
+            order="row-major",
+            size=f"{m(g.electrode_x_mm)} {m(g.electrode_y_mm)}",
+            spacing=f"{m(g.row_pitch_mm)} {m(g.col_pitch_mm)}",
+            offset="0 0",
+        )
+    else:
+        positions, normals, areas = (
+            spec.taxel_positions_mm(), spec.taxel_normals(), spec.areas_mm2,
+        )  # fmt: skip
+        rows = zip(positions, normals, areas, strict=True)
+        for index, (position, normal, area) in enumerate(rows):
+            rpy = _normal_to_rpy(normal)
+            taxel = ET.SubElement(
+                tactile,
+                "taxel",
+                idx=str(index),
+                xyz=" ".join(m(v) for v in position),
+                rpy=" ".join(f"{v:.15g}" for v in rpy),
+            )
+            side = math.sqrt(area)
+            geometry = ET.SubElement(taxel, "geometry")
+            ET.SubElement(geometry, "box", size=f"{m(side)} {m(side)} 0")
     ET.indent(root)
     return '<?xml version="1.0" encoding="utf-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"

@@ -1,0 +1,486 @@
+"""What every kind of sensor shares: the electronics, the flaws, the elastic layer, the
+transduction, TOML input and output, and the checks.
+
+A sensor kind is a frozen dataclass with a ``name``, a ``description`` and one field per
+TOML section; :class:`SpecBase` gives it TOML I/O, ``replace`` and the derived
+quantities every command needs (``shape``, ``scan_period_s``, taxel positions).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, ClassVar
+
+import numpy as np
+import tomli_w
+
+from tactsense._validation import TactsenseInputError
+
+VACUUM_PERMITTIVITY = 8.8541878128e-12  # [F/m]
+STANDARD_GRAVITY = 9.80665  # [m/s^2]
+
+
+class SensorSpecError(TactsenseInputError):
+    """Raised when a sensor description is invalid."""
+
+
+@dataclass(frozen=True)
+class Electronics:
+    """Drive, amplifier and A/D converter (section 2.2 of [1])."""
+
+    load_capacitance_pf: float = 100.0
+    """Lumped load capacitance C_L: cable, amplifier input, strays [pF]."""
+    load_resistance_ohm: float = 1.0e6
+    """Amplifier input resistance R_L [ohm]."""
+    drive_voltage_v: float = 10.0
+    """Amplitude of the drive voltage V_d [V]."""
+    drive_frequency_hz: float = 1.0e5
+    """Frequency of the drive voltage [Hz]."""
+    adc_bits: int = 12
+    """Resolution of the A/D converter [bit]."""
+    adc_full_scale_v: float = 5.0
+    """Input voltage at the A/D converter's full scale [V]."""
+    nominal_counts: float = 2000.0
+    """Reading of an untouched taxel (V_o of the paper, about 2000 A/D units) [counts]."""
+    scan_rate_hz: float = 7.0
+    """Frame rate of the row/column scan [Hz]."""
+
+
+@dataclass(frozen=True)
+class Flaws:
+    """Parameters of the sensor's flaws (section 3 of [1]).
+
+    Which flaws a simulation switches on is chosen when simulating; the
+    numbers that describe them live here.
+    """
+
+    gain_spread_sd: float = 0.35
+    """Relative standard deviation of the per-tactel force threshold (Fig. 8) [-]."""
+    gain_min: float = 0.5
+    """Smallest per-tactel gain multiplier (worst threshold 0.8 g at mean 0.4 g) [-]."""
+    gain_max: float = 2.0
+    """Largest per-tactel gain multiplier (best threshold 0.2 g at mean 0.4 g) [-]."""
+    gain_seed: int = 1990
+    """Seed of this finger's gain spread: the gains belong to the finger, not to a run."""
+    force_jitter_n: float = 0.0098
+    """Standard deviation of the applied force per application, 1 gram-force (Figs. 10-11) [N]."""
+    position_jitter_mm: float = 0.05
+    """Standard deviation of the probe position per application [mm]."""
+    read_noise_counts: float = 0.3
+    """Standard deviation of electronic noise before quantization [counts]."""
+    nonlinear_saturation: float = 0.712
+    """Deflection scale c of the stiffening law d_meas = d / (1 + d/c) (Fig. 6) [-]."""
+    delayed_fraction: float = 0.538
+    """Fraction of the elastic response that is delayed (Fig. 12) [-]."""
+    delayed_time_constant_s: float = 0.0422
+    """Time constant of the delayed elastic response (Fig. 12) [s]."""
+    creep_fraction: float = 1.14
+    """Creep gain relative to the elastic response, reached after long loading [-]."""
+    creep_time_constant_s: float = 20.0
+    """Time constant of creep and of the recovery of the elastic set [s]."""
+    dead_tactels: tuple[tuple[int, int], ...] = ()
+    """Wired tactels (row, col) that give no signal."""
+
+
+@dataclass(frozen=True)
+class Layer:
+    """The elastic layer over a flat array, bonded to a rigid substrate."""
+
+    thickness_mm: float = 3.0
+    """Thickness h of the elastic layer, from the free surface to the substrate [mm]."""
+    youngs_modulus_pa: float = 2.5e5
+    """Young's modulus of the layer [Pa]."""
+    poisson_ratio: float = 0.5
+    """Poisson's ratio of the layer (0.5: incompressible rubber) [-]."""
+    sensing_depth_mm: float = 2.5
+    """Depth below the free surface at which the sensing element reads the strain [mm]."""
+    substrate: str = "rigid"
+    """What the layer is bonded to: only ``rigid`` (perfect adhesion, no displacement)."""
+
+
+@dataclass(frozen=True)
+class Transduction:
+    """From the strain at the sensing depth to the reading of a taxel.
+
+    ``capacitive``: the paper's chain (eqs. 1-4): the plates close by a fraction
+    ``strain_gain * eps`` of their separation (eq. 3 when 1) and the reading rises as
+    the capacitance, from ``nominal_counts`` untouched. ``resistive``: a generic
+    linear transducer, reading ``nominal_counts + counts_per_strain * eps``.
+    """
+
+    kind: str = "capacitive"
+    """``capacitive`` (the paper's chain) or ``resistive`` (a generic gain)."""
+    strain_gain: float = 1.0
+    """Capacitive: fractional plate deflection per unit compressive strain (eq. 3: 1) [-]."""
+    dielectric_thickness_mm: float = 0.5
+    """Capacitive: nominal plate separation d_o [mm]."""
+    dielectric_constant: float = 4.0
+    """Capacitive: relative permittivity K_o of the dielectric [-]."""
+    counts_per_strain: float = 20000.0
+    """Resistive: change of the reading per unit compressive strain [counts]."""
+
+
+def convert(annotation: Any, value: Any) -> Any:
+    """A TOML value converted to a field's type, or TypeError saying what was expected."""
+    kind = str(annotation)
+    if kind == "bool":
+        if not isinstance(value, bool):
+            raise TypeError("expected true or false")
+        return value
+    if kind == "int":
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise TypeError("expected an integer")
+        return value
+    if kind == "float":
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise TypeError("expected a number")
+        return float(value)
+    if kind == "str":
+        if not isinstance(value, str):
+            raise TypeError("expected a string")
+        return value
+    if kind.startswith("tuple[tuple[int"):
+        pairs = []
+        for item in value:
+            if len(item) != 2 or not all(isinstance(v, int) for v in item):
+                raise TypeError("expected a list of [row, col] integer pairs")
+            pairs.append((int(item[0]), int(item[1])))
+        return tuple(pairs)
+    if kind.startswith("tuple[tuple[float"):
+        try:
+            rows = tuple(tuple(float(v) for v in item) for item in value)
+        except (TypeError, ValueError):
+            raise TypeError("expected a list of lists of numbers") from None
+        return rows
+    if kind.startswith("tuple[float"):
+        try:
+            return tuple(float(v) for v in value)
+        except (TypeError, ValueError):
+            raise TypeError("expected a list of numbers") from None
+    return value
+
+
+def _plain(value: Any) -> Any:
+    if isinstance(value, tuple):
+        return [_plain(v) for v in value]
+    return value
+
+
+class SpecBase:
+    """TOML I/O, ``replace`` and shared derived quantities of every sensor kind.
+
+    A kind sets ``kind`` (its name in TOML) and ``SECTIONS`` (TOML section -> dataclass),
+    and defines ``shape`` and ``taxel_positions_mm``/``taxel_normals``.
+    """
+
+    kind: ClassVar[str]
+    SECTIONS: ClassVar[dict[str, type]]
+
+    # ---- shared derived quantities -------------------------------------------
+    @property
+    def scan_period_s(self) -> float:
+        """Time between the starts of two frames [s]."""
+        return 1.0 / self.electronics.scan_rate_hz
+
+    @property
+    def n_taxels(self) -> int:
+        """Number of taxels in a frame [-]."""
+        rows, cols = self.shape
+        return rows * cols
+
+    def check_tactel(self, row: int, col: int) -> tuple[int, int]:
+        """Return ``(row, col)`` after checking it addresses a wired taxel."""
+        rows, cols = self.shape
+        if not (0 <= row < rows and 0 <= col < cols):
+            raise SensorSpecError(
+                f"tactel ({row}, {col}) is outside the {rows}x{cols} array of wired tactels "
+                f"of {self.name!r}"
+            )
+        return int(row), int(col)
+
+    def require_kind(self, *kinds: str, what: str = "this command") -> None:
+        """Raise a one-line error when this sensor's kind is not one ``what`` handles."""
+        if self.kind not in kinds:
+            raise SensorSpecError(
+                f"{what} works on {' and '.join(f'{k} sensors' for k in kinds)}; "
+                f"{self.name!r} is a {self.kind}"
+            )
+
+    # ---- (de)serialization ---------------------------------------------------
+    def to_dict(self) -> dict[str, Any]:
+        """The description as nested plain dictionaries (TOML sections)."""
+        data: dict[str, Any] = {}
+        if self.kind != "finger":  # a finger's TOML is unchanged: no kind key
+            data["kind"] = self.kind
+        data["name"] = self.name
+        data["description"] = self.description
+        for section in self.SECTIONS:
+            values = dataclasses.asdict(getattr(self, section))
+            data[section] = {key: _plain(value) for key, value in values.items()}
+        return data
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any], *, source: str = "sensor description"):
+        """Build a sensor from nested dictionaries, naming every unknown key.
+
+        Every key of every section must be given, unless the description names a
+        preset to start from with ``extends = "NAME"``: then the keys it leaves out take
+        that preset's values. A description that leaves keys out without saying where
+        their values come from is an error, so that a typo or a forgotten section never
+        silently becomes a preset.
+        """
+        from tactsense.sensor.registry import PRESETS, preset
+
+        if not isinstance(data, dict):
+            raise SensorSpecError(
+                f"{source}: expected a table of sections, got {type(data).__name__}"
+            )
+        problems: list[str] = []
+        allowed_top = {"kind", "name", "description", "extends", *cls.SECTIONS}
+        for key in data:
+            if key not in allowed_top:
+                problems.append(
+                    f"unknown key {key!r} at top level; allowed: {', '.join(sorted(allowed_top))}"
+                )
+        base: dict[str, Any] | None = None
+        if "extends" in data:
+            extends = data["extends"]
+            key = extends.removeprefix("fearing1990_") if isinstance(extends, str) else None
+            if key not in PRESETS or PRESETS[key]().kind != cls.kind:
+                same = [name for name, make in PRESETS.items() if make().kind == cls.kind]
+                raise SensorSpecError(
+                    f"{source}: extends = {extends!r} is not a preset; "
+                    f"available: {', '.join(same)} ({cls.kind} presets)"
+                )
+            base = preset(key).to_dict()
+        elif not any(section in data for section in cls.SECTIONS):
+            raise SensorSpecError(
+                f"{source}: no sections ({', '.join(f'[{s}]' for s in cls.SECTIONS)}); "
+                'describe every section, or start from a preset with extends = "NAME" '
+                "(tactsense sensor show prints a complete description to edit)"
+            )
+        sections: dict[str, Any] = {}
+        for section, section_type in cls.SECTIONS.items():
+            values = data.get(section, {})
+            if not isinstance(values, dict):
+                problems.append(f"[{section}] must be a table, got {type(values).__name__}")
+                continue
+            known = {f.name: f for f in dataclasses.fields(section_type)}
+            if base is None:
+                missing = [key for key in known if key not in values]
+                if missing:
+                    problems.append(f"[{section}] is missing {', '.join(missing)}")
+            else:
+                values = {**base[section], **values}
+            converted: dict[str, Any] = {}
+            for key, value in values.items():
+                if key not in known:
+                    problems.append(
+                        f"unknown key {key!r} in [{section}]; allowed: {', '.join(sorted(known))}"
+                    )
+                    continue
+                try:
+                    converted[key] = convert(known[key].type, value)
+                except (TypeError, ValueError) as error:
+                    problems.append(f"[{section}] {key} = {value!r}: {error}")
+            sections[section] = converted
+        if problems:
+            hint = ""
+            if any(" is missing " in problem for problem in problems):
+                hint = (
+                    '\n  (give every key, or add extends = "PRESET" at the top to take '
+                    "the keys left out from a preset)"
+                )
+            raise SensorSpecError(f"{source}:\n  - " + "\n  - ".join(problems) + hint)
+        try:
+            built = {s: kind(**sections[s]) for s, kind in cls.SECTIONS.items()}
+        except TypeError as error:
+            raise SensorSpecError(f"{source}: {error}") from None
+        return cls(
+            name=str(data.get("name", "custom")),
+            description=str(data.get("description", "")),
+            **built,
+        )
+
+    @classmethod
+    def from_toml(cls, path: str | Path):
+        """Load and validate a sensor description from a TOML file (any kind)."""
+        from tactsense.sensor.registry import sensor_from_dict
+
+        return sensor_from_dict(read_toml(path), source=str(path), expected=cls)
+
+    @classmethod
+    def from_toml_string(cls, text: str):
+        """Validate a sensor description given as TOML text (any kind)."""
+        from tactsense.sensor.registry import sensor_from_dict
+
+        try:
+            data = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as error:
+            raise SensorSpecError(f"sensor description is not valid TOML: {error}") from None
+        return sensor_from_dict(data, expected=cls)
+
+    def to_toml_string(self) -> str:
+        """The description as TOML text."""
+        return tomli_w.dumps(self.to_dict())
+
+    def to_toml(self, path: str | Path, *, overwrite: bool = False) -> Path:
+        """Write the description as TOML; an existing file is kept unless ``overwrite``."""
+        path = Path(path)
+        if path.exists() and not overwrite:
+            raise FileExistsError(f"{path} exists; not replacing it (overwrite=True replaces it)")
+        path.write_text(self.to_toml_string(), encoding="utf-8")
+        return path
+
+    def replace(self, **sections: Any):
+        """A copy with whole sections or ``section__key`` values replaced.
+
+        Examples
+        --------
+        >>> from tactsense.sensor import fearing1990_initial
+        >>> spec = fearing1990_initial().replace(elastic__effective_depth_mm=3.0)
+        >>> spec.elastic.effective_depth_mm
+        3.0
+        """
+        updates: dict[str, Any] = {}
+        nested: dict[str, dict[str, Any]] = {}
+        for key, value in sections.items():
+            if "__" in key:
+                section, sub = key.split("__", 1)
+                nested.setdefault(section, {})[sub] = value
+            else:
+                updates[key] = value
+        for section, values in nested.items():
+            if section not in self.SECTIONS:
+                raise SensorSpecError(
+                    f"unknown section {section!r}; allowed: {', '.join(self.SECTIONS)}"
+                )
+            current = updates.get(section, getattr(self, section))
+            try:
+                updates[section] = dataclasses.replace(current, **values)
+            except TypeError as error:
+                raise SensorSpecError(f"[{section}]: {error}") from None
+        return dataclasses.replace(self, **updates)
+
+
+def read_toml(path: str | Path) -> dict[str, Any]:
+    """The tables of a TOML file, or SensorSpecError naming the file."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError:
+        raise SensorSpecError(f"{path} is not a text (TOML) file") from None
+    except OSError as error:
+        raise SensorSpecError(f"cannot read sensor file {path}: {error.strerror}") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as error:
+        raise SensorSpecError(f"{path} is not valid TOML: {error}") from None
+
+
+def positive(problems: list[str], section: str, key: str, value: Any) -> None:
+    """Append a sentence to ``problems`` unless ``value`` is a finite positive number."""
+    if not (
+        isinstance(value, int | float)
+        and not isinstance(value, bool)
+        and math.isfinite(value)
+        and value > 0
+    ):
+        problems.append(f"[{section}] {key} must be positive; got {value!r}")
+
+
+def check_electronics(el: Electronics, problems: list[str]) -> None:
+    """Every problem with the electronics section."""
+    for fld in dataclasses.fields(el):
+        positive(problems, "electronics", fld.name, getattr(el, fld.name))
+    if problems:
+        return
+    if not 1 <= el.adc_bits <= 24:
+        problems.append(f"[electronics] adc_bits = {el.adc_bits} must lie in 1..24")
+    elif el.nominal_counts >= 2**el.adc_bits:
+        problems.append(
+            f"[electronics] nominal_counts = {el.nominal_counts:g} does not fit in a "
+            f"{el.adc_bits}-bit converter (max {2**el.adc_bits - 1})"
+        )
+
+
+def check_flaws(f: Flaws, shape: tuple[int, int], problems: list[str]) -> None:
+    """Every problem with the flaws section of a sensor whose frames have ``shape``."""
+    for key in (
+        "gain_spread_sd",
+        "force_jitter_n",
+        "position_jitter_mm",
+        "read_noise_counts",
+        "creep_fraction",
+    ):
+        value = getattr(f, key)
+        if not (math.isfinite(value) and value >= 0):
+            problems.append(f"[flaws] {key} must be non-negative; got {value!r}")
+    for key in (
+        "nonlinear_saturation",
+        "delayed_time_constant_s",
+        "creep_time_constant_s",
+        "gain_min",
+        "gain_max",
+    ):
+        positive(problems, "flaws", key, getattr(f, key))
+    if f.gain_min > 1.0 or f.gain_max < 1.0:
+        problems.append(
+            f"[flaws] gain_min <= 1 <= gain_max is required; got {f.gain_min}, {f.gain_max}"
+        )
+    if not 0.0 <= f.delayed_fraction <= 1.0:
+        problems.append(f"[flaws] delayed_fraction must lie in [0, 1]; got {f.delayed_fraction!r}")
+    rows, cols = shape
+    for row, col in f.dead_tactels:
+        if not (0 <= row < rows and 0 <= col < cols):
+            problems.append(
+                f"[flaws] dead tactel ({row}, {col}) is outside the wired array {rows}x{cols}"
+            )
+
+
+def check_layer(layer: Layer, problems: list[str]) -> None:
+    """Every problem with an elastic layer section."""
+    for key in ("thickness_mm", "youngs_modulus_pa", "sensing_depth_mm"):
+        positive(problems, "layer", key, getattr(layer, key))
+    nu = layer.poisson_ratio
+    if not (isinstance(nu, float) and -1.0 < nu <= 0.5):
+        problems.append(
+            f"[layer] poisson_ratio = {nu!r} is out of range; Poisson's ratio lies in (-1, 0.5]"
+        )
+    if layer.substrate != "rigid":
+        problems.append(f"[layer] substrate = {layer.substrate!r}; only 'rigid' is modelled")
+    if not problems and layer.sensing_depth_mm > layer.thickness_mm:
+        problems.append(
+            f"[layer] sensing_depth_mm = {layer.sensing_depth_mm:g} lies below the layer "
+            f"(thickness_mm = {layer.thickness_mm:g})"
+        )
+
+
+def check_transduction(t: Transduction, problems: list[str]) -> None:
+    """Every problem with a transduction section."""
+    if t.kind not in ("capacitive", "resistive"):
+        problems.append(f"[transduction] kind = {t.kind!r}; expected 'capacitive' or 'resistive'")
+    for key in ("strain_gain", "dielectric_thickness_mm", "dielectric_constant"):
+        positive(problems, "transduction", key, getattr(t, key))
+    positive(problems, "transduction", "counts_per_strain", t.counts_per_strain)
+
+
+def capacitance_f(t: Transduction, area_mm2: float) -> float:
+    """Undeflected capacitance of a parallel-plate taxel of ``area_mm2``, eq. 2 [F]."""
+    return (
+        t.dielectric_constant
+        * VACUUM_PERMITTIVITY
+        * area_mm2
+        * 1e-6
+        / (t.dielectric_thickness_mm * 1e-3)
+    )
+
+
+def as_unit_vectors(vectors: np.ndarray) -> np.ndarray:
+    """Rows of ``vectors`` scaled to unit length."""
+    vectors = np.asarray(vectors, dtype=float)
+    return vectors / np.linalg.norm(vectors, axis=-1, keepdims=True)

@@ -1,0 +1,159 @@
+"""A taxel point set: any array given as surface positions, outward normals and areas.
+
+For fingertip modules, glove patches and other irregular arrays (the URDF ``<taxel>``
+list of the ROS tactile toolbox describes exactly this). Each taxel lies under the same
+elastic layer, taken as locally flat around it: the twin loads each taxel through the
+flat layer model in its own tangent plane. Frames of a point set have shape
+``(1, N)``: one row, one column per taxel, in the order given.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import ClassVar
+
+import numpy as np
+
+from tactsense.sensor.common import (
+    Electronics,
+    Flaws,
+    Layer,
+    SensorSpecError,
+    SpecBase,
+    Transduction,
+    capacitance_f,
+    check_electronics,
+    check_flaws,
+    check_layer,
+    check_transduction,
+)
+
+
+@dataclass(frozen=True)
+class Taxels:
+    """Where the taxels are: one entry per taxel, in frame order."""
+
+    positions_mm: tuple[tuple[float, ...], ...] = ((0.0, 0.0, 0.0),)
+    """Point on the free surface above each taxel, ``[x, y, z]`` [mm]."""
+    normals: tuple[tuple[float, ...], ...] = ((0.0, 0.0, 1.0),)
+    """Outward surface normal at each taxel, ``[nx, ny, nz]`` (scaled to unit length) [-]."""
+    area_mm2: tuple[float, ...] = (4.0,)
+    """Effective (electrode) area of each taxel [mm^2]."""
+
+
+@dataclass(frozen=True)
+class PointsSpec(SpecBase):
+    """Complete description of a taxel point set (TOML ``kind = "points"``)."""
+
+    name: str = "points"
+    description: str = ""
+    taxels: Taxels = field(default_factory=Taxels)
+    layer: Layer = field(default_factory=Layer)
+    transduction: Transduction = field(default_factory=Transduction)
+    electronics: Electronics = field(default_factory=Electronics)
+    flaws: Flaws = field(default_factory=Flaws)
+
+    kind: ClassVar[str] = "points"
+    SECTIONS: ClassVar[dict[str, type]] = {
+        "taxels": Taxels,
+        "layer": Layer,
+        "transduction": Transduction,
+        "electronics": Electronics,
+        "flaws": Flaws,
+    }
+
+    def __post_init__(self) -> None:
+        problems = _validate(self)
+        if problems:
+            raise SensorSpecError(
+                f"invalid sensor description {self.name!r}:\n  - " + "\n  - ".join(problems)
+            )
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """Shape ``(1, N)`` of a frame [-]."""
+        return (1, len(self.taxels.positions_mm))
+
+    def taxel_positions_mm(self) -> np.ndarray:
+        """Surface point of every taxel, shape (N, 3) [mm]."""
+        return np.asarray(self.taxels.positions_mm, dtype=float).reshape(-1, 3)
+
+    def taxel_normals(self) -> np.ndarray:
+        """Unit outward normal of every taxel, shape (N, 3) [-]."""
+        normals = np.asarray(self.taxels.normals, dtype=float).reshape(-1, 3)
+        return normals / np.linalg.norm(normals, axis=1, keepdims=True)
+
+    @property
+    def areas_mm2(self) -> np.ndarray:
+        """Electrode area of every taxel, shape (N,) [mm^2]."""
+        return np.asarray(self.taxels.area_mm2, dtype=float)
+
+    @property
+    def junction_capacitance_f(self) -> np.ndarray:
+        """Undeflected capacitance of each capacitive taxel, eq. 2 of the paper, (1, N) [F]."""
+        return capacitance_f(self.transduction, self.areas_mm2)[np.newaxis, :]
+
+
+def taxels_from_json(path: str | Path) -> Taxels:
+    """Taxels from a JSON list of ``{"xyz": [x, y, z], "normal": [...], "area": a}`` [mm].
+
+    The list order is the frame order. ``area`` is in mm^2.
+    """
+    path = Path(path)
+    try:
+        entries = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError) as error:
+        raise SensorSpecError(f"cannot read taxel list {path}: {error}") from None
+    except json.JSONDecodeError as error:
+        raise SensorSpecError(f"{path} is not JSON: {error}") from None
+    if not isinstance(entries, list) or not entries:
+        raise SensorSpecError(f"{path}: expected a non-empty JSON list of taxels")
+    positions, normals, areas = [], [], []
+    for index, entry in enumerate(entries):
+        try:
+            positions.append(tuple(float(v) for v in entry["xyz"]))
+            normals.append(tuple(float(v) for v in entry["normal"]))
+            areas.append(float(entry["area"]))
+        except (KeyError, TypeError, ValueError):
+            raise SensorSpecError(
+                f"{path}: taxel {index} must be {{'xyz': [x, y, z], 'normal': [nx, ny, nz], "
+                f"'area': a}} in mm and mm^2; got {entry!r}"
+            ) from None
+    return Taxels(positions_mm=tuple(positions), normals=tuple(normals), area_mm2=tuple(areas))
+
+
+def _validate(spec: PointsSpec) -> list[str]:
+    problems: list[str] = []
+    t = spec.taxels
+    n = len(t.positions_mm)
+    if n == 0:
+        problems.append("[taxels] positions_mm is empty; give at least one taxel")
+    if len(t.normals) != n or len(t.area_mm2) != n:
+        problems.append(
+            f"[taxels] {n} positions, {len(t.normals)} normals and {len(t.area_mm2)} areas: "
+            "give one of each per taxel"
+        )
+    for key, rows in (("positions_mm", t.positions_mm), ("normals", t.normals)):
+        for index, row in enumerate(rows):
+            if len(row) != 3 or not all(math.isfinite(v) for v in row):
+                problems.append(f"[taxels] {key}[{index}] = {list(row)!r}: expected 3 numbers")
+                break
+    for index, normal in enumerate(t.normals):
+        if len(normal) == 3 and math.hypot(*normal) < 1e-9:
+            problems.append(f"[taxels] normals[{index}] is zero; expected a direction")
+            break
+    for index, area in enumerate(t.area_mm2):
+        if not (math.isfinite(area) and area > 0):
+            problems.append(f"[taxels] area_mm2[{index}] = {area!r} must be positive")
+            break
+    if n > 65_536:
+        problems.append(f"[taxels] {n} taxels: at most 65,536 are supported")
+    check_layer(spec.layer, problems)
+    check_transduction(spec.transduction, problems)
+    check_electronics(spec.electronics, problems)
+    if not problems:
+        check_flaws(spec.flaws, spec.shape, problems)
+    return problems

@@ -1,0 +1,202 @@
+"""The kinds of sensor and the built-in presets, by name.
+
+Adding a kind: a module in this package with a :class:`~tactsense.sensor.common.SpecBase`
+dataclass, one line in :data:`KINDS`, and its physics; nothing in ``cli/`` changes.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from tactsense.sensor.common import (
+    Electronics,
+    Flaws,
+    Layer,
+    SensorSpecError,
+    SpecBase,
+    Transduction,
+    read_toml,
+)
+from tactsense.sensor.finger import SensorSpec, fearing1990_improved, fearing1990_initial
+from tactsense.sensor.pad import Grid, PadSpec
+from tactsense.sensor.points import PointsSpec, Taxels
+
+KINDS: dict[str, type] = {"finger": SensorSpec, "pad": PadSpec, "points": PointsSpec}
+"""TOML ``kind`` -> the class that describes it (a TOML without ``kind`` is a finger)."""
+
+_PAPER = "Fearing (1990)"
+_PROVENANCE = (
+    "Elastic layer: the paper's skin rubber (E = 2.5e5 Pa, nu = 0.5, " + _PAPER + ", "
+    "section 2.3). Electronics and flaws: the paper's finger (sections 2-3), assumed to "
+    "hold for this pad. Array size: a class of pad labs own; pitch, electrode size, layer "
+    "thickness, sensing depth, scan rate and transduction gain are assumptions, not "
+    "taken from a datasheet."
+)
+
+
+def pad4() -> PadSpec:
+    """A 4x4 capacitive pad at 5 mm pitch under 4 mm of rubber (a bench-top skin patch)."""
+    return PadSpec(
+        name="pad4",
+        description="4x4 capacitive pad, 5 mm pitch, 4 mm rubber layer. " + _PROVENANCE,
+        grid=Grid(
+            rows=4,
+            cols=4,
+            row_pitch_mm=5.0,
+            col_pitch_mm=5.0,
+            electrode_x_mm=4.0, electrode_y_mm=4.0,
+        ),
+        layer=Layer(
+            thickness_mm=4.0, youngs_modulus_pa=2.5e5, poisson_ratio=0.5, sensing_depth_mm=3.5
+        ),
+        transduction=Transduction(
+            kind="capacitive", strain_gain=1.0, dielectric_thickness_mm=0.5, dielectric_constant=4.0
+        ),
+        electronics=Electronics(scan_rate_hz=100.0),
+        flaws=Flaws(),
+    )
+
+
+def pad16() -> PadSpec:
+    """A 16x16 piezoresistive pad at 2.5 mm pitch under 2 mm of rubber (a gripper pad)."""
+    return PadSpec(
+        name="pad16",
+        description="16x16 piezoresistive pad, 2.5 mm pitch, 2 mm rubber layer. " + _PROVENANCE,
+        grid=Grid(
+            rows=16,
+            cols=16,
+            row_pitch_mm=2.5,
+            col_pitch_mm=2.5,
+            electrode_x_mm=2.0, electrode_y_mm=2.0,
+        ),
+        layer=Layer(
+            thickness_mm=2.0, youngs_modulus_pa=2.5e5, poisson_ratio=0.5, sensing_depth_mm=1.5
+        ),
+        transduction=Transduction(kind="resistive", counts_per_strain=20000.0),
+        electronics=Electronics(nominal_counts=100.0, scan_rate_hz=100.0),
+        flaws=Flaws(),
+    )
+
+
+def pad12x32() -> PadSpec:
+    """A 12x32 piezoresistive strip at 2 mm pitch under 1.5 mm of rubber (a palm patch)."""
+    return PadSpec(
+        name="pad12x32",
+        description="12x32 piezoresistive pad, 2 mm pitch, 1.5 mm rubber layer. " + _PROVENANCE,
+        grid=Grid(
+            rows=12,
+            cols=32,
+            row_pitch_mm=2.0,
+            col_pitch_mm=2.0,
+            electrode_x_mm=1.6, electrode_y_mm=1.6,
+        ),
+        layer=Layer(
+            thickness_mm=1.5, youngs_modulus_pa=2.5e5, poisson_ratio=0.5, sensing_depth_mm=1.0
+        ),
+        transduction=Transduction(kind="resistive", counts_per_strain=20000.0),
+        electronics=Electronics(nominal_counts=100.0, scan_rate_hz=50.0),
+        flaws=Flaws(),
+    )
+
+
+def dome12() -> PointsSpec:
+    """Twelve taxels on a 7.5-mm dome, a fingertip module given as a point set.
+
+    A ring of eight at 50 deg from the apex, a ring of three at 20 deg and one at the
+    apex: the layout is an assumption in the spirit of capacitive fingertips with about a
+    dozen taxels (for example the iCub fingertip's 12), not a copy of one.
+    """
+    radius = 7.5
+    directions = [(0.0, 0.0)]
+    directions += [(20.0, 120.0 * k) for k in range(3)]
+    directions += [(50.0, 45.0 * k) for k in range(8)]
+    normals = []
+    for polar, azimuth in directions:
+        p, a = math.radians(polar), math.radians(azimuth)
+        normals.append((math.sin(p) * math.cos(a), math.sin(p) * math.sin(a), math.cos(p)))
+    positions = [tuple(float(radius * c) for c in n) for n in normals]
+    return PointsSpec(
+        name="dome12",
+        description="12 taxels on a 7.5-mm dome, 2 mm rubber layer (point set). " + _PROVENANCE,
+        taxels=Taxels(
+            positions_mm=tuple(positions),
+            normals=tuple(tuple(float(v) for v in n) for n in normals),
+            area_mm2=tuple([6.0] * len(positions)),
+        ),
+        layer=Layer(
+            thickness_mm=2.0, youngs_modulus_pa=2.5e5, poisson_ratio=0.5, sensing_depth_mm=1.5
+        ),
+        transduction=Transduction(kind="capacitive"),
+        electronics=Electronics(scan_rate_hz=50.0),
+        flaws=Flaws(),
+    )
+
+
+PRESETS = {
+    "initial": fearing1990_initial,
+    "improved": fearing1990_improved,
+    "pad4": pad4,
+    "pad16": pad16,
+    "pad12x32": pad12x32,
+    "dome12": dome12,
+}
+"""Built-in sensors by short name (the fingers also answer to ``fearing1990_...``)."""
+
+
+def preset(name: str = "initial") -> SpecBase:
+    """A built-in sensor by short name (``tactsense sensor show NAME`` prints it)."""
+    key = name.removeprefix("fearing1990_")
+    if key not in PRESETS:
+        raise SensorSpecError(f"unknown preset {name!r}; available: {', '.join(PRESETS)}")
+    return PRESETS[key]()
+
+
+def sensor_from_dict(
+    data: dict[str, Any], *, source: str = "sensor description", expected: type | None = None
+) -> SpecBase:
+    """Any kind of sensor from TOML tables: ``kind`` picks the class (default finger)."""
+    if not isinstance(data, dict):
+        raise SensorSpecError(f"{source}: expected a table of sections, got {type(data).__name__}")
+    kind = data.get("kind", "finger")
+    if kind not in KINDS:
+        raise SensorSpecError(
+            f"{source}: kind = {kind!r} is not a sensor kind; expected one of {', '.join(KINDS)}"
+        )
+    cls = KINDS[kind]
+    if expected is not None and expected is not cls and expected in KINDS.values():
+        raise SensorSpecError(
+            f"{source} describes a {kind} sensor; expected a {expected.kind} sensor"
+        )
+    return cls.from_dict(data, source=source)
+
+
+def load_sensor(source: str | Path | SpecBase | None = None) -> SpecBase:
+    """A sensor from a preset name, a TOML path, or an existing spec (default: initial)."""
+    if source is None:
+        return fearing1990_initial()
+    if isinstance(source, SpecBase):
+        return source
+    text = str(source)
+    if text.removeprefix("fearing1990_") in PRESETS:
+        return preset(text)
+    if not Path(text).exists():
+        raise SensorSpecError(
+            f"no preset or sensor file named {text!r}; presets: {', '.join(PRESETS)}, "
+            "or give the path of a sensor TOML file"
+        )
+    if Path(text).is_dir():
+        raise SensorSpecError(f"sensor {text} is a folder; expected a preset or a TOML file")
+    return sensor_from_dict(read_toml(text), source=text)
+
+
+def taxel_frame(spec: SpecBase) -> tuple[np.ndarray, np.ndarray]:
+    """Surface positions [mm] and outward unit normals of every taxel, frame order, (N, 3).
+
+    Asked of any kind: estimation and display ask "where is taxel i" here instead of
+    testing which kind a sensor is.
+    """
+    return spec.taxel_positions_mm(), spec.taxel_normals()
