@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from enum import StrEnum
 from pathlib import Path
 from typing import Annotated
 
@@ -165,28 +164,26 @@ def sensor_show(
 def sensor_check(
     path: Annotated[Path, typer.Argument(help="Sensor TOML file to validate.")],
 ) -> None:
-    """Validate a sensor TOML file and print its derived quantities."""
+    """Validate a sensor TOML file (finger, pad or point set) and print its derived quantities."""
     try:
-        spec = SensorSpec.from_toml(path)
+        spec = load_sensor(path) if path.suffix.lower() == ".toml" else SensorSpec.from_toml(path)
     except TactsenseInputError as error:
         fail(str(error))
     table = Table(title=f"{spec.name}: valid", show_header=False)
-    table.add_row("frame shape (rows, cols)", f"{spec.shape}")
-    table.add_row("closes the circumference", str(spec.closes_circumference))
-    table.add_row("junction capacitance", f"{spec.junction_capacitance_f * 1e12:.3f} pF")
-    table.add_row("ring flexural length", f"{spec.ring_flexural_length_mm:.3f} mm")
+    for label, value in spec.summary():
+        table.add_row(label, value)
     Console().print(table)
-
-
-class BasePreset(StrEnum):
-    initial = "initial"
-    improved = "improved"
 
 
 @sensor_app.command("import")
 def sensor_import(
     path: Annotated[
-        Path, typer.Argument(help="URDF file with a tactile toolbox <sensor><tactile><array>.")
+        Path,
+        typer.Argument(
+            help="URDF file with a tactile toolbox <sensor><tactile> (an <array> or a <taxel> "
+            'list), or a JSON list of taxels [{"xyz": [x, y, z], "normal": [nx, ny, nz], '
+            '"area": a}] in mm and mm^2.'
+        ),
     ],
     out: Annotated[
         Path | None,
@@ -197,35 +194,55 @@ def sensor_import(
         typer.Option(help="The <sensor name=...> to take when the file describes several."),
     ] = None,
     extends: Annotated[
-        BasePreset,
+        str | None,
         typer.Option(
-            help="Preset giving what the array does not say: body, skin, electronics, flaws, "
-            "and whether data row 0 is a tip row."
+            help="Preset giving what the file does not say (the elastic layer, electronics, "
+            "flaws, ...), and the kind: a finger preset (initial, improved; row 0 a tip row) "
+            "or a pad preset (pad4, pad16, pad12x32) for an <array>; a point-set preset "
+            "(dome12) for a <taxel> list or JSON. Default: initial for an <array>, dome12 "
+            "for taxels."
         ),
-    ] = BasePreset.initial,
+    ] = None,
     force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
 ) -> None:
-    """Read a URDF tactile array (ROS tactile toolbox) into a sensor description (TOML).
+    """Read a URDF tactile sensor (ROS tactile toolbox) or a JSON taxel list into a sensor
+    description (TOML).
 
-    The array gives rows, columns, both spacings (along the finger; around it as the arc
-    at the skin's surface), the taxel size and the update rate; the rest comes from the
-    preset named by --extends.
+    An <array> gives rows, columns, both spacings, the taxel size and the update rate (a
+    finger: along it and the arc around it at the skin's surface; a pad: along x and y); a
+    <taxel idx xyz rpy> list or a JSON list gives each taxel's position, normal and area
+    (a point set). The rest comes from the preset named by --extends.
     """
-    from tactsense.interop.urdf import sensor_from_urdf
+    from tactsense.interop.urdf import sensor_from_urdf_any
+    from tactsense.sensor import PRESETS, preset, sensor_from_dict, taxels_from_json
 
     if out is not None:
         check_output(out, force)
     try:
-        spec = sensor_from_urdf(path, name=name, extends=extends.value)
+        if extends is not None and extends.removeprefix("fearing1990_") not in PRESETS:
+            fail(f"--extends {extends!r} is not a preset; available: {', '.join(PRESETS)}")
+        if path.suffix.lower() == ".json":
+            base = preset(extends or "dome12")
+            if base.kind != "points":
+                fail(f"--extends {extends} is a {base.kind}; a JSON taxel list is a point set")
+            data = base.to_dict()
+            taxels = taxels_from_json(path)
+            data["name"] = name or path.stem
+            data["description"] = f"imported from {path.name} (JSON taxel list), on {base.name}"
+            data["taxels"] = {
+                "positions_mm": [list(p) for p in taxels.positions_mm],
+                "normals": [list(n) for n in taxels.normals],
+                "area_mm2": list(taxels.area_mm2),
+            }
+            spec = sensor_from_dict(data, source=str(path))
+        else:
+            spec = sensor_from_urdf_any(path, name=name, extends=extends)
         if out is None:
             typer.echo(spec.to_toml_string())
         else:
             with atomic_output(out) as temporary:
                 spec.to_toml(temporary)
-            console.print(
-                f"wrote {out}: {spec.name}, {spec.shape[0]} x {spec.shape[1]} tactels, "
-                f"{spec.array.spacing_axial_mm:g} mm x {spec.array.spacing_angle_deg:.4g} deg"
-            )
+            console.print(f"wrote {out}: {spec.name}, {spec.kind}, frames of {spec.shape}")
     except (TactsenseInputError, FileExistsError) as error:
         fail(str(error))
 
@@ -248,12 +265,13 @@ def sensor_export(
     ),
     force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
 ) -> None:
-    """Write a sensor's array as a URDF tactile description for ROS (RViz's tactile display).
+    """Write a sensor as a URDF tactile description for ROS (RViz's tactile display).
 
-    Rows along the finger, columns around it, spacings and sizes in metres (the arc at
-    the skin's surface around); the data vector is a tactsense frame, row-major.
+    A finger or a pad as an <array> (a finger: rows along it, columns around it, the arc
+    at the skin's surface; a pad: rows along x, columns along y), a point set as a
+    <taxel idx xyz rpy> list; metres; the data vector is a tactsense frame, row-major.
     """
-    from tactsense.interop.urdf import sensor_to_urdf
+    from tactsense.interop.urdf import sensor_to_urdf_any as sensor_to_urdf
 
     if not urdf:
         fail("say which format: --urdf (for TOML use 'tactsense sensor show')")

@@ -219,7 +219,7 @@ def sensor_to_urdf(spec: SensorSpec, *, link: str = "finger", robot: str | None 
     )
     ET.SubElement(sensor, "parent", link=link)
     ET.SubElement(sensor, "origin", xyz="0 0 0", rpy="0 0 0")
-    tactile = ET.SubElement(sensor, "tactile")
+    tactile = ET.SubElement(sensor, "tactile", channel=spec.name)
     if spec.array.tip_row:
         tactile.append(
             ET.Comment(

@@ -172,6 +172,16 @@ class SensorSpec(SpecBase):
         """Shape ``(rows, cols)`` of a frame: the wired array [-]."""
         return (self.array.wired_rows, self.array.wired_cols)
 
+    def summary(self) -> list[tuple[str, str]]:
+        """Derived quantities worth printing, as (label, value with unit) rows."""
+        return [
+            ("kind", "finger"),
+            ("frame shape (rows, cols)", f"{self.shape}"),
+            ("closes the circumference", str(self.closes_circumference)),
+            ("junction capacitance", f"{self.junction_capacitance_f * 1e12:.3f} pF"),
+            ("ring flexural length", f"{self.ring_flexural_length_mm:.3f} mm"),
+        ]
+
     def taxel_positions_mm(self) -> np.ndarray:
         """Skin point above every wired tactel, frame order, shape (rows*cols, 3) [mm].
 

@@ -115,6 +115,29 @@ class PadSpec(SpecBase):
         normals[:, 2] = 1.0
         return normals
 
+    def summary(self) -> list[tuple[str, str]]:
+        """Derived quantities worth printing, as (label, value with unit) rows."""
+        g, layer, t = self.grid, self.layer, self.transduction
+        rows = [
+            ("kind", "pad"),
+            ("frame shape (rows, cols)", f"{self.shape}"),
+            ("pitch (rows x cols)", f"{g.row_pitch_mm:g} x {g.col_pitch_mm:g} mm"),
+            ("pad size (x, y)", f"{self.extent_mm[0]:g} x {self.extent_mm[1]:g} mm"),
+            (
+                "layer",
+                f"{layer.thickness_mm:g} mm, E = {layer.youngs_modulus_pa:g} Pa, "
+                f"nu = {layer.poisson_ratio:g}",
+            ),
+            (
+                "sensing depth / pitch",
+                f"{layer.sensing_depth_mm / max(g.row_pitch_mm, g.col_pitch_mm):.2f}",
+            ),
+            ("transduction", t.kind),
+        ]
+        if t.kind == "capacitive":
+            rows.append(("junction capacitance", f"{self.junction_capacitance_f * 1e12:.3f} pF"))
+        return rows
+
     @property
     def electrode_area_mm2(self) -> float:
         """Area of one taxel's electrode [mm^2]."""

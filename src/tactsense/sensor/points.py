@@ -77,6 +77,29 @@ class PointsSpec(SpecBase):
         """Shape ``(1, N)`` of a frame [-]."""
         return (1, len(self.taxels.positions_mm))
 
+    def summary(self) -> list[tuple[str, str]]:
+        """Derived quantities worth printing, as (label, value with unit) rows."""
+        positions = self.taxel_positions_mm()
+        low, high = positions.min(axis=0), positions.max(axis=0)
+        gaps = np.linalg.norm(positions[:, None] - positions[None, :], axis=-1)
+        np.fill_diagonal(gaps, np.inf)
+        nearest = gaps.min(axis=1) if len(positions) > 1 else np.array([np.nan])
+        return [
+            ("kind", "points"),
+            ("taxels", f"{len(positions)} (frame shape {self.shape})"),
+            (
+                "bounding box",
+                " x ".join(f"{h - lo:.3g}" for lo, h in zip(low, high, strict=True)) + " mm",
+            ),
+            ("nearest-neighbour distance", f"{nearest.min():.3g} to {nearest.max():.3g} mm"),
+            ("electrode area", f"{self.areas_mm2.min():.3g} to {self.areas_mm2.max():.3g} mm^2"),
+            (
+                "layer",
+                f"{self.layer.thickness_mm:g} mm, sensing depth {self.layer.sensing_depth_mm:g} mm",
+            ),
+            ("transduction", self.transduction.kind),
+        ]
+
     def taxel_positions_mm(self) -> np.ndarray:
         """Surface point of every taxel, shape (N, 3) [mm]."""
         return np.asarray(self.taxels.positions_mm, dtype=float).reshape(-1, 3)

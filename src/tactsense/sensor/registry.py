@@ -48,7 +48,8 @@ def pad4() -> PadSpec:
             cols=4,
             row_pitch_mm=5.0,
             col_pitch_mm=5.0,
-            electrode_x_mm=4.0, electrode_y_mm=4.0,
+            electrode_x_mm=4.0,
+            electrode_y_mm=4.0,
         ),
         layer=Layer(
             thickness_mm=4.0, youngs_modulus_pa=2.5e5, poisson_ratio=0.5, sensing_depth_mm=3.5
@@ -71,7 +72,8 @@ def pad16() -> PadSpec:
             cols=16,
             row_pitch_mm=2.5,
             col_pitch_mm=2.5,
-            electrode_x_mm=2.0, electrode_y_mm=2.0,
+            electrode_x_mm=2.0,
+            electrode_y_mm=2.0,
         ),
         layer=Layer(
             thickness_mm=2.0, youngs_modulus_pa=2.5e5, poisson_ratio=0.5, sensing_depth_mm=1.5
@@ -92,7 +94,8 @@ def pad12x32() -> PadSpec:
             cols=32,
             row_pitch_mm=2.0,
             col_pitch_mm=2.0,
-            electrode_x_mm=1.6, electrode_y_mm=1.6,
+            electrode_x_mm=1.6,
+            electrode_y_mm=1.6,
         ),
         layer=Layer(
             thickness_mm=1.5, youngs_modulus_pa=2.5e5, poisson_ratio=0.5, sensing_depth_mm=1.0

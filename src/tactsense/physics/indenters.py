@@ -1,0 +1,254 @@
+"""Indenters on a flat surface: the pressure each puts on a pad (or a taxel's tangent plane).
+
+Every indenter is a small frozen dataclass with its centre ``(x_mm, y_mm)`` on the
+surface (the pad's axes, ``tactsense.sensor.pad``), its total normal force [N] and its
+shape, and answers :meth:`pressure_pa` on a regular grid of points. The pressure is
+averaged over each grid cell (sub-sampled) and scaled so that it sums to the force
+exactly: a grid coarser than the contact still carries the right load.
+
+Pressure laws:
+
+* :class:`SphereProbe`: a rigid sphere pressed into the layer, Hertz's elliptical
+  pressure ``p = p0 sqrt(1 - r^2/a^2)`` with the contact radius of a rigid sphere on an
+  elastic half space, ``a = (3 F R / (4 E*))^(1/3)``, ``E* = E / (1 - nu^2)`` (Johnson,
+  *Contact Mechanics*, 1985, eq. 4.22); the layer's thickness is ignored for ``a``.
+* :class:`DiscProbe`: uniform pressure on a disc (a soft-tipped probe).
+* :class:`FlatPunch`: a rigid flat-ended cylinder, ``p = F / (2 pi a sqrt(a^2 - r^2))``
+  (Boussinesq's punch; Johnson 1985, eq. 3.35), its edge singularity cell-averaged.
+* :class:`KnifeEdge`: a line load of a given length, angle and width (elliptical across
+  the edge, as a 2-D Hertz contact).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+
+from tactsense._validation import TactsenseInputError
+
+_SUBSAMPLES = 5  # per grid cell and axis: cell-averages a 1-cell contact to about 1 %
+
+
+def _finite_positive(name: str, value: float) -> None:
+    if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
+        raise TactsenseInputError(f"{name} must be a positive number; got {value!r}")
+
+
+@dataclass(frozen=True)
+class Indenter:
+    """What every indenter has: where, how hard, and its pressure law."""
+
+    x_mm: float
+    y_mm: float
+    force_n: float
+
+    kind: ClassVar[str] = "indenter"
+
+    def __post_init__(self) -> None:
+        for name in ("x_mm", "y_mm", "force_n"):
+            value = getattr(self, name)
+            if not (isinstance(value, int | float) and math.isfinite(value)):
+                raise TactsenseInputError(f"{name} must be a finite number; got {value!r}")
+        if self.force_n < 0:
+            raise TactsenseInputError(f"force_n must be >= 0 (a push); got {self.force_n!r}")
+
+    def _shape(self, dx, dy, modulus_star_pa):  # pragma: no cover - every kind defines it
+        raise NotImplementedError
+
+    def _integral_mm2(self, modulus_star_pa):  # pragma: no cover - every kind defines it
+        raise NotImplementedError
+
+    def reach_mm(self, modulus_star_pa: float) -> float:  # pragma: no cover
+        """Distance from the centre beyond which the pressure is zero [mm]."""
+        raise NotImplementedError
+
+    def pressure_pa(
+        self, x_mm: np.ndarray, y_mm: np.ndarray, *, modulus_star_pa: float = 2.5e5 / 0.75
+    ) -> np.ndarray:
+        """Cell-averaged pressure on a regular grid, scaled to sum to ``force_n`` [Pa].
+
+        Parameters
+        ----------
+        x_mm, y_mm : ndarray, shape (M,), (N,)
+            Cell centres along x and y, evenly spaced [mm].
+        modulus_star_pa : float
+            Plane-strain modulus E / (1 - nu^2) of the layer, for contact sizes that
+            depend on it [Pa].
+
+        Returns
+        -------
+        ndarray, shape (M, N)
+            Pressure [Pa], compression positive.
+        """
+        x_mm = np.asarray(x_mm, dtype=float)
+        y_mm = np.asarray(y_mm, dtype=float)
+        hx = float(x_mm[1] - x_mm[0]) if x_mm.size > 1 else 1.0
+        hy = float(y_mm[1] - y_mm[0]) if y_mm.size > 1 else 1.0
+        if self.force_n == 0:
+            return np.zeros((x_mm.size, y_mm.size))
+        offsets = (np.arange(_SUBSAMPLES) + 0.5) / _SUBSAMPLES - 0.5
+        sub_x = (x_mm[:, None] + hx * offsets[None, :]).ravel() - self.x_mm
+        sub_y = (y_mm[:, None] + hy * offsets[None, :]).ravel() - self.y_mm
+        shape = self._shape(sub_x[:, None], sub_y[None, :], modulus_star_pa)
+        cells = shape.reshape(x_mm.size, _SUBSAMPLES, y_mm.size, _SUBSAMPLES).mean(axis=(1, 3))
+        reach = self.reach_mm(modulus_star_pa)
+        inside = (
+            x_mm[0] - hx / 2 <= self.x_mm - reach
+            and self.x_mm + reach <= x_mm[-1] + hx / 2
+            and y_mm[0] - hy / 2 <= self.y_mm - reach
+            and self.y_mm + reach <= y_mm[-1] + hy / 2
+        )
+        # wholly on the grid: scale so the cells carry the force exactly; partly off it:
+        # the shape's exact integral, so the part off the grid is missing, not moved
+        total = (
+            cells.sum() * hx * hy if inside else self._integral_mm2(modulus_star_pa)
+        ) * 1e-6  # [shape units * m^2]
+        if total <= 0:
+            return np.zeros_like(cells)
+        return cells * (self.force_n / total)
+
+    def moved(self, dx_mm: float, dy_mm: float, force_scale: float = 1.0) -> Indenter:
+        """The same indenter shifted by (dx, dy) [mm] with its force scaled [-]."""
+        return dataclasses.replace(
+            self,
+            x_mm=self.x_mm + dx_mm,
+            y_mm=self.y_mm + dy_mm,
+            force_n=max(0.0, self.force_n * force_scale),
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain description, ``kind`` first (JSON in recordings)."""
+        return {"kind": self.kind, **dataclasses.asdict(self)}
+
+
+@dataclass(frozen=True)
+class SphereProbe(Indenter):
+    """A rigid sphere of ``radius_mm`` pressed with ``force_n``: Hertz pressure."""
+
+    radius_mm: float = 1.6
+    kind: ClassVar[str] = "sphere"
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        _finite_positive("radius_mm", self.radius_mm)
+
+    def contact_radius_mm(self, modulus_star_pa: float) -> float:
+        """Hertz contact radius a = (3 F R / (4 E*))^(1/3) [mm]."""
+        radius_m = self.radius_mm * 1e-3
+        return 1e3 * (3.0 * self.force_n * radius_m / (4.0 * modulus_star_pa)) ** (1.0 / 3.0)
+
+    def reach_mm(self, modulus_star_pa):
+        return min(self.contact_radius_mm(modulus_star_pa), self.radius_mm)
+
+    def _integral_mm2(self, modulus_star_pa):
+        return 2.0 * math.pi * self.reach_mm(modulus_star_pa) ** 2 / 3.0
+
+    def _shape(self, dx, dy, modulus_star_pa):
+        a = self.reach_mm(modulus_star_pa)
+        rho2 = (dx**2 + dy**2) / a**2
+        return np.sqrt(np.clip(1.0 - rho2, 0.0, None))
+
+
+@dataclass(frozen=True)
+class DiscProbe(Indenter):
+    """Uniform pressure on a disc of ``radius_mm``."""
+
+    radius_mm: float = 1.5
+    kind: ClassVar[str] = "disc"
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        _finite_positive("radius_mm", self.radius_mm)
+
+    def reach_mm(self, modulus_star_pa):
+        return self.radius_mm
+
+    def _integral_mm2(self, modulus_star_pa):
+        return math.pi * self.radius_mm**2
+
+    def _shape(self, dx, dy, modulus_star_pa):
+        return (dx**2 + dy**2 <= self.radius_mm**2).astype(float)
+
+
+@dataclass(frozen=True)
+class FlatPunch(Indenter):
+    """A rigid flat-ended cylinder of ``radius_mm``: Boussinesq's punch pressure."""
+
+    radius_mm: float = 3.0
+    kind: ClassVar[str] = "punch"
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        _finite_positive("radius_mm", self.radius_mm)
+
+    def reach_mm(self, modulus_star_pa):
+        return self.radius_mm
+
+    def _integral_mm2(self, modulus_star_pa):
+        return 2.0 * math.pi * self.radius_mm
+
+    def _shape(self, dx, dy, modulus_star_pa):
+        a2 = self.radius_mm**2
+        r2 = dx**2 + dy**2
+        inside = r2 < a2
+        # the singularity at r = a is integrable: a sub-sample never sits exactly on it
+        return np.where(inside, 1.0 / np.sqrt(np.where(inside, a2 - r2, 1.0)), 0.0)
+
+
+@dataclass(frozen=True)
+class KnifeEdge(Indenter):
+    """A line load: ``length_mm`` long at ``angle_deg`` from the x axis, ``width_mm`` wide."""
+
+    length_mm: float = 10.0
+    angle_deg: float = 0.0
+    width_mm: float = 0.5
+    kind: ClassVar[str] = "knife"
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        _finite_positive("length_mm", self.length_mm)
+        _finite_positive("width_mm", self.width_mm)
+        if not math.isfinite(self.angle_deg):
+            raise TactsenseInputError(f"angle_deg must be finite; got {self.angle_deg!r}")
+
+    def reach_mm(self, modulus_star_pa):
+        return math.hypot(self.length_mm / 2.0, self.width_mm / 2.0)
+
+    def _integral_mm2(self, modulus_star_pa):
+        return math.pi / 4.0 * self.width_mm * self.length_mm
+
+    def _shape(self, dx, dy, modulus_star_pa):
+        angle = math.radians(self.angle_deg)
+        along = dx * math.cos(angle) + dy * math.sin(angle)
+        across = -dx * math.sin(angle) + dy * math.cos(angle)
+        half = self.width_mm / 2.0
+        profile = np.sqrt(np.clip(1.0 - (across / half) ** 2, 0.0, None))
+        return profile * (np.abs(along) <= self.length_mm / 2.0)
+
+
+INDENTERS: dict[str, type] = {
+    cls.kind: cls for cls in (SphereProbe, DiscProbe, FlatPunch, KnifeEdge)
+}
+
+
+def indenter_from_dict(data: dict[str, Any]) -> Indenter:
+    """An indenter from :meth:`Indenter.to_dict` output."""
+    data = dict(data)
+    kind = data.pop("kind", None)
+    if kind not in INDENTERS:
+        raise TactsenseInputError(
+            f"unknown indenter kind {kind!r}; expected one of {', '.join(INDENTERS)}"
+        )
+    return INDENTERS[kind](**data)
+
+
+def pressure_map(indenters, x_mm, y_mm, *, modulus_star_pa: float) -> np.ndarray:
+    """Sum of the pressures of several indenters on one grid (superposition) [Pa]."""
+    total = np.zeros((np.size(x_mm), np.size(y_mm)))
+    for indenter in indenters:
+        total += indenter.pressure_pa(x_mm, y_mm, modulus_star_pa=modulus_star_pa)
+    return total
