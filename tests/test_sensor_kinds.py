@@ -10,7 +10,7 @@ import pytest
 from typer.testing import CliRunner
 
 from tactsense.cli import app
-from tactsense.interop.urdf import sensor_from_urdf_any, sensor_to_urdf_any
+from tactsense.interop.urdf import sensor_from_urdf_any, sensor_to_urdf
 from tactsense.sensor import (
     KINDS,
     PRESETS,
@@ -73,7 +73,7 @@ def test_finger_taxel_normals_are_the_skin_normals():
 def test_pad_round_trips_through_urdf(name, tmp_path):
     spec = preset(name)
     path = tmp_path / "pad.urdf"
-    path.write_text(sensor_to_urdf_any(spec))
+    path.write_text(sensor_to_urdf(spec))
     back = sensor_from_urdf_any(path, extends=name)
     assert back.grid == spec.grid
     assert back.electronics.scan_rate_hz == spec.electronics.scan_rate_hz
@@ -86,7 +86,7 @@ def test_pad_round_trips_through_urdf(name, tmp_path):
 def test_point_set_round_trips_through_urdf_taxel_list(tmp_path):
     spec = preset("dome12")
     path = tmp_path / "dome.urdf"
-    path.write_text(sensor_to_urdf_any(spec))
+    path.write_text(sensor_to_urdf(spec))
     back = sensor_from_urdf_any(path)
     np.testing.assert_allclose(back.taxel_positions_mm(), spec.taxel_positions_mm(), atol=1e-12)
     np.testing.assert_allclose(back.taxel_normals(), spec.taxel_normals(), atol=1e-12)
@@ -195,3 +195,31 @@ def test_pad_capacitance_is_eq_2_of_its_electrode():
     area = spec.grid.electrode_x_mm * spec.grid.electrode_y_mm * 1e-6
     expected = 4.0 * 8.8541878128e-12 * area / 0.5e-3  # K eps0 A / d_o, eq. 2
     assert spec.junction_capacitance_f == pytest.approx(expected, rel=1e-12)
+
+
+@pytest.mark.parametrize("name", ["initial", "improved"])
+def test_finger_exports_each_taxel_on_the_skin_and_imports_back(name, tmp_path):
+    """The finger as a <taxel> list: every taxel at its real skin position and normal (as
+    upstream's TaxelInfoIterator reads them: position = xyz, normal = R(rpy) z), and the
+    import recovers the wired layout from the positions."""
+    from tactsense.interop.urdf import _rpy_to_matrix
+
+    spec = preset(name)
+    path = tmp_path / "finger.urdf"
+    path.write_text(sensor_to_urdf(spec))
+    root = ET.parse(path).getroot()
+    taxels = root.findall("sensor/tactile/taxel")
+    assert len(taxels) == spec.n_taxels
+    for element, position, normal in zip(
+        taxels, spec.taxel_positions_mm(), spec.taxel_normals(), strict=True
+    ):
+        xyz = np.array([float(v) for v in element.get("xyz").split()]) * 1e3
+        rpy = [float(v) for v in element.get("rpy").split()]
+        np.testing.assert_allclose(xyz, position, atol=1e-9)
+        np.testing.assert_allclose(_rpy_to_matrix(*rpy)[:, 2], normal, atol=1e-12)
+    back = sensor_from_urdf_any(path, extends=name)
+    assert back.shape == spec.shape
+    np.testing.assert_allclose(back.taxel_positions_mm(), spec.taxel_positions_mm(), atol=1e-9)
+    assert back.array.spacing_axial_mm == pytest.approx(spec.array.spacing_axial_mm, rel=1e-12)
+    assert back.array.spacing_angle_deg == pytest.approx(spec.array.spacing_angle_deg, rel=1e-12)
+    assert back.rings.ring_width_mm == pytest.approx(spec.rings.ring_width_mm, rel=1e-12)

@@ -8,7 +8,12 @@ from typer.testing import CliRunner
 
 import tactsense as ts
 from tactsense.cli import app
-from tactsense.interop.urdf import UrdfError, read_tactile_arrays, sensor_from_urdf, sensor_to_urdf
+from tactsense.interop.urdf import (
+    UrdfError,
+    finger_array_to_urdf,
+    read_tactile_arrays,
+    sensor_from_urdf,
+)
 
 runner = CliRunner()
 
@@ -39,7 +44,7 @@ TOOLBOX_STYLE = textwrap.dedent(
 def test_export_then_import_gives_the_same_layout(tmp_path, name):
     spec = ts.preset(name)
     path = tmp_path / "finger.urdf"
-    path.write_text(sensor_to_urdf(spec))
+    path.write_text(finger_array_to_urdf(spec))
     back = sensor_from_urdf(path, extends=name)
     assert back.shape == spec.shape
     assert back.array.spacing_axial_mm == pytest.approx(spec.array.spacing_axial_mm, rel=1e-12)
@@ -58,7 +63,7 @@ def test_exported_file_is_urdf_that_a_general_parser_reads(tmp_path):
     from urdf_parser_py.urdf import URDF
 
     spec = ts.fearing1990_initial()
-    text = sensor_to_urdf(spec, link="index_distal")
+    text = finger_array_to_urdf(spec, link="index_distal")
     robot = URDF.from_xml_string(text.split("\n", 1)[1])
     assert [link.name for link in robot.links] == ["index_distal"]
     array = ET.fromstring(text.split("\n", 1)[1]).find("sensor/tactile/array")

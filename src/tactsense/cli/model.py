@@ -271,7 +271,7 @@ def sensor_export(
     at the skin's surface; a pad: rows along x, columns along y), a point set as a
     <taxel idx xyz rpy> list; metres; the data vector is a tactsense frame, row-major.
     """
-    from tactsense.interop.urdf import sensor_to_urdf_any as sensor_to_urdf
+    from tactsense.interop.urdf import sensor_to_urdf
 
     if not urdf:
         fail("say which format: --urdf (for TOML use 'tactsense sensor show')")

@@ -201,8 +201,13 @@ def sensor_from_urdf(
         raise UrdfError(f"{path}: the array does not fit the {extends!r} finger: {error}") from None
 
 
-def sensor_to_urdf(spec: SensorSpec, *, link: str = "finger", robot: str | None = None) -> str:
-    """The sensor's array as a URDF document the tactile toolbox reads (RViz's display).
+def finger_array_to_urdf(
+    spec: SensorSpec, *, link: str = "finger", robot: str | None = None
+) -> str:
+    """A finger as the toolbox's flat ``<array>`` (older tactsense; tools that read only arrays).
+
+    The grid lies on a plane, not on the skin: :func:`sensor_to_urdf` writes each taxel at
+    its real position and normal instead.
 
     Spacing and size are in metres: along the finger the ring spacing and ring width,
     around it the arc between strips and the strip width at the skin's surface. The
@@ -255,6 +260,7 @@ class TactileTaxels:
     xyz_m: tuple[tuple[float, float, float], ...]
     rpy: tuple[tuple[float, float, float], ...]
     area_m2: tuple[float | None, ...]
+    box_m: tuple[tuple[float, float] | None, ...]
     update_rate_hz: float | None
 
 
@@ -271,6 +277,19 @@ def _triple(element, attribute: str, source: str) -> tuple[float, float, float]:
 
 def _local(element) -> str:
     return element.tag.rsplit("}", 1)[-1]
+
+
+def _taxel_box(taxel) -> tuple[float, float] | None:
+    """Size (x, y) of a taxel's ``<box>`` geometry [m], if it has one."""
+    geometry = next((c for c in taxel if _local(c) == "geometry"), None)
+    shape = None if geometry is None else next(iter(geometry), None)
+    if shape is None or _local(shape) != "box":
+        return None
+    try:
+        x, y, _ = (abs(float(v)) for v in shape.get("size", "").split())
+    except ValueError:
+        return None
+    return (x, y)
 
 
 def _taxel_area(taxel, source: str) -> float | None:
@@ -314,7 +333,7 @@ def read_tactile_taxels(path: str | Path) -> list[TactileTaxels]:
             continue
         name = sensor.get("name") or f"sensor {len(found)}"
         source = f"{path}: sensor {name!r}"
-        idx, xyz, rpy, area = [], [], [], []
+        idx, xyz, rpy, area, box = [], [], [], [], []
         for taxel in taxels:
             try:
                 idx.append(int(taxel.get("idx")))
@@ -323,12 +342,17 @@ def read_tactile_taxels(path: str | Path) -> list[TactileTaxels]:
             xyz.append(_triple(taxel, "xyz", source))
             rpy.append(_triple(taxel, "rpy", source))
             area.append(_taxel_area(taxel, source))
+            box.append(_taxel_box(taxel))
         rate = sensor.get("update_rate")
         try:
             rate_hz = None if rate is None else float(rate)
         except ValueError:
             raise UrdfError(f"{source}: update_rate={rate!r} is not a number [Hz]") from None
-        found.append(TactileTaxels(name, tuple(idx), tuple(xyz), tuple(rpy), tuple(area), rate_hz))
+        found.append(
+            TactileTaxels(
+                name, tuple(idx), tuple(xyz), tuple(rpy), tuple(area), tuple(box), rate_hz
+            )
+        )
     return found
 
 
@@ -349,12 +373,94 @@ def _rpy_to_matrix(roll: float, pitch: float, yaw: float):
     )
 
 
-def _normal_to_rpy(normal) -> tuple[float, float, float]:
-    """A roll-pitch-yaw whose rotation takes +z to ``normal`` (roll 0)."""
-    nx, ny, nz = normal
-    pitch = math.atan2(math.hypot(nx, ny), nz)
-    yaw = math.atan2(ny, nx) if math.hypot(nx, ny) > 1e-12 else 0.0
-    return 0.0, pitch, yaw
+def _taxel_rpy(normal) -> tuple[float, float, float]:
+    """Roll-pitch-yaw of a taxel frame: z along ``normal``, x along the part of +x (the
+    finger's axis toward the base) tangent to the surface (+y where +x is normal)."""
+    import numpy as np
+
+    n = np.asarray(normal, dtype=float)
+    n = n / np.linalg.norm(n)
+    for axis in (np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])):
+        t = axis - axis.dot(n) * n
+        if np.linalg.norm(t) > 1e-9:
+            break
+    t = t / np.linalg.norm(t)
+    r = np.column_stack([t, np.cross(n, t), n])
+    roll = math.atan2(r[2, 1], r[2, 2])
+    pitch = -math.asin(max(-1.0, min(1.0, r[2, 0])))
+    yaw = math.atan2(r[1, 0], r[0, 0])
+    return roll, pitch, yaw
+
+
+def _finger_from_taxels(path, taxels: TactileTaxels, base):
+    """A finger whose rows and columns are read back from its taxels' skin positions."""
+    import numpy as np
+
+    from tactsense.geometry import wrap_angle_deg, xyz_to_surface
+    from tactsense.sensor import sensor_from_dict
+
+    source = f"{path}: sensor {taxels.name!r}"
+    order = np.argsort(taxels.idx)
+    points = np.asarray(taxels.xyz_m, dtype=float)[order] * 1e3
+    on_cylinder = points[:, 0] >= 0
+    if not on_cylinder.any():
+        raise UrdfError(f"{source}: no taxel on the cylinder (x >= 0); not a finger")
+    radius = float(np.median(np.hypot(points[on_cylinder, 1], points[on_cylinder, 2])))
+    data = base.to_dict()
+    data["body"]["diameter_mm"] = 2.0 * radius
+    try:
+        spec0 = sensor_from_dict(data, source=source)
+    except TactsenseInputError as error:
+        raise UrdfError(
+            f"{source}: radius {radius:g} mm does not fit {base.name!r}: {error}"
+        ) from None
+    axial, angle, _ = xyz_to_surface(spec0, points)
+    distinct = np.unique(np.round(axial, 6))
+    rows = distinct.size
+    if len(points) % rows:
+        raise UrdfError(f"{source}: {len(points)} taxels on {rows} rows is not a grid")
+    cols = len(points) // rows
+    axial = axial.reshape(rows, cols)
+    angle = angle.reshape(rows, cols)
+    if not np.allclose(axial, axial[:, :1], atol=1e-6):
+        raise UrdfError(f"{source}: the taxels are not in row-major order of rings")
+    tip = bool(base.array.tip_row)
+    ring_axial = axial[int(tip) :, 0]
+    spacing_axial = (
+        float(np.mean(np.diff(ring_axial))) if ring_axial.size > 1 else base.array.spacing_axial_mm
+    )
+    spacing_angle = (
+        float(wrap_angle_deg(angle[-1, 1] - angle[-1, 0]))
+        if cols > 1
+        else base.array.spacing_angle_deg
+    )
+    layout = data["array"]
+    layout.update(
+        cylinder_rows=rows - int(tip),
+        cols=cols,
+        wired_rows=rows,
+        wired_cols=cols,
+        wired_col_offset=0,
+        spacing_axial_mm=spacing_axial,
+        spacing_angle_deg=spacing_angle,
+        first_row_axial_mm=float(ring_axial[0]),
+        first_col_angle_deg=float(angle[-1, 0]),
+    )
+    if tip:
+        layout["tip_row_axial_mm"] = float(axial[0, 0])
+    sizes = [taxels.box_m[k] for k in order if taxels.box_m[k] is not None]
+    if sizes:
+        data["rings"].update(ring_width_mm=sizes[0][0] * 1e3, strip_width_mm=sizes[0][1] * 1e3)
+    if taxels.update_rate_hz is not None:
+        data["electronics"]["scan_rate_hz"] = taxels.update_rate_hz
+    data["name"] = taxels.name
+    data["description"] = f"imported from {Path(path).name} (URDF taxel list), on {base.name}"
+    try:
+        return sensor_from_dict(data, source=str(path))
+    except TactsenseInputError as error:
+        raise UrdfError(
+            f"{path}: the taxels do not fit the {base.name!r} finger: {error}"
+        ) from None
 
 
 def sensor_from_urdf_any(path: str | Path, *, name: str | None = None, extends: str | None = None):
@@ -409,10 +515,12 @@ def sensor_from_urdf_any(path: str | Path, *, name: str | None = None, extends: 
         except TactsenseInputError as error:
             raise UrdfError(f"{path}: the array does not fit {base.name!r}: {error}") from None
     base = preset(extends or "dome12")
+    if base.kind == "finger":
+        return _finger_from_taxels(path, taxels, base)
     if not isinstance(base, PointsSpec):
         raise UrdfError(
             f"{path}: sensor {wanted!r} is a <taxel> list, a point set; --extends must name a "
-            "point-set preset (dome12)"
+            "point-set preset (dome12) or a finger preset (initial, improved)"
         )
     order = sorted(range(len(taxels.idx)), key=lambda k: taxels.idx[k])
     if sorted(taxels.idx) != list(range(len(taxels.idx))):
@@ -444,18 +552,18 @@ def sensor_from_urdf_any(path: str | Path, *, name: str | None = None, extends: 
         raise UrdfError(f"{path}: the taxels do not fit {base.name!r}: {error}") from None
 
 
-def sensor_to_urdf_any(spec, *, link: str = "finger", robot: str | None = None) -> str:
+def sensor_to_urdf(spec, *, link: str = "finger", robot: str | None = None) -> str:
     """Any sensor as a URDF tactile description the toolbox's parser accepts.
 
-    A finger: :func:`sensor_to_urdf`. A pad: an ``<array>`` (x along rows, y along
+    A finger or a point set: a ``<taxel idx xyz rpy>`` list, each taxel on the skin at its
+    real position, ``z`` its outward normal (for a finger ``x`` along the axis; a ``<box>``
+    of the ring width by the strip width, or of a point set's taxel area). A pad: an
+    ``<array>`` (x along rows, y along
     columns, as upstream's iterator places taxel (row, col) at (row * spacing.x,
-    col * spacing.y)). A point set: a ``<taxel idx xyz rpy>`` list with a ``<box>``
-    geometry of the taxel's area (a square) and its normal as the rotated +z. Every
+    col * spacing.y)). Every
     ``<tactile>`` carries the ``channel`` attribute upstream's parser requires (the
     sensor's name: the ``TactileState`` channel that holds its data).
     """
-    if spec.kind == "finger":
-        return sensor_to_urdf(spec, link=link, robot=robot)
     m = lambda value_mm: f"{value_mm * 1e-3:.15g}"  # noqa: E731
     root = ET.Element("robot", name=robot or f"{spec.name}_robot")
     ET.SubElement(root, "link", name=link)
@@ -478,12 +586,22 @@ def sensor_to_urdf_any(spec, *, link: str = "finger", robot: str | None = None) 
             offset="0 0",
         )
     else:
-        positions, normals, areas = (
-            spec.taxel_positions_mm(), spec.taxel_normals(), spec.areas_mm2,
-        )  # fmt: skip
-        rows = zip(positions, normals, areas, strict=True)
-        for index, (position, normal, area) in enumerate(rows):
-            rpy = _normal_to_rpy(normal)
+        positions, normals = spec.taxel_positions_mm(), spec.taxel_normals()
+        if spec.kind == "finger":  # ring width along the axis, strip width around it
+            boxes = [(spec.rings.ring_width_mm, spec.rings.strip_width_mm)] * len(positions)
+        else:
+            boxes = [(math.sqrt(a), math.sqrt(a)) for a in spec.areas_mm2]
+        if spec.kind == "finger" and spec.array.tip_row:
+            tactile.append(
+                ET.Comment(
+                    f" tactsense: {spec.name}, row 0 under the hemispherical tip at "
+                    f"{spec.array.tip_row_axial_mm:g} mm along the skin; each taxel on the "
+                    "skin at its real position, z its outward normal, x along the finger "
+                )
+            )
+        rows = zip(positions, normals, boxes, strict=True)
+        for index, (position, normal, (size_x, size_y)) in enumerate(rows):
+            rpy = _taxel_rpy(normal)
             taxel = ET.SubElement(
                 tactile,
                 "taxel",
@@ -491,8 +609,7 @@ def sensor_to_urdf_any(spec, *, link: str = "finger", robot: str | None = None) 
                 xyz=" ".join(m(v) for v in position),
                 rpy=" ".join(f"{v:.15g}" for v in rpy),
             )
-            side = math.sqrt(area)
             geometry = ET.SubElement(taxel, "geometry")
-            ET.SubElement(geometry, "box", size=f"{m(side)} {m(side)} 0")
+            ET.SubElement(geometry, "box", size=f"{m(size_x)} {m(size_y)} 0")
     ET.indent(root)
     return '<?xml version="1.0" encoding="utf-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
