@@ -285,33 +285,34 @@ def test_seek_and_step_on_a_recording(page, sweep_file):
             " s.dispatchEvent(new Event('change')); }",
             target,
         )
-        page.wait_for_function(
-            f"() => document.getElementById('position').textContent.startsWith("
-            f"'frame {target + 1} of {len(rec)}')",
-            timeout=5000,
-        )
         page.wait_for_function(f"() => window.tactsenseView.drawnIndex === {target}", timeout=5000)
         baseline = baseline_from(rec.frames)
         deflection, _ = deflection_from_counts(rec.frames[target], baseline, rec.sensor)
         expected = np.unravel_index(np.argmax(deflection), deflection.shape)
         assert _hottest(page) == tuple(int(v) for v in expected)
-        assert int(page.text_content("#frame-index")) == target
+
+        def numbers():
+            """The frame as the transport and as the stream panel say it."""
+            position = page.text_content("#position")
+            assert position.endswith("s") and f" of 0–{len(rec) - 1} · " in position, position
+            return int(position.split()[1]), int(page.text_content("#frame-index"))
+
+        # the seek bar's value is the frame shown, counted from 0 in both places
+        page.wait_for_function(
+            f"() => document.getElementById('position').textContent.startsWith('frame {target} ')",
+            timeout=5000,
+        )
+        assert numbers() == (target, target)
         page.click("#step-fwd")
-        page.wait_for_function(
-            f"() => document.getElementById('position').textContent.startsWith("
-            f"'frame {target + 2} of')",
-            timeout=5000,
-        )
+        page.wait_for_function(f"() => window.tactsenseView.lastIndex === {target + 1}")
+        assert numbers() == (target + 1, target + 1)
         page.click("#step-back")
         page.click("#step-back")
-        page.wait_for_function(
-            f"() => document.getElementById('position').textContent.startsWith('frame {target}"
-            " of')",
-            timeout=5000,
-        )
+        page.wait_for_function(f"() => window.tactsenseView.lastIndex === {target - 1}")
+        assert numbers() == (target - 1, target - 1)
         # paused means paused: the position holds
         page.wait_for_timeout(600)
-        assert page.text_content("#position").startswith(f"frame {target} of")
+        assert numbers() == (target - 1, target - 1)
     finally:
         _stop(server)
 
@@ -353,3 +354,110 @@ def test_command_line_emulate_and_view(page, tmp_path):
     assert view.returncode == 0, err
     assert "frames shown" in err  # Ctrl-C: a summary line, no traceback
     assert "Traceback" not in err
+
+
+# colour-table index (0..255) of the canvas pixel at each of a list of points
+INDEX_AT_JS = """(points) => {
+  const lut = window.tactsenseView.layout.colormap.lut;
+  const ctx = document.getElementById('map').getContext('2d');
+  return points.map(([x, y]) => {
+    const d = ctx.getImageData(Math.round(x), Math.round(y), 1, 1).data;
+    let best = 0, bestErr = Infinity;
+    lut.forEach((c, i) => {
+      const e = (c[0] - d[0]) ** 2 + (c[1] - d[1]) ** 2 + (c[2] - d[2]) ** 2;
+      if (e < bestErr) { bestErr = e; best = i; }
+    });
+    return best;
+  });
+}"""
+
+
+def _centre(page, row, col) -> tuple[float, float]:
+    return tuple(page.evaluate(f"() => window.tactsenseView.cellCentre({row}, {col})"))
+
+
+def test_counts_surface_does_not_ring_at_the_ends_of_the_finger(page, initial):
+    """Counts mode, a touch in the middle of the finger: between the untouched tactels of
+    the first two and the last two rows the surface has the colour of the dots beside
+    it. (Interpolating raw counts, whose rows' weights sum to up to 1.10 there, painted
+    those bands about 200 counts above every tactel: the top of the colour scale.)"""
+    scene = ts.repeated_load(initial, row=4, col=2, repeats=1, on_s=60.0, settle_s=1.0)
+    rec = ts.simulate(initial, scene, rng=7)
+    server, emulator = _serve_emulated(rec, speed=5.0)
+    try:
+        page.goto(server.url)
+        page.wait_for_function(TOUCHING_JS, timeout=15000)
+        page.check('input[value="counts"]')
+        page.wait_for_function("() => window.tactsenseView.units === 'counts'")
+        _frame_after(page, 2)
+        seen = _seen(page)  # the dots' colours
+        rows = initial.shape[0]
+        points, beside = [], []
+        for r0, r1 in [(1, 2), (rows - 2, rows - 1)]:
+            for c in (5, 6, 7, 0):  # away from the touched column 2
+                (x0, y), (x1, _) = _centre(page, r0, c), _centre(page, r1, c)
+                points.append([(x0 + x1) / 2, y])  # half-way between two dots
+                beside.append((seen[r0, c], seen[r1, c]))
+        between = page.evaluate(INDEX_AT_JS, points)
+        # the touched tactel spreads the scale: the ends are in its lower part
+        assert seen.max() > 200 and max(max(b) for b in beside) < 60, seen
+        for value, (a, b) in zip(between, beside, strict=True):
+            # 12 of 256 steps: a few counts of noise on a scale about 80 counts wide
+            assert min(a, b) - 12 <= value <= max(a, b) + 12, (between, beside)
+    finally:
+        _stop(server, emulator)
+
+
+def test_recentred_map_keeps_dots_in_their_cells_and_clear_of_the_labels(page, initial):
+    """A touch 3 deg past the seam re-centres the map on it (column 0.07): every row of
+    dots stays in the middle of its own band of the map, the surface's peak is at the
+    touched dot, and no dot reaches the labels under the map. (Centring on the contact
+    itself put the 180-deg dots on the top edge and the 135-deg dots over the labels.)"""
+    scene = ts.probe_sweep(
+        initial, along="around", row=4, start=3.0, stop=6.0, increment=1.0, dwell_s=20
+    )
+    rec = ts.simulate(initial, scene, rng=8)
+    server, emulator = _serve_emulated(rec, speed=5.0)
+    try:
+        page.goto(server.url)
+        page.wait_for_function(TOUCHING_JS, timeout=15000)
+        _frame_after(page, 3)
+        state = page.evaluate(
+            "() => { const s = window.tactsenseView; return {centre: s.centre, map: s.map,"
+            " labels: s.labels, dots: [...Array(s.layout.rows).keys()].map((r) =>"
+            " [...Array(s.layout.cols).keys()].map((c) => s.cellCentre(r, c)))}; }"
+        )
+        cols = initial.shape[1]
+        spacing = 360.0 / cols
+        first = initial.col_angle_deg[0] + (cols - 1) / 2 * spacing  # the map's first centre
+        assert abs((state["centre"] - first + 180) % 360 - 180) > 90  # it did re-centre
+        top, height, cell, dot = (state["map"][k] for k in ("top", "height", "cell", "dot"))
+        dots = np.asarray(state["dots"])  # (rows, cols, xy)
+        for row in dots:
+            ys = np.sort(row[:, 1])
+            np.testing.assert_allclose(ys, top + (np.arange(cols) + 0.5) * cell, atol=0.5)
+        # and drawn so: above the map, over each column of dots, the canvas is blank
+        alpha = page.evaluate(
+            "(xs) => xs.map((x) => document.getElementById('map').getContext('2d')"
+            f".getImageData(Math.round(x), {top - 3}, 1, 1).data[3])",
+            dots[:, 0, 0].tolist(),
+        )
+        assert alpha == [0] * len(alpha)
+        # the contact (column 0) is in the middle band, and the surface beside the loaded
+        # dot peaks at that dot's height
+        y0 = dots[4, 0, 1]
+        assert abs(y0 - (top + height / 2)) <= cell / 2 + 0.5
+        x = dots[4, 0, 0] + cell / 2  # half-way to the next row: surface, no dot
+        ys = np.arange(top + 1, top + height - 1)
+        profile = page.evaluate(INDEX_AT_JS, [[x, float(y)] for y in ys])
+        assert abs(ys[int(np.argmax(profile))] - y0) <= cell / 4
+        # the labels: all drawn, none under a dot
+        assert len(state["labels"]) >= initial.shape[0] + cols
+        centres = dots.reshape(-1, 2)
+        for box in state["labels"]:
+            nearest_x = np.clip(centres[:, 0], box["left"], box["right"])
+            nearest_y = np.clip(centres[:, 1], box["top"], box["bottom"])
+            gap = np.hypot(centres[:, 0] - nearest_x, centres[:, 1] - nearest_y)
+            assert gap.min() > dot, box
+    finally:
+        _stop(server, emulator)

@@ -7,6 +7,7 @@
 const CELL = 48;          // pixels per tactel spacing, along and around
 const GAP = 34;           // pixels between the tip row and the cylinder
 const MARGIN = { left: 56, top: 14, bottom: 40, bar: 70 };
+const DOT = 0.32 * CELL;  // radius of a tactel's dot [px]
 const TRAIL = 24;         // estimates kept in the contact's trail
 const TRACE_S = 20;       // seconds shown by the time traces
 
@@ -28,6 +29,7 @@ const state = {
   firstSerial: null,     // the first frame this page received (server's numbering)
   marker: null,           // canvas pixels of the marker, for tests and people alike
   drawnIndex: null,       // index of the frame the map shows
+  labels: [],             // the axes' labels as drawn: text and box [canvas px]
   dirty: false,
   traces: { t: [], force: [], tactel: [] },
 };
@@ -49,6 +51,15 @@ function angleSpan() {
   if (L.closes) return [state.centre - 180, state.centre + 180];
   const a0 = L.col_angle_deg[0], s = L.spacing_deg;
   return [a0 - s / 2, a0 + (n - 0.5) * s];
+}
+
+// the display angle at the middle of the map nearest to ``angle`` that puts the map's
+// top and bottom edges (centre -/+ 180 deg) half-way between two columns, as the
+// initial centre does: every dot then sits in the middle of its own cell band
+function centreNear(angle) {
+  const L = state.layout, s = L.spacing_deg;
+  const base = L.col_angle_deg[0] - s / 2 + 180;   // the edges on the seam
+  return base + Math.round((angle - base) / s) * s;
 }
 
 function mapHeight() { return state.layout.cols * CELL; }
@@ -152,10 +163,34 @@ function surfaceOf(z) {
 
 const offscreen = document.createElement("canvas");
 
-function drawSurface(z, lo, hi) {
+// The surface always interpolates deflection (eq. 48): a tactel's raw counts carry its
+// own baseline, and the sinc of those rings at the open ends of the rows (the row
+// weights sum to up to 1.10 between the first two rows: +200 counts on 2000). In
+// counts mode each point is shown in the counts of the tactel whose cell it lies in:
+// eq. 4 solved for the reading, V = V_o / (1 - f), with that tactel's V_o =
+// counts * (1 - deflection); at the tactel itself this is its own reading.
+function surfaceValues(frame) {
+  const L = state.layout, S = L.surface, first = L.first_row, C = L.cols;
+  const f = surfaceOf(frame.deflection);
+  if (state.units !== "counts") return f;
+  const nr = S.w_rows.length, nc = S.w_cols.length;
+  const colOf = S.col.map((y) => ((Math.round(y) % C) + C) % C);
+  for (let i = 0; i < nr; i++) {
+    const r = first + Math.round(S.row[i]);
+    const counts = frame.counts[r], defl = frame.deflection[r];
+    for (let j = 0; j < nc; j++) {
+      const c = colOf[j];
+      const v0 = counts[c] * (1 - defl[c]);
+      f[i * nc + j] = v0 / Math.max(1 - f[i * nc + j], 1e-3);
+    }
+  }
+  return f;
+}
+
+function drawSurface(frame, lo, hi) {
   const L = state.layout, S = L.surface;
   const nr = S.w_rows.length, nc = S.w_cols.length;
-  const f = surfaceOf(z);
+  const f = surfaceValues(frame);
   offscreen.width = nr; offscreen.height = nc;
   const octx = offscreen.getContext("2d");
   const image = octx.createImageData(nr, nc);
@@ -182,20 +217,21 @@ function draw() {
   if (!L) return;
   ctx.clearRect(0, 0, canvas.width, canvas.height);
   const H = mapHeight(), left = cylinderLeft(), W = cylinderRows() * CELL;
+  state.map = { top: MARGIN.top, height: H, cell: CELL, dot: DOT };   // for tests
   ctx.fillStyle = "#eceff1";
   ctx.fillRect(left, MARGIN.top, W, H);
   if (L.tip_row) ctx.fillRect(MARGIN.left, MARGIN.top, CELL, H);
-  drawAxes();
-  if (!frame) return;
+  if (!frame) { drawAxes(); return; }
   const z = values(frame);
   const [lo, hi, unit] = scale(frame);
-  if (state.showSurface) drawSurface(z, lo, hi);
+  // no surface until there is a deflection to interpolate (the baseline is known)
+  if (state.showSurface && frame.deflection) drawSurface(frame, lo, hi);
   // tactels: dots in the colour of their value, over the surface
   for (let r = 0; r < L.rows; r++) {
     for (let c = 0; c < L.cols; c++) {
       const [x, y] = cellCentre(r, c);
       ctx.beginPath();
-      ctx.arc(x, y, CELL * 0.32, 0, 2 * Math.PI);
+      ctx.arc(x, y, DOT, 0, 2 * Math.PI);
       ctx.fillStyle = rgb(colour(z[r][c], lo, hi));
       ctx.fill();
       const sel = state.selected && state.selected[0] === r && state.selected[1] === c;
@@ -204,27 +240,38 @@ function draw() {
       ctx.stroke();
     }
   }
+  drawAxes();   // after the dots: nothing covers a label
   drawSeam();
   drawColourBar(lo, hi, unit);
   if (state.showMarker) drawContact();
   state.drawnIndex = frame.index;   // what the map shows now (tests wait for it)
 }
 
+// the text, and its box in canvas pixels kept in state.labels (for tests)
+function label(text, x, y) {
+  ctx.fillText(text, x, y);
+  const m = ctx.measureText(text);
+  state.labels.push({
+    text,
+    left: x - m.actualBoundingBoxLeft, right: x + m.actualBoundingBoxRight,
+    top: y - m.actualBoundingBoxAscent, bottom: y + m.actualBoundingBoxDescent,
+  });
+}
+
 function drawAxes() {
   const L = state.layout, H = mapHeight(), left = cylinderLeft();
+  state.labels = [];
   ctx.fillStyle = "#333"; ctx.font = "12px system-ui, sans-serif"; ctx.textAlign = "center";
   for (let r = L.first_row; r < L.rows; r++) {
     const [x] = cellCentre(r, 0);
-    ctx.fillText(L.row_axial_mm[r].toFixed(1), x, MARGIN.top + H + 14);
+    label(L.row_axial_mm[r].toFixed(1), x, MARGIN.top + H + 14);
   }
-  ctx.fillText("along the finger [mm]", left + (cylinderRows() * CELL) / 2, MARGIN.top + H + 30);
-  if (L.tip_row) {
-    ctx.fillText("tip", MARGIN.left + CELL / 2, MARGIN.top + H + 14);
-  }
+  label("along the finger [mm]", left + (cylinderRows() * CELL) / 2, MARGIN.top + H + 30);
+  if (L.tip_row) label("tip", MARGIN.left + CELL / 2, MARGIN.top + H + 14);
   ctx.textAlign = "right";
   for (let c = 0; c < L.cols; c++) {
     const y = yOfAngle(angleOfCol(c));
-    ctx.fillText(`${signedAngle(L.col_angle_deg[c]).toFixed(0)}°`, MARGIN.left - 6, y + 4);
+    label(`${signedAngle(L.col_angle_deg[c]).toFixed(0)}°`, MARGIN.left - 6, y + 4);
   }
   ctx.save();
   ctx.translate(14, MARGIN.top + H / 2); ctx.rotate(-Math.PI / 2); ctx.textAlign = "center";
@@ -335,7 +382,8 @@ function showPlayback(p) {
   if (document.activeElement !== seek) seek.value = p.position;
   $("play").textContent = p.playing ? "pause" : "play";
   const f = state.latest;
-  if (f) $("position").textContent = `frame ${f.index + 1} of ${p.n_frames} · ${f.time_s.toFixed(2)} s`;
+  // frames count from 0, as the stream panel, the seek bar and the estimates' frame column
+  if (f) $("position").textContent = `frame ${f.index} of 0–${p.n_frames - 1} · ${f.time_s.toFixed(2)} s`;
 }
 
 // ---- time traces (uPlot) --------------------------------------------------------------
@@ -390,7 +438,7 @@ state.history = [];   // the frames behind the traces (bounded like the traces)
 
 function onLayout(L) {
   state.layout = L;
-  state.centre = L.closes ? L.col_angle_deg[0] + ((L.cols - 1) / 2) * L.spacing_deg : 0;
+  state.centre = L.closes ? centreNear(L.col_angle_deg[0] + ((L.cols - 1) / 2) * L.spacing_deg) : 0;
   $("sensor").textContent = L.sensor;
   $("source").textContent = `${L.source.kind}: ${L.source.name}`;
   $("calibration").textContent = L.source.calibrated
@@ -444,7 +492,7 @@ function onFrame(f, fromHistory) {
       // on the seam is one blob
       const angle = angleOfCol(est.col);
       const off = wrap360(angle - state.centre + 180) - 180;
-      if (Math.abs(off) > 180 - L.spacing_deg) state.centre = angle;
+      if (Math.abs(off) > 180 - L.spacing_deg) state.centre = centreNear(angle);
     }
     state.trail.push({ row: est.row, col: est.col });
     if (state.trail.length > TRAIL) state.trail.shift();
