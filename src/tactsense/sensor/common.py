@@ -308,21 +308,25 @@ class SpecBase:
 
     @classmethod
     def from_toml(cls, path: str | Path):
-        """Load and validate a sensor description from a TOML file (any kind)."""
+        """Load and validate a sensor description from a TOML file.
+
+        The file's ``kind`` decides the class returned (a finger when it has none), so
+        ``SensorSpec.from_toml`` of a pad's file gives a :class:`PadSpec`.
+        """
         from tactsense.sensor.registry import sensor_from_dict
 
-        return sensor_from_dict(read_toml(path), source=str(path), expected=cls)
+        return sensor_from_dict(read_toml(path), source=str(path))
 
     @classmethod
     def from_toml_string(cls, text: str):
-        """Validate a sensor description given as TOML text (any kind)."""
+        """Validate a sensor description given as TOML text (its ``kind`` picks the class)."""
         from tactsense.sensor.registry import sensor_from_dict
 
         try:
             data = tomllib.loads(text)
         except tomllib.TOMLDecodeError as error:
             raise SensorSpecError(f"sensor description is not valid TOML: {error}") from None
-        return sensor_from_dict(data, expected=cls)
+        return sensor_from_dict(data)
 
     def to_toml_string(self) -> str:
         """The description as TOML text."""
