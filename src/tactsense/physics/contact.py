@@ -363,11 +363,16 @@ CONTACT_TYPES = {"probe": Probe, "flat": FlatContact, "line": LineContact}
 
 def contact_from_dict(data: dict):
     """Rebuild a contact from :meth:`to_dict` output (recording metadata)."""
+    from tactsense.physics.indenters import INDENTERS, indenter_from_dict
+
     data = dict(data)
+    if data.get("kind") in INDENTERS:  # a pad's or a point set's indenter
+        return indenter_from_dict(data)
     kind = data.pop("kind", None)
     if kind not in CONTACT_TYPES:
         raise TactsenseInputError(
-            f"unknown contact kind {kind!r}; expected one of {', '.join(CONTACT_TYPES)}"
+            f"unknown contact kind {kind!r}; expected one of "
+            f"{', '.join([*CONTACT_TYPES, *INDENTERS])}"
         )
     return CONTACT_TYPES[kind](**data)
 

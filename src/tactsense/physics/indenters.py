@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
 import numpy as np
@@ -45,6 +45,8 @@ class Indenter:
     x_mm: float
     y_mm: float
     force_n: float
+    at_taxel: int | None = field(default=None, kw_only=True)
+    """Point sets only: (x_mm, y_mm) are in this taxel's tangent plane, from its centre."""
 
     kind: ClassVar[str] = "indenter"
 
@@ -122,7 +124,10 @@ class Indenter:
 
     def to_dict(self) -> dict[str, Any]:
         """Plain description, ``kind`` first (JSON in recordings)."""
-        return {"kind": self.kind, **dataclasses.asdict(self)}
+        data = dataclasses.asdict(self)
+        if data["at_taxel"] is None:
+            del data["at_taxel"]
+        return {"kind": self.kind, **data}
 
 
 @dataclass(frozen=True)

@@ -70,7 +70,7 @@ def pad_strain(spec: PadSpec, indenters) -> np.ndarray:
         pressure,
         spacing_mm=(hx, hy),
         layer=spec.layer,
-        first_taxel_index=(int(round(-x[0] / hx)), int(round(-y[0] / hy))),
+        first_taxel_index=(round(-x[0] / hx), round(-y[0] / hy)),
         taxel_step=(OVERSAMPLE, OVERSAMPLE),
         taxel_shape=spec.shape,
         electrode_mm=(g.electrode_x_mm, g.electrode_y_mm),

@@ -1,0 +1,240 @@
+"""Scenarios for pads and point sets: what presses where, and for how long.
+
+Each builder returns a :class:`tactsense.simulate.Scenario` of indenters
+(:mod:`tactsense.physics.indenters`) that fits the sensor it is given: positions default
+to the middle of the array and are checked against it. Positions are in the pad's axes
+(x along rows, y along columns, ``docs/nomenclature.md``); on a point set, ``(x, y)``
+are in the tangent plane of a taxel (``at_taxel``, default the first).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from tactsense._validation import TactsenseInputError, check_positive
+from tactsense.physics.indenters import INDENTERS, FlatPunch, Indenter, KnifeEdge, SphereProbe
+from tactsense.simulate import Scenario, Step
+
+
+def _settle(settle_s: float) -> list[Step]:
+    return [Step((), settle_s, "baseline")] if settle_s > 0 else []
+
+
+def centre_mm(spec) -> tuple[float, float]:
+    """The middle of a pad, or of a point set's first taxel's tangent plane [mm]."""
+    if spec.kind == "pad":
+        g = spec.grid
+        return (0.5 * (g.rows - 1) * g.row_pitch_mm, 0.5 * (g.cols - 1) * g.col_pitch_mm)
+    return (0.0, 0.0)
+
+
+def _check_on(spec, x_mm: float, y_mm: float, what: str) -> None:
+    if spec.kind != "pad":
+        return
+    g = spec.grid
+    low_x, high_x = -0.5 * g.row_pitch_mm, (g.rows - 0.5) * g.row_pitch_mm
+    low_y, high_y = -0.5 * g.col_pitch_mm, (g.cols - 0.5) * g.col_pitch_mm
+    if not (low_x <= x_mm <= high_x and low_y <= y_mm <= high_y):
+        raise TactsenseInputError(
+            f"{what} at ({x_mm:g}, {y_mm:g}) mm is off the {g.rows}x{g.cols} pad {spec.name!r} "
+            f"(x in [{low_x:g}, {high_x:g}], y in [{low_y:g}, {high_y:g}] mm)"
+        )
+
+
+def make_indenter(
+    kind: str, x_mm: float, y_mm: float, force_n: float, size_mm: float, **extra
+) -> Indenter:
+    """An indenter by kind: ``sphere`` (radius), ``disc`` (radius), ``punch`` (radius) or
+    ``knife`` (length; ``angle_deg`` in ``extra``)."""
+    if kind not in INDENTERS:
+        raise TactsenseInputError(f"unknown indenter {kind!r}; expected {', '.join(INDENTERS)}")
+    if kind == "knife":
+        return KnifeEdge(x_mm, y_mm, force_n, length_mm=size_mm, **extra)
+    return INDENTERS[kind](x_mm, y_mm, force_n, radius_mm=size_mm, **extra)
+
+
+def press(
+    spec,
+    *,
+    x_mm: float | None = None,
+    y_mm: float | None = None,
+    force_n: float = 0.5,
+    indenter: str = "sphere",
+    size_mm: float = 1.6,
+    dwell_s: float = 0.5,
+    lift_s: float = 0.5,
+    repeats: int = 1,
+    settle_s: float = 0.2,
+    at_taxel: int | None = None,
+) -> Scenario:
+    """Press an indenter ``repeats`` times at one place, lifting between presses."""
+    cx, cy = centre_mm(spec)
+    x, y = (cx if x_mm is None else x_mm), (cy if y_mm is None else y_mm)
+    _check_on(spec, x, y, indenter)
+    check_positive(dwell_s, "dwell_s")
+    if repeats < 1:
+        raise TactsenseInputError(f"repeats must be at least 1; got {repeats}")
+    extra = {"at_taxel": at_taxel} if at_taxel is not None else {}
+    contact = make_indenter(indenter, x, y, force_n, size_mm, **extra)
+    steps = _settle(settle_s)
+    for k in range(repeats):
+        steps.append(Step((contact,), dwell_s, f"press {k + 1}"))
+        if lift_s > 0:
+            steps.append(Step((), lift_s, "lifted"))
+    return Scenario(
+        tuple(steps),
+        "press",
+        f"{indenter} of {size_mm:g} mm pressed {repeats}x with {force_n:g} N at "
+        f"({x:g}, {y:g}) mm",
+        {"x_mm": x, "y_mm": y, "force_n": force_n, "indenter": indenter, "size_mm": size_mm,
+         "repeats": repeats},
+    )  # fmt: skip
+
+
+def hold(spec, *, force_n: float = 0.5, hold_s: float = 5.0, lift_s: float = 5.0, **where):
+    """Press and hold, then lift: the delayed elastic response and creep of section 3.4."""
+    return press(spec, force_n=force_n, dwell_s=hold_s, lift_s=lift_s, **where)
+
+
+def two_probes(
+    spec,
+    *,
+    separation_mm: float = 5.0,
+    force_n: float = 0.5,
+    size_mm: float = 1.6,
+    dwell_s: float = 0.5,
+    settle_s: float = 0.2,
+    angle_deg: float = 90.0,
+) -> Scenario:
+    """Two equal spheres ``separation_mm`` apart about the middle, along ``angle_deg`` from x."""
+    check_positive(separation_mm, "separation_mm")
+    cx, cy = centre_mm(spec)
+    dx = 0.5 * separation_mm * math.cos(math.radians(angle_deg))
+    dy = 0.5 * separation_mm * math.sin(math.radians(angle_deg))
+    first = SphereProbe(cx - dx, cy - dy, force_n, radius_mm=size_mm)
+    second = SphereProbe(cx + dx, cy + dy, force_n, radius_mm=size_mm)
+    for probe in (first, second):
+        _check_on(spec, probe.x_mm, probe.y_mm, "probe")
+    return Scenario(
+        (*_settle(settle_s), Step((first, second), dwell_s, "two probes"), Step((), 0.2, "lifted")),
+        "two-probes",
+        f"two {size_mm:g}-mm spheres of {force_n:g} N each, {separation_mm:g} mm apart",
+        {"separation_mm": separation_mm, "force_n": force_n, "size_mm": size_mm},
+    )
+
+
+def slide(
+    spec,
+    *,
+    start_mm: tuple[float, float] | None = None,
+    end_mm: tuple[float, float] | None = None,
+    force_n: float = 0.5,
+    size_mm: float = 1.6,
+    speed_mm_s: float = 10.0,
+    increment_mm: float = 0.25,
+    settle_s: float = 0.2,
+) -> Scenario:
+    """A sphere sliding at constant force from ``start_mm`` to ``end_mm`` (default: across the
+    middle of the pad along y), moved in steps of ``increment_mm``."""
+    check_positive(speed_mm_s, "speed_mm_s")
+    check_positive(increment_mm, "increment_mm")
+    cx, _ = centre_mm(spec)
+    if spec.kind == "pad":
+        margin = spec.grid.col_pitch_mm
+        span = (spec.grid.cols - 1) * spec.grid.col_pitch_mm
+        default_start, default_end = (cx, margin), (cx, span - margin)
+    else:
+        default_start, default_end = (0.0, -2.0), (0.0, 2.0)
+    start = np.asarray(start_mm if start_mm is not None else default_start, dtype=float)
+    end = np.asarray(end_mm if end_mm is not None else default_end, dtype=float)
+    _check_on(spec, *start, "slide start")
+    _check_on(spec, *end, "slide end")
+    length = float(np.hypot(*(end - start)))
+    n = max(1, math.ceil(length / increment_mm))
+    dwell = (length / n) / speed_mm_s if length > 0 else 0.1
+    steps = _settle(settle_s)
+    for k in range(n + 1):
+        x, y = start + (end - start) * k / n
+        steps.append(Step((SphereProbe(float(x), float(y), force_n, radius_mm=size_mm),), dwell,
+                          f"slide {k}"))  # fmt: skip
+    steps.append(Step((), 0.2, "lifted"))
+    return Scenario(
+        tuple(steps),
+        "slide",
+        f"{size_mm:g}-mm sphere sliding at {speed_mm_s:g} mm/s with {force_n:g} N",
+        {"start_mm": list(start), "end_mm": list(end), "force_n": force_n,
+         "speed_mm_s": speed_mm_s},
+    )  # fmt: skip
+
+
+def sweep(
+    spec,
+    *,
+    force_n: float = 0.5,
+    size_mm: float = 1.6,
+    increment_mm: float = 0.5,
+    dwell_s: float = 0.1,
+    settle_s: float = 0.2,
+    x_mm: float | None = None,
+) -> Scenario:
+    """A sphere pressed at ``increment_mm`` steps along a row line (y), lifted between
+    presses: Fig. 7's probe sweep on a pad."""
+    check_positive(increment_mm, "increment_mm")
+    cx, _ = centre_mm(spec)
+    x = cx if x_mm is None else x_mm
+    if spec.kind == "pad":
+        ys = np.arange(0.0, (spec.grid.cols - 1) * spec.grid.col_pitch_mm + 1e-9, increment_mm)
+    else:
+        ys = np.arange(-3.0, 3.0 + 1e-9, increment_mm)
+    steps = _settle(settle_s)
+    for y in ys:
+        _check_on(spec, x, float(y), "probe")
+        steps.append(Step((SphereProbe(x, float(y), force_n, radius_mm=size_mm),), dwell_s,
+                          f"y = {y:g} mm"))  # fmt: skip
+        steps.append(Step((), dwell_s, "lifted"))
+    return Scenario(
+        tuple(steps),
+        "sweep",
+        f"{size_mm:g}-mm sphere of {force_n:g} N pressed every {increment_mm:g} mm along y",
+        {"x_mm": x, "force_n": force_n, "increment_mm": increment_mm},
+    )
+
+
+def knife(spec, *, force_n: float = 1.0, length_mm: float = 10.0, angle_deg: float = 0.0,
+          dwell_s: float = 0.5, settle_s: float = 0.2) -> Scenario:  # fmt: skip
+    """A knife edge pressed across the middle at ``angle_deg`` from the x axis."""
+    cx, cy = centre_mm(spec)
+    edge = KnifeEdge(cx, cy, force_n, length_mm=length_mm, angle_deg=angle_deg)
+    return Scenario(
+        (*_settle(settle_s), Step((edge,), dwell_s, "knife"), Step((), 0.2, "lifted")),
+        "knife-edge",
+        f"{length_mm:g}-mm knife edge at {angle_deg:g} deg with {force_n:g} N",
+        {"force_n": force_n, "length_mm": length_mm, "angle_deg": angle_deg},
+    )
+
+
+def punch(spec, *, force_n: float = 1.0, radius_mm: float = 3.0, dwell_s: float = 0.5,
+          settle_s: float = 0.2) -> Scenario:  # fmt: skip
+    """A rigid flat punch pressed in the middle (a uniform-press calibration load)."""
+    cx, cy = centre_mm(spec)
+    tool = FlatPunch(cx, cy, force_n, radius_mm=radius_mm)
+    return Scenario(
+        (*_settle(settle_s), Step((tool,), dwell_s, "punch"), Step((), 0.2, "lifted")),
+        "punch",
+        f"flat punch of {radius_mm:g} mm radius with {force_n:g} N",
+        {"force_n": force_n, "radius_mm": radius_mm},
+    )
+
+
+SCENARIOS = {
+    "press": press,
+    "hold": hold,
+    "two-probes": two_probes,
+    "slide": slide,
+    "sweep": sweep,
+    "knife-edge": knife,
+    "punch": punch,
+}
+"""Scenario builders for pads and point sets, by the name ``--scenario`` takes."""
