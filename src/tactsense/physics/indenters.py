@@ -58,7 +58,7 @@ class Indenter:
         if self.force_n < 0:
             raise TactsenseInputError(f"force_n must be >= 0 (a push); got {self.force_n!r}")
 
-    def _shape(self, dx, dy, modulus_star_pa):  # pragma: no cover - every kind defines it
+    def _shape(self, dx, dy, modulus_star_pa, step_mm):  # pragma: no cover - every kind defines it
         raise NotImplementedError
 
     def _integral_mm2(self, modulus_star_pa):  # pragma: no cover - every kind defines it
@@ -95,7 +95,9 @@ class Indenter:
         offsets = (np.arange(_SUBSAMPLES) + 0.5) / _SUBSAMPLES - 0.5
         sub_x = (x_mm[:, None] + hx * offsets[None, :]).ravel() - self.x_mm
         sub_y = (y_mm[:, None] + hy * offsets[None, :]).ravel() - self.y_mm
-        shape = self._shape(sub_x[:, None], sub_y[None, :], modulus_star_pa)
+        shape = self._shape(
+            sub_x[:, None], sub_y[None, :], modulus_star_pa, min(hx, hy) / _SUBSAMPLES
+        )
         cells = shape.reshape(x_mm.size, _SUBSAMPLES, y_mm.size, _SUBSAMPLES).mean(axis=(1, 3))
         reach = self.reach_mm(modulus_star_pa)
         inside = (
@@ -152,7 +154,7 @@ class SphereProbe(Indenter):
     def _integral_mm2(self, modulus_star_pa):
         return 2.0 * math.pi * self.reach_mm(modulus_star_pa) ** 2 / 3.0
 
-    def _shape(self, dx, dy, modulus_star_pa):
+    def _shape(self, dx, dy, modulus_star_pa, step_mm):
         a = self.reach_mm(modulus_star_pa)
         rho2 = (dx**2 + dy**2) / a**2
         return np.sqrt(np.clip(1.0 - rho2, 0.0, None))
@@ -175,7 +177,7 @@ class DiscProbe(Indenter):
     def _integral_mm2(self, modulus_star_pa):
         return math.pi * self.radius_mm**2
 
-    def _shape(self, dx, dy, modulus_star_pa):
+    def _shape(self, dx, dy, modulus_star_pa, step_mm):
         return (dx**2 + dy**2 <= self.radius_mm**2).astype(float)
 
 
@@ -196,12 +198,15 @@ class FlatPunch(Indenter):
     def _integral_mm2(self, modulus_star_pa):
         return 2.0 * math.pi * self.radius_mm
 
-    def _shape(self, dx, dy, modulus_star_pa):
-        a2 = self.radius_mm**2
-        r2 = dx**2 + dy**2
-        inside = r2 < a2
-        # the singularity at r = a is integrable: a sub-sample never sits exactly on it
-        return np.where(inside, 1.0 / np.sqrt(np.where(inside, a2 - r2, 1.0)), 0.0)
+    def _shape(self, dx, dy, modulus_star_pa, step_mm):
+        # 1 / sqrt(a^2 - r^2) averaged over a radial band of one sub-sample (its integral
+        # is arcsin(r / a)): bounded at the edge, where point samples would blow up
+        a = self.radius_mm
+        r = np.hypot(dx, dy)
+        half = 0.5 * step_mm
+        low = np.clip((r - half) / a, -1.0, 1.0)
+        high = np.clip((r + half) / a, -1.0, 1.0)
+        return (np.arcsin(high) - np.arcsin(low)) / (2.0 * half)
 
 
 @dataclass(frozen=True)
@@ -226,7 +231,7 @@ class KnifeEdge(Indenter):
     def _integral_mm2(self, modulus_star_pa):
         return math.pi / 4.0 * self.width_mm * self.length_mm
 
-    def _shape(self, dx, dy, modulus_star_pa):
+    def _shape(self, dx, dy, modulus_star_pa, step_mm):
         angle = math.radians(self.angle_deg)
         along = dx * math.cos(angle) + dy * math.sin(angle)
         across = -dx * math.sin(angle) + dy * math.cos(angle)
