@@ -136,3 +136,23 @@ def sensor_from_urdf_text(rows, cols, rate=7):
         path = pathlib.Path(folder) / "s.urdf"
         path.write_text(URDF.format(name="s", rows=rows, cols=cols, rate=rate))
         return sensor_from_urdf(path)
+
+
+def test_calibrate_partial_does_not_call_an_unreached_tactel_dead(tmp_path):
+    """A sweep along column 0 leaves columns 1-7 unreached: those tactels are
+    uncalibrated (gain 1, listed), not dead. Dead are the two the twin made dead, one in
+    the swept column and one outside it; one unreached tactel was called dead before."""
+    import json
+
+    spec = ts.fearing1990_initial().replace(flaws__dead_tactels=((2, 0), (3, 5)))
+    rec = tmp_path / "sweep.h5"
+    ts.write_recording(rec, ts.simulate(spec, ts.probe_sweep(spec), rng=0))
+    out = tmp_path / "cal.json"
+    result = runner.invoke(app, ["calibrate", str(rec), "--partial", "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    data = json.loads(out.read_text())
+    dead = {tuple(t) for t in np.argwhere(np.array(data["dead"])).tolist()}
+    assert dead == {(2, 0), (3, 5)}
+    unreached = {tuple(t) for t in data["notes"]["uncalibrated_tactels"]}
+    assert len(unreached - dead) >= 50  # the other columns: never deflected, yet alive
+    assert "2 / 0 / 0" in result.output  # the printed count is the count kept
