@@ -89,7 +89,7 @@ def test_bad_arguments_are_reported(initial):
     with pytest.raises(ValueError, match="gains has shape"):
         ts.simulate(initial, scene, gains=np.ones((3, 3)))
     with pytest.raises(ValueError, match="outside the 8x8 array"):
-        ts.probe_sweep(initial, row=9)
+        ts.probe_sweep(initial, along="around", row=9)
     with pytest.raises(ValueError, match="outside the 8x8 array"):
         ts.knife_edge_sweep(initial, col=8)
     with pytest.raises(ValueError, match="outside the 8x8 array"):

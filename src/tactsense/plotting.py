@@ -10,9 +10,36 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
+from tactsense._validation import TactsenseInputError
 from tactsense.io.recording import Recording, RecordingError
 from tactsense.physics.flaws import FLAW_NAMES
 from tactsense.physics.transduction import fractional_deflection
+
+
+def check_plot_format(path: str | Path, option: str = "--plot") -> Path:
+    """Refuse a plot name whose extension matplotlib cannot write, before any work starts.
+
+    The format is taken from the extension (as :meth:`matplotlib.figure.Figure.savefig`
+    does); the supported ones are those of the Agg canvas (png, pdf, svg, ...).
+
+    Raises
+    ------
+    TactsenseInputError
+        Naming the option, the extension and the formats matplotlib writes.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    path = Path(path)
+    # pgf needs a LaTeX installation; every other format is Agg's or Pillow's own
+    formats = sorted(set(FigureCanvasAgg.get_supported_filetypes()) - {"pgf"})
+    suffix = path.suffix.lower().lstrip(".")
+    if suffix not in formats:
+        said = f"'.{suffix}'" if suffix else "no extension"
+        raise TactsenseInputError(
+            f"{option} {path}: matplotlib cannot write {said}; end the name with one of "
+            + ", ".join(f".{f}" for f in formats)
+        )
+    return path
 
 
 def sweep_responses(recording: Recording):

@@ -121,6 +121,43 @@ class Scenario:
 # ---- scenario builders ----------------------------------------------------------
 
 
+def default_row(spec: SensorSpec) -> int:
+    """The row a scenario loads when none is named: the paper's row 4 (the middle of the
+    initial finger's eight), or the middle row of a smaller array [-]."""
+    return min(4, spec.shape[0] // 2)
+
+
+def default_col(spec: SensorSpec) -> int:
+    """The column a scenario loads when none is named: column 0 (every array has it) [-]."""
+    return 0
+
+
+def _tactel(spec: SensorSpec, row: int | None, col: int | None) -> tuple[int, int]:
+    """(row, col) with the defaults of this sensor filled in, checked against its array."""
+    row = default_row(spec) if row is None else int(row)
+    col = default_col(spec) if col is None else int(col)
+    spec.check_tactel(row, col)
+    return row, col
+
+
+def _check_row(spec: SensorSpec, row: int) -> None:
+    rows = spec.shape[0]
+    if not 0 <= row < rows:
+        raise TactsenseInputError(
+            f"row {row} is outside the {rows}x{spec.shape[1]} array of wired tactels "
+            f"(rows 0-{rows - 1})"
+        )
+
+
+def _check_col(spec: SensorSpec, col: int) -> None:
+    cols = spec.shape[1]
+    if not 0 <= col < cols:
+        raise TactsenseInputError(
+            f"column {col} is outside the {spec.shape[0]}x{cols} array of wired tactels "
+            f"(columns 0-{cols - 1})"
+        )
+
+
 def _settle(settle_s: float) -> list[Step]:
     """The untouched start of a scenario, from which a baseline is taken."""
     return [Step((), settle_s, "baseline")] if settle_s > 0 else []
@@ -130,8 +167,8 @@ def probe_sweep(
     spec: SensorSpec,
     *,
     along: str = "axial",
-    row: int = 4,
-    col: int = 0,
+    row: int | None = None,
+    col: int | None = None,
     start: float | None = None,
     stop: float | None = None,
     increment: float | None = None,
@@ -166,7 +203,12 @@ def probe_sweep(
     """
     if along not in ("axial", "around"):
         raise TactsenseInputError(f"along must be 'axial' or 'around'; got {along!r}")
-    spec.check_tactel(row, col)
+    row = default_row(spec) if row is None else int(row)
+    col = default_col(spec) if col is None else int(col)
+    if along == "axial":
+        _check_col(spec, col)
+    else:
+        _check_row(spec, row)
     force_n = grams_force(50.0) if force_n is None else check_positive(force_n, "force_n")
     if along == "axial":
         increment = 0.6 if increment is None else increment
@@ -223,8 +265,8 @@ def probe_sweep(
 def repeated_load(
     spec: SensorSpec,
     *,
-    row: int = 4,
-    col: int = 0,
+    row: int | None = None,
+    col: int | None = None,
     force_n: float | None = None,
     repeats: int = 100,
     on_s: float = 1.0,
@@ -232,7 +274,7 @@ def repeated_load(
     settle_s: float = 1.0,
 ) -> Scenario:
     """A weight applied repeatedly above one tactel (Figs. 10-12: jitter and creep)."""
-    spec.check_tactel(row, col)
+    row, col = _tactel(spec, row, col)
     force_n = grams_force(50.0) if force_n is None else check_positive(force_n, "force_n")
     if repeats < 1:
         raise TactsenseInputError(f"repeats must be at least 1; got {repeats}")
@@ -261,7 +303,7 @@ def calibration_sweep(
     *,
     force_n: float | None = None,
     increment: float = 0.6,
-    dwell_s: float = 0.3,
+    dwell_s: float | None = None,
     settle_s: float = 1.0,
 ) -> Scenario:
     """The section 3.1 calibration: a 50-g probe swept along every column in turn.
@@ -269,7 +311,11 @@ def calibration_sweep(
     Each sweep runs the length of the cylinder at the angle of one wired
     column, starting over the tip row when the finger has one (so that every
     tactel is reached); the probe is lifted for a second between columns.
+    ``dwell_s`` [s] defaults to 0.3 s, or one scan period on a slower sensor (as is the
+    lift).
     """
+    period = spec.scan_period_s
+    dwell_s = max(0.3, period) if dwell_s is None else check_positive(dwell_s, "dwell_s")
     force_n = grams_force(50.0) if force_n is None else check_positive(force_n, "force_n")
     steps = _settle(settle_s)
     start = float(spec.row_axial_mm[0]) if spec.array.tip_row else 0.0
@@ -279,7 +325,7 @@ def calibration_sweep(
             Step((Probe(float(p), float(angle), force_n),), dwell_s, f"col {col}")
             for p in positions
         ]
-        steps.append(Step((), 1.0, "lifted"))
+        steps.append(Step((), max(1.0, period), "lifted"))
     return Scenario(
         tuple(steps),
         name="calibration_sweep",
@@ -291,8 +337,8 @@ def calibration_sweep(
 def force_steps(
     spec: SensorSpec,
     *,
-    row: int = 4,
-    col: int = 0,
+    row: int | None = None,
+    col: int | None = None,
     force_n: float | None = None,
     on_s: float = 1.0,
     off_s: float = 1.0,
@@ -318,17 +364,24 @@ def force_steps(
 def knife_edge_sweep(
     spec: SensorSpec,
     *,
-    row: int = 4,
-    col: int = 0,
+    row: int | None = None,
+    col: int | None = None,
     force_n: float = 0.5,
     span_mm: float = 12.0,
     increment: float = 0.6,
-    dwell_s: float = 0.5,
-    lift_s: float = 0.5,
+    dwell_s: float | None = None,
+    lift_s: float | None = None,
     settle_s: float = 1.0,
 ) -> Scenario:
-    """Section 4.1: a knife edge across the finger stepped past one tactel (Fig. 16)."""
-    spec.check_tactel(row, col)
+    """Section 4.1: a knife edge across the finger stepped past one tactel (Fig. 16).
+
+    ``dwell_s`` and ``lift_s`` [s] default to 0.5 s, or one scan period on a slower
+    sensor.
+    """
+    period = spec.scan_period_s
+    dwell_s = max(0.5, period) if dwell_s is None else dwell_s
+    lift_s = max(0.5, period) if lift_s is None else lift_s
+    row, col = _tactel(spec, row, col)
     centre = float(spec.row_axial_mm[row])
     angle = float(spec.col_angle_deg[col])
     positions = np.arange(centre - span_mm / 2, centre + span_mm / 2 + 1e-9, increment)
@@ -357,15 +410,15 @@ def knife_edge_sweep(
 def load_series(
     spec: SensorSpec,
     *,
-    row: int = 4,
-    col: int = 0,
+    row: int | None = None,
+    col: int | None = None,
     forces_n=None,
     on_s: float = 1.0,
     off_s: float = 1.0,
     settle_s: float = 1.0,
 ) -> Scenario:
     """Increasing weights on one cell (Fig. 6): each applied, held and removed."""
-    spec.check_tactel(row, col)
+    row, col = _tactel(spec, row, col)
     forces = np.linspace(0.1, 1.0, 10) if forces_n is None else np.asarray(forces_n, float)
     probe = Probe(float(spec.row_axial_mm[row]), float(spec.col_angle_deg[col]), 1.0)
     steps = _settle(settle_s)

@@ -163,9 +163,14 @@ def design_sweep(
     )
 
 
-def plot_map(dataset, path, *, designs: dict[str, tuple[float, float]]) -> None:
-    """Sensitivity, aliasing and the position bound over depth x spacing, with the named
-    designs (name -> (depth, spacing)) marked; first Poisson's ratio and load."""
+def draw_map(dataset, *, designs: dict[str, tuple[float, float]]):
+    """The figure of :func:`plot_map` (matplotlib ``Figure``), not yet saved.
+
+    Each named design is a star with its name beside it; names are put alternately above
+    and below their stars (in order of spacing) and on the side of the star away from the
+    nearer edge of the plot, on a white ground, so that two designs of the same depth and
+    close spacings (the paper's two fingers) do not write over each other.
+    """
     import matplotlib
 
     matplotlib.use("Agg")
@@ -174,6 +179,7 @@ def plot_map(dataset, path, *, designs: dict[str, tuple[float, float]]) -> None:
     view = dataset.isel(poisson_ratio=0, load_g=0)
     d, s = view["depth_mm"].values, view["spacing_mm"].values
     fig, axes = plt.subplots(1, 3, figsize=(14, 4.2), constrained_layout=True)
+    ordered = sorted(designs.items(), key=lambda item: (item[1][1], item[1][0]))
     for ax, (name, title) in zip(
         axes,
         (
@@ -185,15 +191,35 @@ def plot_map(dataset, path, *, designs: dict[str, tuple[float, float]]) -> None:
     ):
         mesh = ax.pcolormesh(s, d, view[name].values, shading="nearest", cmap="viridis")
         fig.colorbar(mesh, ax=ax)
-        for label, (depth, spacing) in designs.items():
-            ax.plot(spacing, depth, "r*", ms=12)
+        low, high = ax.get_xlim()
+        for k, (label, (depth, spacing)) in enumerate(ordered):
+            ax.plot(spacing, depth, "r*", ms=12, mec="white", mew=0.8)
+            right_half = spacing > 0.5 * (low + high)
+            above = k % 2 == 0
             ax.annotate(
-                label, (spacing, depth), color="r", xytext=(4, 4), textcoords="offset points"
+                label,
+                (spacing, depth),
+                color="r",
+                fontsize=9,
+                xytext=(-6 if right_half else 6, 9 if above else -9),
+                textcoords="offset points",
+                ha="right" if right_half else "left",
+                va="bottom" if above else "top",
+                bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.85},
             )
         ax.set_xlabel("tactel spacing along the finger [mm]")
         ax.set_ylabel("effective depth [mm]")
         ax.set_title(title, fontsize=10)
     nu, load = float(view["poisson_ratio"]), float(view["load_g"])
     fig.suptitle(f"Design map (nu = {nu:g}, {load:g}-g probe)")
+    return fig
+
+
+def plot_map(dataset, path, *, designs: dict[str, tuple[float, float]]) -> None:
+    """Sensitivity, aliasing and the position bound over depth x spacing, with the named
+    designs (name -> (depth, spacing)) marked; first Poisson's ratio and load."""
+    import matplotlib.pyplot as plt
+
+    fig = draw_map(dataset, designs=designs)
     fig.savefig(path, dpi=100)
     plt.close(fig)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from enum import StrEnum
 from typing import Annotated
 
@@ -41,7 +42,8 @@ RowOption = Annotated[
         max=254,
         help="Row of the tactel: fixes the axial position of a sweep "
         "around, or the tactel loaded by 'repeated' or passed by 'knife-edge' "
-        "(0 = tip row) [default: 4].",
+        "(0 = tip row) [default: 4, the paper's; the middle row of an array of fewer "
+        "than 8 rows].",
     ),
 ]
 ColOption = Annotated[
@@ -76,7 +78,8 @@ DwellOption = Annotated[
     typer.Option(
         min=1e-3,
         max=3600.0,
-        help="Time the probe is held at each position or application [s] [default: 0.5].",
+        help="Time the probe is held at each position or application, at least one scan "
+        "period of the sensor [s] [default: 0.5, or one scan period if that is longer].",
     ),
 ]
 LiftOption = Annotated[
@@ -94,8 +97,17 @@ RepeatsOption = Annotated[
     typer.Option(min=1, max=1_000_000, help="Applications for 'repeated' [default: 100]."),
 ]
 
-DEFAULTS = {"row": 4, "col": 0, "force_g": 50.0, "dwell_s": 0.5, "lift_s": 0.0, "repeats": 100}
-"""The value of each scenario option the user did not give."""
+DEFAULTS = {
+    "row": None,
+    "col": None,
+    "force_g": 50.0,
+    "dwell_s": 0.5,
+    "lift_s": 0.0,
+    "repeats": 100,
+}
+"""The value of each scenario option the user did not give (row and col None: the
+sensor's own default tactel, :func:`tactsense.simulate.default_row`; dwell_s is
+lengthened to one scan period on a slow sensor)."""
 
 USES = {
     ScenarioKind.sweep_axial: ("col", "force_g", "increment", "dwell_s", "lift_s"),
@@ -136,6 +148,34 @@ SeedOption = Annotated[
 ]
 
 
+def _round_up(value: float, digits: int = 4) -> float:
+    """``value`` rounded up to ``digits`` significant digits (a printed minimum that the
+    same number typed back satisfies)."""
+    scale = 10.0 ** (digits - 1 - math.floor(math.log10(value)))
+    return math.ceil(value * scale - 1e-9) / scale
+
+
+def check_timing(spec: SensorSpec, dwell_s: float | None, lift_s: float | None) -> None:
+    """Refuse a dwell (or a lift) shorter than one scan period of the sensor.
+
+    A probe held for less than a scan period moves on before the array is read: the
+    recording would hold frames of nothing (``--dwell-s 0.001`` gave 7 untouched frames).
+    """
+    period = spec.scan_period_s
+    least = _round_up(period)
+    rate = spec.electronics.scan_rate_hz
+    for flag, value, what in (
+        ("--dwell-s", dwell_s, "the probe would move on before the array is read"),
+        ("--lift-s", lift_s, "the lift would fall between two readings of the array"),
+    ):
+        if value is not None and 0 < value < period:
+            zero = " (or 0: no lift)" if flag == "--lift-s" else ""
+            raise TactsenseInputError(
+                f"{flag} {value:g} s is shorter than one scan period of sensor {spec.name!r} "
+                f"({period:.4g} s at {rate:g} Hz): {what}; give at least {least:g} s{zero}"
+            )
+
+
 def build_scenario(
     spec: SensorSpec,
     scenario: ScenarioKind,
@@ -155,6 +195,7 @@ def build_scenario(
     """
     from tactsense.simulate import calibration_sweep, knife_edge_sweep, probe_sweep, repeated_load
 
+    dwell = dwell_s
     values = check_scenario_options(
         scenario,
         dict(
@@ -169,6 +210,9 @@ def build_scenario(
     )
     row, col, force_g = values["row"], values["col"], values["force_g"]
     dwell_s, lift_s, repeats = values["dwell_s"], values["lift_s"], values["repeats"]
+    check_timing(spec, dwell, lift_s)
+    if dwell is None:  # the default fits the sensor: at least one scan period
+        dwell_s = max(dwell_s, spec.scan_period_s)
     force_n = grams_force(force_g)
     if scenario is ScenarioKind.calibration:
         return calibration_sweep(spec, force_n=force_n, increment=increment or 0.6)

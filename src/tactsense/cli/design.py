@@ -329,6 +329,9 @@ def design_sweep_command(
 
     check_output(out, force)
     if plot is not None:
+        from tactsense.plotting import check_plot_format
+
+        check_plot_format(plot)
         check_output(plot, force, what="plot")
     depths = _grid(depth, "--depth", low=0.5, high=20.0)
     spacings = _grid(spacing, "--spacing", low=0.5, high=20.0)

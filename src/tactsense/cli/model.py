@@ -66,9 +66,11 @@ def simulate(
     ] = False,
 ) -> None:
     """Simulate the finger under a scenario and write an HDF5 recording of A/D frames."""
-    from tactsense.plotting import plot_sweep
+    from tactsense.plotting import check_plot_format, plot_sweep
 
     try:
+        if plot is not None:
+            check_plot_format(plot)
         spec = load_sensor(sensor)
         for target in (out, plot):
             if target is not None:

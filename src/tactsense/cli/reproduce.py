@@ -91,9 +91,31 @@ def reproduce(
     from tactsense.reproduce.report import summary
 
     claims = list(result["claims"].values())
-    table = Table(title=f"{len(result['figures'])} figures and {len(claims)} claims in {out}")
-    for column in ("claim", "paper", "tactsense", "unit", "basis", "verdict"):
-        table.add_column(column)
+    table = claims_table(
+        claims, f"{len(result['figures'])} figures and {len(claims)} claims in {out}"
+    )
+    Console().print(table)
+    console.print(
+        f"{summary(claims)} Open {out / 'report.html'} for the figures and the reasons "
+        "behind each difference."
+    )
+
+
+def claims_table(claims, title: str) -> Table:
+    """The terminal table of claims: every claim id whole, however narrow the terminal.
+
+    The ids are what the report and results.json are searched by (three begin with
+    "localization"), so their column is never shortened; the basis column, the one to
+    give way, wraps instead.
+    """
+    table = Table(title=title)
+    width = max((len(claim.id) for claim in claims), default=5)
+    table.add_column("claim", no_wrap=True, min_width=width, overflow="fold")
+    for column in ("paper", "tactsense"):
+        table.add_column(column, no_wrap=True, justify="right")
+    table.add_column("unit", overflow="fold")
+    table.add_column("basis", overflow="fold")
+    table.add_column("verdict", overflow="fold")
     for claim in claims:
         table.add_row(
             claim.id,
@@ -103,8 +125,4 @@ def reproduce(
             claim.basis,
             claim.verdict,
         )
-    Console().print(table)
-    console.print(
-        f"{summary(claims)} Open {out / 'report.html'} for the figures and the reasons "
-        "behind each difference."
-    )
+    return table

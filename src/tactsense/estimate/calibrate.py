@@ -679,7 +679,9 @@ def calibrate_sweep(
         sensor_toml=sensor.to_toml_string(),
         gains=gains,
         baseline=baseline,
-        dead=health["dead"],
+        # a tactel the probe never reached is uncalibrated, not dead: dead is one that
+        # reads nothing, or that the probe reached without a response
+        dead=health["dead"] & ~(uncalibrated & (baseline > 0)),
         weak=health["weak"] & ~uncalibrated,
         noisy=health["noisy"],
         threshold_g=np.where(uncalibrated, np.inf, health["threshold_g"]),
