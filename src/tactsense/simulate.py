@@ -28,6 +28,7 @@ from tactsense.io.recording import Recording
 from tactsense.physics.array_response import deflection_batch
 from tactsense.physics.contact import Probe, contact_from_dict, grams_force, knife_edge
 from tactsense.physics.flaws import FLAW_NAMES, draw_gains, stiffening
+from tactsense.physics.pad_response import deflection_batch_flat, resistive_counts
 from tactsense.physics.transduction import (
     amplifier_gain,
     divider_voltage,
@@ -35,7 +36,7 @@ from tactsense.physics.transduction import (
     voltage_to_counts,
 )
 from tactsense.physics.viscoelastic import viscoelastic_response
-from tactsense.sensor import SensorSpec
+from tactsense.sensor import SensorSpec, SpecBase
 
 _CHUNK_FRAMES = 128
 
@@ -474,9 +475,11 @@ def _jittered_steps(spec: SensorSpec, steps: Sequence[Step], rng) -> list[tuple]
             scale = 1.0
             if contact.force_n > 0:
                 scale = max(0.0, 1.0 + rng.normal(0.0, flaws.force_jitter_n) / contact.force_n)
-            d_axial = rng.normal(0.0, flaws.position_jitter_mm)
-            d_angle = math.degrees(rng.normal(0.0, flaws.position_jitter_mm) / spec.radius_mm)
-            contacts.append(contact.moved(d_axial, d_angle, scale))
+            d_first = rng.normal(0.0, flaws.position_jitter_mm)
+            d_second = rng.normal(0.0, flaws.position_jitter_mm)
+            if spec.kind == "finger":  # along the finger [mm] and around it [deg]
+                d_second = math.degrees(d_second / spec.radius_mm)
+            contacts.append(contact.moved(d_first, d_second, scale))
         out.append(tuple(contacts))
     return out
 
@@ -516,8 +519,11 @@ def simulate(
         ``frames`` (T, rows, cols) A/D counts, timestamps, the truth of
         every step, the sensor and the scenario.
     """
-    if not isinstance(spec, SensorSpec):
-        raise TactsenseInputError(f"spec must be a SensorSpec; got {type(spec).__name__}")
+    if not isinstance(spec, SpecBase):
+        raise TactsenseInputError(
+            f"spec must be a sensor description (SensorSpec, PadSpec, PointsSpec); "
+            f"got {type(spec).__name__}"
+        )
     if not isinstance(scenario, Scenario):
         raise TactsenseInputError(f"scenario must be a Scenario; got {type(scenario).__name__}")
     active = _resolve_flaws(flaws)
@@ -541,7 +547,7 @@ def simulate(
         if "jitter" in active
         else [step.contacts for step in scenario.steps]
     )
-    elastic = deflection_batch(spec, applied) * gains  # (S, rows, cols)
+    elastic = _elastic_deflection(spec, applied) * gains  # (S, rows, cols)
 
     boundaries = np.cumsum([0.0] + [s.duration_s for s in scenario.steps])
     offsets = sample_offsets(spec)
@@ -583,10 +589,13 @@ def simulate(
             sampled = elastic[own_step, row_of_tick, col_of_tick].reshape(last - first, rows, cols)
         if "nonlinearity" in active:
             sampled = stiffening(sampled, spec.flaws.nonlinear_saturation)
-        sampled = np.minimum(sampled, 0.95)  # plates cannot touch
-        counts = voltage_to_counts(
-            spec, gain_v * divider_voltage(spec, c0 / (1.0 - sampled)), quantize=False
-        )
+        if _capacitive(spec):
+            sampled = np.minimum(sampled, 0.95)  # plates cannot touch
+            counts = voltage_to_counts(
+                spec, gain_v * divider_voltage(spec, c0 / (1.0 - sampled)), quantize=False
+            )
+        else:
+            counts = resistive_counts(spec, sampled)
         if "noise" in active:
             counts = counts + rng.normal(0.0, spec.flaws.read_noise_counts, counts.shape)
         full_scale = 2**spec.electronics.adc_bits - 1
@@ -615,23 +624,40 @@ def simulate(
     )
 
 
+def _capacitive(spec) -> bool:
+    """Whether the sensor reads through the paper's capacitive chain (eqs. 1-4)."""
+    return spec.kind == "finger" or spec.transduction.kind == "capacitive"
+
+
+def _elastic_deflection(spec, applied) -> np.ndarray:
+    """Fractional deflection of every tactel for each step's contacts, (S, rows, cols)."""
+    if spec.kind == "finger":
+        return deflection_batch(spec, applied)
+    return deflection_batch_flat(spec, applied)
+
+
 def _truth(spec: SensorSpec, applied: list[tuple], frame_step: np.ndarray) -> dict:
-    """Per-step truth (as applied, jitter included) and the step of each frame."""
+    """Per-step truth (as applied, jitter included) and the step of each frame.
+
+    The first contact's position: ``step_axial_mm``, ``step_angle_deg`` on a finger,
+    ``step_x_mm``, ``step_y_mm`` on a pad or a point set.
+    """
     n = len(applied)
-    axial = np.full(n, np.nan)
-    angle = np.full(n, np.nan)
+    first = np.full(n, np.nan)
+    second = np.full(n, np.nan)
     force = np.zeros(n)
     count = np.zeros(n, dtype=np.int64)
+    names = ("axial_mm", "angle_deg") if spec.kind == "finger" else ("x_mm", "y_mm")
     for k, contacts in enumerate(applied):
         count[k] = len(contacts)
         force[k] = sum(c.force_n for c in contacts)
         if contacts:
-            axial[k] = contacts[0].axial_mm
-            angle[k] = contacts[0].angle_deg
+            first[k] = getattr(contacts[0], names[0])
+            second[k] = getattr(contacts[0], names[1])
     return {
         "frame_step": frame_step.astype(np.int64),
-        "step_axial_mm": axial,
-        "step_angle_deg": angle,
+        f"step_{names[0]}": first,
+        f"step_{names[1]}": second,
         "step_force_n": force,
         "step_n_contacts": count,
         "step_contacts_json": json.dumps([[c.to_dict() for c in s] for s in applied]),

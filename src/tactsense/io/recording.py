@@ -209,7 +209,13 @@ def _write_file(partial: Path, recording: Recording) -> None:
             losses.attrs["kinds"] = ",".join(recording.losses)
         if recording.truth:
             group = h5.create_group("truth")
-            units = {"step_axial_mm": "mm", "step_angle_deg": "deg", "step_force_n": "N"}
+            units = {
+                "step_axial_mm": "mm",
+                "step_angle_deg": "deg",
+                "step_x_mm": "mm",
+                "step_y_mm": "mm",
+                "step_force_n": "N",
+            }
             for key, value in recording.truth.items():
                 if isinstance(value, str):
                     group.attrs[key] = value

@@ -26,8 +26,15 @@ from tactsense._validation import TactsenseInputError
 from tactsense.physics.indenters import Indenter, pressure_map
 from tactsense.sensor import Layer, PadSpec, PointsSpec
 
-OVERSAMPLE = 4
-"""Grid points per taxel pitch on which pressure and strain are computed [-]."""
+GRID_STEP_MM = 0.5
+"""Largest step of the grid on which a pad's pressure and strain are computed [mm]; at
+least four points per pitch (a 1.6-mm probe of 50 g touches a disc of about 1.2 mm)."""
+
+
+def oversample(spec: PadSpec) -> int:
+    """Grid points per taxel pitch: at least 4, and steps of at most GRID_STEP_MM [-]."""
+    pitch = max(spec.grid.row_pitch_mm, spec.grid.col_pitch_mm)
+    return max(4, math.ceil(pitch / GRID_STEP_MM))
 
 
 def modulus_star_pa(layer: Layer) -> float:
@@ -39,12 +46,99 @@ def modulus_star_pa(layer: Layer) -> float:
 def _pad_grid(spec: PadSpec) -> tuple[np.ndarray, np.ndarray, float, float, int]:
     """Fine grid over the pad and a margin of two layer thicknesses: x, y [mm], steps."""
     g = spec.grid
-    hx, hy = g.row_pitch_mm / OVERSAMPLE, g.col_pitch_mm / OVERSAMPLE
+    n = oversample(spec)
+    hx, hy = g.row_pitch_mm / n, g.col_pitch_mm / n
     margin = max(2.0 * spec.layer.thickness_mm, g.row_pitch_mm, g.col_pitch_mm)
     nx_margin, ny_margin = math.ceil(margin / hx), math.ceil(margin / hy)
-    x = hx * np.arange(-nx_margin, (g.rows - 1) * OVERSAMPLE + nx_margin + 1)
-    y = hy * np.arange(-ny_margin, (g.cols - 1) * OVERSAMPLE + ny_margin + 1)
+    x = hx * np.arange(-nx_margin, (g.rows - 1) * n + nx_margin + 1)
+    y = hy * np.arange(-ny_margin, (g.cols - 1) * n + ny_margin + 1)
     return x, y, hx, hy, nx_margin * 1000 + ny_margin
+
+
+def strain_transfer(kx, ky, depth_mm: float, layer: Layer) -> np.ndarray:
+    """Normal strain at ``depth_mm`` per unit surface pressure, in the wavenumber domain.
+
+    A normal load ``p_hat exp(i (kx x + ky y))`` on a layer bonded to a rigid substrate
+    excites a field that does not vary along the wave's crests and has no displacement
+    along them: it is exactly the plane-strain field of the two-dimensional strip at the
+    wavenumber ``|k|`` (section 5 of the paper, :mod:`tactsense.physics.strip`, eqs.
+    27-33 corrected). So ``eps_hat_zz = p_hat dH/dz(|k|, z) / (2 mu)`` in three
+    dimensions too.
+
+    Parameters
+    ----------
+    kx, ky : array_like
+        Wavenumbers [cycles/mm], broadcast together.
+    depth_mm : float
+        Depth below the free surface [mm].
+    layer : Layer
+
+    Returns
+    -------
+    ndarray
+        ``eps_hat_zz / p_hat`` [1/Pa], negative (compression) for a push.
+    """
+    from tactsense.physics.strip import shear_modulus, strip_strain_kernel
+
+    s = np.hypot(np.asarray(kx, dtype=float), np.asarray(ky, dtype=float)) * 1e3  # [1/m]
+    kernel = strip_strain_kernel(
+        s, depth_mm * 1e-3, layer.thickness_mm * 1e-3, layer.poisson_ratio, "plane_strain"
+    )
+    return kernel / (2.0 * shear_modulus(layer.youngs_modulus_pa, layer.poisson_ratio))
+
+
+def strain_map(
+    pressure_pa: np.ndarray,
+    spacing_mm: tuple[float, float],
+    layer: Layer,
+    *,
+    depth_mm: float | None = None,
+    electrode_mm: tuple[float, float] | None = None,
+) -> np.ndarray:
+    """Normal strain ``eps_zz`` at a depth under a pressure map on a regular grid.
+
+    The map is zero-padded to twice its size before the FFT, so the periodic images of
+    the load lie at least one map width away; the pressure map itself should reach two
+    layer thicknesses beyond the loaded area (the response of a bonded layer has died
+    out there, :func:`pad_strain` does so).
+
+    Parameters
+    ----------
+    pressure_pa : ndarray, shape (M, N)
+        Surface pressure on the grid, compression positive [Pa].
+    spacing_mm : (float, float)
+        Grid steps along axis 0 and axis 1 [mm].
+    layer : Layer
+    depth_mm : float, optional
+        Depth of the strain [mm] (default: the layer's sensing depth).
+    electrode_mm : (float, float), optional
+        Average over a rectangle of this size around each point (a taxel's electrode).
+
+    Returns
+    -------
+    ndarray, shape (M, N)
+        ``eps_zz`` [-], negative where compressed.
+    """
+    import scipy.fft
+
+    depth = layer.sensing_depth_mm if depth_mm is None else depth_mm
+    pressure = np.asarray(pressure_pa, dtype=float)
+    m, n = pressure.shape
+    size = (scipy.fft.next_fast_len(2 * m, real=True), scipy.fft.next_fast_len(2 * n, real=True))
+    transfer = _transfer_grid(size, tuple(spacing_mm), layer, depth, electrode_mm)
+    spectrum = scipy.fft.rfft2(pressure, s=size)
+    return scipy.fft.irfft2(-spectrum * transfer, s=size)[:m, :n]
+
+
+@functools.lru_cache(maxsize=64)
+def _transfer_grid(size, spacing_mm, layer, depth_mm, electrode_mm) -> np.ndarray:
+    kx = np.fft.fftfreq(size[0], d=spacing_mm[0])[:, None]
+    ky = np.fft.rfftfreq(size[1], d=spacing_mm[1])[None, :]
+    transfer = -strain_transfer(kx, ky, depth_mm, layer)  # compression positive below
+    if electrode_mm is not None:
+        transfer = transfer * np.sinc(kx * electrode_mm[0]) * np.sinc(ky * electrode_mm[1])
+    transfer.setflags(write=False)
+    return transfer
 
 
 def pad_strain(spec: PadSpec, indenters) -> np.ndarray:
@@ -61,20 +155,15 @@ def pad_strain(spec: PadSpec, indenters) -> np.ndarray:
     ndarray, shape (rows, cols)
         Compressive strain at the sensing depth [-], positive when compressed.
     """
-    from tactsense.physics.layer import taxel_strain
-
     x, y, hx, hy, _ = _pad_grid(spec)
     pressure = pressure_map(indenters, x, y, modulus_star_pa=modulus_star_pa(spec.layer))
     g = spec.grid
-    return taxel_strain(
-        pressure,
-        spacing_mm=(hx, hy),
-        layer=spec.layer,
-        first_taxel_index=(round(-x[0] / hx), round(-y[0] / hy)),
-        taxel_step=(OVERSAMPLE, OVERSAMPLE),
-        taxel_shape=spec.shape,
-        electrode_mm=(g.electrode_x_mm, g.electrode_y_mm),
+    compressive = -strain_map(
+        pressure, (hx, hy), spec.layer, electrode_mm=(g.electrode_x_mm, g.electrode_y_mm)
     )
+    first_x, first_y = round(-x[0] / hx), round(-y[0] / hy)
+    n = oversample(spec)
+    return compressive[first_x : first_x + g.rows * n : n, first_y : first_y + g.cols * n : n]
 
 
 def _local_frame(normal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -96,8 +185,6 @@ def points_strain(spec: PointsSpec, indenters) -> np.ndarray:
     taxel reads the flat layer's response at its in-plane offset from the indenter's
     centre, averaged over a square of its electrode area.
     """
-    from tactsense.physics.layer import point_strain
-
     positions, normals = spec.taxel_positions_mm(), spec.taxel_normals()
     strain = np.zeros(len(positions))
     for indenter in indenters:
@@ -107,14 +194,34 @@ def points_strain(spec: PointsSpec, indenters) -> np.ndarray:
         # the taxel's offset in the contact's tangent plane, and only taxels facing it
         u, v = offsets @ t1, offsets @ t2
         facing = normals @ normal > 0.0
-        strain[facing] += point_strain(
+        strain[facing] += _local_strain(
             indenter.moved(-indenter.x_mm, -indenter.y_mm),
             u[facing],
             v[facing],
-            layer=spec.layer,
-            electrode_mm=np.sqrt(spec.areas_mm2[facing]),
+            spec.layer,
+            np.sqrt(spec.areas_mm2[facing]),
         )
     return strain[np.newaxis, :]
+
+
+def _local_strain(indenter, u, v, layer: Layer, electrode_mm: np.ndarray) -> np.ndarray:
+    """Compressive strain of a flat layer under ``indenter`` (centred at the origin) at the
+    points (u, v) [mm], averaged over a square electrode of side ``electrode_mm`` each."""
+    from scipy.interpolate import RegularGridInterpolator
+
+    step = min(0.25, float(electrode_mm.min()) / 4.0, layer.thickness_mm / 4.0)
+    reach = max(float(np.abs(u).max(initial=0.0)), float(np.abs(v).max(initial=0.0)))
+    half = reach + 2.0 * layer.thickness_mm + float(electrode_mm.max())
+    axis = step * np.arange(-math.ceil(half / step), math.ceil(half / step) + 1)
+    pressure = indenter.pressure_pa(axis, axis, modulus_star_pa=modulus_star_pa(layer))
+    out = np.empty(len(u))
+    for side in np.unique(electrode_mm):
+        chosen = electrode_mm == side
+        compressive = -strain_map(pressure, (step, step), layer, electrode_mm=(side, side))
+        interpolate = RegularGridInterpolator((axis, axis), compressive, bounds_error=False,
+                                              fill_value=0.0)  # fmt: skip
+        out[chosen] = interpolate(np.column_stack([u[chosen], v[chosen]]))
+    return out
 
 
 def surface_point(spec: PointsSpec, indenter: Indenter) -> tuple[np.ndarray, np.ndarray]:
@@ -178,6 +285,11 @@ def deflection_batch_flat(spec: PadSpec | PointsSpec, applied) -> np.ndarray:
 
 
 def resistive_counts(spec: PadSpec | PointsSpec, strain: np.ndarray) -> np.ndarray:
-    """Reading of a resistive taxel: ``nominal_counts + counts_per_strain * strain``,
-    unquantized and unclipped [counts]."""
-    return spec.electronics.nominal_counts + spec.transduction.counts_per_strain * strain
+    """Reading of a resistive taxel: ``nominal_counts + counts_per_strain * max(strain, 0)``,
+    unquantized and unclipped [counts].
+
+    A piezoresistive element responds to compression; the tension beside a contact (an
+    incompressible layer bulges there) leaves its reading at rest.
+    """
+    compression = np.maximum(strain, 0.0)
+    return spec.electronics.nominal_counts + spec.transduction.counts_per_strain * compression

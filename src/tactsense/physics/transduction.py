@@ -48,10 +48,14 @@ def divider_voltage(spec: SensorSpec, capacitance):
 
 
 def amplifier_gain(spec: SensorSpec) -> float:
-    """Gain that maps the undeflected junction to ``nominal_counts`` [V/V]."""
+    """Gain that maps the undeflected junction to ``nominal_counts`` [V/V].
+
+    One number, or one per taxel for a point set whose taxels differ in area.
+    """
     el = spec.electronics
     target = el.nominal_counts / 2**el.adc_bits * el.adc_full_scale_v
-    return target / float(divider_voltage(spec, spec.junction_capacitance_f))
+    gain = target / divider_voltage(spec, np.asarray(spec.junction_capacitance_f, dtype=float))
+    return float(gain) if np.ndim(gain) == 0 else gain
 
 
 def deflection_to_voltage(spec: SensorSpec, deflection):

@@ -39,7 +39,11 @@ _PROVENANCE = (
 
 
 def pad4() -> PadSpec:
-    """A 4x4 capacitive pad at 5 mm pitch under 4 mm of rubber (a bench-top skin patch)."""
+    """A 4x4 capacitive pad at 5 mm pitch under 4 mm of rubber (a bench-top skin patch).
+
+    The dielectric is softer than the rubber, as the paper's (7e4 Pa under 2.5e5 Pa,
+    section 2.3): its plates close by about 3.6 times the rubber's strain.
+    """
     return PadSpec(
         name="pad4",
         description="4x4 capacitive pad, 5 mm pitch, 4 mm rubber layer. " + _PROVENANCE,
@@ -52,10 +56,10 @@ def pad4() -> PadSpec:
             electrode_y_mm=4.0,
         ),
         layer=Layer(
-            thickness_mm=4.0, youngs_modulus_pa=2.5e5, poisson_ratio=0.5, sensing_depth_mm=3.5
+            thickness_mm=4.0, youngs_modulus_pa=2.5e5, poisson_ratio=0.5, sensing_depth_mm=2.0
         ),
         transduction=Transduction(
-            kind="capacitive", strain_gain=1.0, dielectric_thickness_mm=0.5, dielectric_constant=4.0
+            kind="capacitive", strain_gain=3.6, dielectric_thickness_mm=0.5, dielectric_constant=4.0
         ),
         electronics=Electronics(scan_rate_hz=100.0),
         flaws=Flaws(),
