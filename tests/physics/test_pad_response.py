@@ -35,8 +35,8 @@ def test_thick_layer_is_the_half_space_of_boussinesq_and_love(nu, depth):
                   sensing_depth_mm=depth)  # fmt: skip
     step = 0.1
     axis = np.arange(-15.0, 15.0 + 1e-9, step)
-    pressure = DiscProbe(0.0, 0.0, force, radius_mm=a).pressure_pa(axis, axis,
-                                                                     modulus_star_pa=1e6)  # fmt: skip
+    disc = DiscProbe(0.0, 0.0, force, radius_mm=a)
+    pressure = disc.pressure_pa(axis, axis, modulus_star_pa=1e6)
     centre = len(axis) // 2
     computed = strain_map(pressure, (step, step), layer)[centre, centre]
     p0 = force / (math.pi * (a * 1e-3) ** 2)
