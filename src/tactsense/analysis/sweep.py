@@ -75,15 +75,33 @@ def design_point(
     }
 
 
+def variables_of(sensor) -> dict[str, tuple[str, str]]:
+    """The map's variables for a sensor's kind: a finger's, or a pad's
+    (:mod:`tactsense.analysis.pad_design`)."""
+    if sensor.kind == "pad":
+        from tactsense.analysis import pad_design
+
+        return pad_design.VARIABLES
+    if sensor.kind != "finger":
+        raise TactsenseInputError(
+            f"design maps are made for fingers and pads; {sensor.name!r} is a {sensor.kind}"
+        )
+    return VARIABLES
+
+
 def _depth_slice(sensor_toml: str, depth, spacings, poissons, grams) -> np.ndarray:
     """All designs of one depth: array (spacing, poisson, grams, variable)."""
     sensor = SensorSpec.from_toml_string(sensor_toml)
-    out = np.full((len(spacings), len(poissons), len(grams), len(VARIABLES)), np.nan)
+    variables = variables_of(sensor)
+    point_of = design_point
+    if sensor.kind == "pad":
+        from tactsense.analysis.pad_design import design_point as point_of
+    out = np.full((len(spacings), len(poissons), len(grams), len(variables)), np.nan)
     for i, spacing in enumerate(spacings):
         for j, nu in enumerate(poissons):
             for k, g in enumerate(grams):
-                point = design_point(sensor, depth, spacing, nu, g)
-                out[i, j, k] = [point[name] for name in VARIABLES]
+                point = point_of(sensor, depth, spacing, nu, g)
+                out[i, j, k] = [point[name] for name in variables]
     return out
 
 
@@ -154,7 +172,7 @@ def design_sweep(
             cube[..., k],
             {"units": unit, "long_name": text},
         )
-        for k, (name, (unit, text)) in enumerate(VARIABLES.items())
+        for k, (name, (unit, text)) in enumerate(variables_of(sensor).items())
     }
     return xr.Dataset(
         data,
@@ -184,13 +202,27 @@ def draw_map(dataset, *, designs: dict[str, tuple[float, float]]):
         axes,
         (
             ("counts_per_gram", "sensitivity [A/D units per g]"),
-            ("xi", "aliasing xi (eq. 45)"),
-            ("crb_axial_mm", "best possible position sd [mm] (CRB)"),
+            ("xi", "aliasing xi (eq. 45; in 2-D for a pad)"),
+            (
+                "crb_position_mm" if "crb_position_mm" in view else "crb_axial_mm",
+                "best possible position sd [mm] (CRB)",
+            ),
         ),
         strict=True,
     ):
-        mesh = ax.pcolormesh(s, d, view[name].values, shading="nearest", cmap="viridis")
+        values = view[name].values.astype(float)
+        unbounded = bool(np.isinf(values).any())
+        values = np.where(np.isfinite(values), values, np.nan)  # inf: not observable, blank
+        norm = None
+        if name.startswith("crb") and np.nanmin(values, initial=np.inf) > 0:
+            from matplotlib.colors import LogNorm
+
+            finite = values[np.isfinite(values)]
+            norm = LogNorm(finite.min(), finite.max()) if finite.size else None
+        mesh = ax.pcolormesh(s, d, values, shading="nearest", cmap="viridis", norm=norm)
         fig.colorbar(mesh, ax=ax)
+        if unbounded:
+            title = f"{title}\n(blank: not observable, no overlap between taxels)"
         low, high = ax.get_xlim()
         for k, (label, (depth, spacing)) in enumerate(ordered):
             ax.plot(spacing, depth, "r*", ms=12, mec="white", mew=0.8)
@@ -207,8 +239,9 @@ def draw_map(dataset, *, designs: dict[str, tuple[float, float]]):
                 va="bottom" if above else "top",
                 bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.85},
             )
-        ax.set_xlabel("tactel spacing along the finger [mm]")
-        ax.set_ylabel("effective depth [mm]")
+        pad = "crb_position_mm" in view
+        ax.set_xlabel("taxel pitch [mm]" if pad else "tactel spacing along the finger [mm]")
+        ax.set_ylabel("sensing depth [mm]" if pad else "effective depth [mm]")
         ax.set_title(title, fontsize=10)
     nu, load = float(view["poisson_ratio"]), float(view["load_g"])
     fig.suptitle(f"Design map (nu = {nu:g}, {load:g}-g probe)")

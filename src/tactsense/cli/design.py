@@ -298,15 +298,28 @@ def design_sweep_command(
         ),
     ] = Path("design_map.nc"),
     depth: Annotated[
-        str, typer.Option(help="Effective depths [mm]: START:STOP:COUNT or A,B,C (0.5-20).")
-    ] = "2:6:9",
+        str | None,
+        typer.Option(
+            help="Effective depths of a finger, or sensing depths of a pad (its layer's "
+            "thickness scales with it) [mm]: START:STOP:COUNT or A,B,C (0.5-20) "
+            "[default: 2:6:9 for a finger, 0.5:4:8 for a pad]."
+        ),
+    ] = None,
     spacing: Annotated[
-        str,
-        typer.Option(help="Tactel spacings along the finger [mm]: as --depth (0.5-20)."),
-    ] = "2:3.8:7",
+        str | None,
+        typer.Option(
+            help="Tactel spacings along a finger, or a pad's pitch along both axes (its "
+            "electrodes scale with it) [mm]: as --depth (0.5-20) [default: 2:3.8:7 for a "
+            "finger, 1.5:5:8 for a pad]."
+        ),
+    ] = None,
     poisson: Annotated[
-        str, typer.Option(help="Effective Poisson's ratios: A,B,C (0-0.5).")
-    ] = "0.4",
+        str | None,
+        typer.Option(
+            help="Poisson's ratios: a finger's effective one, a pad's layer's: A,B,C (0-0.5) "
+            "[default: 0.4 for a finger (the paper's fit), 0.5 for a pad (rubber)]."
+        ),
+    ] = None,
     force_g: Annotated[str, typer.Option(help="Probe loads [g]: A,B,C (0.1-10000).")] = "50",
     sensor: SensorOption = "initial",
     plot: Annotated[
@@ -322,7 +335,8 @@ def design_sweep_command(
 ) -> None:
     """Map what section 6 trades off over a grid of designs: sensitivity, aliasing,
     interpolation ripple and the Cramer-Rao bound on position and force. The paper's
-    two fingers are marked on the plot."""
+    two fingers are marked on the plot; for a pad (--sensor pad16), sensing depth x pitch
+    with the pad presets marked."""
 
     from tactsense.analysis.sweep import design_sweep, plot_map
     from tactsense.cli._common import atomic_output, check_output, console
@@ -333,11 +347,14 @@ def design_sweep_command(
 
         check_plot_format(plot)
         check_output(plot, force, what="plot")
-    depths = _grid(depth, "--depth", low=0.5, high=20.0)
-    spacings = _grid(spacing, "--spacing", low=0.5, high=20.0)
-    ratios = _grid(poisson, "--poisson", low=0.0, high=0.5)
-    loads = _grid(force_g, "--force-g", low=0.1, high=10_000.0)
     spec = load_sensor(sensor)
+    pad = spec.kind == "pad"
+    if spec.kind not in ("finger", "pad"):
+        fail(f"design maps are made for fingers and pads; {spec.name!r} is a {spec.kind}")
+    depths = _grid(depth or ("0.5:4:8" if pad else "2:6:9"), "--depth", low=0.5, high=20.0)
+    spacings = _grid(spacing or ("1.5:5:8" if pad else "2:3.8:7"), "--spacing", low=0.5, high=20.0)
+    ratios = _grid(poisson or ("0.5" if pad else "0.4"), "--poisson", low=0.0, high=0.5)
+    loads = _grid(force_g, "--force-g", low=0.1, high=10_000.0)
     client = cluster = None
     if workers > 0:
         import logging
@@ -371,15 +388,25 @@ def design_sweep_command(
     with atomic_output(out) as temporary:
         dataset.to_netcdf(temporary, engine="scipy")
     if plot is not None:
-        designs = {
-            "initial": (3.8, 3.8),
-            "improved": (
-                load_sensor("improved").elastic.effective_depth_mm,
-                load_sensor("improved").array.spacing_axial_mm,
-            ),
-        }
+        if spec.kind == "pad":  # the pad presets: sensing depth and pitch
+            from tactsense.sensor import PRESETS
+
+            pads = [make() for make in PRESETS.values()]
+            designs = {
+                p.name: (p.layer.sensing_depth_mm, p.grid.row_pitch_mm)
+                for p in pads
+                if p.kind == "pad"
+            }
+        else:
+            designs = {
+                "initial": (3.8, 3.8),
+                "improved": (
+                    load_sensor("improved").elastic.effective_depth_mm,
+                    load_sensor("improved").array.spacing_axial_mm,
+                ),
+            }
         with atomic_output(plot) as temporary:
             plot_map(dataset, temporary, designs=designs)
     n = len(depths) * len(spacings) * len(ratios) * len(loads)
     fits = int(np.isfinite(dataset["xi"].values).sum())
-    console.print(f"wrote {out}: {n} designs ({n - fits} do not fit the finger: NaN)")
+    console.print(f"wrote {out}: {n} designs ({n - fits} do not fit the {spec.kind}: NaN)")

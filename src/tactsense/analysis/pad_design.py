@@ -1,0 +1,135 @@
+"""Design of a pad: what section 6 of the paper trades off, for a flat array.
+
+For a pad otherwise like the given one, with its sensing element at ``depth_mm`` (the
+layer's thickness scaled with it, keeping the preset's depth-to-thickness ratio) and
+taxels ``pitch_mm`` apart along both axes (electrodes scaled with the pitch):
+
+* ``counts_per_gram``: the A/D units a probe centred on a taxel moves its reading, per
+  gram [1/g];
+* ``xi``: aliasing, eq. 45 carried to two dimensions: the share of the energy of a
+  taxel's response (the layer's strain transfer times its electrode's averaging) beyond
+  the Nyquist square ``|kx|, |ky| < 1 / (2 pitch)`` [-];
+* ``crb_position_mm`` and ``crb_force_pct``: the Cramer-Rao bound on the position
+  (root mean square over x and y) and on the force of a probe a quarter pitch off a
+  taxel along both axes, with the pad's read noise and quantization (what any estimator
+  could reach) [mm], [%]; ``inf`` where the position is not observable (the probe's
+  neighbours do not respond: no overlap between taxels).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from tactsense.physics.contact import grams_force
+from tactsense.physics.indenters import SphereProbe
+from tactsense.physics.pad_response import pad_strain, strain_transfer
+from tactsense.sensor import PadSpec, SensorSpecError
+
+VARIABLES = {
+    "counts_per_gram": ("1/g", "A/D units per gram of a probe centred on a taxel"),
+    "xi": ("1", "aliasing: share of the taxel response's energy beyond the Nyquist square"),
+    "crb_position_mm": ("mm", "Cramer-Rao bound on position (rms of x and y)"),
+    "crb_force_pct": ("%", "Cramer-Rao bound on force"),
+}
+
+PROBE_RADIUS_MM = 1.6
+"""The paper's probe: a 3.2-mm hemisphere (section 3)."""
+_SIZE = 7  # taxels per side of the small pad each design is evaluated on
+
+
+def design_variant(sensor: PadSpec, depth_mm: float, pitch_mm: float, poisson_ratio: float):
+    """The pad of one design: 7 x 7 taxels, depth and pitch as asked, the rest as
+    ``sensor`` (layer thickness and electrodes scaled with depth and pitch)."""
+    g, layer = sensor.grid, sensor.layer
+    scale = pitch_mm / max(g.row_pitch_mm, g.col_pitch_mm)
+    return sensor.replace(
+        grid__rows=_SIZE,
+        grid__cols=_SIZE,
+        grid__row_pitch_mm=pitch_mm,
+        grid__col_pitch_mm=pitch_mm,
+        grid__electrode_x_mm=g.electrode_x_mm * scale,
+        grid__electrode_y_mm=g.electrode_y_mm * scale,
+        layer__sensing_depth_mm=depth_mm,
+        layer__thickness_mm=depth_mm * layer.thickness_mm / layer.sensing_depth_mm,
+        layer__poisson_ratio=poisson_ratio,
+        flaws__dead_tactels=(),
+    )
+
+
+def _counts(spec: PadSpec, strain: np.ndarray) -> np.ndarray:
+    """Reading above the untouched one for a compressive strain [counts] (eq. 4 inverted
+    for a capacitive pad, ``V_S = V_o / (1 - d)``; the linear gain for a resistive one)."""
+    t, nominal = spec.transduction, spec.electronics.nominal_counts
+    if t.kind == "capacitive":
+        deflection = np.minimum(t.strain_gain * strain, 0.95)
+        return nominal * deflection / (1.0 - deflection)
+    return t.counts_per_strain * np.maximum(strain, 0.0)
+
+
+def aliasing(spec: PadSpec, samples: int = 257) -> float:
+    """Share of the energy of a taxel's response beyond the Nyquist square [-].
+
+    Both integrals (over the Nyquist square, and over the quadrant up to 8 cycles per
+    sensing depth, where the response has died out) by the trapezoid rule on a grid of
+    ``samples`` squared points each: the integrand is smooth on each, so the error falls
+    as the square of the step.
+    """
+    pitch = max(spec.grid.row_pitch_mm, spec.grid.col_pitch_mm)
+    g, layer = spec.grid, spec.layer
+
+    def energy(limit: float) -> float:
+        k = np.linspace(0.0, limit, samples)  # [cycles/mm]; even in kx and ky: one quadrant
+        kx, ky = np.meshgrid(k, k, indexing="ij")
+        power = (
+            strain_transfer(kx, ky, layer.sensing_depth_mm, layer)
+            * np.sinc(kx * g.electrode_x_mm)
+            * np.sinc(ky * g.electrode_y_mm)
+        ) ** 2
+        weights = np.full(samples, k[1] - k[0])
+        weights[0] = weights[-1] = 0.5 * (k[1] - k[0])
+        return float(np.einsum("i,j,ij->", weights, weights, power))
+
+    total = energy(max(8.0 / layer.sensing_depth_mm, 0.5 / pitch))
+    return 1.0 - energy(0.5 / pitch) / total if total > 0 else float("nan")
+
+
+def design_point(
+    sensor: PadSpec, depth_mm: float, pitch_mm: float, poisson_ratio: float, grams: float
+) -> dict[str, float]:
+    """The map's variables for one pad design (NaN where it does not make a valid pad)."""
+    try:
+        spec = design_variant(sensor, depth_mm, pitch_mm, poisson_ratio)
+    except SensorSpecError:
+        return dict.fromkeys(VARIABLES, float("nan"))
+    force = grams_force(grams)
+    centre = (_SIZE // 2) * pitch_mm
+
+    def readings(x: float, y: float, f: float) -> np.ndarray:
+        probe = SphereProbe(x, y, f, radius_mm=PROBE_RADIUS_MM)
+        return _counts(spec, pad_strain(spec, [probe])).ravel()
+
+    on_taxel = readings(centre, centre, force)
+    counts_per_gram = float(on_taxel.max()) / grams
+    # Fisher information of (x, y, F) for a probe off the taxel grid, by central differences
+    x0 = y0 = centre + 0.25 * pitch_mm
+    step, df = 0.01 * pitch_mm, 0.01 * force
+    d_x = (readings(x0 + step, y0, force) - readings(x0 - step, y0, force)) / (2 * step)
+    d_y = (readings(x0, y0 + step, force) - readings(x0, y0 - step, force)) / (2 * step)
+    d_f = (readings(x0, y0, force + df) - readings(x0, y0, force - df)) / (2 * df)
+    noise = spec.flaws.read_noise_counts**2 + 1.0 / 12.0  # read noise and quantization
+    jacobian = np.column_stack([d_x, d_y, d_f])
+    fisher = jacobian.T @ jacobian / noise
+    # a position no taxel's reading depends on (no overlap between taxels) is not
+    # observable: the bound is unbounded, inf
+    position = force_pct = float("inf")
+    if np.linalg.cond(fisher) < 1e12:
+        bound = np.linalg.inv(fisher)
+        if bound[0, 0] > 0 and bound[1, 1] > 0 and bound[2, 2] > 0:
+            position = float(np.sqrt(0.5 * (bound[0, 0] + bound[1, 1])))
+            force_pct = float(100.0 * np.sqrt(bound[2, 2]) / force)
+    return {
+        "counts_per_gram": counts_per_gram,
+        "xi": aliasing(spec),
+        "crb_position_mm": position,
+        "crb_force_pct": force_pct,
+    }
