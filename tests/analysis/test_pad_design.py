@@ -1,5 +1,7 @@
 """The pad design map: its variables against independent evaluations and physics."""
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -28,9 +30,9 @@ def test_aliasing_falls_with_depth_and_rises_with_pitch():
     worse (eq. 45 in two dimensions)."""
     spec = ts.preset("pad16")
     by_depth = [aliasing(design_variant(spec, d, 2.5, 0.5)) for d in (0.5, 1.0, 2.0, 4.0)]
-    assert all(a > b for a, b in zip(by_depth, by_depth[1:], strict=False))
+    assert all(a > b for a, b in itertools.pairwise(by_depth))
     by_pitch = [aliasing(design_variant(spec, 1.5, p, 0.5)) for p in (1.5, 2.5, 4.0)]
-    assert all(a < b for a, b in zip(by_pitch, by_pitch[1:], strict=False))
+    assert all(a < b for a, b in itertools.pairwise(by_pitch))
     assert 0.0 <= min(by_depth) and max(by_pitch) <= 1.0
 
 
