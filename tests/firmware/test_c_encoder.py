@@ -8,7 +8,6 @@ compiler fails."""
 
 from __future__ import annotations
 
-import json
 import os
 import re
 import shutil
@@ -63,8 +62,9 @@ def _build(folder: Path, name: str, extra: list[str]) -> Path:
     cc = _compiler()
     library = folder / f"{name}.o"
     exe = folder / name
+    source = str(FIRMWARE / "tactsense.c")
     for command in (
-        [cc, *STRICT, *LIBRARY_ONLY, *extra, "-c", str(FIRMWARE / "tactsense.c"), "-o", str(library)],
+        [cc, *STRICT, *LIBRARY_ONLY, *extra, "-c", source, "-o", str(library)],
         [cc, *STRICT, *extra, f"-I{FIRMWARE}", str(DRIVER), str(library), "-o", str(exe)],
     ):
         done = subprocess.run(command, capture_output=True, text=True, check=False)
@@ -91,9 +91,7 @@ def _run(exe: Path, *args: str, data: bytes = b"", env: dict | None = None) -> b
 def _frame_job(sequence: int, time_us: int, counts: np.ndarray) -> bytes:
     rows, cols = counts.shape
     return (
-        b"F"
-        + struct.pack("<HQBB", sequence, time_us, rows, cols)
-        + counts.astype("<u2").tobytes()
+        b"F" + struct.pack("<HQBB", sequence, time_us, rows, cols) + counts.astype("<u2").tobytes()
     )
 
 
