@@ -7,6 +7,8 @@ frame:
 
 * C, ``ts_encode_frame`` into a buffer;
 * C, ``ts_send_frame`` through a write callback (the streaming API a device uses);
+* C, ``ts_encode_frame`` built with ``-DTS_CRC_BYTE_TABLE`` (a 1-KB CRC table instead of
+  the default 64 bytes);
 * Python, ``tactsense.stream.protocol.encode_frame`` (``cobs`` and ``zlib`` in C under it).
 
 Each figure is the best of three runs; frames cycle through 64 precomputed readings in
@@ -31,14 +33,16 @@ ROOT = Path(__file__).resolve().parents[1]
 SHAPES = [(8, 8), (16, 16)]
 
 
-def build(folder: Path) -> Path:
+def build(folder: Path, *defines: str) -> Path:
     cc = shutil.which("cc") or shutil.which("gcc")
     if cc is None:
         sys.exit("error: no C compiler (cc or gcc) on PATH")
-    exe = folder / "ts_driver"
+    exe = folder / ("ts_driver" + "".join(defines))
     sources = [ROOT / "firmware" / "tactsense.c", ROOT / "tests" / "firmware" / "ts_driver.c"]
     include = f"-I{ROOT / 'firmware'}"
-    subprocess.run([cc, "-std=c99", "-O2", include, *map(str, sources), "-o", str(exe)], check=True)
+    subprocess.run(
+        [cc, "-std=c99", "-O2", *defines, include, *map(str, sources), "-o", str(exe)], check=True
+    )
     return exe
 
 
@@ -69,18 +73,22 @@ def bench_python(rows: int, cols: int, n: int) -> float:
 def main() -> None:
     with tempfile.TemporaryDirectory() as folder:
         exe = build(Path(folder))
+        fast = build(Path(folder), "-DTS_CRC_BYTE_TABLE")
         print("load average before: {:.2f} {:.2f} {:.2f}".format(*os.getloadavg()))
-        header = "| frame | C `ts_encode_frame` | C `ts_send_frame` | Python `encode_frame` |"
-        print(header + " C / Python |")
-        print("|---|---|---|---|---|")
+        header = "| frame | C `ts_encode_frame` | C `ts_send_frame` | C, 1-KB CRC table |"
+        print(header + " Python `encode_frame` | C / Python | C per byte on the wire |")
+        print("|---|---|---|---|---|---|---|")
         for rows, cols in SHAPES:
             n_c = 2_000_000 // (rows * cols // 64)
             buffer = bench_c(exe, "buffer", rows, cols, n_c)
             stream = bench_c(exe, "stream", rows, cols, n_c)
+            table = bench_c(fast, "buffer", rows, cols, n_c)
             python = bench_python(rows, cols, 100_000 // (rows * cols // 64))
+            wire = len(encode_frame(0, 0, np.full((rows, cols), 2000)))
             print(
                 f"| {rows}x{cols} | {buffer:,.0f} frames/s | {stream:,.0f} frames/s | "
-                f"{python:,.0f} frames/s | {buffer / python:.1f}x |"
+                f"{table:,.0f} frames/s | {python:,.0f} frames/s | {buffer / python:.1f}x | "
+                f"{1e9 / buffer / wire:.1f} ns ({wire} bytes) |"
             )
         print("load average after: {:.2f} {:.2f} {:.2f}".format(*os.getloadavg()))
 

@@ -5,8 +5,9 @@
  * (docs/protocol.md): FRAME, IDENT and END, each CRC-32/ISO-HDLC checked,
  * COBS-framed and followed by one 0x00 delimiter; and a decoder of the host's
  * commands IDENTIFY, START and STOP. No dynamic memory, no floating point, no
- * library calls beyond <stddef.h> and <stdint.h>; correct on 8-, 16- and 32-bit
- * targets (int may be 16 bits wide).
+ * library calls beyond <stddef.h> and <stdint.h>; written for 8-, 16- and 32-bit
+ * targets (int may be 16 bits wide). The CRC uses a table of 16 words (64 bytes);
+ * compile with -DTS_CRC_BYTE_TABLE for one of 256 words (1 KB), about twice as fast.
  *
  * Two ways to use it:
  *

@@ -77,6 +77,14 @@ def driver(tmp_path_factory) -> Path:
     return _build(tmp_path_factory.mktemp("c"), "ts_driver", ["-O2"])
 
 
+@pytest.fixture(scope="module", params=["crc-nibble-table", "crc-byte-table"])
+def any_driver(request, driver, tmp_path_factory) -> Path:
+    """The library as built by default (a 16-word CRC table) and with TS_CRC_BYTE_TABLE."""
+    if request.param == "crc-nibble-table":
+        return driver
+    return _build(tmp_path_factory.mktemp("c"), "ts_driver", ["-O2", "-DTS_CRC_BYTE_TABLE"])
+
+
 def _run(exe: Path, *args: str, data: bytes = b"", env: dict | None = None) -> bytes:
     done = subprocess.run(
         [str(exe), *args], input=data, capture_output=True, check=False, timeout=60, env=env
@@ -132,35 +140,35 @@ def _random_frames(rng) -> list[tuple[int, int, np.ndarray]]:
 # ---- the tests ---------------------------------------------------------------------
 
 
-def test_crc_is_zlibs(driver):
-    assert _run(driver, "crc", data=b"123456789").split() == [b"cbf43926"] * 2
+def test_crc_is_zlibs(any_driver):
+    assert _run(any_driver, "crc", data=b"123456789").split() == [b"cbf43926"] * 2
     data = np.random.default_rng(1).integers(0, 256, 3001, dtype=np.uint8).tobytes()
     expected = f"{zlib.crc32(data):08x}".encode()
-    assert _run(driver, "crc", data=data).split() == [expected] * 2
+    assert _run(any_driver, "crc", data=data).split() == [expected] * 2
 
 
 @pytest.mark.parametrize("mode", ["buffer", "stream"])
-def test_worked_example_of_the_docs(driver, mode):
+def test_worked_example_of_the_docs(any_driver, mode):
     # the bytes printed in docs/protocol.md, independent of the Python encoder
     block = re.search(r"<!-- example-frame -->\s*```text\n(.*?)```", DOCS.read_text(), re.S)
     documented = bytes.fromhex("".join(block.group(1).split()))
     counts = np.array([[2000, 2001], [2002, 65535]])
-    wire = _run(driver, "encode", mode, data=_frame_job(1, 142857, counts))
+    wire = _run(any_driver, "encode", mode, data=_frame_job(1, 142857, counts))
     assert wire == documented == encode_frame(1, 142857, counts)
 
 
 @pytest.mark.parametrize("mode", ["buffer", "stream"])
-def test_random_frames_byte_for_byte(driver, mode):
+def test_random_frames_byte_for_byte(any_driver, mode):
     frames = _random_frames(np.random.default_rng(22))
     jobs = b"".join(_frame_job(s, t, c) for s, t, c in frames)
-    got = _packets(_run(driver, "encode", mode, data=jobs))
+    got = _packets(_run(any_driver, "encode", mode, data=jobs))
     assert len(got) == len(frames)
     for (sequence, time_us, counts), packet in zip(frames, got, strict=True):
         assert packet == encode_frame(sequence, time_us, counts), (sequence, counts.shape)
 
 
 @pytest.mark.parametrize("mode", ["buffer", "stream"])
-def test_end_and_any_packet_byte_for_byte(driver, mode):
+def test_end_and_any_packet_byte_for_byte(any_driver, mode):
     rng = np.random.default_rng(5)
     ends = [(0, 0), (0, 1), (65535, 65536), (4, 70000), (1234, 2**32 - 1)]
     jobs = b"".join(b"E" + struct.pack("<HI", last, sent) for last, sent in ends)
@@ -178,7 +186,7 @@ def test_end_and_any_packet_byte_for_byte(driver, mode):
             jobs += b"P" + struct.pack("<BH", 0x42, length) + body
             packet = bytes([1, 0x42]) + body
             expected.append(cobs.encode(packet + struct.pack("<I", zlib.crc32(packet))) + b"\0")
-    assert _packets(_run(driver, "encode", mode, data=jobs)) == expected
+    assert _packets(_run(any_driver, "encode", mode, data=jobs)) == expected
 
 
 @pytest.mark.parametrize("pieces", ["I", "J"])
