@@ -110,6 +110,7 @@ def design_bound(
 
     try:
         spec = load_sensor(sensor)
+        spec.require_kind("finger", what="design bound (design sweep maps pads)")
         bound = cramer_rao_bound(
             spec, axial, angle, grams_force(force_g), contact_diameter_mm=diameter
         )

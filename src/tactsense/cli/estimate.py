@@ -180,6 +180,7 @@ def calibrate(
         # the sweep is read in pieces: any length fits in memory
         with RecordingReader(sweep) as reader:
             sensor = reader.sensor
+            sensor.require_kind("finger", what="calibrate")
             calibration = cal.calibrate_sweep(
                 (frames for _, frames, _ in reader.chunks()),
                 sensor,

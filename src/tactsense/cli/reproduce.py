@@ -56,6 +56,7 @@ def reproduce(
 
     try:
         spec = load_sensor(sensor)
+        spec.require_kind("finger", what="reproduce (the paper's experiments)")
         if out.exists() and not out.is_dir():
             fail(f"{out} is a file; expected a directory for the report")
         if out.exists() and not force:

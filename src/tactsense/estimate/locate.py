@@ -120,6 +120,11 @@ def locate(
         tactel passes the threshold. Frames with unusable tactels are
         processed with those tactels ignored, and flagged.
     """
+    if getattr(sensor, "kind", None) in ("pad", "points"):
+        raise TactsenseInputError(
+            f"contact estimation works on fingers so far; {sensor.name!r} is a {sensor.kind} "
+            "(simulate, record, view, info and design sweep work on it)"
+        )
     if not isinstance(sensor, SensorSpec):
         raise TactsenseInputError(f"sensor must be a SensorSpec; got {type(sensor).__name__}")
     frames = check_frames(frames, sensor.shape)
