@@ -97,10 +97,11 @@ def strain_map(
 ) -> np.ndarray:
     """Normal strain ``eps_zz`` at a depth under a pressure map on a regular grid.
 
-    The map is zero-padded to twice its size before the FFT, so the periodic images of
-    the load lie at least one map width away; the pressure map itself should reach two
-    layer thicknesses beyond the loaded area (the response of a bonded layer has died
-    out there, :func:`pad_strain` does so).
+    The map is zero-padded by four layer thicknesses (at least eight cells) along each
+    axis before the FFT, so the periodic images of the load lie that far beyond its
+    edges: the response of a layer bonded to a rigid base has died out there (it falls
+    off within about two thicknesses; the tests check the half-space limit with a layer
+    sixty radii thick and a padding of twice the map instead).
 
     Parameters
     ----------
@@ -124,7 +125,13 @@ def strain_map(
     depth = layer.sensing_depth_mm if depth_mm is None else depth_mm
     pressure = np.asarray(pressure_pa, dtype=float)
     m, n = pressure.shape
-    size = (scipy.fft.next_fast_len(2 * m, real=True), scipy.fft.next_fast_len(2 * n, real=True))
+    reach = 4.0 * layer.thickness_mm
+    pad_m = min(m, max(8, math.ceil(reach / spacing_mm[0])))
+    pad_n = min(n, max(8, math.ceil(reach / spacing_mm[1])))
+    size = (
+        scipy.fft.next_fast_len(m + pad_m, real=True),
+        scipy.fft.next_fast_len(n + pad_n, real=True),
+    )
     transfer = _transfer_grid(size, tuple(spacing_mm), layer, depth, electrode_mm)
     spectrum = scipy.fft.rfft2(pressure, s=size)
     return scipy.fft.irfft2(-spectrum * transfer, s=size)[:m, :n]
