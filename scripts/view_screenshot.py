@@ -20,7 +20,6 @@ import time
 from pathlib import Path
 
 import numpy as np
-
 from playwright.sync_api import sync_playwright
 
 import tactsense as ts
@@ -99,7 +98,9 @@ def flat_recording(name: str, path: Path) -> Path:
         counts = resistive_counts(spec, deflection)
     else:
         counts = v0 / (1.0 - deflection)  # eq. 4 solved for the reading
-    counts = counts + np.random.default_rng(3).normal(0.0, spec.flaws.read_noise_counts, counts.shape)
+    counts = counts + np.random.default_rng(3).normal(
+        0.0, spec.flaws.read_noise_counts, counts.shape
+    )
     rec = Recording(
         frames=np.clip(np.round(counts), 0, 2**spec.electronics.adc_bits - 1).astype(np.uint16),
         time_s=np.arange(len(forces)) / rate,

@@ -71,15 +71,15 @@ READ_JS = """(points) => {
 }"""
 
 
-def _wait_loaded(page):
-    page.wait_for_function(
+def _wait_loaded(view):
+    view.wait_for_function(
         f"() => {{ const s = window.tactsenseView; return s.drawnIndex !== null"
         f" && s.drawnIndex >= {UNTOUCHED + 3} && s.latest && s.latest.deflection; }}",
         timeout=15000,
     )
-    page.click("#play")  # pause, so the map holds still while it is read
-    page.wait_for_function("() => document.getElementById('play').textContent === 'play'")
-    page.wait_for_function(
+    view.click("#play")  # pause, so the map holds still while it is read
+    view.wait_for_function("() => document.getElementById('play').textContent === 'play'")
+    view.wait_for_function(
         "() => window.tactsenseView.drawnIndex === window.tactsenseView.lastIndex", timeout=5000
     )
 
@@ -100,12 +100,12 @@ def _ticks(labels, map_, axis):
     return out
 
 
-def _no_contact_panel(page, what):
-    assert page.locator("#contact").is_hidden()
-    assert page.locator("#no-estimation").is_visible()
-    assert page.text_content("#no-estimation") == f"contact estimation: not yet for {what}"
-    assert page.locator("#force-trace").is_hidden()
-    assert page.locator("#show-marker").is_hidden()
+def _no_contact_panel(view, what):
+    assert view.locator("#contact").is_hidden()
+    assert view.locator("#no-estimation").is_visible()
+    assert view.text_content("#no-estimation") == f"contact estimation: not yet for {what}"
+    assert view.locator("#force-trace").is_hidden()
+    assert view.locator("#show-marker").is_hidden()
 
 
 @pytest.mark.parametrize("kind", ["resistive", "capacitive"])

@@ -479,8 +479,9 @@ def view(
     apart, the seam marked), a pad as a flat grid in millimetres, a point set as dots at
     their positions; the interpolated surface, the contact with its trail (fingers:
     contacts on pads and point sets are not estimated yet), force and tactel time
-    traces, and the stream's health (frame rate, losses by kind, latency). The server listens on 127.0.0.1 only unless --host says otherwise; it
-    prints the address and serves until Ctrl-C.
+    traces, and the stream's health (frame rate, losses by kind, latency). The server
+    listens on 127.0.0.1 only unless --host says otherwise; it prints the address and
+    serves until Ctrl-C.
     """
     import webbrowser
 
