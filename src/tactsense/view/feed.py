@@ -358,8 +358,9 @@ def view_locator(
         )
     if calibration is not None:
         raise TactsenseInputError(
-            f"--calibration applies to fingers; sensor {sensor.name!r} is a {sensor.kind}, "
-            "whose calibration does not exist yet: leave --calibration out"
+            f"--calibration applies to fingers, not to {PLURAL.get(sensor.kind, sensor.kind)} "
+            f"(sensor {sensor.name!r}), whose calibration does not exist yet: leave "
+            "--calibration out"
         )
     return DeflectionOnly(sensor, baseline_frames=baseline_frames, baseline=baseline)
 
