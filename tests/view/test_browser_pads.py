@@ -8,6 +8,8 @@ against the millimetre ticks of the axes, the axes' titles, and the side panel.
 """
 
 import math
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -69,6 +71,21 @@ READ_JS = """(points) => {
     return [best, Math.sqrt(bestErr), Array.from(d.slice(0, 3))];
   });
 }"""
+
+
+def _seen_dots(view, rows, cols):
+    """The colour-map index drawn on each dot: the median of its centre and four points
+    half its radius from it, read from the canvas's pixels."""
+    state = view.evaluate(
+        "() => { const s = window.tactsenseView, c = [];"
+        " for (let r = 0; r < s.layout.rows; r++) for (let k = 0; k < s.layout.cols; k++)"
+        " c.push(s.cellCentre(r, k)); return {dot: s.map.dot, centres: c}; }"
+    )
+    inside = 0.5 * state["dot"]
+    offsets = [(0, 0), (inside, 0), (-inside, 0), (0, inside), (0, -inside)]
+    points = [[x + dx, y + dy] for x, y in state["centres"] for dx, dy in offsets]
+    seen = np.asarray([p[0] for p in view.evaluate(READ_JS, points)])
+    return np.median(seen.reshape(rows, cols, 5), axis=2)
 
 
 def _wait_loaded(view):
@@ -140,12 +157,7 @@ def test_pad_is_a_grid_in_millimetres_hottest_at_the_touch(page, tmp_path, kind)
         )
         m = state["map"]
         centres = np.asarray(state["centres"]).reshape(6, 10, 2)
-        # the hottest dot (read from its pixels: the centre and four points inside it)
-        inside = 0.5 * m["dot"]
-        offsets = [(0, 0), (inside, 0), (-inside, 0), (0, inside), (0, -inside)]
-        points = [[x + dx, y + dy] for x, y in centres.reshape(-1, 2) for dx, dy in offsets]
-        seen = np.asarray([p[0] for p in page.evaluate(READ_JS, points)]).reshape(6, 10, 5)
-        seen = np.median(seen, axis=2)
+        seen = _seen_dots(page, 6, 10)
         assert np.unravel_index(np.argmax(seen), seen.shape) == (row, col)
         assert seen[row, col] > 200 and seen[0, 0] < 30
         # one scale for both axes: 4 mm along x and 2.5 mm along y span the same pixels
@@ -219,3 +231,55 @@ def test_point_set_is_dots_at_their_positions(page, tmp_path):  # noqa: F811
         _no_contact_panel(page, "point sets")
     finally:
         server.stop()
+
+
+def test_command_line_emulate_and_view_a_pad(page, tmp_path):  # noqa: F811
+    """'tactsense emulate --recording pad.h5 --port 0' and 'tactsense view DEVICE': a live
+    pad, its baseline from the first frames, the touched taxel the hottest dot."""
+    spec = ts.preset("pad4")
+    row, col = 1, 2
+    path = _bump_recording(spec, (row * 5.0, col * 5.0), 0.1, tmp_path / "pad4.h5", n_frames=60)
+    exe = [sys.executable, "-m", "tactsense.cli"]
+    emulate = subprocess.Popen(
+        [*exe, "emulate", "--recording", str(path), "--port", "0", "--loop"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+    )
+    view = None
+    try:
+        device = emulate.stdout.readline().strip()
+        assert device.startswith("socket://127.0.0.1:")
+        view = subprocess.Popen(
+            [*exe, "view", device], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+        )
+        address = view.stdout.readline().strip()
+        assert address.startswith("http://127.0.0.1:"), view.stderr.read()
+        page.goto(address)
+        # a frame of the bump (the recording loops: untouched frames come back each turn)
+        page.wait_for_function(
+            f"() => {{ const f = window.tactsenseView.latest;"
+            f" return f && f.deflection && f.deflection[{row}][{col}] > 0.05"
+            f" && window.tactsenseView.drawnIndex === f.index; }}",
+            timeout=30000,
+        )
+        assert page.text_content("#status") == "streaming"
+        assert page.text_content("#sensor") == "pad4"
+        page.wait_for_function(  # the map drawn from that frame, not the one before
+            "() => window.tactsenseView.drawnIndex === window.tactsenseView.latest.index",
+            timeout=5000,
+        )
+        seen = _seen_dots(page, 4, 4)
+        assert np.unravel_index(np.argmax(seen), seen.shape) == (row, col)
+        _no_contact_panel(page, "pads")
+    finally:
+        for process in (view, emulate):
+            if process is not None:
+                process.send_signal(2)
+                try:
+                    process.wait(10)
+                except subprocess.TimeoutExpired:
+                    process.kill()
+    err = view.stderr.read()
+    assert view.returncode == 0, err
+    assert "frames shown" in err and "Traceback" not in err

@@ -14,7 +14,7 @@ from tactsense.io.recording import Recording, write_recording
 from tactsense.sensor import Electronics, Grid, PadSpec, PointsSpec, Taxels, Transduction
 from tactsense.stream.reader import StreamFrame
 from tactsense.view import DeflectionOnly, RecordingFeed, layout_message, view_locator
-from tactsense.view.feed import SURFACE_STEPS, project_points
+from tactsense.view.feed import MAX_FINE, SURFACE_STEPS, project_points
 
 SOURCE = {"kind": "test", "name": "x"}
 
@@ -188,3 +188,20 @@ def test_point_set_projection_is_an_isometry_of_a_tilted_flat_set():
     layout = layout_message(spec, SOURCE)
     np.testing.assert_allclose(layout["u_mm"], plane["u_mm"])
     assert layout["u_label"].startswith("u [mm]")
+
+
+def test_large_pad_surface_stays_bounded_and_passes_through_the_taxels():
+    """A 64 x 48 pad: at most MAX_FINE surface points per axis (the page evaluates the
+    surface every frame), still an odd number per pitch so that one band sits on each
+    taxel, where the surface is the taxel's value."""
+    spec = PadSpec(name="big", grid=Grid(rows=64, cols=48, row_pitch_mm=1.0, col_pitch_mm=1.0,
+                                         electrode_x_mm=0.8, electrode_y_mm=0.8))  # fmt: skip
+    layout = layout_message(spec, SOURCE)
+    s = layout["surface"]
+    rows, cols = np.asarray(s["row"]), np.asarray(s["col"])
+    assert len(rows) <= MAX_FINE and len(cols) <= MAX_FINE
+    z = np.random.default_rng(3).random(spec.shape)
+    f = np.asarray(s["w_rows"]) @ z @ np.asarray(s["w_cols"]).T
+    i = [int(np.flatnonzero(np.abs(rows - r) < 1e-9)[0]) for r in range(64)]
+    j = [int(np.flatnonzero(np.abs(cols - c) < 1e-9)[0]) for c in range(48)]
+    np.testing.assert_allclose(f[np.ix_(i, j)], z, atol=5e-6)

@@ -88,11 +88,24 @@ def _finger_geometry(sensor: SensorSpec) -> dict:
     }
 
 
+MAX_FINE = 288
+"""At most this many surface points along an axis of a pad (32 taxels at
+:data:`SURFACE_STEPS`); a larger pad gets fewer points per pitch (an odd number, at least
+one), so the page's work per frame stays bounded."""
+
+
+def flat_steps(n: int) -> int:
+    """Surface points per pitch along a pad's axis of ``n`` taxels (odd, 1 to 9)."""
+    steps = min(SURFACE_STEPS, max(1, MAX_FINE // max(n, 1)))
+    return steps if steps % 2 else steps - 1
+
+
 def _flat_weights(n: int) -> tuple[np.ndarray, np.ndarray]:
     """Fine positions [taxel] over ``n`` taxels' span and the windowed-sinc weights (eq. 48's
     kernel, not periodic: the edges are not wrapped) at them, held flat beyond the outer
     taxels; an axis of one taxel is constant."""
-    fine = (np.arange(n * SURFACE_STEPS) + 0.5) / SURFACE_STEPS - 0.5
+    steps = flat_steps(n)
+    fine = (np.arange(n * steps) + 0.5) / steps - 0.5
     if n < 2:
         return np.zeros_like(fine), np.ones((fine.size, 1))
     fine = np.clip(fine, 0.0, n - 1.0)
