@@ -189,6 +189,21 @@ def test_pad_is_a_grid_in_millimetres_hottest_at_the_touch(page, tmp_path, kind)
         mid = (centres[row, col] + centres[row, col - 1]) / 2
         (between,) = page.evaluate(READ_JS, [mid.tolist()])
         assert between[1] < 6 and between[0] > 120
+        # counts mode: the surface is in the counts of the pad's own transduction (eq. 4
+        # for a capacitive pad, the linear law for a resistive one), so it is hot between
+        # the touched taxel and its neighbour too, and the colour of the untouched taxels
+        # between two of them far from the touch (no ringing of raw counts)
+        page.check('input[value="counts"]')
+        page.wait_for_function(
+            "() => window.tactsenseView.units === 'counts' && !window.tactsenseView.dirty"
+        )
+        page.wait_for_timeout(200)
+        far = ((centres[0, 0] + centres[0, 1]) / 2).tolist()
+        (between, far_seen) = page.evaluate(READ_JS, [mid.tolist(), far])
+        counts_seen = _seen_dots(page, 6, 10)
+        assert np.unravel_index(np.argmax(counts_seen), counts_seen.shape) == (row, col)
+        assert between[1] < 6 and between[0] > 120, between
+        assert far_seen[1] < 6 and abs(far_seen[0] - counts_seen[0, 0]) <= 3, far_seen
         _no_contact_panel(page, "pads")
     finally:
         server.stop()
