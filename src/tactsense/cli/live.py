@@ -472,21 +472,22 @@ def view(
     sensor: StreamSensorOption = None,
     timeout: TimeoutOption = None,
 ) -> None:
-    """Show the finger in a web browser: a live stream as it arrives, or a recording played
+    """Show the sensor in a web browser: a live stream as it arrives, or a recording played
     back (play, pause, step, seek, speed).
 
-    The page shows the array unwrapped (length across, circumference down, the tip row
-    apart, the seam marked), the interpolated surface, the contact with its trail,
-    force and tactel time traces, and the stream's health (frame rate, losses by kind,
-    latency). The server listens on 127.0.0.1 only unless --host says otherwise; it
-    prints the address and serves until Ctrl-C.
+    The page shows a finger unwrapped (length across, circumference down, the tip row
+    apart, the seam marked), a pad as a flat grid in millimetres, a point set as dots at
+    their positions; the interpolated surface, the contact with its trail (fingers:
+    contacts on pads and point sets are not estimated yet), force and tactel time
+    traces, and the stream's health (frame rate, losses by kind, latency). The server
+    listens on 127.0.0.1 only unless --host says otherwise; it prints the address and
+    serves until Ctrl-C.
     """
     import webbrowser
 
     from tactsense.estimate import Calibration
     from tactsense.estimate.deflection import baseline_from
-    from tactsense.stream import LiveLocator
-    from tactsense.view import LiveFeed, RecordingFeed, ViewServer
+    from tactsense.view import LiveFeed, RecordingFeed, ViewServer, view_locator
     from tactsense.view.server import is_loopback
 
     listen = "127.0.0.1" if host is None else host.strip()
@@ -508,19 +509,25 @@ def view(
 
             def locator_for(spec, file):
                 if cal is not None:
-                    cal.check_sensor(spec)
-                    return LiveLocator(spec, calibration=cal, threshold=threshold,
-                                       keep_deflection=True)  # fmt: skip
+                    return view_locator(spec, calibration=cal, threshold=threshold)
                 start = file.frames(0, baseline_frames)
                 base = baseline_from(start, min(baseline_frames, len(start)))
-                return LiveLocator(spec, baseline=base, threshold=threshold,
-                                   keep_deflection=True)  # fmt: skip
+                return view_locator(spec, baseline=base, threshold=threshold)
 
             feed = RecordingFeed(path, locator_for, speed=speed)
         else:
-            reader, locator = _stream_and_locator(
-                source, sensor, timeout, cal, baseline_frames, threshold, keep_deflection=True
-            )
+            reader = _open_reader(source, sensor, timeout, start=False)
+            try:
+                locator = view_locator(
+                    reader.sensor,
+                    calibration=cal,
+                    baseline_frames=baseline_frames,
+                    threshold=threshold,
+                    frame_period_s=reader.frame_period_s or None,
+                )
+            except BaseException:
+                reader.close()
+                raise
             feed = LiveFeed(reader, locator)
     except TactsenseInputError as error:
         fail(str(error))

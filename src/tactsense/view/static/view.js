@@ -1,7 +1,9 @@
-// tactsense view: the finger's frames as they arrive over a websocket.
+// tactsense view: the sensor's frames as they arrive over a websocket.
 // The server sends a layout message once, then one message per frame (see
 // src/tactsense/view/feed.py for their fields). Drawing happens at most once per
 // animation frame, with the latest frame; every frame still feeds the time traces.
+// A finger is drawn unwrapped (layout.geometry "finger"); a pad or a point set on a
+// plane in millimetres ("plane": each taxel at (u_mm, v_mm), u across, v up).
 "use strict";
 
 const CELL = 48;          // pixels per tactel spacing, along and around
@@ -10,6 +12,7 @@ const MARGIN = { left: 56, top: 14, bottom: 40, bar: 70 };
 const DOT = 0.32 * CELL;  // radius of a tactel's dot [px]
 const TRAIL = 24;         // estimates kept in the contact's trail
 const TRACE_S = 20;       // seconds shown by the time traces
+const PLANE = { size: 480, cell: 64, minDot: 3 };   // plane: largest side, largest spacing [px]
 
 const state = {
   layout: null,
@@ -81,6 +84,7 @@ function angleOfCol(col) {
 // canvas pixels of the centre of tactel (row, col); fractional row/col allowed
 function cellCentre(row, col) {
   const L = state.layout;
+  if (L.geometry === "plane") return planeCentre(row, col);
   const y = yOfAngle(angleOfCol(col));
   if (L.tip_row && row < L.first_row - 0.5) return [MARGIN.left + CELL / 2, y];
   return [cylinderLeft() + (row - L.first_row + 0.5) * CELL, y];
@@ -89,6 +93,7 @@ state.cellCentre = cellCentre;
 
 function tactelAt(px, py) {
   const L = state.layout;
+  if (L.geometry === "plane") return planeTaxelAt(px, py);
   const [lo, hi] = angleSpan();
   const frac = (py - MARGIN.top) / mapHeight();
   if (frac < 0 || frac >= 1) return null;
@@ -136,9 +141,9 @@ function colour(value, lo, hi) {
 function rgb(c) { return `rgb(${c[0]},${c[1]},${c[2]})`; }
 
 // the windowed-sinc surface of eq. 48 on the fine grid: W_rows @ Z @ W_cols^T
-function surfaceOf(z) {
-  const S = state.layout.surface, first = state.layout.first_row;
-  const nr = S.w_rows.length, nc = S.w_cols.length, R = cylinderRows(), C = state.layout.cols;
+function surfaceOf(z, first = state.layout.first_row, R = cylinderRows()) {
+  const S = state.layout.surface;
+  const nr = S.w_rows.length, nc = S.w_cols.length, C = state.layout.cols;
   const zc = new Float64Array(R * nc);           // Z @ W_cols^T
   for (let r = 0; r < R; r++) {
     const zr = z[r + first];
@@ -215,6 +220,7 @@ function draw() {
   state.dirty = false;
   const L = state.layout, frame = state.latest;
   if (!L) return;
+  if (L.geometry === "plane") { drawPlane(frame); return; }
   ctx.clearRect(0, 0, canvas.width, canvas.height);
   const H = mapHeight(), left = cylinderLeft(), W = cylinderRows() * CELL;
   state.map = { top: MARGIN.top, height: H, cell: CELL, dot: DOT };   // for tests
@@ -293,8 +299,8 @@ function drawSeam() {
   ctx.restore();
 }
 
-function drawColourBar(lo, hi, unit) {
-  const x = cylinderLeft() + cylinderRows() * CELL + 36, H = mapHeight();
+function drawColourBar(lo, hi, unit, right = cylinderLeft() + cylinderRows() * CELL, H = mapHeight()) {
+  const x = right + 36;
   for (let i = 0; i < H; i++) {
     ctx.fillStyle = rgb(colour(hi - (i / (H - 1)) * (hi - lo), lo, hi));
     ctx.fillRect(x, MARGIN.top + i, 12, 1);
@@ -336,6 +342,152 @@ function drawContact() {
     state.marker = { x, y };
   }
   ctx.restore();
+}
+
+// ---- a pad or a point set: taxels on a plane in millimetres ------------------------------
+// One scale [px/mm] for both axes (the aspect ratio is true); u across, v up: the
+// sensor seen from outside, looking down its (mean) normal.
+
+function planeFrame() {
+  const L = state.layout, [u0, u1, v0, v1] = L.bounds_mm;
+  const scale = Math.min(PLANE.size / Math.max(u1 - u0, v1 - v0), PLANE.cell / L.spacing_mm);
+  return {
+    geometry: "plane", left: MARGIN.left, top: MARGIN.top,
+    width: (u1 - u0) * scale, height: (v1 - v0) * scale,
+    scale, u0, u1, v0, v1, dot: Math.max(PLANE.minDot, L.dot_mm * scale),
+  };
+}
+
+function xOfU(u) { const m = state.plane; return m.left + (u - m.u0) * m.scale; }
+function yOfV(v) { const m = state.plane; return m.top + (m.v1 - v) * m.scale; }
+
+function planeCentre(row, col) {
+  const L = state.layout, i = row * L.cols + col;
+  return [xOfU(L.u_mm[i]), yOfV(L.v_mm[i])];
+}
+
+function planeTaxelAt(px, py) {
+  const L = state.layout;
+  let best = null, bestD = Math.max(1.5 * state.plane.dot, 6);
+  for (let r = 0; r < L.rows; r++) {
+    for (let c = 0; c < L.cols; c++) {
+      const [x, y] = planeCentre(r, c), d = Math.hypot(px - x, py - y);
+      if (d < bestD) { bestD = d; best = [r, c]; }
+    }
+  }
+  return best;
+}
+
+// the reading a deflection f gives at a taxel whose frame reads `counts` at deflection
+// `d`: a capacitive taxel's eq. 4 solved for the reading, a resistive taxel's linear law
+function countsAt(f, counts, d) {
+  const t = state.layout.transduction;
+  if (t.kind === "resistive") return counts - d * t.counts_per_strain + f * t.counts_per_strain;
+  return (counts * (1 - d)) / Math.max(1 - f, 1e-3);
+}
+
+// the separable windowed-sinc surface (not periodic) on the fine grid; in counts mode each
+// point in the counts of the taxel whose cell it lies in, as on the finger
+function planeSurfaceValues(frame) {
+  const L = state.layout, S = L.surface;
+  const f = surfaceOf(frame.deflection, 0, L.rows);
+  if (state.units !== "counts") return f;
+  const nr = S.w_rows.length, nc = S.w_cols.length;
+  for (let i = 0; i < nr; i++) {
+    const r = Math.round(S.row[i]);
+    for (let j = 0; j < nc; j++) {
+      const c = Math.round(S.col[j]);
+      f[i * nc + j] = countsAt(f[i * nc + j], frame.counts[r][c], frame.deflection[r][c]);
+    }
+  }
+  return f;
+}
+
+function drawPlaneSurface(frame, lo, hi) {
+  const S = state.layout.surface, m = state.plane;
+  const nr = S.w_rows.length, nc = S.w_cols.length;
+  const f = planeSurfaceValues(frame);
+  offscreen.width = nr; offscreen.height = nc;
+  const octx = offscreen.getContext("2d");
+  const image = octx.createImageData(nr, nc);
+  for (let j = 0; j < nc; j++) {
+    const y = nc - 1 - j;   // v up
+    for (let i = 0; i < nr; i++) {
+      const c = colour(f[i * nc + j], lo, hi);
+      const p = 4 * (y * nr + i);
+      image.data[p] = c[0]; image.data[p + 1] = c[1]; image.data[p + 2] = c[2]; image.data[p + 3] = 255;
+    }
+  }
+  octx.putImageData(image, 0, 0);
+  ctx.imageSmoothingEnabled = true;
+  ctx.drawImage(offscreen, m.left, m.top, m.width, m.height);
+}
+
+function drawPlane(frame) {
+  const L = state.layout, m = state.plane;
+  ctx.clearRect(0, 0, canvas.width, canvas.height);
+  state.map = { ...m };   // for tests: origin, scale [px/mm], dot radius [px]
+  ctx.fillStyle = "#eceff1";
+  ctx.fillRect(m.left, m.top, m.width, m.height);
+  if (!frame) { drawPlaneAxes(); return; }
+  const z = values(frame);
+  const [lo, hi, unit] = scale(frame);
+  if (L.surface && state.showSurface && frame.deflection) drawPlaneSurface(frame, lo, hi);
+  for (let r = 0; r < L.rows; r++) {
+    for (let c = 0; c < L.cols; c++) {
+      const [x, y] = planeCentre(r, c);
+      ctx.beginPath();
+      ctx.arc(x, y, m.dot, 0, 2 * Math.PI);
+      ctx.fillStyle = rgb(colour(z[r][c], lo, hi));
+      ctx.fill();
+      const sel = state.selected && state.selected[0] === r && state.selected[1] === c;
+      ctx.lineWidth = sel ? 3 : 1;
+      ctx.strokeStyle = sel ? "#e91e63" : "rgba(0,0,0,0.35)";
+      ctx.stroke();
+    }
+  }
+  drawPlaneAxes();
+  drawColourBar(lo, hi, unit, m.left + m.width, m.height);
+  state.drawnIndex = frame.index;
+}
+
+// a tick every 1, 2 or 5 x 10^k mm, at least 36 px apart
+function tickStep(scale) {
+  for (let k = -1; k < 4; k++) {
+    for (const b of [1, 2, 5]) {
+      const step = b * 10 ** k;
+      if (step * scale >= 36) return step;
+    }
+  }
+  return 10000;
+}
+
+function drawPlaneAxes() {
+  const L = state.layout, m = state.plane, bottom = m.top + m.height;
+  state.labels = [];
+  const step = tickStep(m.scale), digits = step < 1 ? 1 : 0;
+  ctx.fillStyle = "#333"; ctx.strokeStyle = "#333"; ctx.lineWidth = 1;
+  ctx.font = "12px system-ui, sans-serif"; ctx.textAlign = "center";
+  for (let t = Math.ceil(m.u0 / step) * step; t <= m.u1 + 1e-9; t += step) {
+    const x = xOfU(t);
+    ctx.beginPath(); ctx.moveTo(x, bottom); ctx.lineTo(x, bottom + 3); ctx.stroke();
+    label((Math.abs(t) < 1e-9 ? 0 : t).toFixed(digits), x, bottom + 14);
+  }
+  label(L.u_label, m.left + m.width / 2, bottom + 30);
+  ctx.textAlign = "right";
+  for (let t = Math.ceil(m.v0 / step) * step; t <= m.v1 + 1e-9; t += step) {
+    const y = yOfV(t);
+    ctx.beginPath(); ctx.moveTo(m.left - 3, y); ctx.lineTo(m.left, y); ctx.stroke();
+    label((Math.abs(t) < 1e-9 ? 0 : t).toFixed(digits), m.left - 6, y + 4);
+  }
+  // the v axis' title, turned to read upward (its box as drawn, for tests)
+  ctx.save();
+  const cx = 14, cy = m.top + m.height / 2;
+  ctx.translate(cx, cy); ctx.rotate(-Math.PI / 2); ctx.textAlign = "center";
+  ctx.fillText(L.v_label, 0, 0);
+  const w = ctx.measureText(L.v_label).width;
+  ctx.restore();
+  state.labels.push({ text: L.v_label, left: cx - 12, right: cx + 3, top: cy - w / 2, bottom: cy + w / 2 });
 }
 
 // ---- readouts -----------------------------------------------------------------------
@@ -427,7 +579,8 @@ function drawTraces(now) {
   lastTraceDraw = now;
   const T = state.traces;
   forcePlot.setData([T.t, T.force]);
-  const title = state.selected ? `tactel (${state.selected[0]}, ${state.selected[1]}) [${state.units}]` : "tactel: click one on the map";
+  const word = state.layout && state.layout.geometry === "plane" ? "taxel" : "tactel";
+  const title = state.selected ? `${word} (${state.selected[0]}, ${state.selected[1]}) [${state.units}]` : `${word}: click one on the map`;
   tactelPlot.root.querySelector(".u-title").textContent = title;
   tactelPlot.setData([T.t, T.tactel]);
 }
@@ -441,13 +594,31 @@ function onLayout(L) {
   state.centre = L.closes ? centreNear(L.col_angle_deg[0] + ((L.cols - 1) / 2) * L.spacing_deg) : 0;
   $("sensor").textContent = L.sensor;
   $("source").textContent = `${L.source.kind}: ${L.source.name}`;
-  $("calibration").textContent = L.source.calibrated
+  $("calibration").textContent = L.estimation ? "" : L.source.calibrated
     ? "calibrated"
     : "uncalibrated: per-tactel gains not corrected (tactsense calibrate)";
-  const width = cylinderLeft() + cylinderRows() * CELL + MARGIN.bar + 40;
-  canvas.width = width;
-  canvas.height = MARGIN.top + mapHeight() + MARGIN.bottom;
-  state.selected = [L.first_row + Math.floor(cylinderRows() / 2), 0];
+  // no contact estimate for this kind of sensor (yet): one line instead of the numbers
+  $("contact").hidden = Boolean(L.estimation);
+  $("no-estimation").hidden = !L.estimation;
+  $("no-estimation").textContent = L.estimation || "";
+  $("force-trace").hidden = Boolean(L.estimation);
+  $("show-marker").parentElement.hidden = Boolean(L.estimation);
+  if (L.geometry === "plane") {
+    state.plane = planeFrame();
+    canvas.width = state.plane.left + state.plane.width + MARGIN.bar + 40;
+    canvas.height = state.plane.top + state.plane.height + MARGIN.bottom;
+    state.selected = [Math.floor(L.rows / 2), Math.floor(L.cols / 2)];
+    $("hint").textContent = "Click a taxel to follow it in the trace below. "
+      + `${L.projection[0].toUpperCase()}${L.projection.slice(1)}; `
+      + (L.surface ? "the surface is the windowed-sinc interpolation of the deflection, not wrapped at the edges."
+        : "no surface between scattered taxels, dots only.");
+    $("show-surface").parentElement.hidden = !L.surface;
+  } else {
+    const width = cylinderLeft() + cylinderRows() * CELL + MARGIN.bar + 40;
+    canvas.width = width;
+    canvas.height = MARGIN.top + mapHeight() + MARGIN.bottom;
+    state.selected = [L.first_row + Math.floor(cylinderRows() / 2), 0];
+  }
   state.history = []; state.traces = { t: [], force: [], tactel: [] }; state.trail = [];
   state.lastIndex = null; state.lastSerial = null;   // a (re)connection starts afresh
   if (!forcePlot) makePlots();
