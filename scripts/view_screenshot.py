@@ -82,17 +82,7 @@ def flat_recording(name: str, path: Path) -> Path:
                      force_n=float(f), radius_mm=5.0),) if f > 0 else ()
         for f in forces
     ]  # fmt: skip
-    try:
-        deflection = deflection_batch_flat(spec, applied)
-        how = "the layer model"
-    except ModuleNotFoundError:  # tactsense.physics.layer not merged yet
-        # a stand-in: a Gaussian bump of deflection 0.05 per newton, sigma the layer's depth
-        centre = np.array([applied[-1][0].x_mm, applied[-1][0].y_mm])
-        r2 = ((positions[:, :2] - centre) ** 2).sum(axis=1).reshape(spec.shape)
-        bump = 0.05 * np.exp(-r2 / (2 * spec.layer.thickness_mm**2))
-        deflection = forces[:, None, None] * bump
-        how = "a Gaussian bump (no layer model in this tree)"
-    print(f"{name}: strains from {how}")
+    deflection = deflection_batch_flat(spec, applied)
     v0 = spec.electronics.nominal_counts
     if spec.transduction.kind == "resistive":
         counts = resistive_counts(spec, deflection)
