@@ -272,6 +272,8 @@ def read_xdf(source: Path, *, sensor=None, stream: str | None = None):
         raise ImportError_(
             f"{source} is not a readable XDF file ({type(error).__name__}: {error})"
         ) from None
+    if not streams:
+        raise ImportError_(f"{source} is not a readable XDF file (no streams in it)")
     described = []
     for s in streams:
         info = s["info"]
