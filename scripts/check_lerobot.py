@@ -65,15 +65,21 @@ def main() -> int:
     import torch
     from lerobot.datasets.lerobot_dataset import CODEBASE_VERSION, LeRobotDataset
 
-    print(f"lerobot {getattr(lerobot, '__version__', '?')}, codebase {CODEBASE_VERSION}, "
-          f"torch {torch.__version__}")
+    print(
+        f"lerobot {getattr(lerobot, '__version__', '?')}, codebase {CODEBASE_VERSION}, "
+        f"torch {torch.__version__}"
+    )
     dataset = LeRobotDataset(repo_id=f"local/{args.dataset.name}", root=args.dataset)
     meta = dataset.meta
-    print(f"fps {meta.fps}, episodes {meta.total_episodes}, frames {meta.total_frames}, "
-          f"len(dataset) {len(dataset)}")
+    print(
+        f"fps {meta.fps}, episodes {meta.total_episodes}, frames {meta.total_frames}, "
+        f"len(dataset) {len(dataset)}"
+    )
     print(f"features {sorted(meta.features)}")
-    print(f"observation.tactile shape {meta.features['observation.tactile']['shape']}, "
-          f"state names {meta.features['observation.state']['names']}")
+    print(
+        f"observation.tactile shape {meta.features['observation.tactile']['shape']}, "
+        f"state names {meta.features['observation.state']['names']}"
+    )
     frames = []
     for i in range(len(dataset)):
         item = dataset[i]
@@ -81,8 +87,21 @@ def main() -> int:
         assert int(item["index"]) == i
         assert abs(float(item["timestamp"]) - int(item["frame_index"]) / meta.fps) < 1e-4
     frames = np.stack(frames)
-    print(f"item 0: observation.tactile {tuple(frames[0].shape)} {frames.dtype}, "
-          f"state {dataset[0]['observation.state'].numpy().round(3).tolist()}")
+    print(
+        f"item 0: observation.tactile {tuple(frames[0].shape)} {frames.dtype}, "
+        f"state {dataset[0]['observation.state'].numpy().round(3).tolist()}"
+    )
+    print(f"item 0 task {dataset[0]['task']!r}")
+    history = LeRobotDataset(
+        repo_id=f"local/{args.dataset.name}", root=args.dataset,
+        delta_timestamps={"observation.tactile": [-2 / meta.fps, -1 / meta.fps, 0.0]},
+    )  # fmt: skip
+    window = history[len(history) - 1]["observation.tactile"].numpy()
+    assert np.array_equal(window, frames[-3:]), "delta_timestamps window"
+    print(
+        f"delta_timestamps: the last item's 3-frame window {tuple(window.shape)} equals "
+        "the last 3 frames"
+    )
     stats = meta.stats["observation.tactile"]
     print(f"stats of observation.tactile: mean shape {tuple(np.shape(stats['mean']))}")
     if args.recording is not None:

@@ -167,8 +167,6 @@ def write_dataset(
     extra: dict | None = None,
 ) -> dict:
     """Write the dataset files into ``folder`` (which must be empty or new)."""
-    import pandas as pd
-
     pa, pq = _pyarrow()
     n = len(frames)
     rows, cols = sensor.shape
@@ -246,8 +244,26 @@ def write_dataset(
     stats = {k: _stats(columns[k], features[k]["shape"] == [1]) for k in numeric}
     _write_json(folder / "meta" / "stats.json", _listed(stats))
 
-    tasks = pd.DataFrame({"task_index": [0]}, index=pd.Index([task], name="task"))
-    tasks.to_parquet(folder / "meta" / "tasks.parquet")
+    # meta/tasks.parquet as pandas writes a frame indexed by "task" (LeRobot reads it with
+    # pandas.read_parquet): the metadata that makes "task" the index, without pandas here
+    pandas_meta = {
+        "index_columns": ["task"],
+        "column_indexes": [
+            {"name": None, "field_name": None, "pandas_type": "unicode",
+             "numpy_type": "object", "metadata": {"encoding": "UTF-8"}}
+        ],
+        "columns": [
+            {"name": "task_index", "field_name": "task_index", "pandas_type": "int64",
+             "numpy_type": "int64", "metadata": None},
+            {"name": "task", "field_name": "task", "pandas_type": "unicode",
+             "numpy_type": "object", "metadata": None},
+        ],
+        "creator": {"library": "pyarrow", "version": pa.__version__},
+    }  # fmt: skip
+    tasks = pa.table(
+        {"task_index": pa.array([0], pa.int64()), "task": pa.array([task], pa.string())}
+    ).replace_schema_metadata({"pandas": json.dumps(pandas_meta)})
+    pq.write_table(tasks, folder / "meta" / "tasks.parquet")
 
     info = {
         "codebase_version": CODEBASE_VERSION,
