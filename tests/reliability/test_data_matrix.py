@@ -62,7 +62,10 @@ CASES = [
     ("import DIR/text.xdf --out OUT", "text.xdf is not a readable XDF file"),
     ("import DIR/good.csv --out OUT", "pass --sensor"),
     ("import DIR/good.csv --sensor bogus --out OUT", "--sensor"),
-    ("import DIR/good.csv --sensor pad4 --out OUT", "64 value columns; sensor 'pad4' has 4 x 4 = 16 taxels"),
+    (
+        "import DIR/good.csv --sensor pad4 --out OUT",
+        "64 value columns; sensor 'pad4' has 4 x 4 = 16 taxels",
+    ),
     ("import DIR/short.csv --sensor initial --out OUT", "2 value columns"),
     ("import DIR/nan.csv --sensor initial --out OUT", "line 3"),
     ("import DIR/ragged.csv --sensor initial --out OUT", "line 3: 2 fields"),

@@ -402,7 +402,7 @@ def read_source(
         if (source / "meta" / "info.json").is_file():
             from tactsense.interop.lerobot import import_lerobot
 
-            return import_lerobot(source)
+            return import_lerobot(source, sensor=sensor)
         if (source / "metadata.yaml").is_file():
             return read_rosbag2(source, sensor=sensor, topic=topic)
         raise ImportError_(

@@ -401,7 +401,10 @@ def import_lerobot(folder: str | Path, *, sensor=None):
             f"{folder}: not written by tactsense (no meta/tactsense.json); pass --sensor"
         )
     else:
-        spec = load_sensor(sensor)
+        try:
+            spec = load_sensor(sensor)
+        except SensorSpecError as error:
+            raise LeRobotError(f"--sensor: {error}") from None
     if shape != tuple(spec.shape):
         raise LeRobotError(
             f"{folder}: observation.tactile has shape {list(shape)}; sensor {spec.name!r} "
