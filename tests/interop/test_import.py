@@ -266,3 +266,41 @@ def test_lerobot_export_has_the_v3_layout_and_imports_back(tmp_path, rec_path, s
     np.testing.assert_array_equal(back.frames, sweep.frames)
     np.testing.assert_array_equal(back.time_s, sweep.time_s)
     assert back.sensor == sweep.sensor
+
+
+def test_lerobot_export_interrupted_leaves_nothing(tmp_path, rec_path, monkeypatch):
+    """Ctrl-C while the dataset is being written: no dataset, no temporary folder."""
+    from tactsense.interop import lerobot
+
+    original = lerobot.write_dataset
+
+    def interrupted(folder, **kwargs):
+        original(folder, **kwargs)  # every file written, then the interrupt
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(lerobot, "write_dataset", interrupted)
+    out = tmp_path / "dataset"
+    with pytest.raises(KeyboardInterrupt):
+        lerobot.export_lerobot(rec_path, out)
+    assert not out.exists()
+    assert [p.name for p in tmp_path.iterdir()] == ["rec.h5"]
+
+
+def test_lerobot_dataset_of_another_writer_needs_a_sensor_of_its_shape(tmp_path, sweep):
+    """A v3 dataset without tactsense's metadata: --sensor gives the sensor, and a sensor of
+    another shape is refused (exit 2, both shapes named)."""
+    from tactsense.interop.lerobot import write_dataset
+
+    out = tmp_path / "other"
+    out.mkdir()
+    write_dataset(out, sensor=sweep.sensor, frames=sweep.frames, frame_time=sweep.time_s,
+                  state=np.zeros((len(sweep), 6)))  # fmt: skip
+    (out / "meta" / "tactsense.json").unlink()
+    result = runner.invoke(app, ["import", str(out), "--out", str(tmp_path / "a.h5")])
+    assert result.exit_code == 2 and "--sensor" in result.output
+    back = _import(out, tmp_path / "b.h5", "--sensor", "initial")
+    np.testing.assert_array_equal(back.frames, sweep.frames)
+    result = runner.invoke(
+        app, ["import", str(out), "--out", str(tmp_path / "c.h5"), "--sensor", "pad4"]
+    )
+    assert result.exit_code == 2 and "[8, 8]" in result.output and "[4, 4]" in result.output

@@ -19,6 +19,7 @@ from tactsense.cli._common import (
     fail,
     new_group,
     progress_bar,
+    remove_stale_partials,
 )
 
 app = new_group("Other tools' formats: MCAP (ROS 2, Foxglove) and Rerun.")
@@ -126,6 +127,7 @@ def _export_lerobot(recording, out, calibration, baseline_frames, threshold, epi
     if out.exists():
         fail(f"{out} exists; a LeRobot dataset goes into a new folder")
     check_output(out, False, what="dataset folder")
+    remove_stale_partials(out.parent, f".{out.name}", "")  # left by a run killed outright
     cal = None if calibration is None else Calibration.load(calibration)
     counts = export_lerobot(
         recording, out, calibration=cal, baseline_frames=baseline_frames,
