@@ -131,3 +131,41 @@ def test_record_from_an_lsl_outlet(tmp_path, sweep):
 def test_no_such_outlet_is_a_clear_error():
     with pytest.raises(StreamError, match="no Lab Streaming Layer outlet named"):
         LslReader(f"nothing-{uuid.uuid4().hex}", timeout_s=0.5)
+
+
+@pytest.mark.parametrize("kind", ["initial", "pad4", "dome12"])
+def test_stream_metadata_follows_the_xdf_meta_data_conventions(kind):
+    """channels/channel/{label,unit,type,location/X,Y,Z [mm]}, acquisition/{manufacturer,
+    model}, a type on the contacts stream and its channels: read back through pylsl's XML
+    (StreamInfo.as_xml, the text LabRecorder writes into an XDF stream header)."""
+    import xml.etree.ElementTree as ET
+
+    from tactsense.interop.lsl import contacts_info, frames_info
+
+    sensor = ts.preset(kind)
+    identity = {"serial": "s-1", "device": "tactsense twin", "manufacturer": "lab"}
+    root = ET.fromstring(frames_info(sensor, identity, 7.0).as_xml())
+    assert root.findtext("type") == "Tactile"
+    assert root.findtext("desc/acquisition/manufacturer") == "lab"
+    assert root.findtext("desc/acquisition/model") == "tactsense twin"
+    channels = root.findall("desc/channels/channel")
+    assert len(channels) == sensor.n_taxels
+    positions = np.array(
+        [[float(ch.findtext(f"location/{axis}")) for axis in "XYZ"] for ch in channels]
+    )
+    # the sensor's taxel positions in frame order, to the 6 significant digits written
+    np.testing.assert_allclose(positions, sensor.taxel_positions_mm(), rtol=1e-5, atol=1e-9)
+    for ch in channels:
+        assert ch.findtext("unit") == "counts" and ch.findtext("type") == "Tactile"
+        assert ch.findtext("label") == f"r{ch.findtext('row')}c{ch.findtext('col')}"
+    # tactsense's own reader still finds the sensor
+    assert root.findtext("desc/tactsense/sensor_toml")
+
+    contacts = ET.fromstring(contacts_info(sensor, identity, 7.0).as_xml())
+    assert contacts.findtext("type") == "TactileContact"
+    assert contacts.findtext("desc/acquisition/model") == "tactsense twin"
+    rows = [(c.findtext("label"), c.findtext("unit"), c.findtext("type"))
+            for c in contacts.findall("desc/channels/channel")]  # fmt: skip
+    assert [r[0] for r in rows] == list(CONTACT_CHANNELS)
+    assert all(unit and kind for _, unit, kind in rows)
+    assert dict((r[0], r[1]) for r in rows)["force_n"] == "N"

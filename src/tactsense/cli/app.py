@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import typer
 
-from tactsense.cli import design, estimate, interop, live, model, reproduce
+from tactsense.cli import design, estimate, imports, interop, live, model, reproduce
 
 app = typer.Typer(
     no_args_is_help=True,
@@ -21,6 +21,7 @@ app.add_typer(model.app)
 app.add_typer(estimate.app)
 app.add_typer(live.app)
 app.add_typer(interop.app)
+app.add_typer(imports.app)
 app.add_typer(model.sensor_app, name="sensor")
 app.add_typer(design.app, name="design")
 

@@ -19,6 +19,7 @@ from tactsense.cli._common import (
     fail,
     new_group,
     progress_bar,
+    remove_stale_partials,
 )
 
 app = new_group("Other tools' formats: MCAP (ROS 2, Foxglove) and Rerun.")
@@ -27,6 +28,7 @@ app = new_group("Other tools' formats: MCAP (ROS 2, Foxglove) and Rerun.")
 class ExportFormat(StrEnum):
     mcap = "mcap"
     rerun = "rerun"
+    lerobot = "lerobot"
 
 
 SUFFIXES = {ExportFormat.mcap: ".mcap", ExportFormat.rerun: ".rrd"}
@@ -46,8 +48,17 @@ def export(
         typer.Option(
             "--format",
             help="mcap: tactile_msgs/TactileState and TactileContact messages (ROS 2 CDR) for "
-            "ROS 2 and Foxglove; rerun: heat map, contact and force for the Rerun viewer. "
+            "ROS 2 and Foxglove; rerun: heat map, contact and force for the Rerun viewer; "
+            "lerobot: a LeRobot v3 dataset folder. "
             "Default: from the extension of OUT.",
+        ),
+    ] = None,
+    episode_split: Annotated[
+        int | None,
+        typer.Option(
+            "--episode-split",
+            min=1,
+            help="lerobot: one episode per this many frames (default: one per recording).",
         ),
     ] = None,
     calibration: CalibrationOption = None,
@@ -67,7 +78,15 @@ def export(
         by_suffix = {suffix: kind for kind, suffix in SUFFIXES.items()}
         export_format = by_suffix.get(out.suffix.lower())
         if export_format is None:
-            fail(f"{out}: say --format mcap or rerun, or use the extension .mcap or .rrd")
+            fail(
+                f"{out}: say --format mcap or rerun (or lerobot, for a dataset folder), or use "
+                "the extension .mcap or .rrd"
+            )
+    if export_format is ExportFormat.lerobot:
+        _export_lerobot(recording, out, calibration, baseline_frames, threshold, episode_split)
+        return
+    if episode_split is not None:
+        fail("--episode-split applies to --format lerobot only")
     check_output(out, force)
     try:
         cal = None if calibration is None else Calibration.load(calibration)
@@ -97,4 +116,24 @@ def export(
     console.print(
         f"wrote {out}: {counts['frames']} frames, {counts['contacts']} with a contact "
         f"({export_format.value})"
+    )
+
+
+def _export_lerobot(recording, out, calibration, baseline_frames, threshold, episode_split):
+    """``export --format lerobot``: a new dataset folder (tactsense.interop.lerobot)."""
+    from tactsense.estimate import Calibration
+    from tactsense.interop.lerobot import export_lerobot
+
+    if out.exists():
+        fail(f"{out} exists; a LeRobot dataset goes into a new folder")
+    check_output(out, False, what="dataset folder")
+    remove_stale_partials(out.parent, f".{out.name}", "")  # left by a run killed outright
+    cal = None if calibration is None else Calibration.load(calibration)
+    counts = export_lerobot(
+        recording, out, calibration=cal, baseline_frames=baseline_frames,
+        threshold=threshold, episode_split=episode_split,
+    )  # fmt: skip
+    console.print(
+        f"wrote {out}: {counts['frames']} frames in {counts['episodes']} episodes at "
+        f"{counts['fps']} fps, {counts['contacts']} with a contact (lerobot)"
     )

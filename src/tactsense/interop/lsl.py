@@ -4,13 +4,18 @@ Outlets (``tactsense live SOURCE --lsl``):
 
 * **frames**: name ``<sensor>-frames``, type ``Tactile``, one float32 channel per
   tactel (rows x cols, row-major: channel ``r * cols + c``), at the sensor's nominal
-  rate. Each channel's metadata gives its label (``r3c5``), unit (counts), row,
-  column, axial position [mm] and angle [deg]; the stream's metadata holds the whole
+  rate. Each channel's metadata follows the XDF meta-data conventions
+  (github.com/sccn/xdf/wiki/Meta-Data): ``label`` (``r3c5``), ``unit`` (counts),
+  ``type`` (Tactile), ``location/X,Y,Z`` [mm] (the taxel's point on the skin, the
+  sensor's frame), and, for tactsense's own reader, row, column and (a finger) axial
+  position [mm] and angle [deg]. ``acquisition/manufacturer``, ``model`` and
+  ``serial_number`` name the device; the stream's metadata also holds the whole
   sensor description (TOML) under ``tactsense/sensor_toml``, so an inlet knows the
   finger without asking.
 * **contacts**: name ``<sensor>-contacts``, type ``TactileContact``, double channels
   ``axial_mm, angle_deg, force_n, skew, peak_deflection, flags, row, col, latency_ms``
-  (NaN without a contact), one sample per frame.
+  (NaN without a contact), one sample per frame; each channel has a ``label``, a
+  ``unit`` and a ``type`` (:data:`CONTACT_UNITS`, :data:`CONTACT_TYPES`).
 
 Both carry a ``source_id`` made from the device's serial number (``tactsense:<serial>:
 frames``), so a consumer recovers the stream after the device or tactsense restarts.
@@ -45,7 +50,29 @@ CONTACT_CHANNELS = (
     "col",
     "latency_ms",
 )
-CONTACT_UNITS = ("mm", "deg", "N", "", "", "", "tactel", "tactel", "ms")
+CONTACT_UNITS = ("mm", "deg", "N", "1", "1", "1", "tactel", "tactel", "ms")
+"""Units of the contact channels (``1``: a dimensionless number; ``tactel``: an index)."""
+CONTACT_TYPES = (
+    "Position",
+    "Position",
+    "Force",
+    "Skew",
+    "Deflection",
+    "Flags",
+    "Index",
+    "Index",
+    "Latency",
+)
+"""XDF channel ``type`` of each contact channel."""
+
+
+def _acquisition(desc, identity: dict) -> None:
+    """The XDF ``acquisition`` block: who made the device and which model it is."""
+    acquisition = desc.append_child("acquisition")
+    acquisition.append_child_value("manufacturer", str(identity.get("manufacturer", "tactsense")))
+    acquisition.append_child_value("model", str(identity.get("device", "tactsense twin")))
+    if identity.get("serial"):
+        acquisition.append_child_value("serial_number", str(identity["serial"]))
 
 
 def _pylsl():
@@ -87,20 +114,26 @@ def frames_info(sensor: SensorSpec, identity: dict, rate_hz: float):
         source_id(identity, sensor, "frames"),
     )
     desc = info.desc()
-    desc.append_child_value("manufacturer", str(identity.get("device", "tactsense")))
+    _acquisition(desc, identity)
     channels = desc.append_child("channels")
-    axial = sensor.row_axial_mm
-    angle = sensor.col_angle_deg
+    positions = sensor.taxel_positions_mm()
+    finger = sensor.kind == "finger"
+    if finger:
+        axial, angle = sensor.row_axial_mm, sensor.col_angle_deg
     for r in range(rows):
         for c in range(cols):
             channel = channels.append_child("channel")
             channel.append_child_value("label", f"r{r}c{c}")
             channel.append_child_value("unit", "counts")
             channel.append_child_value("type", "Tactile")
+            location = channel.append_child("location")
+            for axis, value in zip("XYZ", positions[r * cols + c], strict=True):
+                location.append_child_value(axis, f"{value:.6g}")
             channel.append_child_value("row", str(r))
             channel.append_child_value("col", str(c))
-            channel.append_child_value("axial_mm", f"{axial[r]:.6g}")
-            channel.append_child_value("angle_deg", f"{angle[c]:.6g}")
+            if finger:
+                channel.append_child_value("axial_mm", f"{axial[r]:.6g}")
+                channel.append_child_value("angle_deg", f"{angle[c]:.6g}")
     meta = desc.append_child("tactsense")
     meta.append_child_value("sensor_toml", sensor.to_toml_string())
     meta.append_child_value("layout", "row-major: channel = row * cols + col")
@@ -118,11 +151,14 @@ def contacts_info(sensor: SensorSpec, identity: dict, rate_hz: float):
         pylsl.cf_double64,
         source_id(identity, sensor, "contacts"),
     )
-    channels = info.desc().append_child("channels")
-    for name, unit in zip(CONTACT_CHANNELS, CONTACT_UNITS, strict=True):
+    desc = info.desc()
+    _acquisition(desc, identity)
+    channels = desc.append_child("channels")
+    for name, unit, kind in zip(CONTACT_CHANNELS, CONTACT_UNITS, CONTACT_TYPES, strict=True):
         channel = channels.append_child("channel")
         channel.append_child_value("label", name)
         channel.append_child_value("unit", unit)
+        channel.append_child_value("type", kind)
     return info
 
 

@@ -2,18 +2,30 @@
 
 Entities, on the timeline ``time`` (the frames' times on the device clock):
 
-* ``finger/deflection``: a ``DepthImage`` of the fractional deflection (eq. 4) with the
-  viridis colour map; the finger unwrapped, along it across (x = row, the tip row at
-  x = 0) and around it down (y = column);
+* ``finger/deflection``: an RGB ``Image`` of the fractional deflection (eq. 4) through
+  the viridis colour map over one fixed range for the whole file (so a colour means the
+  same deflection in every frame); the finger unwrapped, along it across (x = row, the
+  tip row at x = 0) and around it down (y = column);
 * ``finger/deflection/contact``: a ``Points2D`` at the estimated contact, in the
   image's pixels (x = row + 0.5, y = column + 0.5), present only while touching;
-* ``finger/force_g``: a ``Scalars`` with the estimated force [g] (0 without contact).
+* ``finger/deflection_values``: a ``Tensor`` of the same deflections as numbers
+  (dimensionless fractions of the undeflected reading: 0.05 = 5 %), dims
+  ``(around, along)``, ``value_range`` the same fixed range. Not a ``DepthImage``: Rerun
+  reads a depth image's values as metres;
+* ``finger/force_g``: a ``Scalars`` with the estimated force [g] (0 without contact),
+  its series named ``force [g]``.
+
+Each export gets a recording id of its own (a UUID: two files exported from
+recordings of the same name do not merge when opened together); the file's recording
+properties (``tactsense``) hold that id, the source recording, the sensor, the
+deflection range and the units.
 
 Open the file with ``rerun file.rrd`` (``pip install rerun-sdk`` brings the viewer).
 """
 
 from __future__ import annotations
 
+import uuid
 from pathlib import Path
 
 import numpy as np
@@ -38,12 +50,25 @@ def export_rerun(
     calibration=None,
     baseline_frames: int = 5,
     threshold: float | None = None,
+    deflection_range: tuple[float, float] | None = None,
+    recording_id: str | None = None,
     progress=None,
 ) -> dict:
     """Write a recording's heat maps, contacts and force to a Rerun file, a piece at a time.
 
-    Returns ``frames`` and ``contacts`` written.
+    Parameters
+    ----------
+    deflection_range : (low, high), optional
+        Fractional deflection [-] at the two ends of the colour map, the same for every
+        frame; default: from 0 (or the lowest deflection, if below 0) to the highest
+        deflection of the recording (a first pass over it, a piece at a time).
+    recording_id : str, optional
+        Rerun's recording id; default a new UUID.
+
+    Returns ``frames``, ``contacts``, ``recording_id`` and ``deflection_range``.
     """
+    from matplotlib import colormaps
+
     from tactsense.batch import iter_locate
     from tactsense.estimate import Flag
     from tactsense.estimate.deflection import deflection_from_counts
@@ -52,14 +77,50 @@ def export_rerun(
     from tactsense.physics.contact import newtons_to_grams
 
     rr = _rerun()
+    viridis = colormaps["viridis"]
+    recording_id = recording_id or str(uuid.uuid4())
     frames_written = contacts = 0
     with RecordingReader(recording) as reader:
         sensor = reader.sensor
-        stream = rr.RecordingStream("tactsense", recording_id=Path(recording).stem)
-        stream.save(str(out))
         baseline = None
         if calibration is None:
             baseline = np.median(reader.frames(0, baseline_frames).astype(float), axis=0)
+
+        def deflections(counts):
+            if calibration is None:
+                return deflection_from_counts(counts, baseline, sensor)[0]
+            return calibration.apply(counts, sensor)[0]
+
+        if deflection_range is None:
+            low, high = 0.0, 0.0
+            for _, counts, _ in reader.chunks():
+                values = deflections(counts)
+                if np.isfinite(values).any():
+                    low = min(low, float(np.nanmin(values)))
+                    high = max(high, float(np.nanmax(values)))
+            deflection_range = (low, high if high > low else low + 1e-3)
+        low, high = map(float, deflection_range)
+        if not (np.isfinite(low) and np.isfinite(high) and high > low):
+            raise TactsenseInputError(
+                f"deflection range ({low}, {high}) must be two finite numbers, low < high"
+            )
+
+        stream = rr.RecordingStream("tactsense", recording_id=recording_id)
+        stream.save(str(out))
+        stream.send_recording_name(Path(recording).stem)
+        stream.send_property(
+            "tactsense",
+            rr.AnyValues(
+                recording_id=recording_id,
+                source=str(recording),
+                sensor=sensor.name,
+                deflection_units="1 (fraction of the undeflected reading, eq. 4)",
+                deflection_range=[low, high],
+                force_units="g",
+                time_units="s (device clock)",
+            ),
+        )
+        stream.log("finger/force_g", rr.SeriesLines(names="force [g]"), static=True)
         pieces = iter_locate(
             reader,
             baseline=baseline,
@@ -67,17 +128,20 @@ def export_rerun(
             threshold=CONTACT_THRESHOLD if threshold is None else threshold,
         )
         for start, time_s, est in pieces:
-            counts = reader.frames(start, start + len(time_s))
-            if calibration is None:
-                deflection, _ = deflection_from_counts(counts, baseline, sensor)
-            else:
-                deflection, _ = calibration.apply(counts, sensor)
+            deflection = deflections(reader.frames(start, start + len(time_s)))
+            scaled = np.clip((np.nan_to_num(deflection) - low) / (high - low), 0.0, 1.0)
+            colours = (viridis(scaled)[..., :3] * 255).round().astype(np.uint8)
             touching = ((est.flags & int(Flag.NO_CONTACT)) == 0) & np.isfinite(est.force_n)
             grams = np.where(touching, newtons_to_grams(np.nan_to_num(est.force_n)), 0.0)
             for k, t in enumerate(time_s):
                 stream.set_time("time", duration=float(t))
-                image = np.ascontiguousarray(deflection[k].T, dtype=np.float32)
-                stream.log("finger/deflection", rr.DepthImage(image, colormap="viridis"))
+                image = np.ascontiguousarray(colours[k].transpose(1, 0, 2))
+                stream.log("finger/deflection", rr.Image(image, color_model="RGB"))
+                values = np.ascontiguousarray(deflection[k].T, dtype=np.float32)
+                stream.log(
+                    "finger/deflection_values",
+                    rr.Tensor(values, dim_names=("around", "along"), value_range=(low, high)),
+                )
                 if touching[k]:
                     point = [[float(est.row[k]) + 0.5, float(est.col[k]) + 0.5]]
                     stream.log("finger/deflection/contact", rr.Points2D(point, radii=0.15))
@@ -90,4 +154,9 @@ def export_rerun(
                 progress(start + len(time_s), reader.n_frames)
         stream.flush()
         stream.disconnect()
-    return {"frames": frames_written, "contacts": contacts}
+    return {
+        "frames": frames_written,
+        "contacts": contacts,
+        "recording_id": recording_id,
+        "deflection_range": (low, high),
+    }

@@ -1,0 +1,426 @@
+"""Other tools' files into a tactsense recording (``tactsense import SOURCE --out rec.h5``).
+
+Sources, told apart by their extension (a folder by what it holds):
+
+* **MCAP** (``.mcap``): ``tactile_msgs/msg/TactileState`` messages (ROS 2 CDR) read with
+  ``mcap``'s reader and the ``mcap_ros2`` decoder (the definition the file carries).
+* **rosbag2** (a bag folder with ``metadata.yaml``, sqlite3 or mcap storage, or its
+  ``.db3`` file): read with ``rosbags``, the ``TactileState`` type registered from the
+  upstream ``.msg`` text (the body of :data:`tactsense.interop.ros.TACTILE_STATE_MSGDEF`).
+* **XDF** (``.xdf``, ``.xdfz``): one stream read with ``pyxdf`` (clock offsets applied,
+  time stamps not de-jittered: the times are those recorded). A tactsense LSL outlet's
+  stream carries its sensor (``desc/tactsense/sensor_toml``); any other stream takes
+  ``--sensor`` and must have rows x cols channels.
+* **CSV** (``.csv``): a header line, then one frame per row: a time column
+  (``--time-column``, default ``time``, in seconds) and the frame's rows x cols values
+  in row-major order in the other columns; ``--sensor`` gives the shape.
+* **LeRobot** (a folder with ``meta/info.json``): :func:`tactsense.interop.lerobot.
+  import_lerobot`.
+
+Times: a ``TactileState``'s header stamp, the XDF time stamp, the CSV time. Stamps on the
+Unix clock (after 2001, as ``tactsense export`` writes when the recording has host
+times) are kept as the recording's host times, and its frame times start at 0; other
+stamps are the frame times as they are. Frames are counts as given: whole numbers within
+0-65535 are stored as ``uint16``, anything else as ``float64``.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from pathlib import Path
+
+import numpy as np
+
+from tactsense._validation import TactsenseInputError
+from tactsense.sensor import SensorSpecError, load_sensor
+from tactsense.sensor.common import SpecBase
+
+UNIX_EPOCH_THRESHOLD_S = 1e9
+"""Stamps at or after this [s] (September 2001) are read as Unix times (host clock)."""
+
+
+class ImportError_(TactsenseInputError):
+    """A source that cannot be imported (named, with what was expected)."""
+
+
+def _sensor(sensor, source: Path, what: str) -> SpecBase:
+    if sensor is None:
+        raise ImportError_(f"{source}: {what} does not describe its sensor; pass --sensor")
+    try:
+        return load_sensor(sensor)
+    except SensorSpecError as error:
+        raise ImportError_(f"--sensor: {error}") from None
+
+
+def _frames_array(values: list, sensor: SpecBase) -> np.ndarray:
+    rows, cols = sensor.shape
+    frames = np.asarray(values, dtype=np.float64).reshape(-1, rows, cols)
+    whole = np.all(np.isfinite(frames)) and np.all(frames == np.rint(frames))
+    if whole and frames.size and frames.min() >= 0 and frames.max() <= 65535:
+        return frames.astype(np.uint16)
+    return frames
+
+
+def build_recording(
+    sensor: SpecBase,
+    frames: list,
+    stamps_s,
+    *,
+    source: str,
+    description: str,
+    losses: dict | None = None,
+):
+    """A :class:`~tactsense.io.recording.Recording` of imported frames and their stamps."""
+    from tactsense.io.recording import Recording
+    from tactsense.physics.transduction import sample_offsets
+
+    stamps = np.asarray(stamps_s, dtype=np.float64)
+    if len(frames) == 0:
+        raise ImportError_(f"{source}: no frames to import")
+    if not np.all(np.isfinite(stamps)):
+        raise ImportError_(f"{source}: a time stamp is not a finite number")
+    host = None
+    times = stamps
+    if stamps[0] >= UNIX_EPOCH_THRESHOLD_S:
+        host, times = stamps, stamps - stamps[0]
+    return Recording(
+        frames=_frames_array(frames, sensor),
+        time_s=times,
+        sample_offset_s=sample_offsets(sensor),
+        sensor=sensor,
+        scenario={"description": description},
+        host_time_s=host,
+        losses=dict(losses or {}),
+        source=source,
+    )
+
+
+# ---- ROS 2: MCAP and rosbag2 -----------------------------------------------------------
+
+
+def _pick_values(sensors: list, sensor: SpecBase, where: str) -> list:
+    """The values of the ``ChannelFloat32`` for this sensor in one ``TactileState``."""
+    if len(sensors) == 1:
+        entry = sensors[0]
+    else:
+        named = [s for s in sensors if _get(s, "name") == sensor.name]
+        if len(named) != 1:
+            names = ", ".join(repr(_get(s, "name")) for s in sensors)
+            raise ImportError_(
+                f"{where}: a TactileState holds the sensors {names}; none is named "
+                f"{sensor.name!r} (pass --sensor with that name)"
+            )
+        entry = named[0]
+    values = list(_get(entry, "values"))
+    if len(values) != sensor.n_taxels:
+        rows, cols = sensor.shape
+        raise ImportError_(
+            f"{where}: sensor {_get(entry, 'name')!r} has {len(values)} values; "
+            f"{sensor.name!r} has {rows} x {cols} = {rows * cols} taxels"
+        )
+    return values
+
+
+def _get(obj, name):
+    return obj[name] if isinstance(obj, dict) else getattr(obj, name)
+
+
+def _ros_sensor(sensor, first_names: list[str], source: Path) -> SpecBase:
+    """--sensor, else the preset named by the TactileState's sensor name."""
+    if sensor is not None:
+        return _sensor(sensor, source, "")
+    from tactsense.sensor import PRESETS
+
+    for name in first_names:
+        if name.removeprefix("fearing1990_") in PRESETS:
+            return load_sensor(name)
+    raise ImportError_(
+        f"{source}: the TactileState sensor name {', '.join(map(repr, first_names))} is not a "
+        "tactsense preset; pass --sensor (a preset or a sensor TOML) for its shape"
+    )
+
+
+def _choose_topic(topics: dict[str, str], topic: str | None, source: Path) -> str:
+    """The topic to read: ``topic``, else the one ``TactileState`` topic."""
+    from tactsense.interop.ros import TACTILE_STATE
+
+    states = sorted(
+        t for t, kind in topics.items() if kind in (TACTILE_STATE, "tactile_msgs/TactileState")
+    )
+    if topic is not None:
+        if topic not in states:
+            raise ImportError_(
+                f"{source}: no tactile_msgs/msg/TactileState topic {topic!r}; it has "
+                f"{', '.join(states) or 'none'}"
+            )
+        return topic
+    if not states:
+        found = ", ".join(f"{t} ({k})" for t, k in sorted(topics.items())) or "no topics"
+        raise ImportError_(f"{source}: no tactile_msgs/msg/TactileState topic; it has {found}")
+    if len(states) > 1:
+        raise ImportError_(
+            f"{source}: several TactileState topics ({', '.join(states)}); pass --topic"
+        )
+    return states[0]
+
+
+def read_mcap(source: Path, *, sensor=None, topic: str | None = None):
+    """``TactileState`` messages of a plain MCAP file."""
+    try:
+        from mcap.exceptions import McapError
+        from mcap.reader import make_reader
+        from mcap_ros2.decoder import DecoderFactory
+    except ImportError:
+        raise ImportError_('MCAP needs the mcap extra: pip install "tactsense[mcap]"') from None
+    frames, stamps = [], []
+    spec = None
+    try:
+        with open(source, "rb") as stream:
+            reader = make_reader(stream, decoder_factories=[DecoderFactory()])
+            summary = reader.get_summary()
+            if summary is None:
+                raise ImportError_(
+                    f"{source}: the MCAP file has no summary (a recorder killed mid-way?); "
+                    "rebuild it with 'mcap recover'"
+                )
+            topics = {
+                ch.topic: summary.schemas[ch.schema_id].name
+                for ch in summary.channels.values()
+                if ch.schema_id in summary.schemas
+            }
+            chosen = _choose_topic(topics, topic, source)
+            for _, _, _, ros in reader.iter_decoded_messages(topics=[chosen]):
+                if spec is None:
+                    spec = _ros_sensor(sensor, [s.name for s in ros.sensors], source)
+                frames.append(_pick_values(ros.sensors, spec, str(source)))
+                stamps.append(ros.header.stamp.sec + ros.header.stamp.nanosec * 1e-9)
+    except (McapError, ValueError, KeyError, EOFError) as error:
+        raise ImportError_(f"{source} is not a readable MCAP file ({error})") from None
+    except OSError as error:
+        raise ImportError_(f"{source}: cannot read it ({error.strerror or error})") from None
+    if spec is None:
+        raise ImportError_(f"{source}: topic {chosen} holds no messages")
+    return build_recording(
+        spec, frames, stamps, source=str(source), description=f"imported from {source} ({chosen})"
+    )
+
+
+def read_rosbag2(source: Path, *, sensor=None, topic: str | None = None):
+    """``TactileState`` messages of a rosbag2 bag (sqlite3 or mcap storage) with rosbags."""
+    try:
+        from rosbags.highlevel import AnyReader, AnyReaderError
+        from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+    except ImportError:
+        raise ImportError_(
+            'rosbag2 bags need the import extra: pip install "tactsense[import]"'
+        ) from None
+    from tactsense.interop.ros import SEPARATOR, TACTILE_STATE, TACTILE_STATE_MSGDEF
+
+    msg_text = TACTILE_STATE_MSGDEF.split(SEPARATOR)[0]  # the upstream .msg, no dependencies
+
+    bag = source.parent if source.is_file() else source
+    if not (bag / "metadata.yaml").is_file():
+        raise ImportError_(f"{source}: not a rosbag2 bag (no metadata.yaml in {bag})")
+    typestore = get_typestore(Stores.ROS2_HUMBLE)
+    typestore.register(get_types_from_msg(msg_text, TACTILE_STATE))
+    frames, stamps = [], []
+    spec = None
+    try:
+        with AnyReader([bag], default_typestore=typestore) as reader:
+            topics = {name: info.msgtype for name, info in reader.topics.items()}
+            chosen = _choose_topic(topics, topic, source)
+            connections = [c for c in reader.connections if c.topic == chosen]
+            for connection, _, raw in reader.messages(connections=connections):
+                message = reader.deserialize(raw, connection.msgtype)
+                if spec is None:
+                    spec = _ros_sensor(sensor, [s.name for s in message.sensors], source)
+                frames.append(_pick_values(message.sensors, spec, str(source)))
+                stamps.append(message.header.stamp.sec + message.header.stamp.nanosec * 1e-9)
+    except AnyReaderError as error:
+        raise ImportError_(f"{source} is not a readable rosbag2 bag ({error})") from None
+    if spec is None:
+        raise ImportError_(f"{source}: topic {chosen} holds no messages")
+    return build_recording(
+        spec, frames, stamps, source=str(source), description=f"imported from {source} ({chosen})"
+    )
+
+
+# ---- XDF ------------------------------------------------------------------------------
+
+
+def _xdf_text(info: dict, *path: str) -> str | None:
+    node = info
+    for key in path:
+        if not isinstance(node, dict) or not node.get(key):
+            return None
+        node = node[key][0]
+    return node if isinstance(node, str) else None
+
+
+def read_xdf(source: Path, *, sensor=None, stream: str | None = None):
+    """One stream of an XDF file: a tactsense frames stream or any stream with ``--sensor``."""
+    try:
+        import pyxdf
+    except ImportError:
+        raise ImportError_(
+            'XDF files need the import extra: pip install "tactsense[import]"'
+        ) from None
+    try:
+        streams, _ = pyxdf.load_xdf(str(source), dejitter_timestamps=False, verbose=False)
+    except Exception as error:  # pyxdf raises what its parser meets
+        raise ImportError_(
+            f"{source} is not a readable XDF file ({type(error).__name__}: {error})"
+        ) from None
+    if not streams:
+        raise ImportError_(f"{source} is not a readable XDF file (no streams in it)")
+    described = []
+    for s in streams:
+        info = s["info"]
+        described.append(
+            (
+                _xdf_text(info, "name") or "",
+                _xdf_text(info, "type") or "",
+                _xdf_text(info, "source_id") or "",
+                s,
+            )
+        )
+    if stream is not None:
+        chosen = [d for d in described if stream in (d[0], d[2])]
+        if not chosen:
+            names = ", ".join(repr(d[0]) for d in described) or "none"
+            raise ImportError_(f"{source}: no stream named {stream!r}; streams: {names}")
+    else:
+        chosen = [
+            d for d in described if _xdf_text(d[3]["info"], "desc", "tactsense", "sensor_toml")
+        ]
+        if not chosen:
+            chosen = [d for d in described if d[1] == "Tactile"] or (
+                described if len(described) == 1 else []
+            )
+        if len(chosen) != 1:
+            names = ", ".join(f"{d[0]!r} ({d[1]})" for d in described) or "none"
+            raise ImportError_(f"{source}: say which stream with --stream; streams: {names}")
+    name, _, _, picked = chosen[0]
+    info = picked["info"]
+    toml = _xdf_text(info, "desc", "tactsense", "sensor_toml")
+    if sensor is not None or toml is None:
+        spec = _sensor(sensor, source, f"stream {name!r}")
+    else:
+        import tomllib
+
+        from tactsense.sensor import sensor_from_dict
+
+        try:
+            spec = sensor_from_dict(tomllib.loads(toml), source=f"{source} stream {name!r}")
+        except (tomllib.TOMLDecodeError, SensorSpecError) as error:
+            raise ImportError_(f"{source}: stream {name!r}'s sensor description: {error}") from None
+    series = picked["time_series"]
+    if isinstance(series, list):
+        raise ImportError_(f"{source}: stream {name!r} holds strings; expected numbers")
+    series = np.asarray(series, dtype=np.float64)
+    channels = int(_xdf_text(info, "channel_count") or (series.shape[1] if series.ndim == 2 else 0))
+    rows, cols = spec.shape
+    if channels != rows * cols:
+        raise ImportError_(
+            f"{source}: stream {name!r} has {channels} channels; sensor {spec.name!r} has "
+            f"{rows} x {cols} = {rows * cols} taxels"
+        )
+    return build_recording(
+        spec, series.reshape(-1, rows * cols), picked["time_stamps"], source=str(source),
+        description=f"imported from {source} (stream {name!r})",
+    )  # fmt: skip
+
+
+# ---- CSV ------------------------------------------------------------------------------
+
+
+def read_csv(source: Path, *, sensor=None, time_column: str = "time"):
+    """One frame per row: a time column [s] and rows x cols values in row-major order."""
+    spec = _sensor(sensor, source, "a CSV file")
+    rows, cols = spec.shape
+    frames, stamps = [], []
+    try:
+        with open(source, newline="", encoding="utf-8") as stream:
+            reader = csv.reader(stream)
+            header = next(reader, None)
+            if header is None:
+                raise ImportError_(f"{source} is empty; expected a header line and frames")
+            header = [h.strip() for h in header]
+            if time_column not in header:
+                raise ImportError_(
+                    f"{source}: no time column {time_column!r} in the header "
+                    f"({', '.join(header[:6])}{', ...' if len(header) > 6 else ''}); "
+                    "pass --time-column"
+                )
+            t = header.index(time_column)
+            if len(header) - 1 != rows * cols:
+                raise ImportError_(
+                    f"{source}: {len(header) - 1} value columns; sensor {spec.name!r} has "
+                    f"{rows} x {cols} = {rows * cols} taxels"
+                )
+            for line, row in enumerate(reader, start=2):
+                if not row:
+                    continue
+                if len(row) != len(header):
+                    raise ImportError_(
+                        f"{source} line {line}: {len(row)} fields; the header has {len(header)}"
+                    )
+                try:
+                    numbers = [float(x) for x in row]
+                except ValueError as error:
+                    raise ImportError_(f"{source} line {line}: {error}") from None
+                if not all(math.isfinite(x) for x in numbers):
+                    raise ImportError_(f"{source} line {line}: a value is not a finite number")
+                stamps.append(numbers.pop(t))
+                frames.append(numbers)
+    except UnicodeDecodeError:
+        raise ImportError_(f"{source} is not a text (UTF-8) CSV file") from None
+    except csv.Error as error:
+        raise ImportError_(f"{source}: not a CSV file ({error})") from None
+    return build_recording(
+        spec, frames, stamps, source=str(source), description=f"imported from {source}"
+    )
+
+
+# ---- dispatch -------------------------------------------------------------------------
+
+
+def read_source(
+    source: str | Path,
+    *,
+    sensor=None,
+    time_column: str = "time",
+    topic: str | None = None,
+    stream: str | None = None,
+):
+    """Any supported source as a :class:`~tactsense.io.recording.Recording`."""
+    source = Path(source)
+    if not source.exists():
+        raise ImportError_(f"{source} does not exist")
+    if source.is_dir():
+        if (source / "meta" / "info.json").is_file():
+            from tactsense.interop.lerobot import import_lerobot
+
+            return import_lerobot(source, sensor=sensor)
+        if (source / "metadata.yaml").is_file():
+            return read_rosbag2(source, sensor=sensor, topic=topic)
+        raise ImportError_(
+            f"{source} is a folder but neither a LeRobot dataset (meta/info.json) nor a "
+            "rosbag2 bag (metadata.yaml)"
+        )
+    suffix = source.suffix.lower()
+    if suffix == ".mcap":
+        if (source.parent / "metadata.yaml").is_file():
+            return read_rosbag2(source, sensor=sensor, topic=topic)
+        return read_mcap(source, sensor=sensor, topic=topic)
+    if suffix == ".db3":
+        return read_rosbag2(source, sensor=sensor, topic=topic)
+    if suffix in (".xdf", ".xdfz"):
+        return read_xdf(source, sensor=sensor, stream=stream)
+    if suffix == ".csv":
+        return read_csv(source, sensor=sensor, time_column=time_column)
+    raise ImportError_(
+        f"{source}: unknown kind of file {suffix or '(no extension)'}; expected .mcap, .db3 "
+        "or a rosbag2 folder, .xdf, .csv, or a LeRobot dataset folder"
+    )

@@ -1,0 +1,433 @@
+"""A recording as a LeRobot dataset (codebase version 3.0), and back.
+
+The layout is LeRobot's own (``lerobot/datasets/utils.py``, ``feature_utils.py``,
+``dataset_metadata.py``, ``io_utils.py``; ``lerobot/utils/constants.py`` for the default
+features)::
+
+    meta/info.json                           codebase_version "v3.0", fps, features, ...
+    meta/stats.json                          per feature: min, max, mean, std, count, q01..q99
+    meta/tasks.parquet                       index "task" (str), column task_index
+    meta/episodes/chunk-000/file-000.parquet one row per episode
+    data/chunk-000/file-000.parquet          one row per frame
+    meta/tactsense.json                      tactsense's own: the sensor, source, losses
+
+Features of a row:
+
+* ``observation.tactile``: the frame [counts], float32, shape ``[rows, cols]``, names
+  ``["row", "col"]`` (row-major, as a tactsense frame);
+* ``observation.state``: the contact estimate, float32, names ``contact.present``
+  (1 or 0), ``contact.axial_mm``, ``contact.angle_deg``, ``contact.force_n``,
+  ``contact.row``, ``contact.col`` (0 without a contact; units in the names, tactels for
+  row and col);
+* ``frame_time``: the frame's recorded time [s] (float64; the device clock);
+* LeRobot's ``timestamp`` (float32, ``frame_index / fps``: the time in the episode LeRobot
+  assumes), ``frame_index``, ``episode_index``, ``index``, ``task_index``.
+
+Rates: LeRobot keeps one rate per dataset (``fps``, a whole number). tactsense stores one
+tactile frame per row and sets ``fps`` to the recording's scan rate, rounded to a whole
+number; the recorded time of every frame is kept in ``frame_time``, so frames lost or
+a rate that is not a whole number lose nothing. A dataset that joins the tactile
+stream with slower cameras resamples it to theirs (LeRobot's ``delta_timestamps`` query
+frames by time).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+from pathlib import Path
+
+import numpy as np
+
+from tactsense._validation import TactsenseInputError
+
+CODEBASE_VERSION = "v3.0"
+CHUNKS_SIZE = 1000
+DATA_FILES_SIZE_IN_MB = 100
+VIDEO_FILES_SIZE_IN_MB = 200
+CHUNK_FILE_PATTERN = "chunk-{chunk_index:03d}/file-{file_index:03d}"
+DATA_PATH = "data/" + CHUNK_FILE_PATTERN + ".parquet"
+EPISODES_PATH = "meta/episodes/" + CHUNK_FILE_PATTERN + ".parquet"
+VIDEO_PATH = "videos/{video_key}/" + CHUNK_FILE_PATTERN + ".mp4"
+QUANTILES = (0.01, 0.10, 0.50, 0.90, 0.99)
+STATE_NAMES = (
+    "contact.present",
+    "contact.axial_mm",
+    "contact.angle_deg",
+    "contact.force_n",
+    "contact.row",
+    "contact.col",
+)
+DEFAULT_TASK = "tactile recording"
+
+
+class LeRobotError(TactsenseInputError):
+    """A LeRobot dataset that cannot be written or read."""
+
+
+def _pyarrow():
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    return pa, pq
+
+
+def features_of(shape: tuple[int, int]) -> dict:
+    """The ``features`` of ``meta/info.json`` for a sensor of this frame shape."""
+    rows, cols = shape
+    return {
+        "observation.tactile": {
+            "dtype": "float32",
+            "shape": [rows, cols],
+            "names": ["row", "col"],
+        },
+        "observation.state": {
+            "dtype": "float32",
+            "shape": [len(STATE_NAMES)],
+            "names": list(STATE_NAMES),
+        },
+        "frame_time": {"dtype": "float64", "shape": [1], "names": None},
+        "timestamp": {"dtype": "float32", "shape": [1], "names": None},
+        "frame_index": {"dtype": "int64", "shape": [1], "names": None},
+        "episode_index": {"dtype": "int64", "shape": [1], "names": None},
+        "index": {"dtype": "int64", "shape": [1], "names": None},
+        "task_index": {"dtype": "int64", "shape": [1], "names": None},
+    }
+
+
+def _hf_features(features: dict) -> dict:
+    """The ``datasets.Features`` JSON that ``datasets`` keeps in a parquet file's schema."""
+    out = {}
+    for key, ft in features.items():
+        shape = ft["shape"]
+        if len(shape) == 1 and shape[0] == 1:
+            out[key] = {"dtype": ft["dtype"], "_type": "Value"}
+        elif len(shape) == 1:
+            out[key] = {
+                "feature": {"dtype": ft["dtype"], "_type": "Value"},
+                "length": shape[0],
+                "_type": "Sequence",
+            }
+        else:
+            out[key] = {"shape": list(shape), "dtype": ft["dtype"], "_type": "Array2D"}
+    return out
+
+
+def _stats(values: np.ndarray, scalar: bool) -> dict:
+    """LeRobot's statistics of one feature over axis 0 (``compute_stats.get_feature_stats``)."""
+    values = np.asarray(values, dtype=np.float64)
+    if values.ndim == 1:
+        values = values[:, None]
+    stats = {
+        "min": values.min(axis=0),
+        "max": values.max(axis=0),
+        "mean": values.mean(axis=0),
+        "std": values.std(axis=0),
+        "count": np.array([len(values)]),
+    }
+    for q in QUANTILES:
+        stats[f"q{round(q * 100):02d}"] = np.quantile(values, q, axis=0)
+    return {k: (v if k == "count" else v.reshape(-1) if scalar else v) for k, v in stats.items()}
+
+
+def _listed(stats: dict) -> dict:
+    return {
+        key: {name: np.asarray(v).tolist() for name, v in feature.items()}
+        for key, feature in stats.items()
+    }
+
+
+def _write_json(path: Path, data) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(data, indent=4, ensure_ascii=False) + "\n", encoding="utf-8")
+
+
+def _state(est, n: int) -> np.ndarray:
+    from tactsense.estimate import Flag
+
+    touching = ((est.flags & int(Flag.NO_CONTACT)) == 0) & np.isfinite(est.force_n)
+    state = np.zeros((n, len(STATE_NAMES)), dtype=np.float32)
+    state[:, 0] = touching
+    for j, name in enumerate(("axial_mm", "angle_deg", "force_n", "row", "col"), start=1):
+        state[:, j] = np.where(touching, np.nan_to_num(getattr(est, name)), 0.0)
+    return state
+
+
+def write_dataset(
+    folder: Path,
+    *,
+    sensor,
+    frames: np.ndarray,
+    frame_time: np.ndarray,
+    state: np.ndarray,
+    episode_split: int | None = None,
+    task: str = DEFAULT_TASK,
+    fps: int | None = None,
+    extra: dict | None = None,
+) -> dict:
+    """Write the dataset files into ``folder`` (which must be empty or new)."""
+    pa, pq = _pyarrow()
+    n = len(frames)
+    rows, cols = sensor.shape
+    if n == 0:
+        raise LeRobotError("the recording has no frames")
+    fps = int(fps or max(1, round(sensor.electronics.scan_rate_hz)))
+    split = int(episode_split or n)
+    if split < 1:
+        raise LeRobotError(f"--episode-split must be at least 1 frame; got {split}")
+    starts = list(range(0, n, split))
+    episode = np.zeros(n, dtype=np.int64)
+    frame_index = np.zeros(n, dtype=np.int64)
+    for e, s in enumerate(starts):
+        stop = min(n, s + split)
+        episode[s:stop] = e
+        frame_index[s:stop] = np.arange(stop - s)
+    timestamp = (frame_index / fps).astype(np.float32)
+    tactile = np.asarray(frames, dtype=np.float32)
+    features = features_of((rows, cols))
+    columns = {
+        "observation.tactile": tactile,
+        "observation.state": np.asarray(state, dtype=np.float32),
+        "frame_time": np.asarray(frame_time, dtype=np.float64),
+        "timestamp": timestamp,
+        "frame_index": frame_index,
+        "episode_index": episode,
+        "index": np.arange(n, dtype=np.int64),
+        "task_index": np.zeros(n, dtype=np.int64),
+    }
+
+    # data/chunk-000/file-000.parquet, with the datasets.Features LeRobot loads it with
+    flat = pa.array(tactile.reshape(-1), type=pa.float32())
+    inner = pa.FixedSizeListArray.from_arrays(flat, cols)
+    arrays = {
+        "observation.tactile": pa.ListArray.from_arrays(
+            pa.array(np.arange(0, n * rows + 1, rows, dtype=np.int32)),
+            inner.cast(pa.list_(pa.float32())),
+        ),
+        "observation.state": pa.FixedSizeListArray.from_arrays(
+            pa.array(columns["observation.state"].reshape(-1)), len(STATE_NAMES)
+        ),
+    }
+    for key in ("frame_time", "timestamp", "frame_index", "episode_index", "index", "task_index"):
+        arrays[key] = pa.array(columns[key])
+    metadata = {"huggingface": json.dumps({"info": {"features": _hf_features(features)}})}
+    table = pa.table(arrays).replace_schema_metadata(metadata)
+    data_file = folder / DATA_PATH.format(chunk_index=0, file_index=0)
+    data_file.parent.mkdir(parents=True, exist_ok=True)
+    pq.write_table(table, data_file)
+
+    # statistics, per episode and over the dataset
+    numeric = [k for k in features if k != "observation.tactile"] + ["observation.tactile"]
+    episode_rows = []
+    for e, s in enumerate(starts):
+        stop = min(n, s + split)
+        stats = {k: _stats(columns[k][s:stop], features[k]["shape"] == [1]) for k in numeric}
+        row = {
+            "episode_index": e,
+            "tasks": [task],
+            "length": stop - s,
+            "data/chunk_index": 0,
+            "data/file_index": 0,
+            "dataset_from_index": s,
+            "dataset_to_index": stop,
+            "meta/episodes/chunk_index": 0,
+            "meta/episodes/file_index": 0,
+        }
+        for key, feature in _listed(stats).items():
+            for name, value in feature.items():
+                row[f"stats/{key}/{name}"] = value
+        episode_rows.append(row)
+    episodes_file = folder / EPISODES_PATH.format(chunk_index=0, file_index=0)
+    episodes_file.parent.mkdir(parents=True, exist_ok=True)
+    pq.write_table(pa.Table.from_pylist(episode_rows), episodes_file)
+    stats = {k: _stats(columns[k], features[k]["shape"] == [1]) for k in numeric}
+    _write_json(folder / "meta" / "stats.json", _listed(stats))
+
+    # meta/tasks.parquet as pandas writes a frame indexed by "task" (LeRobot reads it with
+    # pandas.read_parquet): the metadata that makes "task" the index, without pandas here
+    pandas_meta = {
+        "index_columns": ["task"],
+        "column_indexes": [
+            {"name": None, "field_name": None, "pandas_type": "unicode",
+             "numpy_type": "object", "metadata": {"encoding": "UTF-8"}}
+        ],
+        "columns": [
+            {"name": "task_index", "field_name": "task_index", "pandas_type": "int64",
+             "numpy_type": "int64", "metadata": None},
+            {"name": "task", "field_name": "task", "pandas_type": "unicode",
+             "numpy_type": "object", "metadata": None},
+        ],
+        "creator": {"library": "pyarrow", "version": pa.__version__},
+    }  # fmt: skip
+    tasks = pa.table(
+        {"task_index": pa.array([0], pa.int64()), "task": pa.array([task], pa.string())}
+    ).replace_schema_metadata({"pandas": json.dumps(pandas_meta)})
+    pq.write_table(tasks, folder / "meta" / "tasks.parquet")
+
+    info = {
+        "codebase_version": CODEBASE_VERSION,
+        "fps": fps,
+        "features": features,
+        "total_episodes": len(starts),
+        "total_frames": n,
+        "total_tasks": 1,
+        "chunks_size": CHUNKS_SIZE,
+        "data_files_size_in_mb": DATA_FILES_SIZE_IN_MB,
+        "video_files_size_in_mb": VIDEO_FILES_SIZE_IN_MB,
+        "data_path": DATA_PATH,
+        "video_path": None,
+        "robot_type": None,
+        "splits": {"train": f"0:{len(starts)}"},
+    }
+    _write_json(folder / "meta" / "info.json", info)
+    _write_json(
+        folder / "meta" / "tactsense.json",
+        {
+            "sensor_toml": sensor.to_toml_string(),
+            "scan_rate_hz": float(sensor.electronics.scan_rate_hz),
+            "frame_time_units": "s",
+            **(extra or {}),
+        },
+    )
+    return {"frames": n, "episodes": len(starts), "fps": fps}
+
+
+def export_lerobot(
+    recording: str | Path,
+    out: str | Path,
+    *,
+    calibration=None,
+    baseline_frames: int = 5,
+    threshold: float | None = None,
+    episode_split: int | None = None,
+    task: str = DEFAULT_TASK,
+    progress=None,
+) -> dict:
+    """Write a recording and its contact estimates as a LeRobot v3 dataset folder ``out``.
+
+    The dataset is written into a temporary folder beside ``out`` and moved into place
+    when complete. Returns ``frames``, ``contacts``, ``episodes`` and ``fps``.
+    """
+    from tactsense.batch import iter_locate
+    from tactsense.estimate.locate import CONTACT_THRESHOLD
+    from tactsense.io.recording import RecordingReader
+
+    out = Path(out)
+    if out.exists():
+        raise LeRobotError(f"{out} exists; choose a new folder for the dataset")
+    if episode_split is not None and episode_split < 1:
+        raise LeRobotError(f"--episode-split must be at least 1 frame; got {episode_split}")
+    frames, times, states = [], [], []
+    with RecordingReader(recording) as reader:
+        sensor = reader.sensor
+        losses = reader.losses
+        pieces = iter_locate(
+            reader,
+            baseline_frames=baseline_frames,
+            calibration=calibration,
+            threshold=CONTACT_THRESHOLD if threshold is None else threshold,
+        )
+        for start, time_s, est in pieces:
+            frames.append(reader.frames(start, start + len(time_s)))
+            times.append(time_s)
+            states.append(_state(est, len(time_s)))
+            if progress is not None:
+                progress(start + len(time_s), reader.n_frames)
+    if not frames:
+        raise LeRobotError(f"{recording} has no frames")
+    state = np.concatenate(states)
+    temporary = out.with_name(f".{out.name}.{os.getpid()}.partial")
+    shutil.rmtree(temporary, ignore_errors=True)
+    try:
+        temporary.mkdir()
+        counts = write_dataset(
+            temporary,
+            sensor=sensor,
+            frames=np.concatenate(frames),
+            frame_time=np.concatenate(times),
+            state=state,
+            episode_split=episode_split,
+            task=task,
+            extra={"source": str(recording), "losses": losses},
+        )
+        os.replace(temporary, out)
+    except BaseException:
+        shutil.rmtree(temporary, ignore_errors=True)
+        raise
+    return {**counts, "contacts": int(state[:, 0].sum())}
+
+
+def import_lerobot(folder: str | Path, *, sensor=None):
+    """A LeRobot dataset with an ``observation.tactile`` feature, as a recording.
+
+    The sensor is the one in ``meta/tactsense.json`` (a dataset tactsense wrote), else
+    ``sensor`` (its shape must be the feature's). Times: ``frame_time`` where the dataset
+    has it, else ``timestamp`` (made continuous across episodes from ``fps``).
+    """
+    from tactsense.interop.importers import build_recording
+    from tactsense.sensor import SensorSpecError, load_sensor, sensor_from_dict
+
+    pa, pq = _pyarrow()
+    folder = Path(folder)
+    try:
+        info = json.loads((folder / "meta" / "info.json").read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
+        raise LeRobotError(f"{folder}/meta/info.json is not readable JSON ({error})") from None
+    if not isinstance(info, dict):
+        raise LeRobotError(f"{folder}/meta/info.json holds no table; expected LeRobot's info")
+    if not str(info.get("codebase_version", "")).startswith("v3"):
+        raise LeRobotError(
+            f"{folder}: codebase_version {info.get('codebase_version')!r}; this reads LeRobot "
+            "v3 datasets"
+        )
+    feature = info.get("features", {}).get("observation.tactile")
+    if not feature:
+        raise LeRobotError(f"{folder}: no observation.tactile feature in meta/info.json")
+    shape = tuple(feature.get("shape", ()))
+    losses = {}
+    own = folder / "meta" / "tactsense.json"
+    if sensor is None and own.is_file():
+        import tomllib
+
+        try:
+            meta = json.loads(own.read_text(encoding="utf-8"))
+            spec = sensor_from_dict(tomllib.loads(meta["sensor_toml"]), source=str(own))
+            losses = {str(k): int(v) for k, v in (meta.get("losses") or {}).items()}
+        except (OSError, ValueError, KeyError, TypeError, SensorSpecError) as error:
+            raise LeRobotError(f"{own}: unreadable ({error})") from None
+    elif sensor is None:
+        raise LeRobotError(
+            f"{folder}: not written by tactsense (no meta/tactsense.json); pass --sensor"
+        )
+    else:
+        try:
+            spec = load_sensor(sensor)
+        except SensorSpecError as error:
+            raise LeRobotError(f"--sensor: {error}") from None
+    if shape != tuple(spec.shape):
+        raise LeRobotError(
+            f"{folder}: observation.tactile has shape {list(shape)}; sensor {spec.name!r} "
+            f"has {list(spec.shape)}"
+        )
+    paths = sorted((folder / "data").glob("*/*.parquet"))
+    if not paths:
+        raise LeRobotError(f"{folder}: no data/chunk-*/file-*.parquet files")
+    frames, times = [], []
+    for path in paths:
+        try:
+            table = pq.read_table(path)
+        except (OSError, pa.ArrowInvalid) as error:
+            raise LeRobotError(f"{path} is not a readable parquet file ({error})") from None
+        if "index" in table.column_names:
+            table = table.sort_by("index")
+        tactile = np.asarray(table.column("observation.tactile").to_pylist(), dtype=np.float64)
+        frames.append(tactile.reshape(-1, *spec.shape))
+        if "frame_time" in table.column_names:
+            times.append(table.column("frame_time").to_numpy())
+        else:
+            times.append(np.asarray(table.column("index").to_numpy(), float) / float(info["fps"]))
+    return build_recording(
+        spec, list(np.concatenate(frames)), np.concatenate(times), source=str(folder),
+        description=f"imported from the LeRobot dataset {folder}", losses=losses,
+    )  # fmt: skip
