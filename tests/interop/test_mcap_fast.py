@@ -8,7 +8,7 @@ import tactsense as ts
 
 pytest.importorskip("mcap_ros2")
 
-from tactsense.interop.mcap import McapTactileWriter, export_mcap  # noqa: E402
+from tactsense.interop.mcap import McapTactileWriter, export_mcap
 
 
 @pytest.mark.parametrize("frame_id", ["finger", "a_longer_link_name"])
