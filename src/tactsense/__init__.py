@@ -38,6 +38,7 @@ from tactsense.simulate import (
     probe_sweep,
     repeated_load,
     simulate,
+    simulate_to_file,
     static,
 )
 
@@ -71,6 +72,7 @@ __all__ = [
     "repeated_load",
     "rod",
     "simulate",
+    "simulate_to_file",
     "soft_object",
     "static",
     "tactel_deflection",

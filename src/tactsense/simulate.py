@@ -484,6 +484,162 @@ def _jittered_steps(spec: SensorSpec, steps: Sequence[Step], rng) -> list[tuple]
     return out
 
 
+_STEPS_PER_WINDOW = 4096
+"""Scenario steps whose elastic response is computed at a time (memory bound) [-]."""
+
+_WRITE_FRAMES = 1024
+"""Frames per HDF5 chunk and per write of :func:`simulate_to_file` [-]."""
+
+
+class _ElasticWindow:
+    """The elastic deflection of the applied steps, computed a window of steps at a time.
+
+    The whole scenario at once held (steps, rows, cols) floats and every contact's load
+    patches: gigabytes for a long recording. The path (the compiled one for scenarios of
+    single probes, the patch sum otherwise) is chosen once for the whole scenario, as
+    :func:`deflection_batch` chooses it, so a window gives the numbers the whole would.
+    """
+
+    def __init__(self, spec: SensorSpec, applied: list[tuple], gains: np.ndarray):
+        self.spec, self.applied, self.gains = spec, applied, gains
+        probes = [s[0] for s in applied if len(s) == 1 and type(s[0]) is Probe]
+        self.compiled = (
+            len(probes) == len(applied) and len({p.contact_diameter_mm for p in probes}) == 1
+        )
+        self.first, self.values = 0, np.zeros((0, *spec.shape))
+
+    def get(self, lo: int, hi: int) -> np.ndarray:
+        """Deflection times gain of steps ``lo`` to ``hi`` inclusive, shape (k, rows, cols)."""
+        if lo < self.first or hi >= self.first + len(self.values):
+            stop = min(len(self.applied), max(hi + 1, lo + _STEPS_PER_WINDOW))
+            states = list(self.applied[lo:stop])
+            if self.spec.kind != "finger":  # a pad or a point set: the layer model
+                elastic = deflection_batch_flat(self.spec, states)
+            elif self.compiled:
+                elastic = deflection_batch(self.spec, states)
+            else:  # an empty state keeps a window of probes alone on the path of the whole
+                elastic = deflection_batch(self.spec, [*states, ()])[:-1]
+            self.first, self.values = lo, elastic * self.gains
+        return self.values[lo - self.first : hi + 1 - self.first]
+
+
+@dataclass
+class _Run:
+    """Everything a simulation draws before its first frame."""
+
+    active: tuple[str, ...]
+    rng: np.random.Generator
+    gains: np.ndarray
+    applied: list[tuple]
+    n_frames: int
+    boundaries: np.ndarray
+    offsets: np.ndarray
+
+
+def _prepare(spec, scenario, flaws, rng, gains) -> _Run:
+    if not isinstance(spec, SpecBase):
+        raise TactsenseInputError(
+            "spec must be a sensor description (SensorSpec, PadSpec, PointsSpec); "
+            f"got {type(spec).__name__}"
+        )
+    if not isinstance(scenario, Scenario):
+        raise TactsenseInputError(f"scenario must be a Scenario; got {type(scenario).__name__}")
+    active = _resolve_flaws(flaws)
+    rng = np.random.default_rng(rng)
+    n_frames = max(1, math.floor(scenario.duration_s / spec.scan_period_s + 1e-9))
+    if gains is not None:
+        gains = np.asarray(gains, dtype=float)
+        if gains.shape != spec.shape:
+            raise TactsenseInputError(f"gains has shape {gains.shape}; expected {spec.shape}")
+    elif "gain_spread" in active:
+        gains = draw_gains(spec)  # the finger's own gains (flaws.gain_seed)
+    else:
+        gains = np.ones(spec.shape)
+    applied = (
+        _jittered_steps(spec, scenario.steps, rng)
+        if "jitter" in active
+        else [step.contacts for step in scenario.steps]
+    )
+    boundaries = np.cumsum([0.0] + [s.duration_s for s in scenario.steps])
+    return _Run(active, rng, gains, applied, n_frames, boundaries, sample_offsets(spec))
+
+
+def _frame_blocks(spec: SensorSpec, run: _Run):
+    """Yield ``(first, last, counts)``: the frames ``first`` to ``last`` (exclusive),
+    computed :data:`_CHUNK_FRAMES` at a time; memory does not grow with the recording."""
+    active, rng = run.active, run.rng
+    rows, cols = spec.shape
+    period = spec.scan_period_s
+    ticks_per_frame = rows * cols
+    dt = period / ticks_per_frame
+    n_steps = len(run.applied)
+    elastic = _ElasticWindow(spec, run.applied, run.gains)
+    flat_index = np.arange(ticks_per_frame)
+    row_of_tick, col_of_tick = np.divmod(flat_index, cols)
+    dead = np.zeros(spec.shape, dtype=bool)
+    if "dead" in active:
+        for r, c in spec.flaws.dead_tactels:
+            dead[r, c] = True
+    gain_v = amplifier_gain(spec)
+    c0 = spec.junction_capacitance_f
+    full_scale = 2**spec.electronics.adc_bits - 1
+    state = None
+    for first in range(0, run.n_frames, _CHUNK_FRAMES):
+        last = min(run.n_frames, first + _CHUNK_FRAMES)
+        ticks = np.arange(first * ticks_per_frame, last * ticks_per_frame)
+        # the same arithmetic as Recording.sample_step: frame start + the tactel's offset
+        tick_time = (ticks // ticks_per_frame) * period + run.offsets.ravel()[
+            ticks % ticks_per_frame
+        ]
+        step_of_tick = np.clip(
+            np.searchsorted(run.boundaries, tick_time, side="right") - 1, 0, n_steps - 1
+        )
+        lo, hi = int(step_of_tick.min()), int(step_of_tick.max())
+        window = elastic.get(lo, hi)
+        local = step_of_tick - lo
+        if "viscoelastic" in active:
+            f = spec.flaws
+            u = window[local]  # (ticks, rows, cols): every tactel at every tick
+            u, state = viscoelastic_response(
+                u,
+                dt,
+                delayed_fraction=f.delayed_fraction,
+                delayed_time_constant_s=f.delayed_time_constant_s,
+                creep_fraction=f.creep_fraction,
+                creep_time_constant_s=f.creep_time_constant_s,
+                state=state,
+            )
+            sampled = u.reshape(last - first, ticks_per_frame, rows, cols)[
+                :, flat_index, row_of_tick, col_of_tick
+            ].reshape(last - first, rows, cols)
+        else:  # no memory: only the sampled instants matter
+            own_step = local.reshape(last - first, ticks_per_frame)
+            sampled = window[own_step, row_of_tick, col_of_tick].reshape(last - first, rows, cols)
+        if "nonlinearity" in active:
+            sampled = stiffening(sampled, spec.flaws.nonlinear_saturation)
+        if _capacitive(spec):
+            sampled = np.minimum(sampled, 0.95)  # plates cannot touch
+            counts = voltage_to_counts(
+                spec, gain_v * divider_voltage(spec, c0 / (1.0 - sampled)), quantize=False
+            )
+        else:
+            counts = resistive_counts(spec, sampled)
+        if "noise" in active:
+            counts = counts + rng.normal(0.0, spec.flaws.read_noise_counts, counts.shape)
+        counts = np.clip(np.rint(counts) if "quantization" in active else counts, 0, full_scale)
+        counts[:, dead] = 0.0
+        yield first, last, counts
+
+
+def _frame_steps(spec: SensorSpec, run: _Run, first: int, last: int) -> np.ndarray:
+    """The step at the middle of the scan of frames ``first`` to ``last`` (exclusive)."""
+    period = spec.scan_period_s
+    mid_scan = np.arange(first, last) * period + 0.5 * period
+    return np.clip(
+        np.searchsorted(run.boundaries, mid_scan, side="right") - 1, 0, len(run.applied) - 1
+    )
+
+
 def simulate(
     spec: SensorSpec,
     scenario: Scenario,
@@ -494,6 +650,9 @@ def simulate(
     progress: Callable[[int, int], None] | None = None,
 ) -> Recording:
     """Run a scenario through the forward model and return the recorded frames.
+
+    The frames are held in memory; for a long scenario write them to a file as they
+    are made with :func:`simulate_to_file` (the same frames, in bounded memory).
 
     Parameters
     ----------
@@ -519,108 +678,23 @@ def simulate(
         ``frames`` (T, rows, cols) A/D counts, timestamps, the truth of
         every step, the sensor and the scenario.
     """
-    if not isinstance(spec, SpecBase):
-        raise TactsenseInputError(
-            f"spec must be a sensor description (SensorSpec, PadSpec, PointsSpec); "
-            f"got {type(spec).__name__}"
-        )
-    if not isinstance(scenario, Scenario):
-        raise TactsenseInputError(f"scenario must be a Scenario; got {type(scenario).__name__}")
-    active = _resolve_flaws(flaws)
-    rng = np.random.default_rng(rng)
-    rows, cols = spec.shape
-    period = spec.scan_period_s
-    n_frames = max(1, math.floor(scenario.duration_s / period + 1e-9))
-    ticks_per_frame = rows * cols
-    dt = period / ticks_per_frame
-
-    if gains is not None:
-        gains = np.asarray(gains, dtype=float)
-        if gains.shape != spec.shape:
-            raise TactsenseInputError(f"gains has shape {gains.shape}; expected {spec.shape}")
-    elif "gain_spread" in active:
-        gains = draw_gains(spec)  # the finger's own gains (flaws.gain_seed)
-    else:
-        gains = np.ones(spec.shape)
-    applied = (
-        _jittered_steps(spec, scenario.steps, rng)
-        if "jitter" in active
-        else [step.contacts for step in scenario.steps]
-    )
-    elastic = _elastic_deflection(spec, applied) * gains  # (S, rows, cols)
-
-    boundaries = np.cumsum([0.0] + [s.duration_s for s in scenario.steps])
-    offsets = sample_offsets(spec)
-    flat_index = np.arange(ticks_per_frame)
-    row_of_tick, col_of_tick = np.divmod(flat_index, cols)
-    dead = np.zeros(spec.shape, dtype=bool)
-    if "dead" in active:
-        for r, c in spec.flaws.dead_tactels:
-            dead[r, c] = True
-    gain_v = amplifier_gain(spec)
-    c0 = spec.junction_capacitance_f
-    frames = np.empty((n_frames, rows, cols), dtype=np.float64)
-    state = None
-    for first in range(0, n_frames, _CHUNK_FRAMES):
-        last = min(n_frames, first + _CHUNK_FRAMES)
-        ticks = np.arange(first * ticks_per_frame, last * ticks_per_frame)
-        # the same arithmetic as Recording.sample_step: frame start + the tactel's offset
-        tick_time = (ticks // ticks_per_frame) * period + offsets.ravel()[ticks % ticks_per_frame]
-        step_of_tick = np.clip(
-            np.searchsorted(boundaries, tick_time, side="right") - 1, 0, len(scenario.steps) - 1
-        )
-        if "viscoelastic" in active:
-            f = spec.flaws
-            u = elastic[step_of_tick]  # (ticks, rows, cols): every tactel at every tick
-            u, state = viscoelastic_response(
-                u,
-                dt,
-                delayed_fraction=f.delayed_fraction,
-                delayed_time_constant_s=f.delayed_time_constant_s,
-                creep_fraction=f.creep_fraction,
-                creep_time_constant_s=f.creep_time_constant_s,
-                state=state,
-            )
-            sampled = u.reshape(last - first, ticks_per_frame, rows, cols)[
-                :, flat_index, row_of_tick, col_of_tick
-            ].reshape(last - first, rows, cols)
-        else:  # no memory: only the sampled instants matter
-            own_step = step_of_tick.reshape(last - first, ticks_per_frame)
-            sampled = elastic[own_step, row_of_tick, col_of_tick].reshape(last - first, rows, cols)
-        if "nonlinearity" in active:
-            sampled = stiffening(sampled, spec.flaws.nonlinear_saturation)
-        if _capacitive(spec):
-            sampled = np.minimum(sampled, 0.95)  # plates cannot touch
-            counts = voltage_to_counts(
-                spec, gain_v * divider_voltage(spec, c0 / (1.0 - sampled)), quantize=False
-            )
-        else:
-            counts = resistive_counts(spec, sampled)
-        if "noise" in active:
-            counts = counts + rng.normal(0.0, spec.flaws.read_noise_counts, counts.shape)
-        full_scale = 2**spec.electronics.adc_bits - 1
-        counts = np.clip(np.rint(counts) if "quantization" in active else counts, 0, full_scale)
-        counts[:, dead] = 0.0
+    run = _prepare(spec, scenario, flaws, rng, gains)
+    dtype = np.uint16 if "quantization" in run.active else np.float64
+    frames = np.empty((run.n_frames, *spec.shape), dtype=dtype)
+    for first, last, counts in _frame_blocks(spec, run):
         frames[first:last] = counts
         if progress is not None:
-            progress(last, n_frames)
-
-    time_s = np.arange(n_frames) * period
-    mid_scan = time_s + 0.5 * period
-    frame_step = np.clip(
-        np.searchsorted(boundaries, mid_scan, side="right") - 1, 0, len(scenario.steps) - 1
-    )
-    truth = _truth(spec, applied, frame_step)
-    dtype = np.uint16 if "quantization" in active else np.float64
+            progress(last, run.n_frames)
+    truth = _truth(spec, run.applied, _frame_steps(spec, run, 0, run.n_frames))
     return Recording(
-        frames=frames.astype(dtype) if dtype is np.uint16 else frames,
-        time_s=time_s,
-        sample_offset_s=offsets,
+        frames=frames,
+        time_s=np.arange(run.n_frames) * spec.scan_period_s,
+        sample_offset_s=run.offsets,
         sensor=spec,
         scenario=scenario.to_dict(),
-        flaws=active,
+        flaws=run.active,
         truth=truth,
-        gains=gains,
+        gains=run.gains,
     )
 
 
@@ -629,11 +703,117 @@ def _capacitive(spec) -> bool:
     return spec.kind == "finger" or spec.transduction.kind == "capacitive"
 
 
-def _elastic_deflection(spec, applied) -> np.ndarray:
-    """Fractional deflection of every tactel for each step's contacts, (S, rows, cols)."""
-    if spec.kind == "finger":
-        return deflection_batch(spec, applied)
-    return deflection_batch_flat(spec, applied)
+def simulate_to_file(
+    spec: SensorSpec,
+    scenario: Scenario,
+    path,
+    *,
+    flaws="all",
+    rng=None,
+    gains: np.ndarray | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> int:
+    """Run a scenario and write the recording to a new HDF5 file as its frames are made.
+
+    The same recording as ``write_recording(path, simulate(...))`` (the same layout,
+    the same frames for the same ``rng``), in memory that does not grow with its length:
+    frames, their times and the step of each frame go to the file
+    :data:`_WRITE_FRAMES` at a time. The caller chooses the name (the command line
+    writes to a temporary one and moves it into place); an existing file is refused.
+
+    Parameters
+    ----------
+    path : path
+        The new file.
+    spec, scenario, flaws, rng, gains, progress
+        As for :func:`simulate`.
+
+    Returns
+    -------
+    int
+        Frames written [-].
+    """
+    import datetime as _dt
+    from pathlib import Path
+
+    import h5py
+
+    from tactsense._version import __version__
+    from tactsense.io.recording import FORMAT, FORMAT_VERSION
+
+    path = Path(path)
+    if path.exists():
+        raise FileExistsError(f"{path} exists; choose a new name")
+    run = _prepare(spec, scenario, flaws, rng, gains)
+    n, shape = run.n_frames, spec.shape
+    dtype = np.uint16 if "quantization" in run.active else np.float64
+    chunk = max(1, min(n, _WRITE_FRAMES))
+    try:
+        with h5py.File(path, "w", libver=("earliest", "latest")) as h5:
+            h5.attrs["format"] = FORMAT
+            h5.attrs["format_version"] = FORMAT_VERSION
+            h5.attrs["tactsense_version"] = __version__
+            h5.attrs["created"] = _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds")
+            h5.attrs["sensor_toml"] = spec.to_toml_string()
+            h5.attrs["scenario_json"] = json.dumps(scenario.to_dict())
+            h5.attrs["flaws"] = ",".join(run.active)
+            h5.attrs["scan_rate_hz"] = spec.electronics.scan_rate_hz
+            h5.attrs["source"] = ""
+            frames = h5.create_dataset(
+                "frames",
+                (n, *shape),
+                dtype,
+                chunks=(chunk, *shape),
+                maxshape=(None, *shape),
+                compression="gzip",
+                fletcher32=True,
+            )
+            frames.attrs["units"] = "counts"
+            frames.attrs["axes"] = (
+                "time, row (along the finger, 0 = tip), col (around)"
+                if spec.kind == "finger"
+                else "time, row, col"
+            )
+            times = h5.create_dataset("time", (n,), float, chunks=(chunk,), fletcher32=True)
+            times.attrs["units"] = "s"
+            h5.create_dataset("sample_offset", data=run.offsets).attrs["units"] = "s"
+            h5.create_dataset("gains", data=run.gains).attrs["units"] = "1"
+            truth = h5.create_group("truth")
+            frame_step = truth.create_dataset(
+                "frame_step", (n,), np.int64, chunks=(chunk,), compression="gzip", fletcher32=True
+            )
+            frame_step.attrs["units"] = "1"
+            pending: list[np.ndarray] = []
+            written = 0
+            for _, last, counts in _frame_blocks(spec, run):
+                pending.append(counts)
+                if last - written >= chunk or last == n:
+                    block = np.concatenate(pending).astype(dtype, copy=False)
+                    pending.clear()
+                    frames[written:last] = block
+                    times[written:last] = np.arange(written, last) * spec.scan_period_s
+                    frame_step[written:last] = _frame_steps(spec, run, written, last)
+                    written = last
+                if progress is not None:
+                    progress(last, n)
+            units = {
+                "step_axial_mm": "mm",
+                "step_angle_deg": "deg",
+                "step_x_mm": "mm",
+                "step_y_mm": "mm",
+                "step_force_n": "N",
+            }
+            for key, value in _truth(spec, run.applied, np.zeros(0, np.int64)).items():
+                if key == "frame_step":
+                    continue
+                if isinstance(value, str):
+                    truth.attrs[key] = value
+                else:
+                    truth.create_dataset(key, data=value).attrs["units"] = units.get(key, "1")
+    except BaseException:
+        path.unlink(missing_ok=True)  # interrupted: leave nothing behind
+        raise
+    return written
 
 
 def _truth(spec: SensorSpec, applied: list[tuple], frame_step: np.ndarray) -> dict:

@@ -10,7 +10,6 @@ import typer
 
 from tactsense._validation import TactsenseInputError
 from tactsense.cli._common import progress_bar
-from tactsense.io.recording import Recording
 from tactsense.physics.contact import grams_force
 from tactsense.physics.flaws import FLAW_NAMES
 from tactsense.sensor import SensorSpec
@@ -241,9 +240,14 @@ def build_scenario(
     )
 
 
-def run_scenario(spec: SensorSpec, scene, *, flaws: str, seed: int | None) -> Recording:
-    """Simulate ``scene`` with a progress bar on the terminal."""
-    from tactsense.simulate import simulate
+def run_scenario(spec: SensorSpec, scene, *, flaws: str, seed: int | None, path=None):
+    """Simulate ``scene`` with a progress bar on the terminal.
+
+    Without ``path``, the :class:`Recording` (in memory); with it, the recording is
+    written to that new file as it is made (memory bounded however long the scenario)
+    and the number of frames written is returned.
+    """
+    from tactsense.simulate import simulate, simulate_to_file
 
     with progress_bar("simulating", unit="frames") as bar:
         task = bar.add_task("frames", total=None)
@@ -251,4 +255,6 @@ def run_scenario(spec: SensorSpec, scene, *, flaws: str, seed: int | None) -> Re
         def update(done: int, total: int) -> None:
             bar.update(task, completed=done, total=total)
 
+        if path is not None:
+            return simulate_to_file(spec, scene, path, flaws=flaws, rng=seed, progress=update)
         return simulate(spec, scene, flaws=flaws, rng=seed, progress=update)

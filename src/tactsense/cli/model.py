@@ -34,7 +34,7 @@ from tactsense.cli._scenario import (
     build_scenario,
     run_scenario,
 )
-from tactsense.io.recording import read_recording, write_recording
+from tactsense.io.recording import read_recording
 from tactsense.sensor import SensorSpec, load_sensor
 
 app = new_group("Simulate the finger and describe recordings.")
@@ -91,16 +91,16 @@ def simulate(
             lift_s=lift_s,
             repeats=repeats,
         )
-        recording = run_scenario(spec, scene, flaws=flaws, seed=seed)
+        # frames go to the file as they are made: memory stays flat however long
         with atomic_output(out) as temporary:
-            write_recording(temporary, recording)
+            written = run_scenario(spec, scene, flaws=flaws, seed=seed, path=temporary)
         console.print(
-            f"wrote {out}: {len(recording)} frames of {spec.shape[0]}x{spec.shape[1]} "
+            f"wrote {out}: {written} frames of {spec.shape[0]}x{spec.shape[1]} "
             f"counts at {spec.electronics.scan_rate_hz:g} Hz ({spec.name})"
         )
-        if plot is not None:
+        if plot is not None:  # a sweep: a few hundred frames, read back whole
             with atomic_output(plot) as temporary:
-                plot_sweep(recording, temporary)
+                plot_sweep(read_recording(out), temporary)
             console.print(f"wrote {plot}")
     except (TactsenseInputError, FileExistsError) as error:
         fail(str(error))

@@ -13,6 +13,7 @@ arrival time), in nanoseconds.
 
 from __future__ import annotations
 
+import struct
 from pathlib import Path
 
 import numpy as np
@@ -43,8 +44,39 @@ def _writer_class():
     return Writer
 
 
+class _Template:
+    """The CDR bytes of one message type, with the stamp and the trailing numbers left to
+    fill: every other byte (encapsulation, frame_id, name, lengths, padding) is the same
+    in every message of one writer, so it is taken from one message the library encoded.
+
+    ``encode(sec, nanosec, values)`` returns what the library's encoder returns for the
+    message whose stamp is (sec, nanosec) and whose trailing ``n`` numbers (of ``dtype``)
+    are ``values``; checked at construction on two probe messages.
+    """
+
+    def __init__(self, encoder, make, n: int, dtype):
+        self.n, self.dtype = n, np.dtype(dtype)
+        first = np.arange(1, n + 1, dtype=self.dtype)
+        data = bytes(encoder(make(1, 2, first)))
+        tail = n * self.dtype.itemsize
+        self.head, self.middle = data[:4], data[12 : len(data) - tail]
+        second = -np.arange(n, dtype=self.dtype) - 0.5
+        for sec, nanosec, values in ((1, 2, first), (123456, 999_999_999, second)):
+            if self.encode(sec, nanosec, values) != bytes(encoder(make(sec, nanosec, values))):
+                raise AssertionError("the CDR layout is not the one assumed")  # pragma: no cover
+
+    def encode(self, sec: int, nanosec: int, values) -> bytes:
+        values = np.ascontiguousarray(values, dtype=self.dtype.newbyteorder("<"))
+        return b"".join((self.head, _STAMP.pack(sec, nanosec), self.middle, values.tobytes()))
+
+
 class McapTactileWriter:
     """Write frames and contacts of one finger to an MCAP file, as they come.
+
+    Messages are CDR-encoded from a template (:class:`_Template`): the bytes the
+    ``mcap-ros2-support`` encoder makes, without building a dictionary per message
+    (``fast=False`` encodes each message with that encoder instead: the same file,
+    about twenty times slower; kept for the tests and the benchmark).
 
     Parameters
     ----------
@@ -56,25 +88,106 @@ class McapTactileWriter:
     """
 
     def __init__(
-        self, stream, sensor: SensorSpec, *, frame_id: str = "finger", chunk_size: int = 1 << 20
+        self,
+        stream,
+        sensor: SensorSpec,
+        *,
+        frame_id: str = "finger",
+        chunk_size: int = 1 << 20,
+        fast: bool = True,
     ):
         Writer = _writer_class()
+        from mcap_ros2._dynamic import serialize_dynamic
+
         self.sensor = sensor
         self.frame_id = frame_id
         self._writer = Writer(stream, chunk_size=chunk_size)
         self._state = self._writer.register_msgdef(TACTILE_STATE, TACTILE_STATE_MSGDEF)
         self._contact = self._writer.register_msgdef(TACTILE_CONTACT, TACTILE_CONTACT_MSGDEF)
+        self._fast = fast
+        self._raw = self._writer._writer  # the mcap Writer under the ROS 2 one
+        self._channels: dict[str, int] = {}
+        if fast:
+            encode_state = serialize_dynamic(TACTILE_STATE, TACTILE_STATE_MSGDEF)[TACTILE_STATE]
+            encode_contact = serialize_dynamic(TACTILE_CONTACT, TACTILE_CONTACT_MSGDEF)[
+                TACTILE_CONTACT
+            ]
+            cells = int(np.prod(sensor.shape))
+            header = {"frame_id": frame_id}
+
+            def state(sec, nanosec, values):
+                return {
+                    "header": {"stamp": {"sec": sec, "nanosec": nanosec}, **header},
+                    "sensors": [{"name": sensor.name, "values": values.tolist()}],
+                }
+
+            def contact(sec, nanosec, values):
+                names = ("position", "normal")
+                message = {
+                    "header": {"stamp": {"sec": sec, "nanosec": nanosec}, **header},
+                    "name": sensor.name,
+                }
+                for k, name in enumerate(names):
+                    message[name] = dict(
+                        zip("xyz", map(float, values[3 * k : 3 * k + 3]), strict=True)
+                    )
+                message["wrench"] = {
+                    "force": dict(zip("xyz", map(float, values[6:9]), strict=True)),
+                    "torque": dict(zip("xyz", map(float, values[9:12]), strict=True)),
+                }
+                return message
+
+            self._state_bytes = _Template(encode_state, state, cells, np.float32)
+            self._contact_bytes = _Template(encode_contact, contact, 12, np.float64)
         self.frames = 0
         self.contacts = 0
 
+    def _channel(self, topic: str, schema) -> int:
+        """The channel of a topic, registered at its first message as the ROS 2 writer
+        registers it (the same records in the same order)."""
+        if topic not in self._channels:
+            self._channels[topic] = self._raw.register_channel(
+                topic=topic, message_encoding="cdr", schema_id=schema.id
+            )
+            self._writer._channel_ids[topic] = self._channels[topic]
+        return self._channels[topic]
+
     def frame(self, counts, time_s: float, *, sequence: int | None = None) -> None:
         ns = round(float(time_s) * 1e9)
-        message = tactile_state(self.sensor, counts, time_s, self.frame_id)
-        self._writer.write_message(
-            STATES_TOPIC, self._state, message, log_time=ns, publish_time=ns,
-            sequence=self.frames if sequence is None else int(sequence),
-        )  # fmt: skip
+        sequence = self.frames if sequence is None else int(sequence)
+        if not self._fast:
+            message = tactile_state(self.sensor, counts, time_s, self.frame_id)
+            self._writer.write_message(
+                STATES_TOPIC, self._state, message, log_time=ns, publish_time=ns,
+                sequence=sequence,
+            )  # fmt: skip
+        else:
+            data = self._state_bytes.encode(
+                ns // 1_000_000_000, ns % 1_000_000_000, np.ravel(counts)
+            )
+            self._raw.add_message(
+                channel_id=self._channel(STATES_TOPIC, self._state), log_time=ns,
+                publish_time=ns, sequence=sequence, data=data,
+            )  # fmt: skip
         self.frames += 1
+
+    def frames_of(self, counts, time_s, sequence) -> None:
+        """Many frames at once: counts (k, rows, cols), their times [s] and sequences."""
+        if not self._fast:
+            for k in range(len(time_s)):
+                self.frame(counts[k], float(time_s[k]), sequence=int(sequence[k]))
+            return
+        channel = self._channel(STATES_TOPIC, self._state)
+        values = np.asarray(counts, dtype="<f4").reshape(len(time_s), -1)
+        head, middle = self._state_bytes.head, self._state_bytes.middle
+        for k in range(len(time_s)):
+            ns = round(float(time_s[k]) * 1e9)
+            stamp = _STAMP.pack(ns // 1_000_000_000, ns % 1_000_000_000)
+            self._raw.add_message(
+                channel_id=channel, log_time=ns, publish_time=ns, sequence=int(sequence[k]),
+                data=b"".join((head, stamp, middle, values[k].tobytes())),
+            )  # fmt: skip
+        self.frames += len(time_s)
 
     def contacts_of(self, time_s, axial_mm, angle_deg, force_n, has_contact) -> None:
         """Contacts of many frames at once (vectorised geometry)."""
@@ -84,20 +197,37 @@ class McapTactileWriter:
         points, normals = contact_geometry(
             self.sensor, np.asarray(axial_mm)[chosen], np.asarray(angle_deg)[chosen]
         )
+        if self._fast:
+            channel = self._channel(CONTACTS_TOPIC, self._contact)
+            force = -np.asarray(force_n, dtype=float)[chosen, None] * normals
+            numbers = np.zeros((len(chosen), 12), dtype="<f8")
+            numbers[:, 0:3], numbers[:, 3:6], numbers[:, 6:9] = points, normals, force
+            head, middle = self._contact_bytes.head, self._contact_bytes.middle
         for k, i in enumerate(chosen):
             t = float(time_s[i])
             ns = round(t * 1e9)
-            message = tactile_contact(
-                self.sensor, t, points[k], normals[k], force_n[i], self.frame_id
-            )
-            self._writer.write_message(
-                CONTACTS_TOPIC, self._contact, message, log_time=ns, publish_time=ns,
-                sequence=self.contacts,
-            )  # fmt: skip
+            if self._fast:
+                stamp = _STAMP.pack(ns // 1_000_000_000, ns % 1_000_000_000)
+                self._raw.add_message(
+                    channel_id=channel, log_time=ns, publish_time=ns, sequence=self.contacts,
+                    data=b"".join((head, stamp, middle, numbers[k].tobytes())),
+                )  # fmt: skip
+            else:
+                message = tactile_contact(
+                    self.sensor, t, points[k], normals[k], force_n[i], self.frame_id
+                )
+                self._writer.write_message(
+                    CONTACTS_TOPIC, self._contact, message, log_time=ns, publish_time=ns,
+                    sequence=self.contacts,
+                )  # fmt: skip
             self.contacts += 1
 
     def finish(self) -> None:
         self._writer.finish()
+
+
+_STAMP = struct.Struct("<iI")
+"""builtin_interfaces/Time in CDR: int32 sec, uint32 nanosec, little-endian."""
 
 
 def export_mcap(
@@ -109,6 +239,7 @@ def export_mcap(
     threshold: float | None = None,
     frame_id: str = "finger",
     progress=None,
+    fast: bool = True,
 ) -> dict:
     """Write a recording's frames and contacts to MCAP, a piece at a time.
 
@@ -134,7 +265,7 @@ def export_mcap(
     from tactsense.io.recording import RecordingReader
 
     with RecordingReader(recording) as reader, open(out, "wb") as stream:
-        writer = McapTactileWriter(stream, reader.sensor, frame_id=frame_id)
+        writer = McapTactileWriter(stream, reader.sensor, frame_id=frame_id, fast=fast)
         pieces = iter_locate(
             reader,
             baseline_frames=baseline_frames,
@@ -143,8 +274,7 @@ def export_mcap(
         )
         for start, time_s, est in pieces:
             frames = reader.frames(start, start + len(time_s))
-            for k in range(len(time_s)):
-                writer.frame(frames[k], float(time_s[k]), sequence=start + k)
+            writer.frames_of(frames, time_s, np.arange(start, start + len(time_s)))
             touching = ((est.flags & int(Flag.NO_CONTACT)) == 0) & np.isfinite(est.force_n)
             writer.contacts_of(time_s, est.axial_mm, est.angle_deg, est.force_n, touching)
             if progress is not None:
