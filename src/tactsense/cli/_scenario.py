@@ -21,19 +21,74 @@ class ScenarioKind(StrEnum):
     repeated = "repeated"
     calibration = "calibration"
     knife = "knife-edge"
+    press = "press"
+    hold = "hold"
+    two_probes = "two-probes"
+    slide = "slide"
+    sweep = "sweep"
+    punch = "punch"
 
+
+FINGER_SCENARIOS = ("sweep-axial", "sweep-around", "repeated", "calibration", "knife-edge")
+FLAT_SCENARIOS = ("press", "hold", "two-probes", "slide", "sweep", "knife-edge", "punch")
+"""The scenarios of a finger, and of a pad or a point set (``tactsense.flat_scenarios``)."""
 
 ScenarioOption = Annotated[
-    ScenarioKind,
+    ScenarioKind | None,
     typer.Option(
-        help="What touches the finger: 'sweep-axial' steps a probe along the finger "
-        "(Fig. 7), 'sweep-around' steps it around (Fig. 13), 'repeated' applies it "
-        "again and again above one tactel (Figs. 10-12; also the force steps for "
-        "'calibrate --steps'), 'calibration' sweeps the probe along every column "
+        help="What touches the sensor. A finger: 'sweep-axial' (the default) steps a probe "
+        "along the finger (Fig. 7), 'sweep-around' steps it around (Fig. 13), 'repeated' "
+        "applies it again and again above one tactel (Figs. 10-12; also the force steps "
+        "for 'calibrate --steps'), 'calibration' sweeps the probe along every column "
         "(section 3.1, for 'calibrate'), 'knife-edge' steps a 0.5-N knife edge past "
-        "tactel (row, col) (section 4.1, for 'calibrate --knife')."
+        "tactel (row, col) (section 4.1, for 'calibrate --knife'). A pad or a point set: "
+        "'press' (the default) presses an indenter and lifts it, 'hold' presses and holds "
+        "(creep, section 3.4), 'two-probes' presses two spheres --separation-mm apart, "
+        "'slide' slides a sphere across at --speed-mm-s, 'sweep' presses a sphere every "
+        "--increment mm along y (Fig. 7 on a pad), 'knife-edge' presses a knife edge "
+        "across the middle, 'punch' a flat punch (a uniform press)."
     ),
 ]
+XOption = Annotated[
+    float | None,
+    typer.Option("--x-mm", min=-1e4, max=1e4,
+                 help="Pads: where the indenter presses, along x (the rows) [mm] "
+                 "[default: the middle]; point sets: in the tangent plane of taxel 0."),
+]  # fmt: skip
+YOption = Annotated[
+    float | None,
+    typer.Option("--y-mm", min=-1e4, max=1e4,
+                 help="Pads: where the indenter presses, along y (the columns) [mm] "
+                 "[default: the middle]."),
+]  # fmt: skip
+SeparationOption = Annotated[
+    float | None,
+    typer.Option("--separation-mm", min=1e-3, max=1e4,
+                 help="'two-probes': distance between the two spheres' centres [mm] "
+                 "[default: 5]."),
+]  # fmt: skip
+IndenterOption = Annotated[
+    str | None,
+    typer.Option(help="'press' and 'hold': sphere (Hertz), disc (uniform), punch (rigid "
+                 "flat) or knife [default: sphere]."),
+]  # fmt: skip
+SizeOption = Annotated[
+    float | None,
+    typer.Option("--size-mm", min=1e-3, max=1e3,
+                 help="Pads: the indenter's radius (sphere, disc, punch) or a knife edge's "
+                 "length [mm] [default: 1.6, the paper's 3.2-mm probe; punch 3; knife 10]."),
+]  # fmt: skip
+SpeedOption = Annotated[
+    float | None,
+    typer.Option("--speed-mm-s", min=1e-3, max=1e4,
+                 help="'slide': speed of the sliding sphere [mm/s] [default: 10]."),
+]  # fmt: skip
+AngleOption = Annotated[
+    float | None,
+    typer.Option("--angle-deg", min=-360.0, max=360.0,
+                 help="'knife-edge' on a pad: the edge's angle from the x axis [deg] "
+                 "[default: 0]."),
+]  # fmt: skip
 RowOption = Annotated[
     int | None,
     typer.Option(
@@ -109,6 +164,21 @@ sensor's own default tactel, :func:`tactsense.simulate.default_row`; dwell_s is
 lengthened to one scan period on a slow sensor)."""
 
 USES = {
+    ScenarioKind.press: (
+        "x_mm",
+        "y_mm",
+        "force_g",
+        "indenter",
+        "size_mm",
+        "dwell_s",
+        "lift_s",
+        "repeats",
+    ),
+    ScenarioKind.hold: ("x_mm", "y_mm", "force_g", "indenter", "size_mm", "dwell_s", "lift_s"),
+    ScenarioKind.two_probes: ("separation_mm", "force_g", "size_mm", "dwell_s"),
+    ScenarioKind.slide: ("force_g", "size_mm", "speed_mm_s", "increment"),
+    ScenarioKind.sweep: ("x_mm", "force_g", "size_mm", "increment", "dwell_s"),
+    ScenarioKind.punch: ("force_g", "size_mm", "dwell_s"),
     ScenarioKind.sweep_axial: ("col", "force_g", "increment", "dwell_s", "lift_s"),
     ScenarioKind.sweep_around: ("row", "force_g", "increment", "dwell_s", "lift_s"),
     ScenarioKind.repeated: ("row", "col", "force_g", "dwell_s", "lift_s", "repeats"),
@@ -122,16 +192,42 @@ def _flag(name: str) -> str:
     return "--" + name.replace("_", "-")
 
 
-def check_scenario_options(scenario: ScenarioKind, given: dict) -> dict:
+FLAT_KNIFE_USES = ("force_g", "size_mm", "angle_deg", "dwell_s")
+"""'knife-edge' on a pad or a point set (on a finger it is section 4.1's sweep)."""
+
+
+def _uses(scenario: ScenarioKind, kind: str) -> tuple[str, ...]:
+    if scenario is ScenarioKind.knife and kind != "finger":
+        return FLAT_KNIFE_USES
+    return USES[scenario]
+
+
+def check_scenario_options(scenario: ScenarioKind, given: dict, kind: str = "finger") -> dict:
     """Refuse options the scenario does not use; fill in the defaults of the rest."""
+    uses = _uses(scenario, kind)
     unused = [name for name, value in given.items() if value is not None]
-    unused = [name for name in unused if name not in USES[scenario]]
+    unused = [name for name in unused if name not in uses]
     if unused:
         raise TactsenseInputError(
             f"{', '.join(_flag(n) for n in unused)} does not apply to --scenario "
-            f"{scenario.value}, which uses {', '.join(_flag(n) for n in USES[scenario])}"
+            f"{scenario.value}, which uses {', '.join(_flag(n) for n in uses)}"
         )
     return {name: DEFAULTS.get(name) if value is None else value for name, value in given.items()}
+
+
+def resolve_scenario(spec, scenario: ScenarioKind | None) -> ScenarioKind:
+    """The scenario asked for, or the sensor's default; one the sensor cannot run is an
+    error naming those it can."""
+    finger = spec.kind == "finger"
+    if scenario is None:
+        return ScenarioKind.sweep_axial if finger else ScenarioKind.press
+    allowed = FINGER_SCENARIOS if finger else FLAT_SCENARIOS
+    if scenario.value not in allowed:
+        raise TactsenseInputError(
+            f"--scenario {scenario.value} is for {'pads and point sets' if finger else 'fingers'}; "
+            f"{spec.name!r} is a {spec.kind}, which takes {', '.join(allowed)}"
+        )
+    return scenario
 
 
 FlawsOption = Annotated[
@@ -186,12 +282,31 @@ def build_scenario(
     dwell_s: float | None,
     lift_s: float | None,
     repeats: int | None,
+    x_mm: float | None = None,
+    y_mm: float | None = None,
+    separation_mm: float | None = None,
+    indenter: str | None = None,
+    size_mm: float | None = None,
+    speed_mm_s: float | None = None,
+    angle_deg: float | None = None,
 ):
     """The :class:`~tactsense.simulate.Scenario` the command-line options describe.
 
-    Options left as None take :data:`DEFAULTS`; an option given to a scenario that does
+    Options left as None take :data:`DEFAULTS` (a pad's scenarios: the builders' own
+    defaults, :mod:`tactsense.flat_scenarios`); an option given to a scenario that does
     not use it (:data:`USES`) is a :class:`TactsenseInputError`.
     """
+    scenario = resolve_scenario(spec, scenario)
+    if spec.kind != "finger":
+        given = dict(
+            row=row, col=col, force_g=force_g, increment=increment, dwell_s=dwell_s,
+            lift_s=lift_s, repeats=repeats, x_mm=x_mm, y_mm=y_mm,
+            separation_mm=separation_mm, indenter=indenter, size_mm=size_mm,
+            speed_mm_s=speed_mm_s, angle_deg=angle_deg,
+        )  # fmt: skip
+        check_scenario_options(scenario, given, spec.kind)
+        check_timing(spec, dwell_s, lift_s)
+        return _flat_scenario(spec, scenario, given)
     from tactsense.simulate import calibration_sweep, knife_edge_sweep, probe_sweep, repeated_load
 
     dwell = dwell_s
@@ -238,6 +353,31 @@ def build_scenario(
         dwell_s=dwell_s,
         lift_s=lift_s,
     )
+
+
+def _flat_scenario(spec, scenario: ScenarioKind, given: dict):
+    """A pad's or a point set's scenario from the options given (None: the builder's
+    default)."""
+    from tactsense.flat_scenarios import SCENARIOS
+
+    names = {"dwell_s": "dwell_s", "lift_s": "lift_s", "repeats": "repeats", "x_mm": "x_mm",
+             "y_mm": "y_mm", "separation_mm": "separation_mm", "indenter": "indenter",
+             "speed_mm_s": "speed_mm_s", "angle_deg": "angle_deg"}  # fmt: skip
+    options = {names[k]: v for k, v in given.items() if k in names and v is not None}
+    if given["force_g"] is not None:
+        options["force_n"] = grams_force(given["force_g"])
+    if given["increment"] is not None:
+        options["increment_mm"] = given["increment"]
+    if given["size_mm"] is not None:
+        key = {"knife-edge": "length_mm", "punch": "radius_mm"}.get(scenario.value, "size_mm")
+        options[key] = given["size_mm"]
+    if scenario is ScenarioKind.hold and "dwell_s" in options:
+        options["hold_s"] = options.pop("dwell_s")
+    if spec.kind == "points" and scenario in (ScenarioKind.press, ScenarioKind.hold):
+        options.setdefault("at_taxel", 0)
+    if scenario in (ScenarioKind.press, ScenarioKind.hold) and options.get("indenter") == "knife":
+        options.setdefault("size_mm", 10.0)
+    return SCENARIOS[scenario.value](spec, **options)
 
 
 def run_scenario(spec: SensorSpec, scene, *, flaws: str, seed: int | None, path=None):

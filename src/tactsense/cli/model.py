@@ -20,18 +20,26 @@ from tactsense.cli._common import (
     new_group,
 )
 from tactsense.cli._scenario import (
+    AngleOption,
     ColOption,
     DwellOption,
     FlawsOption,
     ForceGOption,
     IncrementOption,
+    IndenterOption,
     LiftOption,
     RepeatsOption,
     RowOption,
     ScenarioKind,
     ScenarioOption,
     SeedOption,
+    SeparationOption,
+    SizeOption,
+    SpeedOption,
+    XOption,
+    YOption,
     build_scenario,
+    resolve_scenario,
     run_scenario,
 )
 from tactsense.io.recording import read_recording
@@ -47,7 +55,7 @@ def simulate(
         "sweep.h5"
     ),
     sensor: SensorOption = "initial",
-    scenario: ScenarioOption = ScenarioKind.sweep_axial,
+    scenario: ScenarioOption = None,
     row: RowOption = None,
     col: ColOption = None,
     force_g: ForceGOption = None,
@@ -55,6 +63,13 @@ def simulate(
     dwell_s: DwellOption = None,
     lift_s: LiftOption = None,
     repeats: RepeatsOption = None,
+    x_mm: XOption = None,
+    y_mm: YOption = None,
+    separation_mm: SeparationOption = None,
+    indenter: IndenterOption = None,
+    size_mm: SizeOption = None,
+    speed_mm_s: SpeedOption = None,
+    angle_deg: AngleOption = None,
     flaws: FlawsOption = "all",
     seed: SeedOption = 0,
     plot: Annotated[
@@ -65,7 +80,8 @@ def simulate(
         bool, typer.Option("--force", help="Replace OUT and PLOT if they already exist.")
     ] = False,
 ) -> None:
-    """Simulate the finger under a scenario and write an HDF5 recording of A/D frames."""
+    """Simulate a sensor (a finger, a pad or a point set) under a scenario and write an
+    HDF5 recording of A/D frames."""
     from tactsense.plotting import check_plot_format, plot_sweep
 
     try:
@@ -75,11 +91,15 @@ def simulate(
         for target in (out, plot):
             if target is not None:
                 check_output(target, force)
+        scenario = resolve_scenario(spec, scenario)
         if plot is not None and scenario not in (
             ScenarioKind.sweep_axial,
             ScenarioKind.sweep_around,
         ):
-            fail("--plot draws the sweeps along or around; not available for this scenario")
+            fail(
+                "--plot draws a finger's sweeps along or around; not available for "
+                f"--scenario {scenario.value} (view a pad's recording with 'tactsense view')"
+            )
         scene = build_scenario(
             spec,
             scenario,
@@ -90,6 +110,13 @@ def simulate(
             dwell_s=dwell_s,
             lift_s=lift_s,
             repeats=repeats,
+            x_mm=x_mm,
+            y_mm=y_mm,
+            separation_mm=separation_mm,
+            indenter=indenter,
+            size_mm=size_mm,
+            speed_mm_s=speed_mm_s,
+            angle_deg=angle_deg,
         )
         # frames go to the file as they are made: memory stays flat however long
         with atomic_output(out) as temporary:
