@@ -346,8 +346,8 @@ def design_sweep_command(
     if plot is not None:
         from tactsense.plotting import check_plot_format
 
-        check_plot_format(plot)
         check_output(plot, force, what="plot")
+        check_plot_format(plot)
     spec = load_sensor(sensor)
     pad = spec.kind == "pad"
     if spec.kind not in ("finger", "pad"):
