@@ -331,8 +331,8 @@ def design_sweep_command(
     if plot is not None:
         from tactsense.plotting import check_plot_format
 
-        check_plot_format(plot)
         check_output(plot, force, what="plot")
+        check_plot_format(plot)
     depths = _grid(depth, "--depth", low=0.5, high=20.0)
     spacings = _grid(spacing, "--spacing", low=0.5, high=20.0)
     ratios = _grid(poisson, "--poisson", low=0.0, high=0.5)

@@ -70,12 +70,12 @@ def simulate(
     from tactsense.plotting import check_plot_format, plot_sweep
 
     try:
-        if plot is not None:
-            check_plot_format(plot)
         spec = load_sensor(sensor)
         for target in (out, plot):
             if target is not None:
                 check_output(target, force)
+        if plot is not None:
+            check_plot_format(plot)
         if plot is not None and scenario not in (
             ScenarioKind.sweep_axial,
             ScenarioKind.sweep_around,
