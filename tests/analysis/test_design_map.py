@@ -15,9 +15,7 @@ def dataset():
 def _boxes(fig):
     fig.canvas.draw()
     renderer = fig.canvas.get_renderer()
-    return [
-        [text.get_window_extent(renderer) for text in ax.texts] for ax in fig.axes if ax.texts
-    ]
+    return [[text.get_window_extent(renderer) for text in ax.texts] for ax in fig.axes if ax.texts]
 
 
 @pytest.mark.parametrize(
