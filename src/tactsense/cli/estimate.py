@@ -201,7 +201,7 @@ def calibrate(
                 read_recording(steps), sensor, row, col, baseline_frames
             )
         if knife is not None:
-            calibration.model_fit = _fit_knife(
+            calibration.model_fit, compensated = _fit_knife(
                 read_recording(knife),
                 sensor,
                 row,
@@ -209,6 +209,7 @@ def calibrate(
                 baseline_frames,
                 creep=calibration.viscoelastic,
             )
+            calibration.notes["knife_fit_creep_compensated"] = compensated
         with atomic_output(out) as temporary:
             calibration.save(temporary)
     except (TactsenseInputError, FileExistsError) as error:
@@ -248,8 +249,13 @@ def calibrate(
             f"RMS {m.rms_percent:.2f} % of full scale"
             + (
                 " (creep compensated)"
-                if calibration.viscoelastic is not None
-                else " (creep not compensated: give --steps)"
+                if calibration.notes.get("knife_fit_creep_compensated")
+                else " (creep not compensated: "
+                + (
+                    "the fit was better without)"
+                    if calibration.viscoelastic is not None
+                    else "give --steps)"
+                )
             ),
         )
     Console(stderr=True).print(table)
@@ -283,9 +289,10 @@ def _fit_steps(rec, sensor, row, col, baseline_frames):
 
 def _fit_knife(rec, sensor, row, col, baseline_frames, *, creep=None):
     """The plane-stress fit to the knife-edge recording; with a creep model (from
-    --steps), the tactel's readings are compensated for creep first: a knife held 0.5 s
-    and lifted 0.5 s leaves the rubber's memory in every reading, which otherwise bends
-    the fit (depth 4.07 mm and nu 0.228 for the twin's 3.8 mm and 0.4)."""
+    --steps), the fit to the readings compensated for creep is kept when it is sound and
+    its residual smaller: a knife held 0.5 s and lifted 0.5 s leaves the rubber's memory
+    in every reading, which otherwise bends the fit (depth 4.07 mm and nu 0.228 for the
+    twin's 3.8 mm and 0.4). Returns (fit, whether it is the compensated one)."""
     from tactsense.estimate import calibrate as cal
 
     if rec.sensor != sensor:
@@ -306,9 +313,15 @@ def _fit_knife(rec, sensor, row, col, baseline_frames, *, creep=None):
             "knife-edge fit needs the edge stepped past the tactel (simulate --scenario "
             "knife-edge)"
         )
-    if creep is not None:
-        signal = cal.compensate_viscoelastic(signal, rec.sensor.scan_period_s, creep)
     fit = cal.fit_plane_stress(positions, signal[last])
+    compensated = False
+    if creep is not None:
+        # the creep model is only as good as the --steps recording: the compensated fit
+        # is kept when it is sound and fits better than the raw one
+        fixed = cal.compensate_viscoelastic(signal, rec.sensor.scan_period_s, creep)
+        other = cal.fit_plane_stress(positions, fixed[last])
+        if not cal.check_model_fit(other) and other.rms_percent < fit.rms_percent:
+            fit, compensated = other, True
     problems = cal.check_model_fit(fit)
     if problems:
         raise TactsenseInputError(
@@ -316,7 +329,7 @@ def _fit_knife(rec, sensor, row, col, baseline_frames, *, creep=None):
             f"{fit.depth_mm:.2f} mm, nu {fit.poisson_ratio:.3f}): {'; '.join(problems)}. "
             "Is the edge stepped past that tactel? Check --row and --col."
         )
-    return fit
+    return fit, compensated
 
 
 class OutputFormat(StrEnum):
