@@ -341,9 +341,9 @@ def _run_check(path: Path, timeout_s: float) -> str | None:
         out, err = process.communicate(timeout=timeout_s)
     except subprocess.TimeoutExpired:
         return (
-            f"libhdf5 did not finish reading its structure within {timeout_s:g} s (a "
-            "damaged index makes it loop; if the file is sound but on a very slow disk, "
-            "raise TACTSENSE_CHECK_TIMEOUT_S)"
+            f"libhdf5 did not finish reading its structure within {timeout_s:g} s "
+            "(damaged metadata can make it loop for ever; if the file is sound but on a "
+            "very slow disk, raise TACTSENSE_CHECK_TIMEOUT_S)"
         )
     finally:
         if process.poll() is None:  # timed out, or Ctrl-C in the parent
