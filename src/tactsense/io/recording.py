@@ -14,10 +14,26 @@ Layout of a recording file (format ``tactsense-recording``, version 2)::
     /host_time           (T,) arrival on the host, Unix time [s] (recorded streams, v2)
     /losses              (K,) int64 loss counters, attrs: kinds = comma list (v2)
 
-Version 1 (no stream datasets) is still read. A recorded stream is written in HDF5's
-single-writer/multiple-reader mode and flushed at least once a second: a recorder killed
-mid-way leaves a file that :func:`read_recording` opens, holding every frame up to the
-last flush (``Recording.closed_cleanly`` is then False).
+Version 1 (no stream datasets) is still read. Every dataset tactsense writes is chunked
+with HDF5's Fletcher-32 checksum filter, and :func:`write_recording` writes HDF5's v110
+file format, whose superblock, object headers and indexes carry checksums too: damaged
+bytes are an error on reading, not wrong numbers. Files written before (no checksums)
+read as before.
+
+A damaged HDF5 file can make libhdf5 loop for ever (a zeroed global-heap object header
+does), holding the interpreter and ignoring Ctrl-C. So every opening of a recording
+(:func:`read_recording`, :class:`RecordingReader`, and through them every command)
+first has a child process walk the file's structure (:func:`check_structure`), killed
+after :data:`CHECK_TIMEOUT_S`; a damaged file ends with ``RecordingError("<path> is
+damaged: ...")`` within seconds, and Ctrl-C works throughout.
+
+A recorded stream is written in HDF5's single-writer/multiple-reader (SWMR) mode and
+flushed at least once a second: a recorder killed mid-way leaves a file that
+:func:`read_recording` opens, holding every frame up to the last flush
+(``Recording.closed_cleanly`` is then False). Plain ``h5py.File(path)`` refuses such a
+file ("file is already open for write": the writer's flag is still set); open it with
+``h5py.File(path, "r", swmr=True)``, or clear the flag once with ``h5clear -s path``
+(Debian/Ubuntu package ``hdf5-tools``), after which any HDF5 reader opens it.
 
 Axis -2 of ``frames`` runs along the finger (row 0 under the tip), axis -1
 around it (``docs/nomenclature.md``).
