@@ -205,3 +205,44 @@ def test_folder_and_empty_file_get_one_clean_line(tmp_path, make, message):
     with pytest.raises(RecordingError, match=message) as error:
         ts.read_recording(path)
     assert "\n" not in str(error.value) and "x.h5" in str(error.value)
+
+
+def _info(path) -> str:
+    from typer.testing import CliRunner
+
+    from tactsense.cli import app
+
+    result = CliRunner().invoke(app, ["info", str(path)], env={"COLUMNS": "400"})
+    assert result.exit_code == 0, result.output
+    return " ".join(result.output.split())
+
+
+def test_info_calls_a_device_recordings_flaws_unknown(recording, tmp_path):
+    _recorded(tmp_path / "d.h5", recording.sensor)
+    assert "flaws │ unknown (a device)" in _info(tmp_path / "d.h5")
+    ts.write_recording(tmp_path / "s.h5", recording)  # a simulation lists its own
+    assert f"flaws │ {', '.join(recording.flaws)}" in _info(tmp_path / "s.h5")
+
+
+def test_info_streams_in_blocks(recording, tmp_path, monkeypatch):
+    """info never reads the whole recording, and its figures over many small blocks are
+    those of the whole array (NaN frames in different blocks, extremes in others)."""
+    import dataclasses
+
+    from tactsense.cli import model
+    from tactsense.io import recording as module
+
+    frames = recording.frames.astype(float)
+    frames[[3, 10, 11, 30]] = np.nan
+    frames[20, 2, 2], frames[25, 5, 5] = -7.5, 9999.25
+    path = ts.write_recording(tmp_path / "f.h5", dataclasses.replace(recording, frames=frames))
+
+    def whole(*_):
+        raise AssertionError("info read the whole recording")
+
+    monkeypatch.setattr(model, "read_recording", whole, raising=False)
+    monkeypatch.setattr(module.RecordingReader, "chunk_frames", property(lambda self: 7))
+    finite = frames[np.isfinite(frames)]
+    text = _info(path)
+    assert f"counts │ {finite.min():g} .. {finite.max():g} (4 frames hold NaN" in text
+    assert f"frames │ {len(frames)} x 8 x 8" in text
