@@ -298,9 +298,27 @@ except Exception as error:
     sys.exit(3)
 """
 
-CHECK_TIMEOUT_S = float(os.environ.get("TACTSENSE_CHECK_TIMEOUT_S", "10"))
-"""Longest time the structure check of a file may take [s] (environment variable
-``TACTSENSE_CHECK_TIMEOUT_S``; raise it for very large files on slow disks)."""
+CHECK_TIMEOUT_S = 10.0
+"""Longest time the structure check of a file may take [s]; the environment variable
+``TACTSENSE_CHECK_TIMEOUT_S`` overrides it (for very large files on slow disks)."""
+
+
+def _check_timeout_s() -> float:
+    """:data:`CHECK_TIMEOUT_S`, or ``TACTSENSE_CHECK_TIMEOUT_S`` if set [s]."""
+    text = os.environ.get("TACTSENSE_CHECK_TIMEOUT_S", "").strip()
+    if not text:
+        return CHECK_TIMEOUT_S
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not 0 < value < 1e6:
+        raise RecordingError(
+            f"TACTSENSE_CHECK_TIMEOUT_S={text!r} is not a time in seconds; expected a "
+            "positive number, e.g. 30"
+        )
+    return value
+
 
 _verdicts: dict[tuple, str | None] = {}
 
@@ -324,7 +342,8 @@ def check_structure(path: str | Path, *, timeout_s: float | None = None) -> None
     path : path
         An existing regular file.
     timeout_s : float, optional
-        Longest time the check may take [s]; default :data:`CHECK_TIMEOUT_S`.
+        Longest time the check may take [s]; default :data:`CHECK_TIMEOUT_S` (or the
+        environment variable ``TACTSENSE_CHECK_TIMEOUT_S``).
 
     Raises
     ------
@@ -336,7 +355,7 @@ def check_structure(path: str | Path, *, timeout_s: float | None = None) -> None
     stat = path.stat()
     key = (str(path.resolve()), stat.st_size, stat.st_mtime_ns)
     if key not in _verdicts:
-        _verdicts[key] = _run_check(path, CHECK_TIMEOUT_S if timeout_s is None else timeout_s)
+        _verdicts[key] = _run_check(path, _check_timeout_s() if timeout_s is None else timeout_s)
     if _verdicts[key] is not None:
         raise RecordingError(f"{path} is damaged: {_verdicts[key]}")
 
