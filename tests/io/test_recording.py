@@ -246,3 +246,11 @@ def test_info_streams_in_blocks(recording, tmp_path, monkeypatch):
     text = _info(path)
     assert f"counts │ {finite.min():g} .. {finite.max():g} (4 frames hold NaN" in text
     assert f"frames │ {len(frames)} x 8 x 8" in text
+
+
+@pytest.mark.parametrize("value", ["abc", "0", "-3", "nan"])
+def test_a_bad_check_timeout_is_one_line(recording, tmp_path, monkeypatch, value):
+    path = ts.write_recording(tmp_path / "r.h5", recording)
+    monkeypatch.setenv("TACTSENSE_CHECK_TIMEOUT_S", value)
+    with pytest.raises(RecordingError, match=r"TACTSENSE_CHECK_TIMEOUT_S=.*expected a positive"):
+        ts.read_recording(path)
