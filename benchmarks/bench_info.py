@@ -73,7 +73,7 @@ def main(n_frames: int = 2_000_000) -> None:
         del long, index
         print(f"{n_frames:,} frames: {big.stat().st_size / 1e6:.1f} MB on disk")
         cli = [sys.executable, "-m", "tactsense_launcher", "info"]
-        check = [sys.executable, "-I", "-c", _CHECK_CODE]  # the child process alone
+        check = [sys.executable, "-c", _CHECK_CODE]  # the child process alone
         rows = [
             ("structure check alone, 154 frames", [*check, str(small), "60"]),
             (
