@@ -136,34 +136,57 @@ def simulate(
 @app.command()
 def info(recording: Annotated[Path, typer.Argument(help="HDF5 recording to describe.")]) -> None:
     """Describe a recording: sensor, scenario, frames and their range."""
+    import json
+
+    from tactsense.io.recording import RecordingReader
+
     try:
-        rec = read_recording(recording)
+        # streamed in blocks of the file's chunks: memory stays flat however long it is
+        with RecordingReader(recording) as reader:
+            n, spec = reader.n_frames, reader.sensor
+            low, high, bad, finite_seen = np.inf, -np.inf, 0, False
+            for _, frames, _ in reader.chunks():
+                if frames.dtype.kind == "f":
+                    finite = np.isfinite(frames)
+                    bad += int(np.count_nonzero(~finite.all(axis=(1, 2))))
+                    frames = frames[finite]
+                if frames.size:
+                    finite_seen = True
+                    low, high = min(low, frames.min()), max(high, frames.max())
+            last = reader.time_s(n - 1, n) if n else np.zeros(0)
+            attrs = reader.attrs
+            losses = reader.losses
+            closed_cleanly = reader.closed_cleanly
     except TactsenseInputError as error:
         fail(str(error))
+    try:
+        scenario = json.loads(str(attrs.get("scenario_json", "{}")))
+    except json.JSONDecodeError as error:
+        fail(f"{recording}: scenario metadata is not valid JSON ({error})")
+    source = str(attrs.get("source", ""))
+    flaws = [f for f in str(attrs.get("flaws", "")).split(",") if f]
     table = Table(title=str(recording), show_header=False)
-    frames = np.asarray(rec.frames)
-    table.add_row("sensor", rec.sensor.name)
-    table.add_row("frames", f"{frames.shape[0]} x {frames.shape[1]} x {frames.shape[2]} counts")
-    duration = rec.time_s[-1] + rec.sensor.scan_period_s if len(rec) else 0.0
-    table.add_row("duration", f"{duration:.3f} s at {rec.sensor.electronics.scan_rate_hz:g} Hz")
-    finite = np.isfinite(frames) if frames.dtype.kind == "f" else np.ones(frames.shape, bool)
-    if finite.any():
-        counts = f"{frames[finite].min():g} .. {frames[finite].max():g}"
-        bad = int(np.count_nonzero(~finite.all(axis=(1, 2))))
+    table.add_row("sensor", spec.name)
+    table.add_row("frames", f"{n} x {spec.shape[0]} x {spec.shape[1]} counts")
+    duration = float(last[-1]) + spec.scan_period_s if n else 0.0
+    table.add_row("duration", f"{duration:.3f} s at {spec.electronics.scan_rate_hz:g} Hz")
+    if finite_seen:
+        counts = f"{low:g} .. {high:g}"
         if bad:
             counts += f" ({bad} frames hold NaN or infinite readings)"
     else:
-        counts = "none (no frames)" if frames.size == 0 else "none finite"
+        counts = "none (no frames)" if n == 0 else "none finite"
     table.add_row("counts", counts)
-    if rec.source:
-        table.add_row("source", rec.source)
-    if rec.losses:
-        lost = ", ".join(f"{k} {v}" for k, v in rec.losses.items() if v) or "none"
+    if source:
+        table.add_row("source", source)
+    if losses:
+        lost = ", ".join(f"{k} {v}" for k, v in losses.items() if v) or "none"
         table.add_row("losses", lost)
-    if not rec.closed_cleanly:
+    if not closed_cleanly:
         table.add_row("state", "not closed by its writer (killed?): frames up to its last flush")
-    table.add_row("scenario", str(rec.scenario.get("description", "")))
-    table.add_row("flaws", ", ".join(rec.flaws) or "none")
+    table.add_row("scenario", str(scenario.get("description", "")))
+    # a simulation lists the flaws it switched on; a device's flaws are not known
+    table.add_row("flaws", ", ".join(flaws) or ("unknown (a device)" if source else "none"))
     Console().print(table)
 
 

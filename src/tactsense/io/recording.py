@@ -14,10 +14,26 @@ Layout of a recording file (format ``tactsense-recording``, version 2)::
     /host_time           (T,) arrival on the host, Unix time [s] (recorded streams, v2)
     /losses              (K,) int64 loss counters, attrs: kinds = comma list (v2)
 
-Version 1 (no stream datasets) is still read. A recorded stream is written in HDF5's
-single-writer/multiple-reader mode and flushed at least once a second: a recorder killed
-mid-way leaves a file that :func:`read_recording` opens, holding every frame up to the
-last flush (``Recording.closed_cleanly`` is then False).
+Version 1 (no stream datasets) is still read. Every dataset tactsense writes is chunked
+with HDF5's Fletcher-32 checksum filter, and :func:`write_recording` writes HDF5's v110
+file format, whose superblock, object headers and indexes carry checksums too: damaged
+bytes are an error on reading, not wrong numbers. Files written before (no checksums)
+read as before.
+
+A damaged HDF5 file can make libhdf5 loop for ever (a zeroed global-heap object header
+does), holding the interpreter and ignoring Ctrl-C. So every opening of a recording
+(:func:`read_recording`, :class:`RecordingReader`, and through them every command)
+first has a child process walk the file's structure (:func:`check_structure`), killed
+after :data:`CHECK_TIMEOUT_S`; a damaged file ends with ``RecordingError("<path> is
+damaged: ...")`` within seconds, and Ctrl-C works throughout.
+
+A recorded stream is written in HDF5's single-writer/multiple-reader (SWMR) mode and
+flushed at least once a second: a recorder killed mid-way leaves a file that
+:func:`read_recording` opens, holding every frame up to the last flush
+(``Recording.closed_cleanly`` is then False). Plain ``h5py.File(path)`` refuses such a
+file ("file is already open for write": the writer's flag is still set); open it with
+``h5py.File(path, "r", swmr=True)``, or clear the flag once with ``h5clear -s path``
+(Debian/Ubuntu package ``hdf5-tools``), after which any HDF5 reader opens it.
 
 Axis -2 of ``frames`` runs along the finger (row 0 under the tip), axis -1
 around it (``docs/nomenclature.md``).
@@ -27,7 +43,11 @@ from __future__ import annotations
 
 import datetime as _dt
 import json
+import os
+import subprocess
+import sys
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -174,8 +194,23 @@ def write_recording(path: str | Path, recording: Recording, *, overwrite: bool =
     return path
 
 
+def _checked_dataset(group, name: str, data, **options):
+    """A chunked dataset with HDF5's Fletcher-32 checksum: damage is an error, not numbers."""
+    data = np.asarray(data)
+    if data.ndim == 0:  # a scalar cannot be chunked (none is written today)
+        return group.create_dataset(name, data=data)
+    if "chunks" not in options:
+        row = int(np.prod(data.shape[1:], dtype=np.int64))
+        options["chunks"] = (max(1, min(data.shape[0], 65_536 // max(row, 1))), *data.shape[1:])
+    if data.shape[0] == 0 or 0 in data.shape[1:]:
+        options["maxshape"] = (None, *data.shape[1:])
+        options["chunks"] = tuple(max(1, n) for n in options["chunks"])
+    return group.create_dataset(name, data=data, fletcher32=True, **options)
+
+
 def _write_file(partial: Path, recording: Recording) -> None:
-    with h5py.File(partial, "w") as h5:
+    # format v110: object headers, B-trees and the superblock carry checksums too
+    with h5py.File(partial, "w", libver=("v110", "v110")) as h5:
         h5.attrs["format"] = FORMAT
         h5.attrs["format_version"] = FORMAT_VERSION
         h5.attrs["tactsense_version"] = __version__
@@ -184,28 +219,30 @@ def _write_file(partial: Path, recording: Recording) -> None:
         h5.attrs["scenario_json"] = json.dumps(recording.scenario)
         h5.attrs["flaws"] = ",".join(recording.flaws)
         h5.attrs["scan_rate_hz"] = recording.sensor.electronics.scan_rate_hz
-        frames = h5.create_dataset(
+        frames = _checked_dataset(
+            h5,
             "frames",
-            data=recording.frames,
+            recording.frames,
             compression="gzip",
             chunks=(max(1, min(len(recording), 1024)), *recording.sensor.shape),
             maxshape=(None, *recording.sensor.shape),
         )
         frames.attrs["units"] = "counts"
         frames.attrs["axes"] = "time, row (along the finger, 0 = tip), col (around)"
-        h5.create_dataset("time", data=np.asarray(recording.time_s, float)).attrs["units"] = "s"
-        offset = h5.create_dataset("sample_offset", data=recording.sample_offset_s)
+        time_s = _checked_dataset(h5, "time", np.asarray(recording.time_s, float))
+        time_s.attrs["units"] = "s"
+        offset = _checked_dataset(h5, "sample_offset", recording.sample_offset_s)
         offset.attrs["units"] = "s"
         if recording.gains is not None:
-            h5.create_dataset("gains", data=recording.gains).attrs["units"] = "1"
+            _checked_dataset(h5, "gains", recording.gains).attrs["units"] = "1"
         h5.attrs["source"] = recording.source
         if recording.sequence is not None:
-            h5.create_dataset("sequence", data=np.asarray(recording.sequence, np.uint16))
+            _checked_dataset(h5, "sequence", np.asarray(recording.sequence, np.uint16))
         if recording.host_time_s is not None:
-            host = h5.create_dataset("host_time", data=np.asarray(recording.host_time_s, float))
+            host = _checked_dataset(h5, "host_time", np.asarray(recording.host_time_s, float))
             host.attrs["units"] = "s"
         if recording.losses:
-            losses = h5.create_dataset("losses", data=np.array(list(recording.losses.values())))
+            losses = _checked_dataset(h5, "losses", np.array(list(recording.losses.values())))
             losses.attrs["kinds"] = ",".join(recording.losses)
         if recording.truth:
             group = h5.create_group("truth")
@@ -220,76 +257,268 @@ def _write_file(partial: Path, recording: Recording) -> None:
                 if isinstance(value, str):
                     group.attrs[key] = value
                 else:
-                    group.create_dataset(key, data=value).attrs["units"] = units.get(key, "1")
+                    dataset = _checked_dataset(group, key, value)
+                    dataset.attrs["units"] = units.get(key, "1")
+
+
+# The structure check, run in a child process so that a loop inside libhdf5 (a damaged
+# B-tree or heap makes it cycle for ever, holding the GIL and ignoring Ctrl-C) can be cut
+# off. It imports h5py alone, opens the file as the reader will, walks every object,
+# reads every attribute, every small dataset and every chunked dataset's chunk index;
+# exit status 3 and one line on standard output when libhdf5 raises.
+_CHECK_CODE = r"""
+import signal, sys
+signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent decides; it kills us
+if hasattr(signal, "alarm"):  # end even if the parent was killed: SIG_DFL acts inside C
+    signal.signal(signal.SIGALRM, signal.SIG_DFL)
+    signal.alarm(int(float(sys.argv[2])) + 5)
+try:
+    import h5py
+except Exception:  # no check possible here: not a verdict on the file
+    sys.exit(4)
+SMALL = 4 << 20  # datasets stored in fewer bytes are read whole
+
+def check(name, obj):
+    for key in obj.attrs:
+        obj.attrs[key]
+    if isinstance(obj, h5py.Dataset):
+        obj.shape, obj.dtype
+        if obj.chunks:
+            try:
+                obj.id.chunk_iter(lambda info: None)
+            except (AttributeError, NotImplementedError):
+                for index in range(obj.id.get_num_chunks()):
+                    obj.id.get_chunk_info(index)
+        if obj.id.get_storage_size() <= SMALL:
+            obj[()]
+
+try:
+    try:
+        h5 = h5py.File(sys.argv[1], "r")
+    except OSError as error:
+        if "already open for write" not in str(error):
+            raise
+        h5 = h5py.File(sys.argv[1], "r", swmr=True)
+    with h5:
+        check("/", h5)
+        h5.visititems(check)
+except Exception as error:
+    print(" ".join(str(error).split()) or type(error).__name__, flush=True)
+    sys.exit(3)
+"""
+
+CHECK_TIMEOUT_S = 10.0
+"""Longest time the structure check of a file may take [s]; the environment variable
+``TACTSENSE_CHECK_TIMEOUT_S`` overrides it (for very large files on slow disks)."""
+
+
+def _check_timeout_s() -> float:
+    """:data:`CHECK_TIMEOUT_S`, or ``TACTSENSE_CHECK_TIMEOUT_S`` if set [s]."""
+    text = os.environ.get("TACTSENSE_CHECK_TIMEOUT_S", "").strip()
+    if not text:
+        return CHECK_TIMEOUT_S
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not 0 < value < 1e6:
+        raise RecordingError(
+            f"TACTSENSE_CHECK_TIMEOUT_S={text!r} is not a time in seconds; expected a "
+            "positive number, e.g. 30"
+        )
+    return value
+
+
+_verdicts: dict[tuple, str | None] = {}
+
+
+def _one_line(error: BaseException | str) -> str:
+    return " ".join(str(error).split())
+
+
+def check_structure(path: str | Path, *, timeout_s: float | None = None) -> None:
+    """Check that libhdf5 can walk a file's structure, in a child process with a timeout.
+
+    A damaged HDF5 file can make libhdf5 loop for ever (it holds the interpreter and
+    ignores Ctrl-C), or fail deep inside a read. Before a recording is trusted, a child
+    process opens it, walks every object, reads every attribute and small dataset and
+    walks every chunk index; it is killed after ``timeout_s``. The parent waits
+    interruptibly (Ctrl-C works at any moment). The verdict is kept per (path, size,
+    modification time), so a file is checked once per process.
+
+    Parameters
+    ----------
+    path : path
+        An existing regular file.
+    timeout_s : float, optional
+        Longest time the check may take [s]; default :data:`CHECK_TIMEOUT_S` (or the
+        environment variable ``TACTSENSE_CHECK_TIMEOUT_S``).
+
+    Raises
+    ------
+    RecordingError
+        ``"<path> is damaged: ..."`` naming what libhdf5 found, or that the check did
+        not finish in time.
+    """
+    path = Path(path)
+    stat = path.stat()
+    key = (str(path.resolve()), stat.st_size, stat.st_mtime_ns)
+    if key not in _verdicts:
+        _verdicts[key] = _run_check(path, _check_timeout_s() if timeout_s is None else timeout_s)
+    if _verdicts[key] is not None:
+        raise RecordingError(f"{path} is damaged: {_verdicts[key]}")
+
+
+def _run_check(path: Path, timeout_s: float) -> str | None:
+    """Run the child; None if the structure is sound, else what is wrong."""
+    if not sys.executable:  # an embedded interpreter: nothing to run the check with
+        return None
+    process = subprocess.Popen(
+        # the same interpreter and path as this process (h5py may come from PYTHONPATH)
+        [sys.executable, "-c", _CHECK_CODE, str(path), f"{timeout_s:g}"],
+        stdin=subprocess.DEVNULL,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,  # a Ctrl-C at the terminal reaches the parent alone
+    )
+    try:
+        out, err = process.communicate(timeout=timeout_s)
+    except subprocess.TimeoutExpired:
+        return (
+            f"libhdf5 did not finish reading its structure within {timeout_s:g} s "
+            "(damaged metadata can make it loop for ever; if the file is sound but on a "
+            "very slow disk, raise TACTSENSE_CHECK_TIMEOUT_S)"
+        )
+    finally:
+        if process.poll() is None:  # timed out, or Ctrl-C in the parent
+            process.kill()
+            process.wait()
+    if process.returncode in (0, 4):  # sound, or h5py not importable there: no verdict
+        return None
+    if process.returncode == 3 and out.strip():
+        return _one_line(out.strip().splitlines()[-1])
+    lines = (err or "").strip().splitlines()
+    return f"the check of its structure ended with status {process.returncode}" + (
+        f" ({_one_line(lines[-1])})" if lines else ""
+    )
+
+
+@contextmanager
+def _damage(path: Path):
+    """Turn an error libhdf5 raises while reading ``path`` into a :class:`RecordingError`."""
+    try:
+        yield
+    except (OSError, RuntimeError, KeyError, ValueError) as error:
+        if isinstance(error, RecordingError):
+            raise
+        raise RecordingError(f"{path} is damaged: {_one_line(error)}") from None
+
+
+def _check_file(path: Path) -> None:
+    """Refuse what is not a readable HDF5 file with one line naming it, then check it."""
+    if not path.exists():
+        raise RecordingError(f"recording {path} does not exist")
+    if path.is_dir():
+        raise RecordingError(
+            f"{path} is a folder; expected a recording (an HDF5 file written by tactsense)"
+        )
+    if not path.is_file():
+        raise RecordingError(f"{path} is not a regular file; expected a recording")
+    if path.stat().st_size == 0:
+        raise RecordingError(f"{path} is empty (0 bytes); expected a recording")
+    try:
+        with open(path, "rb"):
+            pass
+    except OSError as error:
+        raise RecordingError(f"cannot read {path}: {error.strerror or error}") from None
+    if not h5py.is_hdf5(path):
+        raise RecordingError(
+            f"{path} is not a readable HDF5 file (no HDF5 signature: another kind of "
+            "file, or its start is damaged); expected a recording"
+        )
+    check_structure(path)
 
 
 def _open_validated(path: str | Path):
     """Open a recording and check it: (h5 file, sensor, number of frames, closed cleanly).
 
-    The caller closes the file. Raises :class:`RecordingError` for everything
+    The file's structure is checked first in a child process (:func:`check_structure`),
+    so a damaged file ends with a :class:`RecordingError` instead of a hang. The caller
+    closes the file. Raises :class:`RecordingError` for everything
     :func:`read_recording` refuses.
     """
     path = Path(path)
-    if not path.exists():
-        raise RecordingError(f"recording {path} does not exist")
+    _check_file(path)
     closed_cleanly = True
     try:
         h5 = h5py.File(path, "r")
     except OSError as error:
         if "already open for write" not in str(error):
-            raise RecordingError(f"{path} is not a readable HDF5 file ({error})") from None
+            raise RecordingError(
+                f"{path} is not a readable HDF5 file ({_one_line(error)})"
+            ) from None
         # a recorder still writing, or killed: SWMR readers see everything flushed
         closed_cleanly = False
         try:
             h5 = h5py.File(path, "r", swmr=True)
         except OSError as again:
-            raise RecordingError(f"{path} is not a readable HDF5 file ({again})") from None
-    try:
-        if h5.attrs.get("format") != FORMAT:
             raise RecordingError(
-                f"{path} is not a tactsense recording (format attribute "
-                f"{h5.attrs.get('format')!r}, expected {FORMAT!r})"
-            )
-        try:
-            version = int(h5.attrs.get("format_version", -1))
-        except (TypeError, ValueError):
-            raise RecordingError(
-                f"{path}: format_version {h5.attrs.get('format_version')!r} is not a number"
+                f"{path} is not a readable HDF5 file ({_one_line(again)})"
             ) from None
-        if version > FORMAT_VERSION:
-            raise RecordingError(
-                f"{path} has format version {version}; this tactsense reads up to "
-                f"{FORMAT_VERSION}: upgrade tactsense"
-            )
-        for name in ("frames", "time", "sample_offset"):
-            if name not in h5:
-                raise RecordingError(f"{path} lacks the dataset /{name}")
-        try:
-            sensor = SensorSpec.from_toml_string(str(h5.attrs["sensor_toml"]))
-        except (KeyError, SensorSpecError) as error:
-            raise RecordingError(f"{path}: sensor description unreadable: {error}") from None
-        for name in ("frames", "time", "sample_offset", "sequence", "host_time"):
-            if name in h5 and h5[name].dtype.kind not in "uif":
-                raise RecordingError(
-                    f"{path}: /{name} holds {h5[name].dtype} values; expected numbers "
-                    "(counts or fractional deflections for /frames, seconds for times)"
-                )
-        per_frame = [
-            h5[name].shape[0]
-            for name in ("frames", "time", "sequence", "host_time")
-            if name in h5 and h5[name].ndim >= 1
-        ]
-        n = min(per_frame)  # a killed writer may have flushed one dataset further
-        shape = h5["frames"].shape
-        if len(shape) != 3 or shape[1:] != sensor.shape:
-            raise RecordingError(
-                f"{path}: /frames has shape {shape}; expected (T, {sensor.shape[0]}, "
-                f"{sensor.shape[1]}) for its sensor {sensor.name!r}"
-            )
+    try:
+        with _damage(path):
+            sensor, n = _validate(path, h5)
     except BaseException:
         h5.close()
         raise
     return h5, sensor, n, closed_cleanly
+
+
+def _validate(path: Path, h5) -> tuple[SensorSpec, int]:
+    """Check the open file is a recording this tactsense reads: (sensor, frames)."""
+    if h5.attrs.get("format") != FORMAT:
+        raise RecordingError(
+            f"{path} is not a tactsense recording (format attribute "
+            f"{h5.attrs.get('format')!r}, expected {FORMAT!r})"
+        )
+    try:
+        version = int(h5.attrs.get("format_version", -1))
+    except (TypeError, ValueError):
+        raise RecordingError(
+            f"{path}: format_version {h5.attrs.get('format_version')!r} is not a number"
+        ) from None
+    if version > FORMAT_VERSION:
+        raise RecordingError(
+            f"{path} has format version {version}; this tactsense reads up to "
+            f"{FORMAT_VERSION}: upgrade tactsense"
+        )
+    for name in ("frames", "time", "sample_offset"):
+        if name not in h5:
+            raise RecordingError(f"{path} lacks the dataset /{name}")
+    try:
+        sensor = SensorSpec.from_toml_string(str(h5.attrs["sensor_toml"]))
+    except (KeyError, SensorSpecError) as error:
+        raise RecordingError(f"{path}: sensor description unreadable: {error}") from None
+    for name in ("frames", "time", "sample_offset", "sequence", "host_time"):
+        if name in h5 and h5[name].dtype.kind not in "uif":
+            raise RecordingError(
+                f"{path}: /{name} holds {h5[name].dtype} values; expected numbers "
+                "(counts or fractional deflections for /frames, seconds for times)"
+            )
+    per_frame = [
+        h5[name].shape[0]
+        for name in ("frames", "time", "sequence", "host_time")
+        if name in h5 and h5[name].ndim >= 1
+    ]
+    n = min(per_frame)  # a killed writer may have flushed one dataset further
+    shape = h5["frames"].shape
+    if len(shape) != 3 or shape[1:] != sensor.shape:
+        raise RecordingError(
+            f"{path}: /frames has shape {shape}; expected (T, {sensor.shape[0]}, "
+            f"{sensor.shape[1]}) for its sensor {sensor.name!r}"
+        )
+    return sensor, n
 
 
 def _losses(h5) -> dict[str, int]:
@@ -311,7 +540,7 @@ def read_recording(path: str | Path) -> Recording:
     """
     path = Path(path)
     h5, sensor, n, closed_cleanly = _open_validated(path)
-    with h5:
+    with h5, _damage(path):
         frames = h5["frames"][:n]
         truth: dict = {}
         if "truth" in h5:
@@ -377,16 +606,25 @@ class RecordingReader:
 
     def frames(self, start: int, stop: int) -> np.ndarray:
         """Frames ``start`` to ``stop`` (exclusive) [counts]."""
-        return self._h5["frames"][start : min(stop, self.n_frames)]
+        with _damage(self.path):
+            return self._h5["frames"][start : min(stop, self.n_frames)]
 
     def time_s(self, start: int, stop: int) -> np.ndarray:
         """Their times [s]."""
-        return self._h5["time"][start : min(stop, self.n_frames)]
+        with _damage(self.path):
+            return self._h5["time"][start : min(stop, self.n_frames)]
 
     @property
     def losses(self) -> dict[str, int]:
         """Frames lost by kind, as the recorder counted them (empty if none recorded)."""
-        return _losses(self._h5)
+        with _damage(self.path):
+            return _losses(self._h5)
+
+    @property
+    def attrs(self) -> dict:
+        """The file's top-level attributes (sensor, scenario, flaws, source, ...)."""
+        with _damage(self.path):
+            return dict(self._h5.attrs)
 
     def chunks(self, chunk_frames: int | None = None):
         """Yield ``(start, frames, time_s)`` for consecutive pieces of the recording."""
@@ -480,23 +718,26 @@ class RecordingWriter:
                 chunks=(chunk, rows, cols),
                 compression="gzip",
                 compression_opts=1,
+                fletcher32=True,
             )
             self._frames.attrs["units"] = "counts"
             self._frames.attrs["axes"] = "time, row (along the finger, 0 = tip), col (around)"
-            self._time = h5.create_dataset("time", (0,), float, maxshape=(None,), chunks=(chunk,))
+            self._time = h5.create_dataset(
+                "time", (0,), float, maxshape=(None,), chunks=(chunk,), fletcher32=True
+            )
             self._time.attrs["units"] = "s"
             self._sequence = h5.create_dataset(
-                "sequence", (0,), np.uint16, maxshape=(None,), chunks=(chunk,)
+                "sequence", (0,), np.uint16, maxshape=(None,), chunks=(chunk,), fletcher32=True
             )
             self._host = h5.create_dataset(
-                "host_time", (0,), float, maxshape=(None,), chunks=(chunk,)
+                "host_time", (0,), float, maxshape=(None,), chunks=(chunk,), fletcher32=True
             )
             self._host.attrs["units"] = "s"
-            offset = h5.create_dataset("sample_offset", data=np.asarray(sample_offset_s, float))
+            offset = _checked_dataset(h5, "sample_offset", np.asarray(sample_offset_s, float))
             offset.attrs["units"] = "s"
             self._kinds = list(loss_kinds)
-            self._losses = h5.create_dataset(
-                "losses", data=np.zeros(max(len(self._kinds), 1), np.int64)
+            self._losses = _checked_dataset(
+                h5, "losses", np.zeros(max(len(self._kinds), 1), np.int64)
             )
             self._losses.attrs["kinds"] = ",".join(self._kinds)
             h5.swmr_mode = True
