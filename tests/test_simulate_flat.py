@@ -6,6 +6,7 @@ from typer.testing import CliRunner
 
 import tactsense as ts
 from tactsense.cli import app
+from tactsense.flat_scenarios import press
 
 runner = CliRunner()
 
@@ -67,3 +68,26 @@ def test_bad_pad_scenarios_are_one_line(tmp_path, monkeypatch, line, message):
     assert message in result.output
     assert "Traceback" not in result.output
     assert not (tmp_path / "x.h5").exists()
+
+
+def test_a_pad_exports_its_frames_to_mcap_as_tactile_state(tmp_path):
+    """No contacts yet on pads: every frame as a TactileState, values equal to the counts
+    (read back with mcap's reader and the ROS 2 decoder)."""
+    from mcap.reader import make_reader
+    from mcap_ros2.decoder import DecoderFactory
+
+    pad = ts.preset("pad4")
+    rec_path, out = tmp_path / "pad.h5", tmp_path / "pad.mcap"
+    ts.write_recording(rec_path, ts.simulate(pad, press(pad), rng=2))
+    result = runner.invoke(app, ["export", str(rec_path), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    recording = ts.read_recording(rec_path)
+    with open(out, "rb") as stream:
+        reader = make_reader(stream, decoder_factories=[DecoderFactory()])
+        values = [
+            np.asarray(message.sensors[0].values)
+            for _, _, _, message in reader.iter_decoded_messages(topics=["/tactile_states"])
+        ]
+    assert len(values) == len(recording.frames)
+    np.testing.assert_array_equal(np.stack(values), recording.frames.reshape(len(values), -1))
+    assert f"{len(values)} frames, 0 with a contact" in result.output

@@ -24,6 +24,7 @@ CASES = [
     ("locate pad.h5 --out OUT.csv", "contact estimation works on fingers so far; 'pad4' is a pad"),
     ("calibrate pad.h5 --out OUT.json", "calibrate works on finger sensors; 'pad4' is a pad"),
     ("reproduce --sensor pad16 --out OUT", "works on finger sensors; 'pad16' is a pad"),
+    ("export pad.h5 --out OUT.rrd", "contact estimation works on fingers so far; 'pad4'"),
     ("design bound --sensor dome12", "works on finger sensors; 'dome12' is a points"),
     ("design sweep --sensor dome12 --out OUT.nc", "fingers and pads; 'dome12' is a points"),
     ("sensor import pad.h5 --extends bogus", "--extends 'bogus' is not a preset"),

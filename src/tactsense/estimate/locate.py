@@ -123,7 +123,7 @@ def locate(
     if getattr(sensor, "kind", None) in ("pad", "points"):
         raise TactsenseInputError(
             f"contact estimation works on fingers so far; {sensor.name!r} is a {sensor.kind} "
-            "(simulate, record, view, info and design sweep work on it)"
+            "(simulate, record, view, info, export to MCAP and design sweep work on it)"
         )
     if not isinstance(sensor, SensorSpec):
         raise TactsenseInputError(f"sensor must be a SensorSpec; got {type(sensor).__name__}")

@@ -243,6 +243,9 @@ def export_mcap(
 ) -> dict:
     """Write a recording's frames and contacts to MCAP, a piece at a time.
 
+    A pad's or a point set's recording gives its frames only (contacts are estimated on
+    fingers so far).
+
     Parameters
     ----------
     recording : path
@@ -266,6 +269,13 @@ def export_mcap(
 
     with RecordingReader(recording) as reader, open(out, "wb") as stream:
         writer = McapTactileWriter(stream, reader.sensor, frame_id=frame_id, fast=fast)
+        if reader.sensor.kind != "finger":  # no contact estimation yet: frames only
+            for start, frames, time_s in reader.chunks():
+                writer.frames_of(frames, time_s, np.arange(start, start + len(time_s)))
+                if progress is not None:
+                    progress(start + len(time_s), reader.n_frames)
+            writer.finish()
+            return {"frames": writer.frames, "contacts": writer.contacts}
         pieces = iter_locate(
             reader,
             baseline_frames=baseline_frames,
