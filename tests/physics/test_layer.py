@@ -210,16 +210,32 @@ def test_half_space_disc_matches_boussinesq_love(nu):
 
 
 def hankel_disc(r, z, h, nu, a, p, name="W_P"):
-    """(1 / 2 mu) (1 / 2 pi) int P(k) X(k, z) J0(kr) k dk for a disc of pressure p, by quadrature."""
+    """(1 / 2 mu) (1 / 2 pi) int P(k) X(k, z) J0(kr) k dk for a disc of pressure p.
+
+    ``P(k) = 2 pi a p J1(ka) / k``; composite 16-point Gauss-Legendre rule on 600 panels
+    up to k = 80 / max(z, a / 20), where exp(-kz) and the disc's spectrum have decayed
+    (checked against scipy.integrate.quad in ``test_hankel_rule_matches_quad``).
+    """
+    mu = E / (2 * (1 + nu))
+    top = 80.0 / max(z, 0.05 * a)
+    nodes, weights = np.polynomial.legendre.leggauss(16)
+    edges = np.linspace(0.0, top, 601)
+    half = np.diff(edges)[:, None] / 2
+    k = ((edges[:-1, None] + edges[1:, None]) / 2 + half * nodes).ravel()
+    wk = (half * weights).ravel()
+    tf = layer.transfer_functions(k, z, h, nu)[name].real
+    return np.sum(wk * a * p * special.j1(k * a) * tf * special.j0(k * r)) / (2 * mu)
+
+
+def test_hankel_rule_matches_quad():
+    h, nu, a, p, z, r = 3e-3, 0.3, 1.5e-3, 1e3, 1e-3, 1e-3
     mu = E / (2 * (1 + nu))
 
     def f(k):
-        return a * p * special.j1(k * a) * layer.transfer_functions(k, z, h, nu)[name].real * special.j0(k * r)
+        return a * p * special.j1(k * a) * layer.transfer_functions(k, z, h, nu)["W_P"].real * special.j0(k * r)
 
-    top = 80.0 / max(z, 0.05 * a)
-    edges = np.linspace(0.0, top, 200)
-    total = sum(integrate.quad(f, lo, hi, limit=200)[0] for lo, hi in zip(edges[:-1], edges[1:]))
-    return total / (2 * mu)
+    ref = integrate.quad(f, 0, 80 / z, limit=2000)[0] / (2 * mu)
+    assert hankel_disc(r, z, h, nu, a, p) == pytest.approx(ref, rel=1e-7)
 
 
 @pytest.mark.parametrize("nu", [0.3, 0.5])
@@ -282,9 +298,10 @@ def test_rotation_and_mirror_symmetry(p):
     out = _SQUARE(p)
     # a load rotated by 90 degrees (x -> y) gives the rotated response
     rot = _SQUARE(np.rot90(p))
-    tol = 1e-6 * (np.max(np.abs(out["u_z"])) + 1e-30)
+    # exact up to the wrap-around left by the 10-h padding (~exp(-14) of the peak)
+    tol = 1e-5 * (np.max(np.abs(out["u_z"])) + 1e-30)
     np.testing.assert_allclose(rot["u_z"], np.rot90(out["u_z"]), atol=tol)
-    etol = 1e-6 * (np.max(np.abs(out["eps_zz"])) + 1e-30)
+    etol = 1e-5 * (np.max(np.abs(out["eps_zz"])) + 1e-30)
     np.testing.assert_allclose(rot["eps_zz"], np.rot90(out["eps_zz"]), atol=etol)
     # np.rot90 maps (row, col) = (y, x) -> (n-1-x, y): the new eps_xx is the old eps_yy
     np.testing.assert_allclose(rot["eps_xx"], np.rot90(out["eps_yy"]), atol=etol)

@@ -287,7 +287,7 @@ class LayerResponse:
         Accept tangential tractions (three inputs instead of one).
     padding : (int, int) or None
         Zero samples appended along y and x; None: the reach of the response
-        (``REACH_IN_THICKNESSES * h``, at most the grid again) rounded up to a fast size.
+        (``REACH_IN_THICKNESSES * h``, at most 8 grids; one grid for the half space) rounded up to a fast size.
     electrode : (float, float) or None
         ``(ly, lx)`` [m]: average each field over a rectangle of this size centred on the
         output point (a ``sinc`` factor per axis); None: point values.
@@ -329,8 +329,10 @@ class LayerResponse:
                     f"unknown quantity {q!r}; expected one of {', '.join(QUANTITIES)}"
                 )
         if padding is None:
-            reach_y = ny if not np.isfinite(h) else min(ny, math.ceil(REACH_IN_THICKNESSES * h / dy))
-            reach_x = nx if not np.isfinite(h) else min(nx, math.ceil(REACH_IN_THICKNESSES * h / dx))
+            reach_y, reach_x = ny, nx  # half space: strains decay as 1 / r^3
+            if np.isfinite(h):
+                reach_y = min(8 * ny, math.ceil(REACH_IN_THICKNESSES * h / dy))
+                reach_x = min(8 * nx, math.ceil(REACH_IN_THICKNESSES * h / dx))
             my = scipy.fft.next_fast_len(ny + reach_y, real=True)
             mx = scipy.fft.next_fast_len(nx + reach_x, real=True)
         else:
