@@ -55,8 +55,8 @@ import scipy.fft
 from tactsense._validation import (
     TactsenseInputError,
     as_float_array,
-    check_positive,
     check_poisson_ratio,
+    check_positive,
 )
 
 QUANTITIES = ("u_x", "u_y", "u_z", "eps_xx", "eps_yy", "eps_zz", "eps_xy", "eps_xz", "eps_yz")
@@ -79,7 +79,9 @@ def shear_modulus(youngs_modulus, poisson_ratio):
 def _check_layer(thickness, youngs_modulus, poisson_ratio):
     h = float(thickness)
     if not (h > 0):  # also rejects NaN
-        raise TactsenseInputError(f"thickness must be positive (np.inf: half space); got {thickness!r}")
+        raise TactsenseInputError(
+            f"thickness must be positive (np.inf: half space); got {thickness!r}"
+        )
     check_positive(youngs_modulus, "youngs_modulus")
     nu = check_poisson_ratio(poisson_ratio)
     return h, float(youngs_modulus), nu
@@ -287,12 +289,15 @@ class LayerResponse:
         Accept tangential tractions (three inputs instead of one).
     padding : (int, int) or None
         Zero samples appended along y and x; None: the reach of the response
-        (``REACH_IN_THICKNESSES * h``, at most 8 grids; one grid for the half space) rounded up to a fast size.
+        (``REACH_IN_THICKNESSES * h``, at most 8 grids; one grid for the half space),
+        rounded up to a fast size.
     electrode : (float, float) or None
         ``(ly, lx)`` [m]: average each field over a rectangle of this size centred on the
         output point (a ``sinc`` factor per axis); None: point values.
     shift : (float, float)
         Evaluate the fields at the sample positions plus ``(sy, sx)`` [m].
+    multiple_of : int
+        Make the automatic padded size a multiple of this (for :meth:`decimated`).
     """
 
     def __init__(
@@ -309,6 +314,7 @@ class LayerResponse:
         padding=None,
         electrode=None,
         shift=(0.0, 0.0),
+        multiple_of=1,
     ):
         h, E, nu = _check_layer(thickness, youngs_modulus, poisson_ratio)
         ny, nx = (int(n) for n in shape)
@@ -328,13 +334,14 @@ class LayerResponse:
                 raise TactsenseInputError(
                     f"unknown quantity {q!r}; expected one of {', '.join(QUANTITIES)}"
                 )
+        multiple = int(multiple_of)
         if padding is None:
             reach_y, reach_x = ny, nx  # half space: strains decay as 1 / r^3
             if np.isfinite(h):
                 reach_y = min(8 * ny, math.ceil(REACH_IN_THICKNESSES * h / dy))
                 reach_x = min(8 * nx, math.ceil(REACH_IN_THICKNESSES * h / dx))
-            my = scipy.fft.next_fast_len(ny + reach_y, real=True)
-            mx = scipy.fft.next_fast_len(nx + reach_x, real=True)
+            my = multiple * scipy.fft.next_fast_len(-(-(ny + reach_y) // multiple), real=True)
+            mx = multiple * scipy.fft.next_fast_len(-(-(nx + reach_x) // multiple), real=True)
         else:
             py, px = (int(p) for p in padding)
             if py < 0 or px < 0:
@@ -381,9 +388,11 @@ class LayerResponse:
             "eps_xx": tuple(ikx * g for g in ops["u"]),
             "eps_yy": tuple(iky * g for g in ops["v"]),
             "eps_zz": ops["dw"],
-            "eps_xy": tuple(0.5 * (iky * a + ikx * b) for a, b in zip(ops["u"], ops["v"])),
-            "eps_xz": tuple(0.5 * (a + ikx * b) for a, b in zip(ops["du"], ops["w"])),
-            "eps_yz": tuple(0.5 * (a + iky * b) for a, b in zip(ops["dv"], ops["w"])),
+            "eps_xy": tuple(
+                0.5 * (iky * a + ikx * b) for a, b in zip(ops["u"], ops["v"], strict=True)
+            ),
+            "eps_xz": tuple(0.5 * (a + ikx * b) for a, b in zip(ops["du"], ops["w"], strict=True)),
+            "eps_yz": tuple(0.5 * (a + iky * b) for a, b in zip(ops["dv"], ops["w"], strict=True)),
         }
         factor = 1.0 / (2 * mu)
         if electrode is not None:
@@ -398,6 +407,61 @@ class LayerResponse:
             parts = [np.broadcast_to(p * factor, k.shape) for p in parts]
             parts = [p.real.copy() if not np.any(p.imag) else p.copy() for p in parts]
             self._kernels.append(parts)
+
+    def _spectra(self, pressure, traction_x, traction_y):
+        loads = [_check_load(pressure, self.shape, "pressure")]
+        if traction_x is not None or traction_y is not None:
+            if not self.tangential:
+                raise TactsenseInputError(
+                    "tangential tractions need a LayerResponse built with tangential=True"
+                )
+            for t, name in ((traction_x, "traction_x"), (traction_y, "traction_y")):
+                loads.append(None if t is None else _check_load(t, self.shape, name))
+        spectra = [
+            None if a is None else scipy.fft.rfft2(a, s=self.padded_shape, workers=1) for a in loads
+        ]
+        for parts in self._kernels:
+            total = None
+            for spectrum, kernel in zip(spectra, parts, strict=False):
+                if spectrum is not None:
+                    term = spectrum * kernel
+                    total = term if total is None else total + term
+            yield total
+
+    def decimated(self, step, pressure, traction_x=None, traction_y=None):
+        """Fields at every ``step``-th sample along both axes, from a folded spectrum.
+
+        Sampling every ``step``-th point of the periodic field is the inverse FFT of the
+        spectrum folded ``step`` times along y, so the inverse transform along y is
+        ``step`` times shorter and the one along x runs on ``1/step`` of the rows.
+
+        Parameters
+        ----------
+        step : int
+            Must divide both padded sizes (``multiple_of`` at construction).
+        pressure, traction_x, traction_y
+            As in :meth:`__call__`.
+
+        Returns
+        -------
+        dict of ndarray
+            Shape (..., ceil(ny / step), ceil(nx / step)): samples 0, step, 2 step, ...
+        """
+        my, mx = self.padded_shape
+        if my % step or mx % step:
+            raise TactsenseInputError(
+                f"step {step} must divide the padded shape {self.padded_shape}"
+            )
+        ny, nx = self.shape
+        out = {}
+        for q, total in zip(
+            self.quantities, self._spectra(pressure, traction_x, traction_y), strict=True
+        ):
+            folded = total.reshape(*total.shape[:-2], step, my // step, total.shape[-1]).sum(-3)
+            rows = scipy.fft.ifft(folded, axis=-2, workers=1) / step
+            field = scipy.fft.irfft(rows, n=mx, axis=-1, workers=1)[..., ::step]
+            out[q] = field[..., : -(-ny // step), : -(-nx // step)]
+        return out
 
     def __call__(self, pressure, traction_x=None, traction_y=None):
         """Fields under the load.
@@ -414,27 +478,11 @@ class LayerResponse:
         dict of ndarray
             One array of shape (..., ny, nx) per quantity, at the sample positions.
         """
-        loads = [_check_load(pressure, self.shape, "pressure")]
-        if traction_x is not None or traction_y is not None:
-            if not self.tangential:
-                raise TactsenseInputError(
-                    "tangential tractions need a LayerResponse built with tangential=True"
-                )
-            for t, name in ((traction_x, "traction_x"), (traction_y, "traction_y")):
-                loads.append(None if t is None else _check_load(t, self.shape, name))
-        dy, dx = self.spacing
         ny, nx = self.shape
-        spectra = [
-            None if a is None else scipy.fft.rfft2(a, s=self.padded_shape, workers=1) for a in loads
-        ]
         out = {}
-        for q, parts in zip(self.quantities, self._kernels):
-            total = None
-            for spectrum, kernel in zip(spectra, parts):
-                if spectrum is None:
-                    continue
-                term = spectrum * kernel
-                total = term if total is None else total + term
+        for q, total in zip(
+            self.quantities, self._spectra(pressure, traction_x, traction_y), strict=True
+        ):
             field = scipy.fft.irfft2(total, s=self.padded_shape, workers=1)
             out[q] = field[..., :ny, :nx]
         return out
@@ -444,7 +492,8 @@ def _check_load(load, shape, name):
     array = as_float_array(load, name)
     if array.ndim < 2 or tuple(array.shape[-2:]) != tuple(shape):
         raise TactsenseInputError(
-            f"{name} has shape {array.shape}; expected (..., {shape[0]}, {shape[1]}) = (..., ny, nx)"
+            f"{name} has shape {array.shape}; "
+            f"expected (..., {shape[0]}, {shape[1]}) = (..., ny, nx)"
         )
     return array
 
@@ -511,7 +560,8 @@ class TaxelPad:
     subsamples``, and taxel ``(r, c)`` is centred at ``((r + 1/2) pitch_y, (c + 1/2)
     pitch_x)``. Its reading is the field at its depth averaged over its electrode (a
     rectangle ``ly x lx``), computed exactly for the sampled load in the wavenumber
-    domain (sinc factors, and a half-sample shift when ``subsamples`` is even).
+    domain (sinc factors and a phase shift to the taxel centres), and only at the taxel
+    centres (:meth:`LayerResponse.decimated`).
 
     Parameters
     ----------
@@ -561,8 +611,8 @@ class TaxelPad:
         self.pitch, self.electrode = (float(py), float(px)), (float(ly), float(lx))
         self.spacing = (py / n, px / n)
         self.grid_shape = (rows * n, cols * n)
-        self._first = (n - 1) // 2  # the sample at or just before each taxel centre
-        half = ((n - 1) / 2 - self._first) * np.array(self.spacing)
+        # taxel centres lie (n - 1) / 2 samples after samples 0, n, 2n, ...
+        offset = (n - 1) / 2 * np.array(self.spacing)
         self.response = LayerResponse(
             self.grid_shape,
             self.spacing,
@@ -572,8 +622,9 @@ class TaxelPad:
             poisson_ratio=poisson_ratio,
             quantities=(quantity,),
             electrode=(ly, lx),
-            shift=tuple(half),
+            shift=tuple(offset),
             padding=padding,
+            multiple_of=n,
         )
         self.quantity = quantity
 
@@ -590,6 +641,4 @@ class TaxelPad:
 
     def __call__(self, pressure):
         """Taxel readings [-] (strain) for pressure maps of shape (..., rows*n, cols*n) [Pa]."""
-        field = self.response(pressure)[self.quantity]
-        n, f = self.subsamples, self._first
-        return field[..., f::n, f::n]
+        return self.response.decimated(self.subsamples, pressure)[self.quantity]
