@@ -33,7 +33,7 @@ A load sampled on a regular grid is zero-padded, transformed with ``scipy.fft.rf
 multiplied by these transfer functions (precomputed once per grid, depth and layer in
 :class:`LayerResponse`) and transformed back. The FFT is periodic; the padding makes
 the period longer than the load plus the reach of the layer's response (10 h for a
-bonded layer, whose response decays as about exp(-1.4 r / h); the whole grid again
+bonded layer, whose response dies out over a few h; the whole grid again
 for the half space, whose strains decay as 1 / r^3).
 
 References
