@@ -435,3 +435,27 @@ def test_bad_inputs_name_what_is_wrong():
         layer.TaxelPad(
             2, 2, 1e-3, 2e-3, 0.5e-3, thickness=2e-3, youngs_modulus=E, poisson_ratio=0.3
         )
+
+
+@pytest.mark.parametrize(("n", "shape"), [(3, (12, 15)), (4, (16, 20)), (2, (7, 9))])
+def test_decimated_equals_the_full_field_sampled(n, shape):
+    rng = np.random.default_rng(2)
+    load = rng.uniform(0, 1e3, (2, *shape))
+    response = layer.LayerResponse(
+        shape,
+        0.4e-3,
+        0.8e-3,
+        thickness=2e-3,
+        youngs_modulus=E,
+        poisson_ratio=0.5,
+        quantities=("eps_zz", "u_x"),
+        shift=(0.2e-3, 0.1e-3),
+        electrode=(0.8e-3, 0.6e-3),
+        multiple_of=n,
+    )
+    full = response(load)
+    part = response.decimated(n, load)
+    for name in full:
+        expected = full[name][..., ::n, ::n]
+        assert part[name].shape == expected.shape
+        np.testing.assert_allclose(part[name], expected, atol=1e-12 * np.max(np.abs(expected)))

@@ -417,8 +417,15 @@ class LayerResponse:
                 )
             for t, name in ((traction_x, "traction_x"), (traction_y, "traction_y")):
                 loads.append(None if t is None else _check_load(t, self.shape, name))
+        my, mx = self.padded_shape
+        # x first, on the load's rows only; the zero rows appended along y cost nothing
         spectra = [
-            None if a is None else scipy.fft.rfft2(a, s=self.padded_shape, workers=1) for a in loads
+            None
+            if a is None
+            else scipy.fft.fft(
+                scipy.fft.rfft(a, n=mx, axis=-1, workers=1), n=my, axis=-2, workers=1
+            )
+            for a in loads
         ]
         for parts in self._kernels:
             total = None
@@ -457,10 +464,14 @@ class LayerResponse:
         for q, total in zip(
             self.quantities, self._spectra(pressure, traction_x, traction_y), strict=True
         ):
-            folded = total.reshape(*total.shape[:-2], step, my // step, total.shape[-1]).sum(-3)
-            rows = scipy.fft.ifft(folded, axis=-2, workers=1) / step
-            field = scipy.fft.irfft(rows, n=mx, axis=-1, workers=1)[..., ::step]
-            out[q] = field[..., : -(-ny // step), : -(-nx // step)]
+            kx = total.shape[-1]
+            folded = total.reshape(*total.shape[:-2], step, my // step, kx).sum(-3)
+            rows = scipy.fft.ifft(folded, axis=-2, workers=1)[..., : -(-ny // step), :]
+            # the full spectrum along x (Hermitian), folded in turn
+            full = np.concatenate([rows, np.conj(rows[..., 1 : mx - kx + 1][..., ::-1])], -1)
+            folded = full.reshape(*full.shape[:-1], step, mx // step).sum(-2)
+            field = scipy.fft.ifft(folded, axis=-1, workers=1).real / (step * step)
+            out[q] = field[..., : -(-nx // step)]
         return out
 
     def __call__(self, pressure, traction_x=None, traction_y=None):
