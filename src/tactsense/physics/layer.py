@@ -417,15 +417,8 @@ class LayerResponse:
                 )
             for t, name in ((traction_x, "traction_x"), (traction_y, "traction_y")):
                 loads.append(None if t is None else _check_load(t, self.shape, name))
-        my, mx = self.padded_shape
-        # x first, on the load's rows only; the zero rows appended along y cost nothing
         spectra = [
-            None
-            if a is None
-            else scipy.fft.fft(
-                scipy.fft.rfft(a, n=mx, axis=-1, workers=1), n=my, axis=-2, workers=1
-            )
-            for a in loads
+            None if a is None else scipy.fft.rfft2(a, s=self.padded_shape, workers=1) for a in loads
         ]
         for parts in self._kernels:
             total = None
