@@ -39,11 +39,15 @@ def main() -> None:
         n = 200
         cached = best_time(lambda p=pad, f=frame, m=n: [p(f) for _ in range(m)], 5) / n
         batch = best_time(lambda p=pad, f=frames: p(f), 5) / 64
+        single = layer.TaxelPad(*args, subsamples=4, precision="single", **LAYER)
+        single(frame)
+        cached32 = best_time(lambda p=single, f=frame, m=n: [p(f) for _ in range(m)], 5) / n
         fresh = best_time(lambda a=args, f=frame: layer.TaxelPad(*a, subsamples=4, **LAYER)(f), 5)
         print(
             f"{size}x{size} taxels, grid {pad.grid_shape} padded to {pad.response.padded_shape}: "
             f"cached {cached * 1e6:7.1f} us/frame ({1 / cached:,.0f} frames/s), "
             f"64-frame batch {batch * 1e6:7.1f} us/frame, "
+            f"single precision {cached32 * 1e6:7.1f} us/frame, "
             f"kernel recomputed per frame {fresh * 1e6:8.1f} us/frame, "
             f"ratio {fresh / cached:5.1f}x"
         )

@@ -459,3 +459,13 @@ def test_decimated_equals_the_full_field_sampled(n, shape):
         expected = full[name][..., ::n, ::n]
         assert part[name].shape == expected.shape
         np.testing.assert_allclose(part[name], expected, atol=1e-12 * np.max(np.abs(expected)))
+
+
+def test_single_precision_keeps_six_digits():
+    kwargs = dict(thickness=3e-3, youngs_modulus=E, poisson_ratio=0.5)
+    double = layer.TaxelPad(8, 8, 2e-3, 1.5e-3, 2e-3, **kwargs)
+    single = layer.TaxelPad(8, 8, 2e-3, 1.5e-3, 2e-3, precision="single", **kwargs)
+    load = np.random.default_rng(3).uniform(0, 1e4, double.grid_shape)
+    ref, got = double(load), single(load)
+    assert got.dtype == np.float32
+    assert np.max(np.abs(got - ref)) < 1e-5 * np.max(np.abs(ref))

@@ -298,6 +298,9 @@ class LayerResponse:
         Evaluate the fields at the sample positions plus ``(sy, sx)`` [m].
     multiple_of : int
         Make the automatic padded size a multiple of this (for :meth:`decimated`).
+    precision : {"double", "single"}
+        Floating-point precision of the transforms; "single" is faster and keeps about
+        six significant digits of each field (relative to its largest value).
     """
 
     def __init__(
@@ -315,6 +318,7 @@ class LayerResponse:
         electrode=None,
         shift=(0.0, 0.0),
         multiple_of=1,
+        precision="double",
     ):
         h, E, nu = _check_layer(thickness, youngs_modulus, poisson_ratio)
         ny, nx = (int(n) for n in shape)
@@ -401,11 +405,16 @@ class LayerResponse:
         sy, sx = (float(s) for s in shift)
         if sx or sy:
             factor = factor * np.exp(1j * (kx * sx + ky * sy))
+        if precision not in ("double", "single"):
+            raise TactsenseInputError(f"precision must be 'double' or 'single'; got {precision!r}")
+        self._real = np.float32 if precision == "single" else np.float64
         self._kernels = []
         for q in quantities:
             parts = fields[q] if self.tangential else fields[q][:1]
             parts = [np.broadcast_to(p * factor, k.shape) for p in parts]
-            parts = [p.real.copy() if not np.any(p.imag) else p.copy() for p in parts]
+            parts = [p.real if not np.any(p.imag) else p for p in parts]
+            complex_type = np.complex64 if precision == "single" else np.complex128
+            parts = [p.astype(self._real if p.dtype.kind == "f" else complex_type) for p in parts]
             self._kernels.append(parts)
 
     def _spectra(self, pressure, traction_x, traction_y):
@@ -417,6 +426,7 @@ class LayerResponse:
                 )
             for t, name in ((traction_x, "traction_x"), (traction_y, "traction_y")):
                 loads.append(None if t is None else _check_load(t, self.shape, name))
+        loads = [None if a is None else a.astype(self._real, copy=False) for a in loads]
         spectra = [
             None if a is None else scipy.fft.rfft2(a, s=self.padded_shape, workers=1) for a in loads
         ]
@@ -583,6 +593,8 @@ class TaxelPad:
         Load samples per pitch along each axis.
     quantity : str
         From :data:`QUANTITIES` (default ``eps_zz``).
+    padding, precision
+        As in :class:`LayerResponse`.
     """
 
     def __init__(
@@ -599,6 +611,7 @@ class TaxelPad:
         subsamples=4,
         quantity="eps_zz",
         padding=None,
+        precision="double",
     ):
         rows, cols, n = int(rows), int(cols), int(subsamples)
         if rows < 1 or cols < 1 or n < 1:
@@ -629,6 +642,7 @@ class TaxelPad:
             shift=tuple(offset),
             padding=padding,
             multiple_of=n,
+            precision=precision,
         )
         self.quantity = quantity
 
