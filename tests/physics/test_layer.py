@@ -431,6 +431,14 @@ def test_bad_inputs_name_what_is_wrong():
         r(np.full((4, 4), np.nan))
     with pytest.raises(TactsenseInputError, match="tangential"):
         r(np.zeros((4, 4)), np.zeros((4, 4)))
+    with pytest.raises(TactsenseInputError, match="pressure has shape"):
+        layer.layer_response(
+            np.zeros(5), 1e-3, 0.0, thickness=2e-3, youngs_modulus=E, poisson_ratio=0.3
+        )
+    with pytest.raises(TactsenseInputError, match="precision"):
+        layer.LayerResponse(
+            (4, 4), 1e-3, 0.0, thickness=2e-3, youngs_modulus=E, poisson_ratio=0.3, precision="half"
+        )
     with pytest.raises(TactsenseInputError, match="electrode"):
         layer.TaxelPad(
             2, 2, 1e-3, 2e-3, 0.5e-3, thickness=2e-3, youngs_modulus=E, poisson_ratio=0.3

@@ -551,10 +551,15 @@ def layer_response(
     dict of ndarray
         Each quantity, shape (..., ny, nx).
     """
-    shape = np.shape(pressure)[-2:]
+    shape = np.shape(pressure)
+    if len(shape) < 2:
+        raise TactsenseInputError(
+            f"pressure has shape {shape}; expected (..., ny, nx) samples on a regular grid"
+        )
+    shape = shape[-2:]
     spacing = tuple(np.broadcast_to(np.asarray(spacing, dtype=float), (2,)).tolist())
     response = _cached_response(
-        tuple(shape) if len(shape) == 2 else (0, 0),
+        tuple(shape),
         spacing,
         float(depth),
         thickness=float(thickness),
