@@ -58,12 +58,10 @@ def _pad_grid(spec: PadSpec) -> tuple[np.ndarray, np.ndarray, float, float, int]
 def strain_transfer(kx, ky, depth_mm: float, layer: Layer) -> np.ndarray:
     """Normal strain at ``depth_mm`` per unit surface pressure, in the wavenumber domain.
 
-    A normal load ``p_hat exp(i (kx x + ky y))`` on a layer bonded to a rigid substrate
-    excites a field that does not vary along the wave's crests and has no displacement
-    along them: it is exactly the plane-strain field of the two-dimensional strip at the
-    wavenumber ``|k|`` (section 5 of the paper, :mod:`tactsense.physics.strip`, eqs.
-    27-33 corrected). So ``eps_hat_zz = p_hat dH/dz(|k|, z) / (2 mu)`` in three
-    dimensions too.
+    The bonded layer's closed-form transfer function (:mod:`tactsense.physics.layer`):
+    ``eps_hat_zz = p_hat dW_P(|k|, z) / (2 mu)``. A normal-load mode excites a field that
+    does not vary along its crests, exactly the plane-strain strip of section 5 at
+    ``|k|`` (:mod:`tactsense.physics.strip`); the tests check the two against each other.
 
     Parameters
     ----------
@@ -78,13 +76,13 @@ def strain_transfer(kx, ky, depth_mm: float, layer: Layer) -> np.ndarray:
     ndarray
         ``eps_hat_zz / p_hat`` [1/Pa], negative (compression) for a push.
     """
-    from tactsense.physics.strip import shear_modulus, strip_strain_kernel
+    from tactsense.physics.layer import shear_modulus, transfer_functions
 
-    s = np.hypot(np.asarray(kx, dtype=float), np.asarray(ky, dtype=float)) * 1e3  # [1/m]
-    kernel = strip_strain_kernel(
-        s, depth_mm * 1e-3, layer.thickness_mm * 1e-3, layer.poisson_ratio, "plane_strain"
-    )
-    return kernel / (2.0 * shear_modulus(layer.youngs_modulus_pa, layer.poisson_ratio))
+    k = 2.0 * np.pi * 1e3 * np.hypot(np.asarray(kx, dtype=float), np.asarray(ky, dtype=float))
+    derivative = transfer_functions(
+        k, depth_mm * 1e-3, layer.thickness_mm * 1e-3, layer.poisson_ratio
+    )["dW_P"].real
+    return derivative / (2.0 * shear_modulus(layer.youngs_modulus_pa, layer.poisson_ratio))
 
 
 def strain_map(
@@ -97,11 +95,8 @@ def strain_map(
 ) -> np.ndarray:
     """Normal strain ``eps_zz`` at a depth under a pressure map on a regular grid.
 
-    The map is zero-padded by four layer thicknesses (at least eight cells) along each
-    axis before the FFT, so the periodic images of the load lie that far beyond its
-    edges: the response of a layer bonded to a rigid base has died out there (it falls
-    off within about two thicknesses; the tests check the half-space limit with a layer
-    sixty radii thick and a padding of twice the map instead).
+    :class:`tactsense.physics.layer.LayerResponse` (zero-padded FFT, the transfer
+    function cached per grid, depth and layer), in millimetres.
 
     Parameters
     ----------
@@ -120,32 +115,33 @@ def strain_map(
     ndarray, shape (M, N)
         ``eps_zz`` [-], negative where compressed.
     """
-    import scipy.fft
-
     depth = layer.sensing_depth_mm if depth_mm is None else depth_mm
     pressure = np.asarray(pressure_pa, dtype=float)
-    m, n = pressure.shape
-    reach = 4.0 * layer.thickness_mm
-    pad_m = min(m, max(8, math.ceil(reach / spacing_mm[0])))
-    pad_n = min(n, max(8, math.ceil(reach / spacing_mm[1])))
-    size = (
-        scipy.fft.next_fast_len(m + pad_m, real=True),
-        scipy.fft.next_fast_len(n + pad_n, real=True),
+    response = _response(
+        pressure.shape[-2:],
+        (float(spacing_mm[0]), float(spacing_mm[1])),
+        float(depth),
+        layer,
+        None if electrode_mm is None else (float(electrode_mm[0]), float(electrode_mm[1])),
     )
-    transfer = _transfer_grid(size, tuple(spacing_mm), layer, depth, electrode_mm)
-    spectrum = scipy.fft.rfft2(pressure, s=size)
-    return scipy.fft.irfft2(-spectrum * transfer, s=size)[:m, :n]
+    return response(pressure)["eps_zz"]
 
 
 @functools.lru_cache(maxsize=64)
-def _transfer_grid(size, spacing_mm, layer, depth_mm, electrode_mm) -> np.ndarray:
-    kx = np.fft.fftfreq(size[0], d=spacing_mm[0])[:, None]
-    ky = np.fft.rfftfreq(size[1], d=spacing_mm[1])[None, :]
-    transfer = -strain_transfer(kx, ky, depth_mm, layer)  # compression positive below
-    if electrode_mm is not None:
-        transfer = transfer * np.sinc(kx * electrode_mm[0]) * np.sinc(ky * electrode_mm[1])
-    transfer.setflags(write=False)
-    return transfer
+def _response(shape, spacing_mm, depth_mm, layer, electrode_mm):
+    from tactsense.physics.layer import LayerResponse
+
+    return LayerResponse(
+        shape,
+        (spacing_mm[0] * 1e-3, spacing_mm[1] * 1e-3),
+        depth_mm * 1e-3,
+        thickness=layer.thickness_mm * 1e-3,
+        youngs_modulus=layer.youngs_modulus_pa,
+        poisson_ratio=layer.poisson_ratio,
+        electrode=None
+        if electrode_mm is None
+        else (electrode_mm[0] * 1e-3, electrode_mm[1] * 1e-3),
+    )
 
 
 def pad_strain(spec: PadSpec, indenters) -> np.ndarray:
