@@ -116,3 +116,26 @@ def test_a_flat_point_set_reads_as_the_pad_with_the_same_taxels():
     # the same probe in the tangent plane of taxel 0 (at the origin): (x, y) unchanged
     on_points = points_strain(points, [SphereProbe(6.0, 8.0, 0.5, radius_mm=1.6, at_taxel=0)])
     np.testing.assert_allclose(on_points.ravel(), on_pad, rtol=0.03, atol=2e-5)
+
+
+@pytest.mark.parametrize("nu", [0.0, 0.3, 0.49, 0.5])
+def test_three_dimensional_layer_mode_is_the_plane_strain_strip(nu):
+    """A normal-load mode exp(i k.x) on the bonded layer has no displacement along its
+    crests: it is the plane-strain strip of section 5 at |k|. Two independent derivations
+    (tactsense.physics.layer's Papkovich-Neuber 3-D solve and tactsense.physics.strip's
+    2-D one, itself checked by finite elements) agree to rounding."""
+    from tactsense.physics.layer import transfer_functions
+    from tactsense.physics.strip import strip_kernel, strip_strain_kernel
+
+    h = 3e-3
+    k = np.geomspace(1.0, 5e4, 40)  # [rad/m], k h from 0.003 to 150
+    for z in (0.0, 1e-3, 2.5e-3):
+        layer = transfer_functions(k, z, h, nu)
+        s = k / (2 * np.pi)  # [cycles/m]
+        np.testing.assert_allclose(
+            layer["W_P"].real, strip_kernel(s, z, h, nu, "plane_strain"), rtol=1e-7, atol=1e-14
+        )
+        np.testing.assert_allclose(
+            layer["dW_P"].real, strip_strain_kernel(s, z, h, nu, "plane_strain"), rtol=1e-7,
+            atol=1e-12,
+        )  # fmt: skip
