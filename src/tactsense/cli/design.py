@@ -12,7 +12,7 @@ from rich.console import Console
 from rich.table import Table
 
 from tactsense._validation import TactsenseInputError
-from tactsense.cli._common import SensorOption, fail, new_group, progress_bar
+from tactsense.cli._common import SensorOption, fail, new_group, progress_bar, same_file
 from tactsense.physics.contact import grams_force
 from tactsense.sensor import load_sensor
 
@@ -325,11 +325,13 @@ def design_sweep_command(
     two fingers are marked on the plot."""
 
     from tactsense.analysis.sweep import design_sweep, plot_map
-    from tactsense.cli._common import atomic_output, check_output, console
+    from tactsense.cli._common import atomic_output, check_output, console, sensor_file
 
-    check_output(out, force)
+    check_output(out, force, inputs=sensor_file(sensor))
     if plot is not None:
-        check_output(plot, force, what="plot")
+        check_output(plot, force, what="plot", inputs=sensor_file(sensor))
+        if same_file(plot, out):
+            fail(f"--plot {plot} and --out {out} are the same file; choose two names")
     depths = _grid(depth, "--depth", low=0.5, high=20.0)
     spacings = _grid(spacing, "--spacing", low=0.5, high=20.0)
     ratios = _grid(poisson, "--poisson", low=0.0, high=0.5)

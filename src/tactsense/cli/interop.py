@@ -68,7 +68,7 @@ def export(
         export_format = by_suffix.get(out.suffix.lower())
         if export_format is None:
             fail(f"{out}: say --format mcap or rerun, or use the extension .mcap or .rrd")
-    check_output(out, force)
+    check_output(out, force, inputs=[recording, calibration])
     try:
         cal = None if calibration is None else Calibration.load(calibration)
         if export_format is ExportFormat.mcap:

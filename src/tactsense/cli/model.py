@@ -19,6 +19,8 @@ from tactsense.cli._common import (
     console,
     fail,
     new_group,
+    same_file,
+    sensor_file,
 )
 from tactsense.cli._scenario import (
     ColOption,
@@ -73,7 +75,9 @@ def simulate(
         spec = load_sensor(sensor)
         for target in (out, plot):
             if target is not None:
-                check_output(target, force)
+                check_output(target, force, inputs=sensor_file(sensor))
+        if plot is not None and same_file(plot, out):
+            fail(f"--plot {plot} and --out {out} are the same file; choose two names")
         if plot is not None and scenario not in (
             ScenarioKind.sweep_axial,
             ScenarioKind.sweep_around,
@@ -153,7 +157,7 @@ def sensor_show(
         if out is None:
             typer.echo(spec.to_toml_string())
         else:
-            check_output(out, force)
+            check_output(out, force, inputs=sensor_file(sensor))
             with atomic_output(out) as temporary:
                 spec.to_toml(temporary)
             console.print(f"wrote {out}")
@@ -214,7 +218,7 @@ def sensor_import(
     from tactsense.interop.urdf import sensor_from_urdf
 
     if out is not None:
-        check_output(out, force)
+        check_output(out, force, inputs=[path])
     try:
         spec = sensor_from_urdf(path, name=name, extends=extends.value)
         if out is None:
@@ -260,7 +264,7 @@ def sensor_export(
     if not link.strip():
         fail("--link is empty; give the name of the link the sensor is mounted on")
     if out is not None:
-        check_output(out, force)
+        check_output(out, force, inputs=sensor_file(sensor))
     try:
         text = sensor_to_urdf(load_sensor(sensor), link=link.strip())
         if out is None:
