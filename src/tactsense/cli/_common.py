@@ -274,8 +274,15 @@ def atomic_output(path: Path):
             temporary.unlink(missing_ok=True)
         except OSError:
             pass
+        # the user named the output, not our temporary file
         if isinstance(error, OSError) and error.filename in (str(temporary), temporary):
-            # the user named the output, not our temporary file
             error.filename = str(path)
             error.filename2 = None
+        elif isinstance(error, OSError | TactsenseInputError) and str(temporary) in str(error):
+            # libraries that put the name in the message (pyarrow: "Failed to open local file")
+            if isinstance(error, OSError) and error.strerror:
+                renamed = error.strerror.replace(str(temporary), str(path))
+                raise OSError(error.errno, renamed) from error
+            renamed = str(error).replace(str(temporary), str(path))
+            raise (OSError if isinstance(error, OSError) else type(error))(renamed) from error
         raise
