@@ -215,9 +215,7 @@ def _losses(recording: str) -> dict[str, int]:
     from tactsense.io.recording import read_losses
 
     counts = read_losses(recording)
-    return {
-        column: int(counts.get(column.removesuffix("_frames"), 0)) for column in LOSS_COLUMNS
-    }
+    return {column: int(counts.get(column.removesuffix("_frames"), 0)) for column in LOSS_COLUMNS}
 
 
 def _has_creep(recording: Path, calibration: str) -> bool:

@@ -83,7 +83,9 @@ def spelled(folder, name, how):
 
 
 @pytest.mark.parametrize("how", SPELLINGS)
-@pytest.mark.parametrize(("line", "source"), CLASHES, ids=[c[0].split(" --out")[0] for c in CLASHES])
+@pytest.mark.parametrize(
+    ("line", "source"), CLASHES, ids=[c[0].split(" --out")[0] for c in CLASHES]
+)
 def test_an_output_never_replaces_its_input(folder, monkeypatch, line, source, how):
     monkeypatch.chdir(folder)
     before = digest(folder / source)
@@ -215,7 +217,8 @@ def test_one_column_naming_in_every_format(folder, tmp_path):
     names = {}
     for suffix in (".csv", ".parquet", ".h5"):
         out = tmp_path / f"e{suffix}"
-        assert runner.invoke(app, ["locate", str(folder / "rec.h5"), "--out", str(out)]).exit_code == 0
+        located = runner.invoke(app, ["locate", str(folder / "rec.h5"), "--out", str(out)])
+        assert located.exit_code == 0, located.output
         if suffix == ".csv":
             names[suffix] = next(csv.reader(out.open()))
         elif suffix == ".parquet":
@@ -237,7 +240,8 @@ def test_hdf5_estimates_are_compressed_checksummed_and_small(folder, tmp_path):
 
     h5_out, pq_out = tmp_path / "e.h5", tmp_path / "e.parquet"
     for out in (h5_out, pq_out):
-        assert runner.invoke(app, ["locate", str(folder / "rec.h5"), "--out", str(out)]).exit_code == 0
+        located = runner.invoke(app, ["locate", str(folder / "rec.h5"), "--out", str(out)])
+        assert located.exit_code == 0, located.output
     frames = pq.read_metadata(pq_out).num_rows
     with h5py.File(h5_out) as h5:
         for name in h5:
@@ -258,9 +262,7 @@ def test_batch_summary_gives_every_loss_counter_its_own_column(tmp_path):
     spec = ts.fearing1990_initial()
     counts = {"lost": 104, "gaps": 3, "bad_check": 200, "truncated": 5, "garbage": 30,
               "timeouts": 2}  # fmt: skip
-    recording = dataclasses.replace(
-        ts.simulate(spec, ts.probe_sweep(spec), rng=0), losses=counts
-    )
+    recording = dataclasses.replace(ts.simulate(spec, ts.probe_sweep(spec), rng=0), losses=counts)
     ts.write_recording(tmp_path / "r.h5", recording)
     row = cluster.process_recording(str(tmp_path / "r.h5"), str(tmp_path / "r.parquet"))
     row.update(recording=str(tmp_path / "r.h5"), output=str(tmp_path / "r.parquet"), status="done")

@@ -8,9 +8,9 @@ import math
 import os
 import re
 import warnings
+from collections.abc import Iterable
 from contextlib import contextmanager
 from pathlib import Path
-from collections.abc import Iterable
 from typing import Annotated, NoReturn
 
 import numpy as np
@@ -49,6 +49,8 @@ BaselineFramesOption = Annotated[
         "undeflected reading V_o of eq. 4.",
     ),
 ]
+
+
 def _threshold(value: float) -> float:
     """``--threshold``: a number in (0, 1]; NaN and infinities are refused by name."""
     if not (math.isfinite(value) and 0.0 < value <= 1.0):

@@ -369,9 +369,7 @@ def live(
     from tactsense.stream.live import FIELDS
 
     if out is not None:
-        check_output(
-            out, force, inputs=[calibration, *sensor_file(sensor), *_source_file(source)]
-        )
+        check_output(out, force, inputs=[calibration, *sensor_file(sensor), *_source_file(source)])
     try:
         cal = None if calibration is None else Calibration.load(calibration)
         reader, locator = _stream_and_locator(
