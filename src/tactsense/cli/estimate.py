@@ -327,7 +327,8 @@ def batch(
             "--out",
             "-o",
             help="Folder for one output per recording (created if its parent exists) and "
-            "summary.csv (rewritten by every run).",
+            "summary.csv (rewritten by every run; a skipped recording keeps its row). "
+            "It may be the recordings' folder unless an output would replace an input.",
         ),
     ],
     format: Annotated[
@@ -365,7 +366,11 @@ def batch(
 ) -> None:
     """Locate every frame of many recordings on a Dask cluster, one task per recording.
 
-    Resumable: a recording whose output is complete and newer is skipped. A failed
+    Resumable: a recording whose output is complete and newer is skipped (its row in
+    summary.csv keeps the numbers of the run that wrote it). summary.csv has one column
+    per loss counter of a recording (lost_frames, gaps, bad_check, truncated, garbage,
+    timeouts, duplicates), never their sum. The Dask dashboard's address is printed
+    when it is served (bokeh installed: the dask extra ``diagnostics``). A failed
     recording is listed with its reason in the summary and does not stop the others; a
     worker that dies has its tasks run again elsewhere. Exit status 1 if any failed.
     """
