@@ -74,8 +74,9 @@ def test_every_format_reads_back_at_full_precision(recording, tmp_path, suffix):
     assert summary["contacts"] == int(np.isfinite(whole.row).sum())
     if suffix == ".csv":
         table = pa_csv.read_csv(out)
-        force, time_s = table["force [N]"].to_numpy(), table["time [s]"].to_numpy()
-        flags = table["flags [names]"].to_pylist()
+        force, time_s = table["force_n"].to_numpy(), table["time_s"].to_numpy()
+        np.testing.assert_array_equal(table["flags"].to_numpy(), whole.flags)
+        flags = table["flag_names"].to_pylist()
         assert flags[0] == ts.estimate.Flag.describe(int(whole.flags[0]))
     elif suffix == ".parquet":
         table = pq.read_table(out)

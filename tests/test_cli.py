@@ -164,11 +164,11 @@ def test_locate_writes_csv_with_units(tmp_path):
     rows = list(csv.reader(out.open()))
     assert rows[0][:6] == [
         "frame",
-        "time [s]",
-        "row [tactel]",
-        "col [tactel]",
-        "axial [mm]",
-        "angle [deg]",
+        "time_s",
+        "row",
+        "col",
+        "axial_mm",
+        "angle_deg",
     ]
     recording = ts.read_recording(rec)
     assert len(rows) == len(recording) + 1
@@ -217,11 +217,11 @@ def test_calibrate_then_locate_with_the_calibration(tmp_path):
     table = np.genfromtxt(estimates, delimiter=",", names=True)
     rec = ts.read_recording(steps)
     api = ts.locate(rec.frames, spec, calibration=calibration, frame_period_s=spec.scan_period_s)
-    np.testing.assert_allclose(table["force_N"], api.force_n, rtol=1e-5, equal_nan=True)
+    np.testing.assert_allclose(table["force_n"], api.force_n, rtol=1e-5, equal_nan=True)
     applied = rec.truth["step_force_n"][rec.truth["frame_step"]]
     loaded = applied > 0
     assert loaded.sum() > 10
-    assert np.all(np.abs(table["force_N"][loaded] / applied[loaded] - 1) < 0.2)
+    assert np.all(np.abs(table["force_n"][loaded] / applied[loaded] - 1) < 0.2)
     other = tmp_path / "other.h5"
     improved = ts.fearing1990_improved()
     ts.write_recording(other, ts.simulate(improved, ts.force_steps(improved, repeats=1)))

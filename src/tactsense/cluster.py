@@ -21,6 +21,14 @@ from pathlib import Path
 
 from tactsense._validation import TactsenseInputError
 
+LOSS_COLUMNS = tuple(
+    f"{kind}_frames" if kind == "lost" else kind
+    for kind in ("lost", "gaps", "bad_check", "truncated", "garbage", "timeouts", "duplicates")
+)
+"""One column per loss counter of a recording (``tactsense.stream.LOSS_KINDS``): a lost
+frame, a gap, a bad checksum, a truncation, garbage bytes and a timeout are different
+things and are never summed. ``lost`` is named ``lost_frames``."""
+
 SUMMARY_FIELDS = [
     "recording",
     "output",
@@ -30,7 +38,7 @@ SUMMARY_FIELDS = [
     "saturated",
     "force_mean_n",
     "force_max_n",
-    "losses",
+    *LOSS_COLUMNS,
     "seconds",
     "reason",
 ]
@@ -82,7 +90,7 @@ def process_recording(
         os.replace(temporary, output)
     finally:
         temporary.unlink(missing_ok=True)
-    summary.update(losses=_losses(recording), seconds=time.perf_counter() - start)
+    summary.update(_losses(recording), seconds=time.perf_counter() - start)
     return summary
 
 
@@ -196,16 +204,18 @@ def combine_parts(parts: list[dict], recording: str, output: str) -> dict:
     return {
         "frames": sum(p["frames"] for p in parts),
         **tally.summary(),
-        "losses": _losses(recording),
+        **_losses(recording),
         "seconds": time.perf_counter() - start_time,
     }
 
 
-def _losses(recording: str) -> int:
-    """Frames the recording's writer counted as lost (0 for a simulated recording)."""
+def _losses(recording: str) -> dict[str, int]:
+    """The recording's loss counters, one column each (:data:`LOSS_COLUMNS`; 0 for a
+    simulated recording or a counter its writer did not keep)."""
     from tactsense.io.recording import read_losses
 
-    return sum(read_losses(recording).values())
+    counts = read_losses(recording)
+    return {column: int(counts.get(column.removesuffix("_frames"), 0)) for column in LOSS_COLUMNS}
 
 
 def _has_creep(recording: Path, calibration: str) -> bool:
@@ -254,10 +264,13 @@ def run_batch(
 
     rows: dict[Path, dict] = {}
     futures = {}
+    earlier = read_summary(out_dir / "summary.csv")
     for recording in recordings:
         output = output_for(recording, out_dir, fmt)
         if is_done(recording, output):
+            # its numbers are those of the run that wrote the output
             rows[recording] = {
+                **(earlier or {}).get(_key(output), {}),
                 "recording": str(recording),
                 "output": str(output),
                 "status": "skipped",
@@ -337,6 +350,32 @@ def run_batch(
         if progress is not None:
             progress(done, len(recordings))
     return [{key: rows[r].get(key) for key in SUMMARY_FIELDS} for r in recordings]
+
+
+def _key(output: Path | str) -> str:
+    # summary.csv lives beside the outputs, whose names are unique (see expand)
+    return Path(output).name
+
+
+def read_summary(path: Path) -> dict[str, dict]:
+    """The rows of an earlier run's summary.csv that finished (status done or skipped),
+    by their output's file name; empty if there is none or it cannot be read."""
+    import pyarrow.csv as pa_csv
+
+    try:
+        table = pa_csv.read_csv(str(path))
+    except (OSError, ValueError):
+        return {}
+    numeric = set(SUMMARY_FIELDS) - {"recording", "output", "status", "reason"}
+    rows = {}
+    for row in table.to_pylist():
+        if row.get("status") not in ("done", "skipped") or not row.get("output"):
+            continue
+        kept = {key: row.get(key) for key in SUMMARY_FIELDS if key in numeric}
+        if kept.get("frames") is None:
+            continue  # a blank row of an older summary
+        rows[_key(row["output"])] = kept
+    return rows
 
 
 def write_summary(path: Path, rows: list[dict]) -> None:

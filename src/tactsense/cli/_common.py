@@ -4,8 +4,11 @@ an error into a one-line message and an exit code."""
 from __future__ import annotations
 
 import functools
+import math
 import os
+import re
 import warnings
+from collections.abc import Iterable
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated, NoReturn
@@ -46,11 +49,21 @@ BaselineFramesOption = Annotated[
         "undeflected reading V_o of eq. 4.",
     ),
 ]
+
+
+def _threshold(value: float) -> float:
+    """``--threshold``: a number in (0, 1]; NaN and infinities are refused by name."""
+    if not (math.isfinite(value) and 0.0 < value <= 1.0):
+        raise typer.BadParameter(
+            f"{value} is not a fraction: it must be a number in (0, 1], e.g. 0.005 for 0.5 %"
+        )
+    return value
+
+
 ThresholdOption = Annotated[
     float,
     typer.Option(
-        min=1e-6,
-        max=1.0,
+        callback=_threshold,
         help="Smallest tactel deflection that counts as a contact, as a fraction (0.005 = "
         "0.5 %, about 10 counts at 2000).",
     ),
@@ -132,15 +145,56 @@ def fail(message: str) -> NoReturn:
     raise typer.Exit(code=2)
 
 
-def check_output(path: Path, force: bool, *, what: str = "output") -> Path:
+def same_file(a: Path, b: Path) -> bool:
+    """Whether two paths name the same file however they are spelled (relative or
+    absolute, ``./``, ``..``, symlinks, hard links)."""
+    try:
+        return os.path.samefile(a, b)
+    except OSError:  # one of them does not exist (yet): compare the resolved names
+        try:
+            return Path(a).resolve() == Path(b).resolve()
+        except (OSError, RuntimeError):
+            return False
+
+
+def inside(path: Path, folder: Path) -> bool:
+    """Whether ``path`` is ``folder`` or lies anywhere under it (symlinks resolved)."""
+    try:
+        path, folder = Path(path).resolve(), Path(folder).resolve()
+    except (OSError, RuntimeError):
+        return False
+    return path == folder or folder in path.parents
+
+
+def sensor_file(sensor: str | None) -> list[Path]:
+    """The ``--sensor`` value as a list of input files: empty for a built-in finger."""
+    if sensor is None or not Path(sensor).exists():
+        return []
+    return [Path(sensor)]
+
+
+def check_output(
+    path: Path,
+    force: bool,
+    *,
+    what: str = "output",
+    inputs: Iterable[Path | str | None] = (),
+) -> Path:
     """Refuse an output path that cannot be written, before any work starts.
 
     The rule for every command: the parent folder must exist (it is never created, so a
-    typo does not scatter folders), an existing directory is never an output file, and
-    an existing file is replaced only with ``--force``.
+    typo does not scatter folders), an existing directory is never an output file, an
+    output is never one of the command's ``inputs`` (however the path is spelled, with
+    or without ``--force``), and an existing file is replaced only with ``--force``.
     """
     path = Path(path)
     parent = path.parent if str(path.parent) else Path(".")
+    for source in inputs:
+        if source is not None and same_file(path, Path(source)):
+            fail(
+                f"{what} {path} is the input {source}; an output never replaces an input "
+                "(--force or not): choose another name"
+            )
     if path.is_dir():
         fail(f"{what} {path} is a directory; expected a file name")
     if parent.exists() and not parent.is_dir():
@@ -164,34 +218,73 @@ def _alive(pid: int) -> bool:
     return True
 
 
-def remove_stale_partials(folder: Path, prefix: str, suffix: str) -> None:
-    """Remove ``{prefix}.{pid}.partial{suffix}`` left in ``folder`` by a killed run.
+_PARTIAL = re.compile(r"^\.(?P<stem>.+)\.(?P<pid>\d+)\.partial(?P<suffix>\.[^.]+)?$")
+
+
+def remove_stale_partials(folder: Path) -> list[Path]:
+    """Remove every ``.{name}.{pid}.partial{suffix}`` left in ``folder`` by a killed run.
 
     A run killed outright (SIGKILL, power loss) cannot clean up its temporary output;
-    the next run toward the same name removes it, if the process that wrote it is gone.
+    the next command that writes into the same folder removes it, whatever its name, if
+    the process that wrote it is gone. Only tactsense's own naming pattern is touched,
+    and only when the writer's process id is not alive.
+
+    Returns
+    -------
+    list of Path
+        The leftovers removed.
     """
     import shutil
 
-    for leftover in folder.glob(f"{prefix}.*.partial{suffix}"):
-        pid = leftover.name[len(prefix) + 1 :].split(".", 1)[0]
-        if pid.isdigit() and not _alive(int(pid)):
-            if leftover.is_dir():
-                shutil.rmtree(leftover, ignore_errors=True)
+    removed = []
+    try:
+        candidates = list(Path(folder).glob(".*.partial*"))
+    except OSError:
+        return removed
+    for leftover in candidates:
+        match = _PARTIAL.match(leftover.name)
+        if match is None or _alive(int(match["pid"])) or int(match["pid"]) == os.getpid():
+            continue
+        try:
+            if leftover.is_dir() and not leftover.is_symlink():
+                shutil.rmtree(leftover)
             else:
-                leftover.unlink(missing_ok=True)
+                leftover.unlink()
+        except OSError:
+            continue
+        removed.append(leftover)
+    return removed
 
 
 @contextmanager
 def atomic_output(path: Path):
     """Yield a temporary name beside ``path``; move it into place only if the block ends
-    without an exception (Ctrl-C included), else remove it."""
+    without an exception (Ctrl-C included), else remove it.
+
+    Leftovers of killed runs in the same folder are removed first
+    (:func:`remove_stale_partials`); an error about the temporary file names ``path``.
+    """
     path = Path(path)
     # hidden, unique, and with the final suffix (matplotlib picks the format from it)
-    remove_stale_partials(path.parent, f".{path.stem}", path.suffix)
+    remove_stale_partials(path.parent if str(path.parent) else Path("."))
     temporary = path.with_name(f".{path.stem}.{os.getpid()}.partial{path.suffix}")
     try:
         yield temporary
-    except BaseException:
-        temporary.unlink(missing_ok=True)
+        os.replace(temporary, path)
+    except BaseException as error:
+        try:
+            temporary.unlink(missing_ok=True)
+        except OSError:
+            pass
+        # the user named the output, not our temporary file
+        if isinstance(error, OSError) and error.filename in (str(temporary), temporary):
+            error.filename = str(path)
+            error.filename2 = None
+        elif isinstance(error, OSError | TactsenseInputError) and str(temporary) in str(error):
+            # libraries that put the name in the message (pyarrow: "Failed to open local file")
+            if isinstance(error, OSError) and error.strerror:
+                renamed = error.strerror.replace(str(temporary), str(path))
+                raise OSError(error.errno, renamed) from error
+            renamed = str(error).replace(str(temporary), str(path))
+            raise (OSError if isinstance(error, OSError) else type(error))(renamed) from error
         raise
-    os.replace(temporary, path)

@@ -12,7 +12,7 @@ from rich.console import Console
 from rich.table import Table
 
 from tactsense._validation import TactsenseInputError
-from tactsense.cli._common import SensorOption, fail, new_group, progress_bar
+from tactsense.cli._common import SensorOption, fail, new_group, progress_bar, same_file
 from tactsense.physics.contact import grams_force
 from tactsense.sensor import load_sensor
 
@@ -340,13 +340,15 @@ def design_sweep_command(
     with the pad presets marked."""
 
     from tactsense.analysis.sweep import design_sweep, plot_map
-    from tactsense.cli._common import atomic_output, check_output, console
+    from tactsense.cli._common import atomic_output, check_output, console, sensor_file
 
-    check_output(out, force)
+    check_output(out, force, inputs=sensor_file(sensor))
     if plot is not None:
         from tactsense.plotting import check_plot_format
 
-        check_output(plot, force, what="plot")
+        check_output(plot, force, what="plot", inputs=sensor_file(sensor))
+        if same_file(plot, out):
+            fail(f"--plot {plot} and --out {out} are the same file; choose two names")
         check_plot_format(plot)
     spec = load_sensor(sensor)
     pad = spec.kind == "pad"

@@ -22,6 +22,7 @@ from tactsense.cli._common import (
     fail,
     new_group,
     progress_bar,
+    same_file,
 )
 from tactsense.io.recording import read_recording
 
@@ -75,7 +76,7 @@ def locate(
     from tactsense.batch import locate_file, output_format
 
     try:
-        check_output(out, force)
+        check_output(out, force, inputs=[recording, calibration])
         output_format(out)
         calibrated = None
         if calibration is not None:
@@ -174,7 +175,7 @@ def calibrate(
     from tactsense.estimate import calibrate as cal
 
     try:
-        check_output(out, force)
+        check_output(out, force, inputs=[sweep, steps, knife])
         from tactsense.io.recording import RecordingReader
 
         # the sweep is read in pieces: any length fits in memory
@@ -332,6 +333,12 @@ def _fit_knife(rec, sensor, row, col, baseline_frames, *, creep=None):
     return fit, compensated
 
 
+def _has_bokeh() -> bool:
+    from importlib.util import find_spec
+
+    return find_spec("bokeh") is not None
+
+
 class OutputFormat(StrEnum):
     parquet = "parquet"
     csv = "csv"
@@ -350,7 +357,8 @@ def batch(
             "--out",
             "-o",
             help="Folder for one output per recording (created if its parent exists) and "
-            "summary.csv (rewritten by every run).",
+            "summary.csv (rewritten by every run; a skipped recording keeps its row). "
+            "It may be the recordings' folder unless an output would replace an input.",
         ),
     ],
     format: Annotated[
@@ -388,7 +396,11 @@ def batch(
 ) -> None:
     """Locate every frame of many recordings on a Dask cluster, one task per recording.
 
-    Resumable: a recording whose output is complete and newer is skipped. A failed
+    Resumable: a recording whose output is complete and newer is skipped (its row in
+    summary.csv keeps the numbers of the run that wrote it). summary.csv has one column
+    per loss counter of a recording (lost_frames, gaps, bad_check, truncated, garbage,
+    timeouts, duplicates), never their sum. The Dask dashboard's address is printed
+    when it is served (bokeh installed: the dask extra ``diagnostics``). A failed
     recording is listed with its reason in the summary and does not stop the others; a
     worker that dies has its tasks run again elsewhere. Exit status 1 if any failed.
     """
@@ -404,6 +416,15 @@ def batch(
             fail(f"folder {out.parent} of --out {out} does not exist; create it first")
         if calibration is not None and not calibration.is_file():
             fail(f"--calibration {calibration} is not a file")
+        # an output never replaces an input: <name>.<format> and summary.csv in OUT
+        targets = [cluster.output_for(p, out, format.value) for p in paths]
+        for target in [*targets, out / "summary.csv"]:
+            for source in [*paths, calibration]:
+                if source is not None and same_file(target, source):
+                    fail(
+                        f"output {target} would replace the input {source}; an output never "
+                        "replaces an input: choose another --out folder or --format"
+                    )
         if scheduler is not None and not scheduler.startswith(("tcp://", "tls://", "inproc://")):
             fail(f"--scheduler {scheduler!r} is not a scheduler address (tcp://HOST:PORT)")
         out.mkdir(exist_ok=True)
@@ -422,7 +443,8 @@ def batch(
             local = None
             client = Client(scheduler, timeout=10)
         try:
-            console.print(f"Dask dashboard: {client.dashboard_link}")
+            if _has_bokeh():  # the dashboard is served only with bokeh installed
+                console.print(f"Dask dashboard: {client.dashboard_link}")
             with progress_bar("recordings", eta=False, quiet=quiet) as bar:
                 task = bar.add_task("batch", total=len(paths))
                 rows = cluster.run_batch(

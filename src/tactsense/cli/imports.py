@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from tactsense.cli._common import atomic_output, check_output, console, new_group
+from tactsense.cli._common import atomic_output, check_output, console, new_group, sensor_file
 
 app = new_group("Other tools' files into tactsense recordings.")
 
@@ -49,11 +49,10 @@ def import_(
     (LabRecorder), one frame per CSV row, or a LeRobot dataset written by tactsense.
     """
     from tactsense.interop.importers import read_source
-    from tactsense.io.recording import RecordingError, write_recording
+    from tactsense.io.recording import write_recording
 
-    check_output(out, force)
-    if out.exists() and source.exists() and out.resolve() == source.resolve():
-        raise RecordingError(f"--out {out} is the source; choose another name")
+    sensor_input = [] if sensor is None else sensor_file(sensor)
+    check_output(out, force, inputs=[source, *sensor_input])
     recording = read_source(
         source, sensor=sensor, time_column=time_column, topic=topic, stream=stream
     )

@@ -87,7 +87,7 @@ def export(
         return
     if episode_split is not None:
         fail("--episode-split applies to --format lerobot only")
-    check_output(out, force)
+    check_output(out, force, inputs=[recording, calibration])
     try:
         cal = None if calibration is None else Calibration.load(calibration)
         if export_format is ExportFormat.mcap:
@@ -126,7 +126,7 @@ def _export_lerobot(recording, out, calibration, baseline_frames, threshold, epi
 
     if out.exists():
         fail(f"{out} exists; a LeRobot dataset goes into a new folder")
-    check_output(out, False, what="dataset folder")
+    check_output(out, False, what="dataset folder", inputs=[recording, calibration])
     remove_stale_partials(out.parent, f".{out.name}", "")  # left by a run killed outright
     cal = None if calibration is None else Calibration.load(calibration)
     counts = export_lerobot(

@@ -24,6 +24,7 @@ from tactsense.cli._common import (
     console,
     fail,
     new_group,
+    sensor_file,
 )
 from tactsense.cli._scenario import (
     ColOption,
@@ -86,6 +87,11 @@ LSL_PREFIX = "lsl:"
 class RecordFormat(StrEnum):
     h5 = "h5"
     mcap = "mcap"
+
+
+def _source_file(source: str) -> list[Path]:
+    """A source that names a file or device (not an address): an input no output replaces."""
+    return [] if "://" in source or source.startswith(LSL_PREFIX) else [Path(source)]
 
 
 def _open_reader(source: str, sensor: str | None, timeout: float | None, *, start: bool = True):
@@ -292,7 +298,7 @@ def record(
             _writer_class()
         except TactsenseInputError as error:
             fail(str(error))
-    check_output(out, force)
+    check_output(out, force, inputs=[*sensor_file(sensor), *_source_file(source)])
     try:
         reader = _open_reader(source, sensor, timeout)
     except TactsenseInputError as error:
@@ -363,7 +369,7 @@ def live(
     from tactsense.stream.live import FIELDS
 
     if out is not None:
-        check_output(out, force)
+        check_output(out, force, inputs=[calibration, *sensor_file(sensor), *_source_file(source)])
     try:
         cal = None if calibration is None else Calibration.load(calibration)
         reader, locator = _stream_and_locator(

@@ -18,6 +18,8 @@ from tactsense.cli._common import (
     console,
     fail,
     new_group,
+    same_file,
+    sensor_file,
 )
 from tactsense.cli._scenario import (
     AngleOption,
@@ -88,7 +90,9 @@ def simulate(
         spec = load_sensor(sensor)
         for target in (out, plot):
             if target is not None:
-                check_output(target, force)
+                check_output(target, force, inputs=sensor_file(sensor))
+        if plot is not None and same_file(plot, out):
+            fail(f"--plot {plot} and --out {out} are the same file; choose two names")
         if plot is not None:
             check_plot_format(plot)
         scenario = resolve_scenario(spec, scenario)
@@ -204,7 +208,7 @@ def sensor_show(
         if out is None:
             typer.echo(spec.to_toml_string())
         else:
-            check_output(out, force)
+            check_output(out, force, inputs=sensor_file(sensor))
             with atomic_output(out) as temporary:
                 spec.to_toml(temporary)
             console.print(f"wrote {out}")
@@ -269,7 +273,7 @@ def sensor_import(
     from tactsense.sensor import PRESETS, preset, sensor_from_dict, taxels_from_json
 
     if out is not None:
-        check_output(out, force)
+        check_output(out, force, inputs=[path])
     try:
         if extends is not None and extends.removeprefix("fearing1990_") not in PRESETS:
             fail(f"--extends {extends!r} is not a preset; available: {', '.join(PRESETS)}")
@@ -330,7 +334,7 @@ def sensor_export(
     if not link.strip():
         fail("--link is empty; give the name of the link the sensor is mounted on")
     if out is not None:
-        check_output(out, force)
+        check_output(out, force, inputs=sensor_file(sensor))
     try:
         text = sensor_to_urdf(load_sensor(sensor), link=link.strip())
         if out is None:

@@ -16,9 +16,11 @@ from tactsense.cli._common import (
     SensorOption,
     console,
     fail,
+    inside,
     new_group,
     progress_bar,
     remove_stale_partials,
+    sensor_file,
 )
 from tactsense.sensor import load_sensor
 
@@ -59,6 +61,12 @@ def reproduce(
         spec.require_kind("finger", what="reproduce (the paper's experiments)")
         if out.exists() and not out.is_dir():
             fail(f"{out} is a file; expected a directory for the report")
+        for source in sensor_file(sensor):
+            if inside(source, out):
+                fail(
+                    f"the report directory {out} holds the input --sensor {source}; an output "
+                    "never replaces an input: choose another directory"
+                )
         if out.exists() and not force:
             fail(f"{out} exists; pass --force to write into it, or choose another directory")
         parent = out.parent
@@ -69,7 +77,7 @@ def reproduce(
         if not os.access(parent, os.W_OK | os.X_OK):
             fail(f"cannot write the report: folder {parent} is not writable")
         # a new report is built in a hidden folder and renamed into place when complete
-        remove_stale_partials(parent, f".{out.name}", "")
+        remove_stale_partials(parent)
         target = out if out.exists() else parent / f".{out.name}.{os.getpid()}.partial"
         with progress_bar("{task.description:<36}") as bar:
             task = bar.add_task("experiments", total=None)

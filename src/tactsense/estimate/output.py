@@ -40,10 +40,13 @@ def _flag_names(flags: np.ndarray) -> np.ndarray:
 class EstimatesWriter:
     """Append estimates to a CSV, Parquet or HDF5 file (by extension), piece by piece.
 
-    CSV has one header line with units (``frame, time [s], row [tactel], ...``) and
-    flags by name; Parquet and HDF5 have the field names of :class:`Estimates` with
-    ``frame`` and ``time_s``, units in the metadata, and flags as integers (bits of
-    :class:`~tactsense.estimate.deflection.Flag`). Floats keep full precision.
+    Every format has the same column names, those of :class:`Estimates` with ``frame``
+    and ``time_s`` (units in the name or in :attr:`Estimates.UNITS`: ``axial_mm``,
+    ``force_n``...; the names ``live`` writes), and flags as integers (bits of
+    :class:`~tactsense.estimate.deflection.Flag`); CSV adds ``flag_names`` (``A|B``,
+    empty when none). Parquet and HDF5 keep the units in their metadata. Floats keep
+    full precision. HDF5 datasets are compressed (gzip) and checksummed (Fletcher-32),
+    with chunks no longer than the data.
     """
 
     def __init__(self, path: str | Path, *, format: str | None = None):
@@ -71,28 +74,14 @@ class EstimatesWriter:
             value = np.ravel(getattr(estimates, name))
             if name == "flags":
                 value = value.astype(np.int64)
-                if self.format == "csv":
-                    value = _flag_names(value)
             elif name == "iterations":
                 value = value.astype(np.int64)
             elif name == "converged":
                 value = value.astype(bool)
             columns[name] = value
-        table = pa.table(columns)
-        if self.format == "csv":
-            labels = {
-                "time_s": "time [s]",
-                "axial_mm": "axial [mm]",
-                "angle_deg": "angle [deg]",
-                "force_n": "force [N]",
-                "peak_deflection": "peak deflection [1]",
-            }
-            names = ["frame"] + [
-                labels.get(name) or f"{name} [{Estimates.UNITS.get(name, '1')}]"
-                for name in table.column_names[1:]
-            ]
-            table = table.rename_columns(names)
-        return table
+        if self.format == "csv":  # a text file also says the flags by name, as `live` does
+            columns["flag_names"] = _flag_names(columns["flags"])
+        return pa.table(columns)
 
     def write(self, start: int, time_s, estimates: Estimates) -> None:
         """Append the estimates of frames ``start ...`` with their times [s]."""
@@ -116,10 +105,22 @@ class EstimatesWriter:
             self._h5 = h5py.File(self.path, "w")
             self._h5.attrs["format"] = "tactsense-estimates"
             units = {"time_s": "s", **Estimates.UNITS, "flags": "Flag bits"}
+            # chunks sized to the data: the first piece (a short file is one small chunk),
+            # at least 1024 rows so that a long file written in small pieces is not
+            # split into tiny chunks, at most 65,536 rows
+            rows = min(65_536, max(1_024, table.num_rows))
             for name in table.column_names:
                 column = table.column(name).to_numpy()
                 data = self._h5.create_dataset(
-                    name, shape=(0,), maxshape=(None,), dtype=column.dtype, chunks=(65_536,)
+                    name,
+                    shape=(0,),
+                    maxshape=(None,),
+                    dtype=column.dtype,
+                    chunks=(rows,),
+                    compression="gzip",
+                    compression_opts=4,
+                    shuffle=True,
+                    fletcher32=True,
                 )
                 data.attrs["units"] = units.get(name, "1")
         n = table.num_rows
