@@ -75,8 +75,8 @@ def main() -> None:
         probe = SphereProbe(cx + 0.3, cy - 0.7, 0.5, radius_mm=1.6)
         assert np.allclose(pad_strain(spec, [probe]), fresh_frame(spec, probe), rtol=1e-9,
                            atol=1e-15)  # fmt: skip
-        t_frame = best_of(lambda: pad_strain(spec, [probe.moved(1e-3, 0.0)]))
-        t_fresh = best_of(lambda: fresh_frame(spec, probe), 3, 2)
+        t_frame = best_of(lambda s=spec, p=probe: pad_strain(s, [p.moved(1e-3, 0.0)]))
+        t_fresh = best_of(lambda s=spec, p=probe: fresh_frame(s, p), 3, 2)
         scene = press(spec, repeats=3, dwell_s=0.2, lift_s=0.2)
         start = time.perf_counter()
         frames = len(ts.simulate(spec, scene, flaws="none").frames)
