@@ -47,7 +47,7 @@ def emulator():
 
 
 def test_emulate_record_locate_equals_simulate_locate(tmp_path, emulator):
-    url = emulator("--speed", "0", "--seed", "4")
+    url = emulator("--speed", "1e6", "--seed", "4")
     recorded, simulated = tmp_path / "rec.h5", tmp_path / "sim.h5"
     run = {"check": True, "capture_output": True, "text": True, "timeout": 120}
     subprocess.run([*CLI, "record", url, "--out", str(recorded), "--quiet"], **run)
@@ -120,7 +120,7 @@ def test_ctrl_c_closes_the_recording_cleanly(tmp_path, emulator):
 def test_recording_refuses_to_overwrite(tmp_path, emulator):
     out = tmp_path / "exists.h5"
     out.write_bytes(b"precious")
-    url = emulator("--speed", "0")
+    url = emulator("--speed", "1e6")
     result = subprocess.run(
         [*CLI, "record", url, "--out", str(out)], capture_output=True, text=True, timeout=60
     )
@@ -129,7 +129,7 @@ def test_recording_refuses_to_overwrite(tmp_path, emulator):
 
 
 def test_live_estimates_follow_the_probe(emulator):
-    url = emulator("--speed", "0")
+    url = emulator("--speed", "1e6")
     result = subprocess.run(
         [*CLI, "live", url, "--format", "jsonl"], capture_output=True, text=True, timeout=120
     )
