@@ -351,7 +351,8 @@ def record(
             interrupted = True
         except (StreamError, TactsenseInputError, FileExistsError) as error:
             if kept[0] and out.exists():
-                fail(f"{error}; kept {kept[0]} frames in {out} ({reader.stats.summary(kept[0])})")
+                losses = reader.stats.summary(kept[0]).partition(", ")[2]
+                fail(f"{error}; kept {kept[0]} frames in {out}" + (f" ({losses})" if losses else ""))
             fail(f"{error}; no frame was recorded, nothing written")
     if interrupted:
         stopped = f" (stopped by {stopped_by()})"
