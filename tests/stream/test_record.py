@@ -78,7 +78,15 @@ def test_a_recorder_killed_by_sigkill_leaves_a_readable_file(tmp_path, emulator,
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
     )
-    time.sleep(6.0)  # 280 frames/s: several flushes (at least one a second)
+    # 280 frames/s: wait (however loaded the machine) until several flushes are in
+    deadline = time.monotonic() + 90
+    while time.monotonic() < deadline:
+        try:
+            if len(read_recording(out)) >= 3 * 280:
+                break
+        except Exception:  # noqa: BLE001 - not there yet, or between flushes
+            pass
+        time.sleep(0.2)
     recorder.send_signal(signal.SIGKILL)
     recorder.wait(10)
     rec = read_recording(out)
@@ -108,7 +116,14 @@ def test_ctrl_c_closes_the_recording_cleanly(tmp_path, emulator):
         stderr=subprocess.PIPE,
         text=True,
     )
-    time.sleep(3.0)
+    deadline = time.monotonic() + 60  # the machine may be loaded: wait for frames, not 3 s
+    while time.monotonic() < deadline:
+        try:
+            if len(read_recording(out)) >= 5:
+                break
+        except Exception:  # noqa: BLE001 - not there yet, or between flushes
+            pass
+        time.sleep(0.2)
     recorder.send_signal(signal.SIGINT)
     _, err = recorder.communicate(timeout=20)
     assert recorder.returncode == 0, err
