@@ -84,7 +84,7 @@ def test_a_recorder_killed_by_sigkill_leaves_a_readable_file(tmp_path, emulator,
         try:
             if len(read_recording(out)) >= 3 * 280:
                 break
-        except Exception:  # noqa: BLE001 - not there yet, or between flushes
+        except Exception:
             pass
         time.sleep(0.2)
     recorder.send_signal(signal.SIGKILL)
@@ -121,7 +121,7 @@ def test_ctrl_c_closes_the_recording_cleanly(tmp_path, emulator):
         try:
             if len(read_recording(out)) >= 5:
                 break
-        except Exception:  # noqa: BLE001 - not there yet, or between flushes
+        except Exception:
             pass
         time.sleep(0.2)
     recorder.send_signal(signal.SIGINT)

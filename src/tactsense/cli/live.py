@@ -352,7 +352,9 @@ def record(
         except (StreamError, TactsenseInputError, FileExistsError) as error:
             if kept[0] and out.exists():
                 losses = reader.stats.summary(kept[0]).partition(", ")[2]
-                fail(f"{error}; kept {kept[0]} frames in {out}" + (f" ({losses})" if losses else ""))
+                fail(
+                    f"{error}; kept {kept[0]} frames in {out}" + (f" ({losses})" if losses else "")
+                )
             fail(f"{error}; no frame was recorded, nothing written")
     if interrupted:
         stopped = f" (stopped by {stopped_by()})"
