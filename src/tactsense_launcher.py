@@ -4,12 +4,24 @@ Importing :mod:`tactsense` (NumPy, SciPy, Numba, h5py) takes about a second; a C
 in that second would otherwise print a Python traceback. This module imports nothing
 heavy itself, so it can hold that interrupt until the imports are done and then end as
 every command does: one line, exit status 1.
+
+SIGTERM takes the same path as Ctrl-C (:func:`tactsense._signals.install_sigterm`):
+outputs are closed or removed as on Ctrl-C; a command that ends on it reports exit
+status 143 (128 + SIGTERM), as a shell does for a process SIGTERM ended.
 """
 
 import sys
 
 
-def _interrupted() -> None:
+def _terminated() -> bool:
+    signals = sys.modules.get("tactsense._signals")
+    return bool(signals is not None and signals.terminated)
+
+
+def _interrupted(terminated: bool = False) -> None:
+    if terminated or _terminated():
+        sys.stderr.write("error: stopped by SIGTERM; no output was left half-written\n")
+        sys.exit(143)
     sys.stderr.write("error: interrupted; no output was left half-written\n")
     sys.exit(1)
 
@@ -33,14 +45,17 @@ def main() -> None:
 
     sys.unraisablehook = _unraisable
     # a Ctrl-C during the imports is noted, not raised inside some module's import
-    pressed = []
+    pressed, terms = [], []
     previous = signal.signal(signal.SIGINT, lambda *_: pressed.append(True))
+    signal.signal(signal.SIGTERM, lambda *_: terms.append(True))
     try:
+        from tactsense._signals import install_sigterm
         from tactsense.cli.app import main as run
     finally:
         signal.signal(signal.SIGINT, previous)
-    if pressed:
-        _interrupted()
+    install_sigterm()
+    if pressed or terms:
+        _interrupted(bool(terms))
     try:
         run()
     except KeyboardInterrupt:
@@ -50,6 +65,9 @@ def main() -> None:
             _interrupted()
         # the command is over and its output complete: a Ctrl-C now changes nothing
         signal.signal(signal.SIGINT, signal.SIG_IGN)
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
+        if _terminated() and done.code in (0, None):
+            sys.exit(143)  # stopped cleanly, but by SIGTERM: say so to the caller
         raise
 
 

@@ -46,7 +46,7 @@ class _Hold:
             self.pressed = False
             if callable(previous):
                 previous(signal.SIGINT, None)
-            elif previous == signal.SIG_DFL:
+            elif previous == signal.SIG_DFL or terminated:
                 raise KeyboardInterrupt
 
 
@@ -57,3 +57,36 @@ def deferred_interrupts() -> _Hold:
     handler runs in the main thread anyway).
     """
     return _Hold()
+
+
+# ---- SIGTERM ---------------------------------------------------------------------
+# A script or a service manager stops a program with SIGTERM, whose default action ends
+# the process on the spot: a recording is then left "not closed by its writer" and an
+# output half-written. tactsense takes SIGTERM the way it takes Ctrl-C: the handler does
+# what the SIGINT handler in force does (raise KeyboardInterrupt, or note it while
+# compiled code runs), so every command's Ctrl-C path (close the file, remove a partial
+# output, say what was kept) serves both.
+
+terminated = False
+"""True once a SIGTERM has arrived."""
+
+
+def _on_sigterm(number, frame) -> None:
+    global terminated
+    terminated = True
+    handler = signal.getsignal(signal.SIGINT)
+    if callable(handler):
+        handler(signal.SIGINT, frame)
+    else:  # SIG_DFL, or SIG_IGN as a background job of a script inherits it
+        raise KeyboardInterrupt
+
+
+def install_sigterm() -> None:
+    """Route SIGTERM to the current SIGINT handler (the main thread only)."""
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGTERM, _on_sigterm)
+
+
+def stopped_by() -> str:
+    """What stopped the command: ``"SIGTERM"`` or ``"Ctrl-C"``, for its last message."""
+    return "SIGTERM" if terminated else "Ctrl-C"

@@ -105,6 +105,13 @@ def guarded(function):
             try:
                 return function(*args, **kwargs)
             except KeyboardInterrupt:
+                from tactsense import _signals
+
+                if _signals.terminated:  # SIGTERM takes Ctrl-C's path; 143 = 128 + SIGTERM
+                    console.print(
+                        "[bold red]error:[/] stopped by SIGTERM; no output was left half-written"
+                    )
+                    raise typer.Exit(code=143) from None
                 console.print("[bold red]error:[/] interrupted; no output was left half-written")
                 raise typer.Exit(code=1) from None
             except (TactsenseInputError, FileExistsError) as error:

@@ -13,6 +13,7 @@ import numpy as np
 import typer
 from rich.progress import Progress, TextColumn
 
+from tactsense._signals import stopped_by
 from tactsense._validation import TactsenseInputError
 from tactsense.cli._common import (
     BaselineFramesOption,
@@ -77,8 +78,14 @@ FramesLimit = Annotated[
 ]
 DurationLimit = Annotated[
     float | None,
-    typer.Option("--duration", min=0.0, max=1e7, help="Stop after this long [s]."),
+    typer.Option("--duration", help="Stop after this long [s] (more than 0, at most 1e7)."),
 ]
+
+
+def _check_duration(duration: float | None) -> None:
+    """Refuse a --duration that would record nothing (0), or is not a number [s]."""
+    if duration is not None and not 0 < duration <= 1e7:
+        fail(f"--duration must be more than 0 s and at most 1e7 s; got {duration:g} s")
 
 
 LSL_PREFIX = "lsl:"
@@ -132,8 +139,16 @@ def _stream_and_locator(
     return reader, locator
 
 
+SCENARIO_PARAMETERS = (
+    "sensor", "scenario", "row", "col", "force_g", "increment", "dwell_s", "lift_s",
+    "repeats", "flaws", "seed",
+)  # fmt: skip
+"""emulate's options that build a scenario: a --recording brings its own frames."""
+
+
 @app.command()
 def emulate(
+    ctx: typer.Context,
     sensor: SensorOption = "initial",
     scenario: ScenarioOption = ScenarioKind.sweep_axial,
     row: RowOption = None,
@@ -161,10 +176,8 @@ def emulate(
     speed: Annotated[
         float,
         typer.Option(
-            min=0.0,
-            max=1e6,
-            help="Send frames at this multiple of the sensor's scan rate (0: as fast as "
-            "the line takes them).",
+            help="Send frames at this multiple of the sensor's scan rate (more than 0, at "
+            "most 1e6; 1e6 sends as fast as the line takes them).",
         ),
     ] = 1.0,
     loop: Annotated[
@@ -199,6 +212,22 @@ def emulate(
     from tactsense.io.recording import read_recording
     from tactsense.stream import Emulator, FaultRates
 
+    if not 0 < speed <= 1e6:
+        fail(
+            f"--speed must be more than 0 and at most 1e6 (a multiple of the scan rate); "
+            f"got {speed:g}; 1e6 sends as fast as the line takes them"
+        )
+    if recording is not None:
+        given = [
+            "--" + name.replace("_", "-")
+            for name in SCENARIO_PARAMETERS
+            if getattr(ctx.get_parameter_source(name), "name", "") == "COMMANDLINE"
+        ]
+        if given:
+            fail(
+                f"--recording excludes {', '.join(given)}: the recording brings its own "
+                "sensor and frames"
+            )
     try:
         faults = FaultRates(garbage, bitflip, drop, truncate, stall, stall_s)
         if recording is not None:
@@ -286,6 +315,7 @@ def record(
     from tactsense.stream import StreamError
     from tactsense.stream import record as run_record
 
+    _check_duration(duration)
     if record_format is None:
         mcap = out.suffix.lower() == ".mcap"
     else:
@@ -310,8 +340,11 @@ def record(
     ) as bar:
         task = bar.add_task(f"recording {source}")
 
+        kept = [0]  # frames in the file, as the recorder last reported
+
         def update(count: int, stats, rate: float) -> None:
-            bar.update(task, description=f"{out}: {rate:7.1f} frames/s, {stats.summary()}")
+            kept[0] = count
+            bar.update(task, description=f"{out}: {rate:7.1f} frames/s, {stats.summary(count)}")
 
         interrupted = False
         try:
@@ -323,9 +356,20 @@ def record(
         except KeyboardInterrupt:
             interrupted = True
         except (StreamError, TactsenseInputError, FileExistsError) as error:
-            fail(str(error))
-    stopped = " (stopped by Ctrl-C)" if interrupted else ""
-    console.print(f"wrote {out}{stopped}: {reader.stats.summary()}")
+            if kept[0] and out.exists():
+                losses = reader.stats.summary(kept[0]).partition(", ")[2]
+                fail(
+                    f"{error}; kept {kept[0]} frames in {out}" + (f" ({losses})" if losses else "")
+                )
+            fail(f"{error}; no frame was recorded, nothing written")
+    if interrupted:
+        stopped = f" (stopped by {stopped_by()})"
+        if not kept[0] and not out.exists():
+            console.print(f"stopped by {stopped_by()} before any frame arrived; nothing written")
+            raise typer.Exit(0)
+    else:
+        stopped = ""
+    console.print(f"wrote {out}{stopped}: {reader.stats.summary(kept[0])}")
 
 
 class LiveFormat(StrEnum):
@@ -368,6 +412,7 @@ def live(
     from tactsense.stream import StreamError
     from tactsense.stream.live import FIELDS
 
+    _check_duration(duration)
     if out is not None:
         check_output(out, force, inputs=[calibration, *sensor_file(sensor), *_source_file(source)])
     try:
@@ -385,6 +430,7 @@ def live(
     except TactsenseInputError as error:
         fail(str(error))
     latencies: list[float] = []
+    used = [0]  # frames given to the locator
 
     def run(stream) -> None:
         writer = None
@@ -392,6 +438,7 @@ def live(
             writer = csv.DictWriter(stream, fieldnames=FIELDS, lineterminator="\n")
             writer.writeheader()
         for frame in reader.frames(max_frames=frames, duration_s=duration):
+            used[0] += 1
             estimate = locator(frame)
             if outlets is not None:
                 outlets.push(frame, estimate)
@@ -413,14 +460,21 @@ def live(
     interrupted = False
     try:
         with reader:
-            if out is None:
-                run(sys.stdout)
-            else:
-                with atomic_output(out) as temporary, open(temporary, "w", newline="") as stream:
-                    try:
-                        run(stream)
-                    except KeyboardInterrupt:
-                        interrupted = True  # what was estimated so far is complete: keep it
+            try:
+                if out is None:
+                    run(sys.stdout)
+                else:
+                    with (
+                        atomic_output(out) as temporary,
+                        open(temporary, "w", newline="") as stream,
+                    ):
+                        try:
+                            run(stream)
+                        except KeyboardInterrupt:
+                            interrupted = True  # what was estimated so far is complete
+            finally:
+                if hasattr(reader, "stop"):
+                    reader.stop(wait_s=0.5)  # END settles the last frames' losses
     except KeyboardInterrupt:
         interrupted = True
     except (StreamError, TactsenseInputError) as error:
@@ -428,12 +482,16 @@ def live(
     except BrokenPipeError:
         sys.stderr.close()
         return
-    summary = reader.stats.summary()
+    warmup = used[0] - len(latencies)
+    summary = reader.stats.summary(used[0])
+    if warmup:  # after "N frames"
+        head, _, rest = summary.partition(", ")
+        summary = f"{head} ({warmup} for the baseline)" + (f", {rest}" if rest else "")
     if latencies:
         median, p99 = np.percentile(latencies, [50, 99])
         summary += f"; latency median {median:.3f} ms, p99 {p99:.3f} ms"
-    stopped = " (stopped by Ctrl-C)" if interrupted else ""
-    console.print(f"{len(latencies)} estimates{stopped}: {summary}")
+    stopped = f" (stopped by {stopped_by()})" if interrupted else ""
+    console.print(f"{len(latencies)} estimates{stopped} from {summary}")
 
 
 RECORDING_SUFFIXES = (".h5", ".hdf5")

@@ -317,6 +317,7 @@ def record_mcap(
     out = Path(out)
     _writer_class()  # a clear error before the file is made, if the extra is missing
     stream = open(out, "wb" if overwrite else "xb")
+    writer = None
     try:
         writer = McapTactileWriter(stream, reader.sensor, frame_id=frame_id, chunk_size=4096)
         start = last = time.perf_counter()
@@ -332,10 +333,18 @@ def record_mcap(
                         progress(writer.frames, reader.stats, rate)
                     last, reported = now, writer.frames
         finally:
-            writer.finish()
-            if progress is not None:
-                elapsed = max(time.perf_counter() - start, 1e-9)
-                progress(writer.frames, reader.stats, writer.frames / elapsed)
-    finally:
+            try:
+                if hasattr(reader, "stop"):
+                    reader.stop(wait_s=0.5)  # END settles the last frames' losses
+            finally:
+                writer.finish()
+                if progress is not None:
+                    elapsed = max(time.perf_counter() - start, 1e-9)
+                    progress(writer.frames, reader.stats, writer.frames / elapsed)
+    except BaseException:
         stream.close()
+        if writer is None or writer.frames == 0:
+            out.unlink(missing_ok=True)  # a failed start leaves no empty file
+        raise
+    stream.close()
     return out

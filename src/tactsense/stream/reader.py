@@ -2,8 +2,13 @@
 
 Every frame that does not arrive is counted: by the kind of damage seen on the line
 (bad check, truncated, garbage), and in total from the gaps in the sequence counter
-(and, when the device ends the stream, from its END packet). ``received + lost`` is
-the number of frames the device sent.
+(and, when the device ends the stream, from its END packet). ``frames + lost`` is
+the number of frames the device sent up to the last one delivered.
+
+``frames`` counts the frames delivered to the caller (written, estimated), not those
+that arrived: a fast device sends more than ``max_frames`` before it sees STOP, and
+those are dropped, neither counted as frames nor as losses (:attr:`StreamReader.unused`
+says how many).
 """
 
 from __future__ import annotations
@@ -45,7 +50,7 @@ class LossCounters:
     """What the reader received and what it lost, by kind."""
 
     frames: int = 0
-    """Frames received intact."""
+    """Frames received intact and delivered to the caller."""
     lost: int = 0
     """Frames missing from the sequence (every gap, and the tail reported by END)."""
     gaps: int = 0
@@ -65,9 +70,10 @@ class LossCounters:
     def as_dict(self) -> dict:
         return asdict(self)
 
-    def summary(self) -> str:
-        """One line for a terminal: every counter that is not zero."""
-        parts = [f"{self.frames} frames"]
+    def summary(self, frames: int | None = None) -> str:
+        """One line for a terminal: every counter that is not zero (``frames``: the
+        number of frames kept, when the caller knows it better)."""
+        parts = [f"{self.frames if frames is None else frames} frames"]
         for kind in LOSS_KINDS:
             value = getattr(self, kind)
             if value:
@@ -95,10 +101,26 @@ class StreamFrame:
 
 def open_port(url: str, *, baudrate: int = 921600) -> serial.SerialBase:
     """Open a pyserial port (device path, pty path, ``socket://HOST:PORT``, ``loop://``)."""
+    _check_socket_url(url)
     try:
         return serial.serial_for_url(url, baudrate=baudrate, timeout=0)
     except (serial.SerialException, ValueError, OSError) as error:
         raise StreamError(f"cannot open {url}: {error}") from None
+
+
+def _check_socket_url(url: str) -> None:
+    """One clear line for a malformed ``socket://HOST:PORT`` (pyserial answers with its
+    whole URL grammar, log levels included)."""
+    if not url.lower().startswith("socket://"):
+        return
+    address = url[len("socket://") :].split("?", 1)[0]
+    host, colon, port = address.rpartition(":")
+    if not colon or not host:
+        raise StreamError(f"{url}: expected socket://HOST:PORT, e.g. socket://127.0.0.1:5000")
+    if not port.isdigit():
+        raise StreamError(f"{url}: port {port!r} is not a number; expected 1-65535")
+    if not 1 <= int(port) <= 65535:
+        raise StreamError(f"{url}: port {int(port)} is out of range 1-65535")
 
 
 class StreamReader:
@@ -120,6 +142,9 @@ class StreamReader:
         prepare first (e.g. compile an estimator) and call :meth:`start` after.
     identify_timeout_s : float
         How long to wait for the device's IDENT answer [s].
+    first_frame_timeout_s : float, optional
+        A device that sends no intact frame this long after START is an error
+        (:class:`StreamError`) [s]. Default: the larger of 5 s and ``timeout_s``.
 
     Examples
     --------
@@ -137,6 +162,7 @@ class StreamReader:
         timeout_s: float | None = None,
         start: bool = True,
         identify_timeout_s: float = 3.0,
+        first_frame_timeout_s: float | None = None,
     ):
         self.url = url if isinstance(url, str) else getattr(url, "port", repr(url))
         self.port = open_port(url) if isinstance(url, str) else url
@@ -145,7 +171,13 @@ class StreamReader:
         self.ended = False
         self.frames_sent: int | None = None
         self._splitter = PacketSplitter()
-        self._ready: deque[StreamFrame] = deque()
+        self._ready: deque[tuple[StreamFrame, int]] = deque()  # (frame, sequence step)
+        self.unused = 0
+        """Intact frames that arrived after the caller stopped taking them (not kept)."""
+        self._finished = False
+        self._end_sequence: int | None = None  # END's last sequence, until settled
+        self._received_any = False
+        self._started_at: float | None = None
         self._last_seq: int | None = None
         self._last_time_us = 0
         self._index = -1
@@ -168,6 +200,11 @@ class StreamReader:
             )
             if not self.timeout_s > 0:
                 raise StreamError(f"timeout_s must be positive; got {timeout_s!r}")
+            self.first_frame_timeout_s = (
+                float(first_frame_timeout_s)
+                if first_frame_timeout_s is not None
+                else max(5.0, self.timeout_s)
+            )
             if start:
                 self.start()
         except BaseException:
@@ -226,11 +263,7 @@ class StreamReader:
         if isinstance(packet, FramePacket):
             self._accept(packet, host_time, arrival)
         elif isinstance(packet, EndPacket):
-            if self._last_seq is not None:
-                tail = (packet.last_sequence - self._last_seq) % SEQUENCE_MODULUS
-                if tail:
-                    self.stats.lost += tail
-                    self.stats.gaps += 1
+            self._end_sequence = packet.last_sequence
             self.frames_sent = packet.frames_sent
             self.ended = True
         elif isinstance(packet, ControlPacket) and packet.kind == Kind.IDENT:
@@ -238,7 +271,15 @@ class StreamReader:
 
     def _accept(self, packet: FramePacket, host_time: float, arrival: float) -> None:
         if self.sensor is not None and packet.counts.shape != self.sensor.shape:
-            self.stats.bad_check += 1
+            rows, cols = packet.counts.shape
+            raise StreamError(
+                f"{self.url}: the device sends frames of {rows}x{cols} tactels, but the "
+                f"sensor {self.sensor.name} has {self.sensor.shape[0]}x{self.sensor.shape[1]}; "
+                "give the device's own sensor description (--sensor) or fix its IDENT"
+            )
+        self._received_any = True
+        if self._finished:
+            self.unused += 1  # arrived after the caller stopped: not kept, not lost
             return
         if self._last_seq is None:
             step = 1
@@ -256,23 +297,52 @@ class StreamReader:
             if step == 0:
                 self.stats.duplicates += 1
                 return
-            if step > 1:
-                self.stats.lost += step - 1
-                self.stats.gaps += 1
         self._last_seq = packet.sequence
         self._last_time_us = packet.device_time_us
         self._index += step
-        self.stats.frames += 1
-        self._ready.append(
-            StreamFrame(
-                packet.sequence,
-                self._index,
-                packet.device_time_us * 1e-6,
-                host_time,
-                arrival,
-                packet.counts,
-            )
+        frame = StreamFrame(
+            packet.sequence,
+            self._index,
+            packet.device_time_us * 1e-6,
+            host_time,
+            arrival,
+            packet.counts,
         )
+        self._ready.append((frame, step))
+
+    def _settle_end(self) -> None:
+        """Count the frames the device sent after the last one received as lost, once
+        every frame received has been delivered: unless the caller stopped taking
+        frames before them (then they do not belong to its run)."""
+        if self._end_sequence is None or self._ready:
+            return
+        last, self._end_sequence = self._end_sequence, None
+        if self._last_seq is not None and not self.unused:
+            tail = (last - self._last_seq) % SEQUENCE_MODULUS
+            if tail:
+                self.stats.lost += tail
+                self.stats.gaps += 1
+
+    def _deliver(self) -> StreamFrame:
+        """The next frame for the caller; the frame and the gap before it count now."""
+        frame, step = self._ready.popleft()
+        self.stats.frames += 1
+        if step > 1:
+            self.stats.lost += step - 1
+            self.stats.gaps += 1
+        return frame
+
+    def _check_streaming(self, now: float) -> None:
+        """Raise if nothing intact came within ``first_frame_timeout_s`` of START."""
+        if self._received_any or self._started_at is None:
+            return
+        if now - self._started_at >= self.first_frame_timeout_s:
+            seen = self.stats.summary().removeprefix("0 frames")
+            raise StreamError(
+                f"{self.url}: no frame arrived within {self.first_frame_timeout_s:g} s of "
+                f"START{'; seen' + seen if seen else ''}; is the device streaming? "
+                "(--timeout sets a longer wait)"
+            )
 
     def _identify(self, timeout_s: float) -> SensorSpec:
         self.port.write(encode_control(Kind.IDENTIFY))
@@ -305,16 +375,18 @@ class StreamReader:
         last_frame = time.perf_counter()
         while max_frames is None or delivered < max_frames:
             while self._ready and (max_frames is None or delivered < max_frames):
-                yield self._ready.popleft()
+                yield self._deliver()
                 delivered += 1
                 last_frame = time.perf_counter()
             if max_frames is not None and delivered >= max_frames:
                 return
             if self.ended and not self._ready:
+                self._settle_end()
                 return
             now = time.perf_counter()
             if deadline is not None and now >= deadline:
                 return
+            self._check_streaming(now)
             wait = self.timeout_s - (now - last_frame)
             if deadline is not None:
                 wait = min(wait, deadline - now)
@@ -332,7 +404,10 @@ class StreamReader:
             self._pump(wait_s)
         while self._pump(0.0) and len(self._ready) < max_frames:
             pass
-        return [self._ready.popleft() for _ in range(min(max_frames, len(self._ready)))]
+        batch = [self._deliver() for _ in range(min(max_frames, len(self._ready)))]
+        if self.ended:
+            self._settle_end()
+        return batch
 
     def start(self) -> None:
         """Ask the device to stream (sent by the constructor unless ``start=False``)."""
@@ -340,21 +415,37 @@ class StreamReader:
             self.port.write(encode_control(Kind.START))
         except (serial.SerialException, OSError) as error:
             raise StreamError(f"{self.url}: cannot send START: {error}") from None
+        self._started_at = time.perf_counter()
 
     def stop(self, wait_s: float = 1.0) -> None:
-        """Ask the device to stop and account for the frames it sent before END."""
-        try:
-            self.port.write(encode_control(Kind.STOP))
-        except (serial.SerialException, OSError):
+        """Ask the device to stop and account for the frames it sent before END.
+
+        The caller takes no more frames: those waiting and those still arriving are
+        dropped (counted in :attr:`unused`, not in ``stats``). Waits up to ``wait_s``
+        [s] for END, whose count of frames sent tells whether the last frames before
+        the stop were lost on the line. Calling it again does nothing.
+        """
+        if self._finished:
             return
-        deadline = time.perf_counter() + wait_s
-        while not self.ended and time.perf_counter() < deadline:
-            self._pump(min(0.05, wait_s))
+        self._finished = True
+        self.unused += len(self._ready)
+        self._ready.clear()
+        if not self.ended and self.port.is_open:
+            try:
+                self.port.write(encode_control(Kind.STOP))
+                deadline = time.perf_counter() + wait_s
+                while not self.ended and time.perf_counter() < deadline:
+                    self._pump(min(0.05, wait_s))
+            except (serial.SerialException, OSError, StreamError):
+                pass
+        self.unused += len(self._ready)  # a frame sent before STOP and after the last taken
+        self._ready.clear()
+        self._settle_end()
 
     def close(self) -> None:
         """Tell the device to stop streaming (if it still is) and close the line."""
         if self.port.is_open:
-            if not self.ended:
+            if not self.ended and not self._finished:
                 try:
                     self.port.write(encode_control(Kind.STOP))
                     self.port.flush()
