@@ -5,6 +5,7 @@ import pytest
 from typer.testing import CliRunner
 
 import tactsense as ts
+import tactsense.flat_scenarios
 from tactsense.cli import app
 from tactsense.flat_scenarios import press
 
@@ -91,3 +92,35 @@ def test_a_pad_exports_its_frames_to_mcap_as_tactile_state(tmp_path):
     assert len(values) == len(recording.frames)
     np.testing.assert_array_equal(np.stack(values), recording.frames.reshape(len(values), -1))
     assert f"{len(values)} frames, 0 with a contact" in result.output
+
+
+def test_an_emulated_pad_records_bit_identical_to_its_simulation(tmp_path):
+    """`emulate --sensor pad16` plays the twin's pad frames over TCP; `record` keeps them
+    exactly (the same frames `simulate` writes for the same scenario and seed)."""
+    import subprocess
+    import sys
+
+    cli = [sys.executable, "-m", "tactsense_launcher"]
+    emulator = subprocess.Popen(
+        [*cli, "emulate", "--sensor", "pad16", "--scenario", "two-probes", "--port", "0",
+         "--speed", "1e6"],
+        stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True,
+    )  # fmt: skip
+    try:
+        url = emulator.stdout.readline().strip()
+        assert url.startswith("socket://127.0.0.1:"), url
+        out = tmp_path / "live.h5"
+        done = subprocess.run(
+            [*cli, "record", url, "--out", str(out), "--frames", "60"],
+            capture_output=True, text=True, timeout=120,
+        )  # fmt: skip
+        assert done.returncode == 0, done.stderr
+    finally:
+        emulator.terminate()
+        emulator.wait(timeout=30)
+    recorded = ts.read_recording(out)
+    assert recorded.sensor == ts.preset("pad16")
+    simulated = ts.simulate(
+        ts.preset("pad16"), ts.flat_scenarios.two_probes(ts.preset("pad16")), rng=0
+    )
+    np.testing.assert_array_equal(recorded.frames, simulated.frames[:60])

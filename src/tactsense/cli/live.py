@@ -28,17 +28,23 @@ from tactsense.cli._common import (
     sensor_file,
 )
 from tactsense.cli._scenario import (
+    AngleOption,
     ColOption,
     DwellOption,
     FlawsOption,
     ForceGOption,
     IncrementOption,
+    IndenterOption,
     LiftOption,
     RepeatsOption,
     RowOption,
-    ScenarioKind,
     ScenarioOption,
     SeedOption,
+    SeparationOption,
+    SizeOption,
+    SpeedOption,
+    XOption,
+    YOption,
     build_scenario,
     run_scenario,
 )
@@ -141,7 +147,8 @@ def _stream_and_locator(
 
 SCENARIO_PARAMETERS = (
     "sensor", "scenario", "row", "col", "force_g", "increment", "dwell_s", "lift_s",
-    "repeats", "flaws", "seed",
+    "repeats", "x_mm", "y_mm", "separation_mm", "indenter", "size_mm", "speed_mm_s",
+    "angle_deg", "flaws", "seed",
 )  # fmt: skip
 """emulate's options that build a scenario: a --recording brings its own frames."""
 
@@ -150,7 +157,7 @@ SCENARIO_PARAMETERS = (
 def emulate(
     ctx: typer.Context,
     sensor: SensorOption = "initial",
-    scenario: ScenarioOption = ScenarioKind.sweep_axial,
+    scenario: ScenarioOption = None,
     row: RowOption = None,
     col: ColOption = None,
     force_g: ForceGOption = None,
@@ -158,6 +165,13 @@ def emulate(
     dwell_s: DwellOption = None,
     lift_s: LiftOption = None,
     repeats: RepeatsOption = None,
+    x_mm: XOption = None,
+    y_mm: YOption = None,
+    separation_mm: SeparationOption = None,
+    indenter: IndenterOption = None,
+    size_mm: SizeOption = None,
+    speed_mm_s: SpeedOption = None,
+    angle_deg: AngleOption = None,
     flaws: FlawsOption = "all",
     seed: SeedOption = 0,
     recording: Annotated[
@@ -203,7 +217,8 @@ def emulate(
         int, typer.Option(min=0, help="Seed of the fault draws, for a repeatable line.")
     ] = 0,
 ) -> None:
-    """Play the finger as a device: frames of the twin in the wire protocol on a pty or TCP.
+    """Play a sensor as a device: frames of the twin (a finger, a pad or a point set) in the
+    wire protocol on a pty or TCP.
 
     Prints where to connect on standard output (a pty path, or socket://127.0.0.1:PORT)
     and serves until Ctrl-C. The device streams after a host sends START
@@ -236,7 +251,9 @@ def emulate(
             spec = load_sensor(sensor)
             scene = build_scenario(
                 spec, scenario, row=row, col=col, force_g=force_g, increment=increment,
-                dwell_s=dwell_s, lift_s=lift_s, repeats=repeats,
+                dwell_s=dwell_s, lift_s=lift_s, repeats=repeats, x_mm=x_mm, y_mm=y_mm,
+                separation_mm=separation_mm, indenter=indenter, size_mm=size_mm,
+                speed_mm_s=speed_mm_s, angle_deg=angle_deg,
             )  # fmt: skip
             source = run_scenario(spec, scene, flaws=flaws, seed=seed)
         emulator = Emulator.from_recording(
