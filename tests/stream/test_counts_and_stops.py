@@ -133,3 +133,34 @@ def test_sigterm_on_a_long_locate_leaves_nothing_half_written(tmp_path):
     assert not out.exists()
     assert not [p for p in os.listdir(tmp_path) if ".partial" in p]
     assert read_recording(rec).frames.shape == frames.shape  # the input untouched
+
+
+def test_device_time_is_stored_exactly_in_microseconds(tmp_path):
+    """Issue 22: the device clock is kept exactly, as the integers the frames carried
+    (float seconds were one float step off for about 29 % of frames at 7 Hz)."""
+    from tactsense.io.recording import write_recording
+    from tactsense.stream import Emulator, StreamReader, record
+
+    spec = ts.fearing1990_initial()
+    source = ts.simulate(spec, ts.probe_sweep(spec), rng=0)
+    emulator = Emulator.from_recording(source, speed=1e6)
+    thread, port = emulator.start_tcp()
+    out = tmp_path / "exact.h5"
+    try:
+        with StreamReader(f"socket://127.0.0.1:{port}") as stream:
+            record(stream, out, max_frames=120)
+    finally:
+        emulator.stop()
+        thread.join(timeout=10)
+    recording = ts.read_recording(out)
+    assert recording.device_time_us.dtype == np.int64
+    # the twin's clock: round(k * period) microseconds from its first scan (docs/protocol.md)
+    k = np.arange(len(recording.frames)) + int(recording.sequence[0])
+    period_us = 1e6 / spec.electronics.scan_rate_hz
+    np.testing.assert_array_equal(
+        recording.device_time_us, np.round(k * period_us).astype(np.int64)
+    )
+    # and it survives a copy through write_recording
+    copy = tmp_path / "copy.h5"
+    write_recording(copy, recording)
+    np.testing.assert_array_equal(ts.read_recording(copy).device_time_us, recording.device_time_us)

@@ -12,6 +12,7 @@ Layout of a recording file (format ``tactsense-recording``, version 2)::
     /truth/...           what was applied, for simulated recordings (optional)
     /sequence            (T,) uint16 sequence number on the wire (recorded streams, v2)
     /host_time           (T,) arrival on the host, Unix time [s] (recorded streams, v2)
+    /device_time_us      (T,) int64 device clock as sent [us] (recorded streams, exact)
     /losses              (K,) int64 loss counters, attrs: kinds = comma list (v2)
 
 Version 1 (no stream datasets) is still read. Every dataset tactsense writes is chunked
@@ -91,6 +92,9 @@ class Recording:
         Sequence number of each frame on the wire (recorded streams).
     host_time_s : ndarray, shape (T,), optional
         Arrival of each frame on the host, Unix time [s] (recorded streams).
+    device_time_us : ndarray of int64, shape (T,), optional
+        Start of each frame's scan on the device clock, exactly as the wire carried it
+        [us] (recorded streams; ``time_s`` holds it as float seconds).
     losses : dict
         Loss counters of the stream it was recorded from (``tactsense.stream``).
     source : str
@@ -110,6 +114,7 @@ class Recording:
     gains: np.ndarray | None = None
     sequence: np.ndarray | None = None
     host_time_s: np.ndarray | None = None
+    device_time_us: np.ndarray | None = None
     losses: dict = field(default_factory=dict)
     source: str = ""
     closed_cleanly: bool = True
@@ -241,6 +246,11 @@ def _write_file(partial: Path, recording: Recording) -> None:
         if recording.host_time_s is not None:
             host = _checked_dataset(h5, "host_time", np.asarray(recording.host_time_s, float))
             host.attrs["units"] = "s"
+        if recording.device_time_us is not None:
+            device = _checked_dataset(
+                h5, "device_time_us", np.asarray(recording.device_time_us, np.int64)
+            )
+            device.attrs["units"] = "us"
         if recording.losses:
             losses = _checked_dataset(h5, "losses", np.array(list(recording.losses.values())))
             losses.attrs["kinds"] = ",".join(recording.losses)
@@ -500,7 +510,7 @@ def _validate(path: Path, h5) -> tuple[SensorSpec, int]:
         sensor = SensorSpec.from_toml_string(str(h5.attrs["sensor_toml"]))
     except (KeyError, SensorSpecError) as error:
         raise RecordingError(f"{path}: sensor description unreadable: {error}") from None
-    for name in ("frames", "time", "sample_offset", "sequence", "host_time"):
+    for name in ("frames", "time", "sample_offset", "sequence", "host_time", "device_time_us"):
         if name in h5 and h5[name].dtype.kind not in "uif":
             raise RecordingError(
                 f"{path}: /{name} holds {h5[name].dtype} values; expected numbers "
@@ -508,7 +518,7 @@ def _validate(path: Path, h5) -> tuple[SensorSpec, int]:
             )
     per_frame = [
         h5[name].shape[0]
-        for name in ("frames", "time", "sequence", "host_time")
+        for name in ("frames", "time", "sequence", "host_time", "device_time_us")
         if name in h5 and h5[name].ndim >= 1
     ]
     n = min(per_frame)  # a killed writer may have flushed one dataset further
@@ -564,6 +574,7 @@ def read_recording(path: str | Path) -> Recording:
             gains=h5["gains"][()] if "gains" in h5 else None,
             sequence=h5["sequence"][:n] if "sequence" in h5 else None,
             host_time_s=h5["host_time"][:n] if "host_time" in h5 else None,
+            device_time_us=h5["device_time_us"][:n] if "device_time_us" in h5 else None,
             losses=losses,
             source=str(h5.attrs.get("source", "")),
             closed_cleanly=closed_cleanly,
@@ -733,6 +744,14 @@ class RecordingWriter:
                 "host_time", (0,), float, maxshape=(None,), chunks=(chunk,), fletcher32=True
             )
             self._host.attrs["units"] = "s"
+            self._device_us = h5.create_dataset(
+                "device_time_us", (0,), np.int64, maxshape=(None,), chunks=(chunk,),
+                fletcher32=True,
+            )  # fmt: skip
+            self._device_us.attrs["units"] = "us"
+            self._device_us.attrs["meaning"] = (
+                "start of each frame's scan on the device clock, exactly as sent (-1: not known)"
+            )
             offset = _checked_dataset(h5, "sample_offset", np.asarray(sample_offset_s, float))
             offset.attrs["units"] = "s"
             self._kinds = list(loss_kinds)
@@ -751,9 +770,21 @@ class RecordingWriter:
     def __len__(self) -> int:
         return self._count + len(self._buffer)
 
-    def append(self, counts, device_time_s: float, sequence: int, host_time_s: float) -> None:
-        """Add one frame; flushes when ``flush_interval_s`` has passed since the last."""
-        self._buffer.append((counts, device_time_s, sequence, host_time_s))
+    def append(
+        self,
+        counts,
+        device_time_s: float,
+        sequence: int,
+        host_time_s: float,
+        *,
+        device_time_us: int = -1,
+    ) -> None:
+        """Add one frame; flushes when ``flush_interval_s`` has passed since the last.
+
+        ``device_time_us`` is the device clock exactly as the frame carried it [us]
+        (``/device_time_us``; ``/time`` holds it in seconds, a float).
+        """
+        self._buffer.append((counts, device_time_s, sequence, host_time_s, int(device_time_us)))
         if time.monotonic() - self._last_flush >= self._interval:
             self.flush()
 
@@ -761,13 +792,16 @@ class RecordingWriter:
         """Write the buffered frames and the loss counters, and flush the file."""
         if self._buffer:
             n, k = self._count, len(self._buffer)
-            counts, times, seqs, hosts = zip(*self._buffer, strict=True)
-            for dataset in (self._frames, self._time, self._sequence, self._host):
+            counts, times, seqs, hosts, device_us = zip(*self._buffer, strict=True)
+            for dataset in (
+                self._frames, self._time, self._sequence, self._host, self._device_us
+            ):  # fmt: skip
                 dataset.resize(n + k, axis=0)
             self._frames[n:] = np.stack(counts)
             self._time[n:] = times
             self._sequence[n:] = seqs
             self._host[n:] = hosts
+            self._device_us[n:] = device_us
             self._count += k
             self._buffer.clear()
         if self._loss_source is not None and self._kinds:

@@ -97,6 +97,9 @@ class StreamFrame:
     """Arrival on :func:`time.perf_counter` [s], for latency measurements."""
     counts: np.ndarray
     """(rows, cols) readings [counts]."""
+    device_time_us: int = -1
+    """Start of the frame's scan on the device clock, exactly as sent [us] (-1: unknown,
+    a frame that did not come over the wire protocol)."""
 
 
 def open_port(url: str, *, baudrate: int = 921600) -> serial.SerialBase:
@@ -307,6 +310,7 @@ class StreamReader:
             host_time,
             arrival,
             packet.counts,
+            int(packet.device_time_us),
         )
         self._ready.append((frame, step))
 

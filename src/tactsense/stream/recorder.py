@@ -63,7 +63,13 @@ def record(
     reported = 0
     try:
         for frame in reader.frames(max_frames=max_frames, duration_s=duration_s):
-            writer.append(frame.counts, frame.device_time_s, frame.sequence, frame.host_time_s)
+            writer.append(
+                frame.counts,
+                frame.device_time_s,
+                frame.sequence,
+                frame.host_time_s,
+                device_time_us=frame.device_time_us,
+            )
             now = time.perf_counter()
             if progress is not None and now - last_report >= progress_interval_s:
                 rate = (len(writer) - reported) / (now - last_report)
