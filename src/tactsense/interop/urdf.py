@@ -78,8 +78,13 @@ def _positive_int(element, attribute: str, source: str) -> int:
     return value
 
 
-def read_tactile_arrays(path: str | Path) -> list[TactileArray]:
-    """Every tactile array described in a URDF file (sensors without one are skipped)."""
+def _local(element) -> str:
+    """An element's tag without its XML namespace."""
+    return element.tag.rsplit("}", 1)[-1]
+
+
+def _tactile_sensors(path: str | Path):
+    """Every ``(<sensor>, <tactile>)`` pair of a URDF file, or UrdfError naming the file."""
     path = Path(path)
     try:
         root = ET.parse(path).getroot()
@@ -87,14 +92,27 @@ def read_tactile_arrays(path: str | Path) -> list[TactileArray]:
         raise UrdfError(f"{path}: not XML ({error})") from None
     except OSError as error:
         raise UrdfError(f"cannot read {path}: {error.strerror or error}") from None
-    arrays = []
     for sensor in root.iter():
-        if sensor.tag.rsplit("}", 1)[-1] != "sensor":
+        if _local(sensor) != "sensor":
             continue
-        tactile = next((c for c in sensor if c.tag.rsplit("}", 1)[-1] == "tactile"), None)
-        if tactile is None:
-            continue
-        array = next((c for c in tactile if c.tag.rsplit("}", 1)[-1] == "array"), None)
+        tactile = next((c for c in sensor if _local(c) == "tactile"), None)
+        if tactile is not None:
+            yield sensor, tactile
+
+
+def _update_rate(sensor, source: str) -> float | None:
+    rate = sensor.get("update_rate")
+    try:
+        return None if rate is None else float(rate)
+    except ValueError:
+        raise UrdfError(f"{source}: update_rate={rate!r} is not a number [Hz]") from None
+
+
+def read_tactile_arrays(path: str | Path) -> list[TactileArray]:
+    """Every tactile array described in a URDF file (sensors without one are skipped)."""
+    arrays = []
+    for sensor, tactile in _tactile_sensors(path):
+        array = next((c for c in tactile if _local(c) == "array"), None)
         if array is None:
             continue
         name = sensor.get("name") or f"sensor {len(arrays)}"
@@ -110,12 +128,8 @@ def read_tactile_arrays(path: str | Path) -> list[TactileArray]:
         spacing = _pair(array, "spacing", size, source)
         if spacing == (0.0, 0.0):
             spacing = size  # the toolbox: "equals size by default"
-        rate = sensor.get("update_rate")
-        try:
-            rate_hz = None if rate is None else float(rate)
-        except ValueError:
-            raise UrdfError(f"{source}: update_rate={rate!r} is not a number [Hz]") from None
-        parent = next((c for c in sensor if c.tag.rsplit("}", 1)[-1] == "parent"), None)
+        rate_hz = _update_rate(sensor, source)
+        parent = next((c for c in sensor if _local(c) == "parent"), None)
         arrays.append(
             TactileArray(
                 name=name,
@@ -275,10 +289,6 @@ def _triple(element, attribute: str, source: str) -> tuple[float, float, float]:
     return values
 
 
-def _local(element) -> str:
-    return element.tag.rsplit("}", 1)[-1]
-
-
 def _taxel_box(taxel) -> tuple[float, float] | None:
     """Size (x, y) of a taxel's ``<box>`` geometry [m], if it has one."""
     geometry = next((c for c in taxel if _local(c) == "geometry"), None)
@@ -314,20 +324,8 @@ def _taxel_area(taxel, source: str) -> float | None:
 
 def read_tactile_taxels(path: str | Path) -> list[TactileTaxels]:
     """Every tactile sensor of a URDF file given as a ``<taxel>`` list."""
-    path = Path(path)
-    try:
-        root = ET.parse(path).getroot()
-    except ET.ParseError as error:
-        raise UrdfError(f"{path}: not XML ({error})") from None
-    except OSError as error:
-        raise UrdfError(f"cannot read {path}: {error.strerror or error}") from None
     found = []
-    for sensor in root.iter():
-        if _local(sensor) != "sensor":
-            continue
-        tactile = next((c for c in sensor if _local(c) == "tactile"), None)
-        if tactile is None:
-            continue
+    for sensor, tactile in _tactile_sensors(path):
         taxels = [c for c in tactile if _local(c) == "taxel"]
         if not taxels:
             continue
@@ -343,11 +341,7 @@ def read_tactile_taxels(path: str | Path) -> list[TactileTaxels]:
             rpy.append(_triple(taxel, "rpy", source))
             area.append(_taxel_area(taxel, source))
             box.append(_taxel_box(taxel))
-        rate = sensor.get("update_rate")
-        try:
-            rate_hz = None if rate is None else float(rate)
-        except ValueError:
-            raise UrdfError(f"{source}: update_rate={rate!r} is not a number [Hz]") from None
+        rate_hz = _update_rate(sensor, source)
         found.append(
             TactileTaxels(
                 name, tuple(idx), tuple(xyz), tuple(rpy), tuple(area), tuple(box), rate_hz

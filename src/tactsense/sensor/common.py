@@ -180,6 +180,16 @@ class SpecBase:
     kind: ClassVar[str]
     SECTIONS: ClassVar[dict[str, type]]
 
+    def __post_init__(self) -> None:
+        problems = self.problems()
+        if problems:
+            raise SensorSpecError(
+                f"invalid sensor description {self.name!r}:\n  - " + "\n  - ".join(problems)
+            )
+
+    def problems(self) -> list[str]:  # pragma: no cover - every kind defines it
+        raise NotImplementedError
+
     # ---- shared derived quantities -------------------------------------------
     @property
     def scan_period_s(self) -> float:

@@ -30,7 +30,6 @@ from tactsense.sensor.common import (
     VACUUM_PERMITTIVITY,
     Electronics,
     Flaws,
-    SensorSpecError,
     SpecBase,
     check_electronics,
     check_flaws,
@@ -159,12 +158,9 @@ class SensorSpec(SpecBase):
     kind: ClassVar[str] = "finger"
     SECTIONS: ClassVar[dict[str, type]] = _SECTIONS
 
-    def __post_init__(self) -> None:
-        problems = _validate(self)
-        if problems:
-            raise SensorSpecError(
-                f"invalid sensor description {self.name!r}:\n  - " + "\n  - ".join(problems)
-            )
+    def problems(self) -> list[str]:
+        """Every problem with this description, as readable sentences (none: valid)."""
+        return _validate(self)
 
     # ---- derived quantities -------------------------------------------------
     @property

@@ -65,12 +65,9 @@ class PointsSpec(SpecBase):
         "flaws": Flaws,
     }
 
-    def __post_init__(self) -> None:
-        problems = _validate(self)
-        if problems:
-            raise SensorSpecError(
-                f"invalid sensor description {self.name!r}:\n  - " + "\n  - ".join(problems)
-            )
+    def problems(self) -> list[str]:
+        """Every problem with this description, as readable sentences (none: valid)."""
+        return _validate(self)
 
     @property
     def shape(self) -> tuple[int, int]:
