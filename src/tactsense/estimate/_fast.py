@@ -281,6 +281,15 @@ def locate_into(
             zy0[r] = a0
             peak += kx0[r] * a0
         value[f] = peak
+        if first_row == 1 and x < 1.0:
+            # the tip gap: the tip row lies a long step (11 mm on the paper's fingers)
+            # before row 1, not one spacing, so the position between them is the
+            # deflection-weighted mean of the two rows' true positions (the row is the
+            # fraction of that step; the geometry maps it linearly)
+            tip = max(zy0[0], 0.0)
+            ring = max(zy0[1], 0.0)
+            if tip + ring > 0.0:
+                row[f] = ring / (tip + ring)
         # skew along the finger (eqs. 62-63) at offsets within the cylinder rows
         room = min(x - first_row, rows - 1 - x)
         if room < 0.5:
