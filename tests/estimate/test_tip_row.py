@@ -65,7 +65,7 @@ def test_gap_rule_is_the_weighted_mean_of_the_true_row_positions():
     """Independent evaluation: the two rows interpolated along the columns at the
     estimated column, negative readings as 0, their deflection-weighted mean of the
     rows' positions in millimetres (not tactel units), against the estimate."""
-    spec, axial, frames = gap_sweep(22.5)
+    spec, _, frames = gap_sweep(22.5)
     est = ts.locate(frames, spec, counts=False, threshold=1e-4)
     in_gap = est.row < 1.0
     assert in_gap.sum() >= 20

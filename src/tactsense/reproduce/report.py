@@ -91,8 +91,9 @@ BASIS_TEXT = (
     "match it; the note names it), *by construction* (true of the model by definition, "
     "e.g. a fit recovering the twin's own parameters, or a residual that is the twin's "
     "own noise), *arithmetic* (a formula of the paper evaluated, a unit conversion) or "
-    "*restated* (a prediction already in the table, in other units: shown, not counted). Fitted and by-construction claims within "
-    "tolerance are *consistent*, never *agrees*: they are echoes, not evidence."
+    "*restated* (a prediction already in the table, in other units: shown, not "
+    "counted). Fitted and by-construction claims within tolerance are *consistent*, "
+    "never *agrees*: they are echoes, not evidence."
 )
 
 INTRO = (
