@@ -95,6 +95,14 @@ def test_every_figure_is_written_and_reported(report):
     assert not re.search(r"src=['\"](?!data:)", page)
     for claim_id in REQUIRED:
         assert claim_id in markdown and claim_id in page
+    # issue 26: Fig. 7 states the gains' bias with numbers that agree with each other;
+    # Fig. 21 is drawn at the rows' true positions; Fig. 22 draws both 20 % branches
+    text = {f["number"]: f for f in results["figures"]}
+    bias = re.search(r"(\d+) of (\d+) errors negative, median ([-+0-9.]+) %", text[7]["result"])
+    negative, total, median = int(bias[1]), int(bias[2]), float(bias[3])
+    assert total == 56 and (median < 0) == (negative > total / 2)
+    assert "11.1 mm before row 1" in text[21]["simulated"]
+    assert "two separate branches, both drawn" in text[22]["result"]
 
 
 def test_arithmetic_claims_against_independent_evaluations(report):
