@@ -146,7 +146,14 @@ def test_fifty_grams_gives_about_100_counts(initial):
 def test_rod_and_flat_contacts_spread_and_conserve_shape(initial):
     rod = ts.rod(12.0, 0.0, G50, orientation_deg=45.0)
     frame = tactel_deflection(initial, rod)
-    assert frame.max() > 0
+    # linear elasticity: twice the force, twice every tactel (to rounding)
+    double = tactel_deflection(initial, ts.rod(12.0, 0.0, 2 * G50, orientation_deg=45.0))
+    np.testing.assert_allclose(double, 2 * frame, rtol=1e-9, atol=1e-15)
+    # the largest tactel lies under the rod's centre (12 mm: between rows 3 and 4, column
+    # 0), and spreading the force along the rod lowers it below a probe's
+    assert np.unravel_index(frame.argmax(), frame.shape) in {(3, 0), (4, 0)}
+    probe = tactel_deflection(initial, ts.Probe(12.0, 0.0, G50))
+    assert 0.1 * probe.max() < frame.max() < probe.max()
     # a rod at 45 deg loads neighbouring columns at neighbouring rows (Fig. 22)
     assert frame[2, 7] > frame[2, 1] and frame[4, 1] > frame[4, 7]
     small = tactel_deflection(initial, ts.soft_object(12.0, 0.0, G50, length_mm=2.0))

@@ -261,7 +261,21 @@ def test_odd_strain_peak_and_skew_coefficient(nu):
 def test_printed_skew_constant_is_a_misprint():
     # eq. 67 prints 0.2441 for nu = 0.5; the maximum is 0.2805. The printed eq. 65
     # (with -4 for -4 nu) puts the peak at 0.685 d, where the ratio is 0.2430.
-    assert hp.line_load_skew_coefficient(0.5) == pytest.approx(0.28055, abs=1e-5)
-    t_printed = np.sqrt((4.5 - np.sqrt(9 * 1.5**2 - 4)) / 1.0)
-    at_printed = t_printed * (1 - 0.5 * t_printed**2) / (1 + t_printed**2) ** 2
-    assert at_printed == pytest.approx(0.2441, rel=0.01)
+    # The ratio is evaluated with the code's own eq. 7 (odd part at the offset over the
+    # even peak, per tan alpha), at the printed location and at the code's location.
+    nu, alpha = 0.5, np.radians(20.0)
+
+    def ratio(x):
+        plus = hp.line_load_strain(x, D, 1.0, alpha, youngs_modulus=E, poisson_ratio=nu)
+        minus = hp.line_load_strain(-x, D, 1.0, alpha, youngs_modulus=E, poisson_ratio=nu)
+        even = hp.line_load_strain(0.0, D, 1.0, alpha, youngs_modulus=E, poisson_ratio=nu)
+        return 0.5 * (plus - minus) / even / np.tan(alpha)
+
+    printed_t = np.sqrt((3 * (1 + nu) - np.sqrt(9 * (1 + nu) ** 2 - 4)) / (2 * nu))
+    assert printed_t == pytest.approx(0.685, abs=1e-3)
+    # the code's offset is not the printed one, and its ratio is the larger (the maximum)
+    assert hp.odd_peak_offset(D, nu) / D == pytest.approx(0.4775, abs=1e-4)
+    assert ratio(printed_t * D) == pytest.approx(0.2430, abs=5e-4)
+    assert ratio(printed_t * D) == pytest.approx(0.2441, rel=0.01)  # the printed constant
+    assert hp.line_load_skew_coefficient(nu) == pytest.approx(ratio(hp.odd_peak_offset(D, nu)))
+    assert hp.line_load_skew_coefficient(nu) == pytest.approx(0.28055, abs=1e-5)

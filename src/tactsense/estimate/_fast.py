@@ -122,7 +122,41 @@ def locate_frames(z, valid, periodic, first_row, tolerance, max_iterations, max_
         z, valid, periodic, first_row, tolerance, max_iterations, max_step,
         row, col, value, iterations, converged, summed, skew, second,
     )  # fmt: skip
+    if first_row == 1:
+        place_tip_gap(z, periodic, row, col)
     return row, col, value, iterations, converged, summed, skew, second
+
+
+@jit(nogil=True, fastmath=FASTMATH, error_model="numpy")
+def place_tip_gap(z, periodic, row, col):
+    """Peaks between the tip row and row 1 placed in the true step between them.
+
+    The tip row lies a long step (11.1 mm on the paper's fingers) before row 1, not one
+    spacing, so the sinc interpolation cannot place a peak inside that step. A frame
+    whose ``row`` is below 1 gets ``row = z1 / (z0 + z1)``, with ``z0``, ``z1`` the two
+    rows interpolated around the finger at ``col`` (negative values as 0): the
+    deflection-weighted mean of the two rows' true positions once the geometry maps
+    the row linearly onto the step. Other frames (and NaN rows) are left alone. A pass
+    of its own after :func:`locate_into`, so that the Newton kernel stays as it was.
+    """
+    n_frames, _, cols = z.shape
+    ky0 = np.empty(cols)
+    ky1 = np.empty(cols)
+    ky2 = np.empty(cols)
+    cos_c, sin_c = _trig_table(cols)
+    for f in range(n_frames):
+        if not row[f] < 1.0:
+            continue
+        _axis_weights(col[f], cols, periodic, cos_c, sin_c, ky0, ky1, ky2)
+        tip = 0.0
+        ring = 0.0
+        for c in range(cols):
+            tip += z[f, 0, c] * ky0[c]
+            ring += z[f, 1, c] * ky0[c]
+        tip = max(tip, 0.0)
+        ring = max(ring, 0.0)
+        if tip + ring > 0.0:
+            row[f] = ring / (tip + ring)
 
 
 @jit(nogil=True, fastmath=FASTMATH, error_model="numpy")

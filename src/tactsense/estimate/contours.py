@@ -50,6 +50,7 @@ def track_contour(
     periodic: bool = False,
     step: float = 0.05,
     max_steps: int = 4000,
+    toward: float = 1.0,
 ) -> Contour:
     """Follow the contour f = level around a peak (eqs. 49-51).
 
@@ -74,6 +75,11 @@ def track_contour(
         reaches the first ring ends there, open.
     step : float
         Delta r of eq. 51 [tactel].
+    toward : {1.0, -1.0}
+        Which way along the finger the start is searched: toward the base (+1, the
+        default) or toward the tip (-1). An open contour can have two separate branches,
+        one on each side of the peak (a rod across the array): each is tracked from its
+        own side.
 
     Returns
     -------
@@ -89,12 +95,14 @@ def track_contour(
     x, y = float(start_row), float(start_col)
     if surface(z, x, y, periodic=periodic) <= level:
         raise ValueError("the start point must lie inside the contour (above its level)")
+    if toward not in (1.0, -1.0):
+        raise ValueError(f"toward must be 1 or -1; got {toward!r}")
     low = x
     while surface(z, low, y, periodic=periodic) > level:
-        low += step
-        if low > rows - 1:
+        low += toward * step
+        if not first <= low <= rows - 1:
             raise ValueError("the contour does not close along the finger within the array")
-    high, low = low, low - step
+    high, low = low, low - toward * step
     for _ in range(40):  # bisection onto the level
         mid = 0.5 * (low + high)
         if surface(z, mid, y, periodic=periodic) > level:

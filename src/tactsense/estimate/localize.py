@@ -37,6 +37,7 @@ def newton_peak(
     periodic: bool = False,
     tolerance: float = TOLERANCE,
     max_iterations: int = MAX_ITERATIONS,
+    tip_row: bool = False,
 ) -> Peak:
     """Find the maximum of the interpolated surface near a starting tactel (eq. 53).
 
@@ -52,6 +53,14 @@ def newton_peak(
         Starting point, usually the largest tactel [tactel].
     periodic : bool
         Columns close around the finger.
+    tip_row : bool
+        Row 0 is a tip row, a long step before row 1 (11.1 mm on the paper's fingers,
+        not one spacing). A peak found between them (row < 1) is placed at the
+        deflection-weighted mean of the two rows' true positions: the returned row is
+        ``z1 / (z0 + z1)``, with ``z0``, ``z1`` the two rows interpolated at the peak's
+        column (negative values as 0), which the geometry maps linearly onto the step.
+        The sinc interpolation assumes equal spacing and cannot place a peak inside
+        that step; ``docs/estimation.md`` gives the error this leaves.
 
     Returns
     -------
@@ -94,6 +103,13 @@ def newton_peak(
         converged[index] = done
         active[index] = ~done
     value = surface(z, x, y, periodic=periodic)
+    if tip_row:
+        gap = x < 1.0
+        if gap.any():
+            tip = np.maximum(surface(z[gap], np.zeros(gap.sum()), y[gap], periodic=periodic), 0.0)
+            ring = np.maximum(surface(z[gap], np.ones(gap.sum()), y[gap], periodic=periodic), 0.0)
+            total = tip + ring
+            x[gap] = np.where(total > 0, ring / np.where(total > 0, total, 1.0), x[gap])
     return Peak(
         row=x.reshape(lead),
         col=y.reshape(lead),
@@ -141,6 +157,7 @@ def locate_contacts(
     threshold: float = 0.005,
     relative: float = 0.2,
     min_separation: float = 1.5,
+    tip_row: bool = False,
 ) -> list[Peak]:
     """Every separate contact of one frame, each located by Newton's method.
 
@@ -154,6 +171,8 @@ def locate_contacts(
         Smallest secondary maximum as a share of the largest [-].
     min_separation : float
         Two maxima closer than this after Newton are one contact [tactel].
+    tip_row : bool
+        Row 0 is a tip row (see :func:`newton_peak`).
 
     Returns
     -------
@@ -170,7 +189,7 @@ def locate_contacts(
     for row, col in candidates:
         if z[row, col] < floor:
             break
-        peak = newton_peak(z, row, col, periodic=periodic)
+        peak = newton_peak(z, row, col, periodic=periodic, tip_row=tip_row)
         duplicate = False
         for other in found:
             d_col = peak.col - other.col

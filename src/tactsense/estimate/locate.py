@@ -10,7 +10,7 @@ import numpy as np
 
 from tactsense._signals import deferred_interrupts
 from tactsense._validation import TactsenseInputError, check_frames
-from tactsense.estimate._fast import locate_into, prepare_frames
+from tactsense.estimate._fast import locate_into, place_tip_gap, prepare_frames
 from tactsense.estimate.deflection import Flag
 from tactsense.estimate.force import force_per_deflection
 from tactsense.estimate.localize import MAX_ITERATIONS, MAX_STEP, TOLERANCE
@@ -177,6 +177,8 @@ def locate(
             deflection, flags[lo:hi], peak = prepare_frames(source[lo:hi], *shared)
             touched[lo:hi] = peak >= threshold
             locate_into(deflection, touched[lo:hi], *geometry, *(a[lo:hi] for a in outputs))
+            if sensor.array.tip_row:  # a pass of its own: the Newton kernel as it was
+                place_tip_gap(deflection, sensor.closes_circumference, *_row_col(outputs, lo, hi))
 
         _for_blocks(block, n, workers)
         row, col, value, iterations, converged, summed, skew, second = outputs
@@ -204,13 +206,13 @@ def locate(
         flags[~touched] |= int(Flag.NO_CONTACT)
         geometry = (periodic, 1 if sensor.array.tip_row else 0, TOLERANCE, MAX_ITERATIONS, MAX_STEP)
         outputs = _kernel_outputs(flat.shape[0])
-        _for_blocks(
-            lambda lo, hi: locate_into(
-                flat[lo:hi], touched[lo:hi], *geometry, *(a[lo:hi] for a in outputs)
-            ),
-            flat.shape[0],
-            workers,
-        )
+
+        def flat_block(lo: int, hi: int) -> None:
+            locate_into(flat[lo:hi], touched[lo:hi], *geometry, *(a[lo:hi] for a in outputs))
+            if sensor.array.tip_row:
+                place_tip_gap(flat[lo:hi], periodic, *_row_col(outputs, lo, hi))
+
+        _for_blocks(flat_block, flat.shape[0], workers)
         row, col, value, iterations, converged, summed, skew, second = outputs
     force = force_per_deflection(sensor) * summed
     # a clipped reading understates its tactel's deflection, so the sum is only a lower
@@ -256,6 +258,11 @@ def _kernel_outputs(n: int) -> tuple[np.ndarray, ...]:
         np.empty(n, np.bool_),
         *(np.empty(n) for _ in range(3)),
     )
+
+
+def _row_col(outputs, lo: int, hi: int) -> tuple[np.ndarray, np.ndarray]:
+    """The row and column slices of :func:`_kernel_outputs` for frames ``lo:hi``."""
+    return outputs[0][lo:hi], outputs[1][lo:hi]
 
 
 def _for_blocks(work, n: int, workers: int) -> None:

@@ -102,6 +102,8 @@ class Claim:
             "paper": self.paper,
             "computed": self.computed,
             "unit": self.unit,
+            "tolerance": self.tolerance,
+            "kind": self.kind,
             "relative_difference": self.relative_difference,
             "basis": self.basis,
             "basis_note": self.basis_note,

@@ -80,7 +80,10 @@ def fig26_force(ctx: Context) -> None:
             0.15,
             "Worst over the three contact lengths of Fig. 26 and over contact angles across "
             "one strip spacing; the integral is exact for the linear model, the error is the "
-            "finite array and the sampling around the finger.",
+            "finite array and the sampling around the finger. The force conversion (force "
+            "per summed deflection) is calibrated on the twin's own model "
+            "(estimate.force.force_per_deflection), so a finger unlike the twin would add "
+            "its model error (robustness study).",
             kind="within",
         )
     )

@@ -72,7 +72,9 @@ def fig16_fit(ctx: Context) -> None:
             rms,
             "%",
             0.5,
-            note + " The paper's data had a 2 % repeatability; the twin's noise is lower.",
+            "The twin's own noise floor, not a prediction of eq. 7: the twin's along-finger "
+            "response is eq. 7, so the residual is its noise, jitter and quantization. The "
+            "paper's data had a 2 % repeatability; the twin's noise is lower.",
         ),
     ]
     ctx.claims.append(

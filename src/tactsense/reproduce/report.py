@@ -8,7 +8,14 @@ import json
 from pathlib import Path
 
 from tactsense.reproduce._common import Claim, Figure
-from tactsense.reproduce.basis import ARITHMETIC, BY_CONSTRUCTION, FITTED, HOLDOUTS, PREDICTED
+from tactsense.reproduce.basis import (
+    ARITHMETIC,
+    BY_CONSTRUCTION,
+    FITTED,
+    HOLDOUTS,
+    PREDICTED,
+    RESTATED,
+)
 
 
 def _format(value: float | None) -> str:
@@ -42,11 +49,17 @@ def summary(claims: list[Claim]) -> str:
     consistent = sum(c.verdict == "consistent" for c in echoes)
     sums = [c for c in claims if c.basis == ARITHMETIC]
     sums_agree = sum(c.verdict == "agrees" for c in sums)
+    restated = sum(c.basis == RESTATED for c in claims)
     return (
         f"{agree} of {len(predicted)} predictions agree with the paper; "
         f"{consistent} of {len(echoes)} claims the twin was fitted to (or holds by "
         f"construction) are consistent, which is not evidence; {sums_agree} of {len(sums)} "
-        "arithmetic checks of the paper's formulas agree."
+        "arithmetic checks of the paper's formulas agree"
+        + (
+            f"; {restated} restate a prediction in other units and are not counted."
+            if restated
+            else "."
+        )
     )
 
 
@@ -76,9 +89,11 @@ BASIS_TEXT = (
     "The basis column says how each value was obtained: *predicted* (computed from "
     "parameters not set from this claim), *fitted* (a constant of the twin was chosen to "
     "match it; the note names it), *by construction* (true of the model by definition, "
-    "e.g. a fit recovering the twin's own parameters) or *arithmetic* (a formula of the "
-    "paper evaluated, a unit conversion). Fitted and by-construction claims within "
-    "tolerance are *consistent*, never *agrees*: they are echoes, not evidence."
+    "e.g. a fit recovering the twin's own parameters, or a residual that is the twin's "
+    "own noise), *arithmetic* (a formula of the paper evaluated, a unit conversion) or "
+    "*restated* (a prediction already in the table, in other units: shown, not "
+    "counted). Fitted and by-construction claims within tolerance are *consistent*, "
+    "never *agrees*: they are echoes, not evidence."
 )
 
 INTRO = (

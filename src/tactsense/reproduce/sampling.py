@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import matplotlib.pyplot as plt
 import numpy as np
+from scipy.integrate import quad
 from scipy.optimize import minimize_scalar
 
 import tactsense as ts
 from tactsense.analysis import aliasing as al
 from tactsense.estimate.contours import track_contour
 from tactsense.estimate.interpolate import surface
+from tactsense.geometry import tactel_to_surface
 from tactsense.reproduce._common import (
     Claim,
     Context,
@@ -30,6 +32,12 @@ def fig19_20_aliasing(ctx: Context) -> None:
     )
     peak = float(best.x)
     xi = float(al.reconstruction_error(d, b, 0.5))
+    # the other readings of the printed 0.20 (errata 15): eq. 41 itself instead of its
+    # square, and both folded images against the band kept
+    above = quad(lambda f: al.normalized_response(f, d, 0.5), 1 / (2 * b), np.inf)[0]
+    total = quad(lambda f: al.normalized_response(f, d, 0.5), 0.0, np.inf)[0]
+    xi_amplitude = above / total
+    xi_folded = float(np.sqrt(2 * xi / (1 - xi)))
     fig, ax = plt.subplots(figsize=(7, 4), constrained_layout=True)
     ax.plot(s, response, label="H(s) / H(0)")
     ax.plot(s, aliased, label="A(s) / H(0)")
@@ -84,9 +92,10 @@ def fig19_20_aliasing(ctx: Context) -> None:
             xi,
             "1",
             0.25,
-            f"Eq. 45 (an energy ratio) gives {xi:.3f}; its square root {np.sqrt(xi):.3f}, "
-            "the RMS amplitude error, is about 0.2: the printed value is most likely the "
-            "amplitude ratio (errata 15).",
+            f"Eq. 45 (an energy ratio) gives {xi:.4f}. Which quantity the printed 0.20 "
+            f"is remains a conjecture (errata 15): the square root {np.sqrt(xi):.3f} (RMS "
+            f"amplitude ratio), the ratio of the amplitude integrals {xi_amplitude:.3f}, "
+            f"or the folded-over RMS against the in-band one {xi_folded:.3f}; none is 0.20.",
         ),
     ]
 
@@ -95,28 +104,55 @@ def fig21_22_surface(ctx: Context) -> None:
     spec = ctx.spec
     soft = ts.soft_object(12.0, 20.0, ts.grams_force(100), length_mm=12.0, width_mm=15.0)
     frame = ts.tactel_deflection(spec, soft)
-    x = np.linspace(0, spec.shape[0] - 1, 71)
+    first = 1 if spec.array.tip_row else 0
+    x = np.linspace(first, spec.shape[0] - 1, 71)
     if spec.closes_circumference:
         # unwrapped around the contact, so that it is one blob and the seam lies opposite
         centre = float(np.argmax(frame.max(axis=0)))
         y = np.linspace(centre - spec.shape[1] / 2, centre + spec.shape[1] / 2, 81)
     else:
         y = np.linspace(0, spec.shape[1] - 1, 81)
-    values = surface(frame, x[:, None], y[None, :], periodic=spec.closes_circumference)
+    # the cylinder alone is interpolated (uniform rings); the tip row lies 11 mm before
+    # row 1, not one spacing, so it is drawn as its samples at their true position
+    cylinder = frame.copy()
+    cylinder[:first] = 0.0
+    values = surface(cylinder, x[:, None], y[None, :], periodic=spec.closes_circumference)
+    grid_x, grid_y = np.meshgrid(x, y, indexing="ij")
+    axial, _ = tactel_to_surface(spec, grid_x, np.zeros_like(grid_y))
+    around = spec.col_angle_deg[0] + spec.array.spacing_angle_deg * grid_y
     fig = plt.figure(figsize=(7, 5))
     ax = fig.add_subplot(projection="3d")
-    grid_x, grid_y = np.meshgrid(x, y, indexing="ij")
-    ax.plot_surface(grid_y, grid_x, 100 * values, cmap="viridis", linewidth=0)
-    ax.set_xlabel("column (around) [tactel]")
-    ax.set_ylabel("row (along, 0 = tip) [tactel]")
+    ax.plot_surface(around, axial, 100 * values, cmap="viridis", linewidth=0)
+    if first:
+        cols = np.arange(spec.shape[1], dtype=float)
+        if spec.closes_circumference:
+            cols = np.where(cols < y[0], cols + spec.shape[1], cols)
+            cols = np.where(cols > y[-1], cols - spec.shape[1], cols)
+        tip_angle = spec.col_angle_deg[0] + spec.array.spacing_angle_deg * cols
+        tip_axial = np.full(cols.shape, float(spec.row_axial_mm[0]))
+        for a, b, h in zip(tip_angle, tip_axial, 100 * frame[0], strict=True):
+            ax.plot([a, a], [b, b], [0, h], color="C3", lw=1)
+        ax.scatter(tip_angle, tip_axial, 100 * frame[0], color="C3", s=8, label="tip row")
+        ax.legend(fontsize=7)
+    ax.set_xlabel("angle around the finger [deg]")
+    ax.set_ylabel("along the finger [mm]")
     ax.set_zlabel("deflection [%]")
+    gap = float(spec.row_axial_mm[1] - spec.row_axial_mm[0]) if first else 0.0
     ctx.save(
         fig,
         21,
         "interpolated deflection surface",
         "Eq. 48 for a contact with a large soft object (another finger), cylinder and "
         "tip unwrapped onto a plane.",
-        "A 100-g soft object 12 x 15 mm on the simulated finger, eq. 48 on 8 x 8 tactels.",
+        "A 100-g soft object 12 x 15 mm on the simulated finger, eq. 48 on the cylinder's "
+        "tactels, drawn at the rows' true surface positions"
+        + (
+            f"; the tip row (red) lies {gap:.1f} mm before row 1, not one "
+            f"{spec.array.spacing_axial_mm:g}-mm spacing, and is shown as its samples"
+            if first
+            else ""
+        )
+        + ".",
         "A smooth single-peaked surface; the low-pass response keeps it well behaved.",
     )
     rod = ts.rod(12.0, on_array(spec, 90.0), ts.grams_force(100), orientation_deg=45.0)
@@ -124,20 +160,40 @@ def fig21_22_surface(ctx: Context) -> None:
     est = ts.locate(frame, spec, counts=False)
     fig, ax = plt.subplots(figsize=(6, 5), constrained_layout=True)
     lines = []
-    for share in (0.2, 0.4, 0.6, 0.8):
-        try:
-            line = track_contour(
-                frame,
-                share * float(est.peak_deflection),
-                est.row,
-                est.col,
-                sensor=spec,
-                periodic=spec.closes_circumference,
-            )
-        except ValueError:
+    branches = 0
+    for k, share in enumerate((0.2, 0.4, 0.6, 0.8)):
+        # an open contour may have a second branch on the other side of the peak (the
+        # two edges of a rod across the array): track from both sides, keep both
+        found = []
+        for toward in (1.0, -1.0):
+            try:
+                line = track_contour(
+                    frame,
+                    share * float(est.peak_deflection),
+                    est.row,
+                    est.col,
+                    sensor=spec,
+                    periodic=spec.closes_circumference,
+                    toward=toward,
+                )
+            except ValueError:
+                continue
+            if found and (found[0].closed or _same_line(found[0], line, spec)):
+                continue
+            found.append(line)
+        if not found:
             continue
-        lines.append(line)
-        ax.plot(line.angle_deg, line.axial_mm, ".", ms=1.5, label=f"{100 * share:.0f} % of peak")
+        lines.append(found[0])
+        branches += len(found) - 1
+        for j, line in enumerate(found):
+            ax.plot(
+                line.angle_deg,
+                line.axial_mm,
+                ".",
+                ms=1.5,
+                color=f"C{k}",
+                label=f"{100 * share:.0f} % of peak" if j == 0 else None,
+            )
     ax.plot(est.angle_deg, est.axial_mm, "k+", ms=10, label="peak")
     open_levels = ", ".join(
         f"{100 * line.level / float(est.peak_deflection):.0f} %"
@@ -156,7 +212,20 @@ def fig21_22_surface(ctx: Context) -> None:
         "45-deg, 3.8-mm finger.",
         "A 100-g rod at 45 deg on the simulated finger; contours tracked at four levels.",
         f"{sum(line.closed for line in lines)} of {len(lines)} contours close "
-        f"({open_levels or 'none'} open: they leave the array); they are elongated along "
+        f"({open_levels or 'none'} open: they leave the array"
+        + (f"; {branches} of them in two separate branches, both drawn" if branches else "")
+        + "); they are elongated along "
         "the rod, and around the "
         "finger the strips resolve the rod's tilt only coarsely, as the paper found.",
     )
+
+
+def _same_line(first, second, spec) -> bool:
+    """Whether two tracked open contours are the same line (the middle point of the
+    second lies on the first, within 0.1 tactel)."""
+    cols = spec.shape[1]
+    mid = len(second.row) // 2
+    d_col = first.col - second.col[mid]
+    if spec.closes_circumference:
+        d_col = (d_col + cols / 2) % cols - cols / 2
+    return bool(np.min(np.hypot(first.row - second.row[mid], d_col)) < 0.1)
