@@ -127,7 +127,7 @@ def _export_lerobot(recording, out, calibration, baseline_frames, threshold, epi
     if out.exists():
         fail(f"{out} exists; a LeRobot dataset goes into a new folder")
     check_output(out, False, what="dataset folder", inputs=[recording, calibration])
-    remove_stale_partials(out.parent, f".{out.name}", "")  # left by a run killed outright
+    remove_stale_partials(out.parent)  # left by a run killed outright
     cal = None if calibration is None else Calibration.load(calibration)
     counts = export_lerobot(
         recording, out, calibration=cal, baseline_frames=baseline_frames,
