@@ -35,7 +35,7 @@ from tactsense.physics.transduction import (
     sample_offsets,
     voltage_to_counts,
 )
-from tactsense.physics.viscoelastic import viscoelastic_response
+from tactsense.physics.viscoelastic import sampled_viscoelastic_response
 from tactsense.sensor import SensorSpec, SpecBase
 
 _CHUNK_FRAMES = 128
@@ -599,9 +599,13 @@ def _frame_blocks(spec: SensorSpec, run: _Run):
         local = step_of_tick - lo
         if "viscoelastic" in active:
             f = spec.flaws
-            u = window[local]  # (ticks, rows, cols): every tactel at every tick
-            u, state = viscoelastic_response(
-                u,
+            # each tactel is read at its own tick of the scan (tick i of a frame reads
+            # tactel i, row-major): the memories are evaluated there alone
+            sample_ticks = np.arange(last - first)[:, None] * ticks_per_frame + flat_index[None, :]
+            sampled, state = sampled_viscoelastic_response(
+                window.reshape(len(window), -1),
+                local,
+                sample_ticks,
                 dt,
                 delayed_fraction=f.delayed_fraction,
                 delayed_time_constant_s=f.delayed_time_constant_s,
@@ -609,9 +613,7 @@ def _frame_blocks(spec: SensorSpec, run: _Run):
                 creep_time_constant_s=f.creep_time_constant_s,
                 state=state,
             )
-            sampled = u.reshape(last - first, ticks_per_frame, rows, cols)[
-                :, flat_index, row_of_tick, col_of_tick
-            ].reshape(last - first, rows, cols)
+            sampled = sampled.reshape(last - first, rows, cols)
         else:  # no memory: only the sampled instants matter
             own_step = local.reshape(last - first, ticks_per_frame)
             sampled = window[own_step, row_of_tick, col_of_tick].reshape(last - first, rows, cols)

@@ -93,3 +93,79 @@ def viscoelastic_response(
     m_c, last_c = first_order_memory(u, dt, creep_time_constant_s, axis, m_c_prev)
     y = (1.0 - delayed_fraction) * np.asarray(u, float) + delayed_fraction * m_d
     return y + creep_fraction * m_c, (last_d, last_c)
+
+
+def sampled_viscoelastic_response(
+    values,
+    tick_step,
+    sample_ticks,
+    dt,
+    *,
+    delayed_fraction,
+    delayed_time_constant_s,
+    creep_fraction,
+    creep_time_constant_s,
+    state=None,
+):
+    """:func:`viscoelastic_response` read only where it is sampled, for a piecewise-constant
+    input: the same memories, in time linear in the number of taxels.
+
+    The scan holds each step's elastic deflection over whole ticks and reads each taxel
+    at one tick per frame. Between step changes the recursion ``m[n] = e m[n-1] +
+    (1 - e) u`` has the closed form ``m[a + n] = e^(n+1) m[a-1] + (1 - e^(n+1)) u``, so
+    the memories are advanced from one step change to the next (for every taxel at
+    once) and evaluated at the sampled ticks alone, instead of at every tick for every
+    taxel (``rows * cols`` ticks per frame, each over ``rows * cols`` taxels).
+
+    Parameters
+    ----------
+    values : ndarray, shape (S, N)
+        Elastic deflection of each of N taxels during each of S steps [-].
+    tick_step : ndarray of int, shape (K,)
+        The step (an index into ``values``) held at each of K consecutive ticks.
+    sample_ticks : ndarray of int, shape (F, N)
+        The tick (an index into ``tick_step``) at which each taxel is read in each frame.
+    dt : float
+        Tick interval [s].
+    delayed_fraction, creep_fraction, delayed_time_constant_s, creep_time_constant_s
+        As :func:`viscoelastic_response`.
+    state : tuple of two ndarrays of shape (N,), optional
+        Memories after the tick before the first (zero if None).
+
+    Returns
+    -------
+    y : ndarray, shape (F, N)
+        Readings at the sampled ticks [-].
+    state : tuple of two ndarrays
+        Memories after the last of the K ticks.
+    """
+    check_positive(dt, "dt")
+    values = np.asarray(values, dtype=float)
+    tick_step = np.asarray(tick_step)
+    n_taxels = values.shape[1]
+    starts = np.flatnonzero(np.r_[True, tick_step[1:] != tick_step[:-1]])  # run starts
+    lengths = np.diff(np.r_[starts, len(tick_step)])
+    run_values = values[tick_step[starts]]  # (R, N)
+    run_of_tick = np.cumsum(np.r_[False, tick_step[1:] != tick_step[:-1]])
+    runs = run_of_tick[sample_ticks]  # (F, N)
+    ticks_into_run = sample_ticks - starts[runs] + 1
+    sampled_u = run_values[runs, np.arange(n_taxels)[None, :]]  # (F, N)
+    previous = (None, None) if state is None else state
+    out = (1.0 - delayed_fraction) * sampled_u
+    last = []
+    for fraction, tau, before in (
+        (delayed_fraction, delayed_time_constant_s, previous[0]),
+        (creep_fraction, creep_time_constant_s, previous[1]),
+    ):
+        check_positive(tau, "time_constant")
+        memory = np.zeros(n_taxels) if before is None else np.asarray(before, dtype=float)
+        at_start = np.empty_like(run_values)  # memory after the tick before each run
+        for r in range(len(starts)):
+            at_start[r] = memory
+            keep = np.exp(-lengths[r] * dt / tau)
+            memory = keep * memory + (1.0 - keep) * run_values[r]
+        keep = np.exp(-ticks_into_run * dt / tau)
+        sampled = keep * at_start[runs, np.arange(n_taxels)[None, :]] + (1.0 - keep) * sampled_u
+        out = out + fraction * sampled
+        last.append(memory)
+    return out, (last[0], last[1])
