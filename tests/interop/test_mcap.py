@@ -77,7 +77,13 @@ def test_export_frames_and_contacts_field_by_field(tmp_path, sweep):
         np.testing.assert_allclose(normal, (0.0, math.cos(angle), math.sin(angle)), atol=1e-12)
         force = (msg.wrench.force.x, msg.wrench.force.y, msg.wrench.force.z)
         np.testing.assert_allclose(force, -est.force_n[i] * np.asarray(normal), rtol=1e-12)
-        assert (msg.wrench.torque.x, msg.wrench.torque.y, msg.wrench.torque.z) == (0, 0, 0)
+        # upstream: the wrench in the reference frame; the torque of the force about its
+        # origin, position x force, worked by hand component by component
+        (px, py, pz), (fx, fy, fz) = got, force
+        by_hand = (py * fz - pz * fy, pz * fx - px * fz, px * fy - py * fx)
+        torque = (msg.wrench.torque.x, msg.wrench.torque.y, msg.wrench.torque.z)
+        np.testing.assert_allclose(torque, by_hand, rtol=1e-12, atol=1e-18)
+        assert max(abs(t) for t in torque) > 0  # off the axis, a push has a moment
 
 
 @pytest.mark.parametrize("name, options", [("live.mcap", []), ("live.bag", ["--format", "mcap"])])
@@ -100,3 +106,46 @@ def test_record_writes_mcap_as_frames_arrive(tmp_path, sweep, name, options):
     got = np.stack([np.asarray(m.ros_msg.sensors[0].values).reshape(8, 8) for m in states])
     np.testing.assert_array_equal(got, rec.frames[:60])
     assert [m.message.sequence for m in states] == list(range(60))
+
+
+def test_export_stamps_on_the_host_clock_and_says_which(tmp_path):
+    """Issue 25: a recorded stream is exported on its host times (so the file aligns with
+    the lab's other bags), a simulation on its own times plus --start-time; the metadata
+    record 'tactsense' names the clock; --frame-id is every header's frame_id."""
+    from mcap.reader import make_reader
+    from typer.testing import CliRunner
+
+    from tactsense.cli import app
+    from tactsense.io.recording import Recording, write_recording
+
+    spec = ts.fearing1990_initial()
+    simulated = ts.simulate(spec, ts.probe_sweep(spec), rng=1)
+    sim_path = tmp_path / "sim.h5"
+    write_recording(sim_path, simulated)
+    host = 1_795_000_000.0 + np.arange(len(simulated.frames)) / 7.0 + 0.0123
+    streamed = Recording(
+        frames=simulated.frames, time_s=simulated.time_s, sample_offset_s=simulated.sample_offset_s,
+        sensor=spec, host_time_s=host, sequence=np.arange(len(host), dtype=np.uint16),
+    )  # fmt: skip
+    rec_path = tmp_path / "rec.h5"
+    write_recording(rec_path, streamed)
+    runner = CliRunner()
+    for path, options, clock, first in (
+        (rec_path, [], "host", host[0]),
+        (sim_path, ["--start-time", "1700000000"], "recording", 1_700_000_000.0),
+    ):
+        out = tmp_path / f"{path.stem}.mcap"
+        result = runner.invoke(app, ["export", str(path), "--out", str(out), "--frame-id",
+                                     "index_tip", *options])  # fmt: skip
+        assert result.exit_code == 0, result.output
+        assert f"{clock} clock" in result.output
+        with open(out, "rb") as stream:
+            reader = make_reader(stream)
+            (meta,) = [m for m in reader.iter_metadata() if m.name == "tactsense"]
+            assert meta.metadata["clock"] == clock
+            assert meta.metadata["frame_id"] == "index_tip"
+            stamps = [m.log_time for _, c, m in reader.iter_messages(topics=["/tactile_states"])]
+        assert stamps[0] == round(first * 1e9)
+    refused = runner.invoke(app, ["export", str(rec_path), "--out", str(tmp_path / "x.mcap"),
+                                  "--start-time", "5"])  # fmt: skip
+    assert refused.exit_code == 2 and "holds host times" in refused.output

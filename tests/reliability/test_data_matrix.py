@@ -83,6 +83,9 @@ CASES = [
     ("export REC --format lerobot --out DIR/a_dir", "exists"),
     ("export REC --format lerobot --episode-split 0 --out OUT", "--episode-split"),
     ("export REC --episode-split 10 --out OUT.mcap", "applies to --format lerobot only"),
+    ("export REC --out OUT.rrd --frame-id x", "apply to --format mcap only"),
+    ("export REC --out OUT.mcap --start-time -5", "--start-time"),
+    ("export REC --out OUT.mcap --start-time nan", "--start-time"),
     ("export DIR/good.csv --format lerobot --out OUT", "good.csv"),
 ]
 

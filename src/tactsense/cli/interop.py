@@ -61,6 +61,24 @@ def export(
             help="lerobot: one episode per this many frames (default: one per recording).",
         ),
     ] = None,
+    frame_id: Annotated[
+        str,
+        typer.Option(
+            "--frame-id",
+            help="mcap: the frame_id of every header, the URDF link the sensor is mounted on "
+            "(the link 'tactsense sensor export --urdf --link' wrote; default finger).",
+        ),
+    ] = "finger",
+    start_time: Annotated[
+        float | None,
+        typer.Option(
+            "--start-time",
+            min=0.0,
+            max=4.2e9,
+            help="mcap: Unix time of the first frame [s] for a recording without host times "
+            "(a simulation); a recorded stream is stamped with its host times (default: 0).",
+        ),
+    ] = None,
     calibration: CalibrationOption = None,
     baseline_frames: BaselineFramesOption = 5,
     threshold: ThresholdOption = 0.005,
@@ -87,6 +105,10 @@ def export(
         return
     if episode_split is not None:
         fail("--episode-split applies to --format lerobot only")
+    if export_format is not ExportFormat.mcap and (frame_id != "finger" or start_time is not None):
+        fail("--frame-id and --start-time apply to --format mcap only")
+    if not frame_id.strip() or any(c.isspace() for c in frame_id):
+        fail(f"--frame-id {frame_id!r}: give a link name without spaces")
     check_output(out, force, inputs=[recording, calibration])
     try:
         cal = None if calibration is None else Calibration.load(calibration)
@@ -106,16 +128,22 @@ def export(
             def update(done: int, total: int) -> None:
                 bar.update(task, completed=done, total=total)
 
+            extra = (
+                {"frame_id": frame_id, "start_time_s": start_time}
+                if export_format is ExportFormat.mcap
+                else {}
+            )
             with atomic_output(out) as temporary:
                 counts = run(
                     recording, temporary, calibration=cal, baseline_frames=baseline_frames,
-                    threshold=threshold, progress=update,
+                    threshold=threshold, progress=update, **extra,
                 )  # fmt: skip
     except (TactsenseInputError, FileExistsError) as error:
         fail(str(error))
+    clock = f", {counts['clock']} clock" if "clock" in counts else ""
     console.print(
         f"wrote {out}: {counts['frames']} frames, {counts['contacts']} with a contact "
-        f"({export_format.value})"
+        f"({export_format.value}{clock})"
     )
 
 

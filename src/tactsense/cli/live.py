@@ -320,6 +320,14 @@ def record(
     duration: DurationLimit = None,
     sensor: StreamSensorOption = None,
     timeout: TimeoutOption = None,
+    frame_id: Annotated[
+        str | None,
+        typer.Option(
+            "--frame-id",
+            help="mcap: the frame_id of every header, the URDF link the sensor is mounted "
+            "on [default: finger].",
+        ),
+    ] = None,
     quiet: Annotated[bool, typer.Option("--quiet", help="No live status line.")] = False,
     force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
 ) -> None:
@@ -337,6 +345,11 @@ def record(
         mcap = out.suffix.lower() == ".mcap"
     else:
         mcap = record_format is RecordFormat.mcap
+    if frame_id is not None and not mcap:
+        fail("--frame-id applies to MCAP recordings (--out X.mcap or --format mcap)")
+    if frame_id is not None and (not frame_id.strip() or any(c.isspace() for c in frame_id)):
+        fail(f"--frame-id {frame_id!r}: give a link name without spaces")
+    extra = {"frame_id": frame_id} if frame_id is not None else {}
     if mcap:
         from tactsense.interop.mcap import _writer_class
         from tactsense.interop.mcap import record_mcap as run_record
@@ -368,7 +381,7 @@ def record(
             with reader:
                 run_record(
                     reader, out, max_frames=frames, duration_s=duration, overwrite=force,
-                    progress=update,
+                    progress=update, **extra,
                 )  # fmt: skip
         except KeyboardInterrupt:
             interrupted = True

@@ -202,6 +202,7 @@ class McapTactileWriter:
             force = -np.asarray(force_n, dtype=float)[chosen, None] * normals
             numbers = np.zeros((len(chosen), 12), dtype="<f8")
             numbers[:, 0:3], numbers[:, 3:6], numbers[:, 6:9] = points, normals, force
+            numbers[:, 9:12] = np.cross(points, force)  # about the frame's origin [N m]
             head, middle = self._contact_bytes.head, self._contact_bytes.middle
         for k, i in enumerate(chosen):
             t = float(time_s[i])
@@ -222,6 +223,10 @@ class McapTactileWriter:
                 )  # fmt: skip
             self.contacts += 1
 
+    def metadata(self, name: str, data: dict[str, str]) -> None:
+        """An MCAP metadata record (name and string pairs) in the file."""
+        self._raw.add_metadata(name, data)
+
     def finish(self) -> None:
         self._writer.finish()
 
@@ -238,13 +243,19 @@ def export_mcap(
     baseline_frames: int = 5,
     threshold: float | None = None,
     frame_id: str = "finger",
+    start_time_s: float | None = None,
     progress=None,
     fast: bool = True,
 ) -> dict:
     """Write a recording's frames and contacts to MCAP, a piece at a time.
 
-    A pad's or a point set's recording gives its frames only (contacts are estimated on
-    fingers so far).
+    Stamps (headers and log times) are on the host's clock when the recording holds it
+    (a recorded stream: each frame's arrival, Unix time), so the file aligns with the
+    lab's other bags; otherwise the recording's own times plus ``start_time_s`` (Unix
+    time of its first frame; default 0, i.e. 1970). The file's metadata record
+    ``tactsense`` says which clock (``clock``: ``host`` or ``recording``), the sensor and
+    the frame id. A pad's or a point set's recording gives its frames only (contacts are
+    estimated on fingers so far).
 
     Parameters
     ----------
@@ -255,12 +266,17 @@ def export_mcap(
         and moves it into place).
     calibration : Calibration, optional
         Applied to the contacts, as for ``locate``.
+    frame_id : str
+        The ``frame_id`` of every header: the URDF link the sensor is mounted on.
+    start_time_s : float, optional
+        Unix time of the first frame [s], for a recording without host times; an error
+        for one with them (they are the truth).
     progress : callable(done, total), optional
 
     Returns
     -------
     dict
-        ``frames`` and ``contacts`` written.
+        ``frames`` and ``contacts`` written, and the ``clock`` used.
     """
     from tactsense.batch import iter_locate
     from tactsense.estimate import Flag
@@ -268,14 +284,44 @@ def export_mcap(
     from tactsense.io.recording import RecordingReader
 
     with RecordingReader(recording) as reader, open(out, "wb") as stream:
+        host = reader.has_host_time
+        if host and start_time_s is not None:
+            raise TactsenseInputError(
+                f"{recording} holds host times (a recorded stream): they are the stamps; "
+                "--start-time is for recordings without them"
+            )
+        offset = 0.0 if start_time_s is None else float(start_time_s)
+
+        def stamps(start: int, time_s: np.ndarray) -> np.ndarray:
+            if host:
+                return reader.host_time_s(start, start + len(time_s))
+            return time_s + offset
+
         writer = McapTactileWriter(stream, reader.sensor, frame_id=frame_id, fast=fast)
+        writer.metadata(
+            "tactsense",
+            {
+                "clock": "host" if host else "recording",
+                "clock_meaning": (
+                    "arrival of each frame on the recording host, Unix time"
+                    if host
+                    else f"the recording's frame times plus {offset:.6f} s (Unix time)"
+                ),
+                "sensor": reader.sensor.name,
+                "frame_id": frame_id,
+                "source": str(Path(recording).name),
+            },
+        )
         if reader.sensor.kind != "finger":  # no contact estimation yet: frames only
             for start, frames, time_s in reader.chunks():
-                writer.frames_of(frames, time_s, np.arange(start, start + len(time_s)))
+                writer.frames_of(
+                    frames, stamps(start, time_s), np.arange(start, start + len(time_s))
+                )
                 if progress is not None:
                     progress(start + len(time_s), reader.n_frames)
             writer.finish()
-            return {"frames": writer.frames, "contacts": writer.contacts}
+            clock = "host" if host else "recording"
+            return {"frames": writer.frames, "contacts": writer.contacts, "clock": clock}
         pieces = iter_locate(
             reader,
             baseline_frames=baseline_frames,
@@ -284,13 +330,15 @@ def export_mcap(
         )
         for start, time_s, est in pieces:
             frames = reader.frames(start, start + len(time_s))
-            writer.frames_of(frames, time_s, np.arange(start, start + len(time_s)))
+            when = stamps(start, time_s)
+            writer.frames_of(frames, when, np.arange(start, start + len(time_s)))
             touching = ((est.flags & int(Flag.NO_CONTACT)) == 0) & np.isfinite(est.force_n)
-            writer.contacts_of(time_s, est.axial_mm, est.angle_deg, est.force_n, touching)
+            writer.contacts_of(when, est.axial_mm, est.angle_deg, est.force_n, touching)
             if progress is not None:
                 progress(start + len(time_s), reader.n_frames)
         writer.finish()
-        return {"frames": writer.frames, "contacts": writer.contacts}
+        clock = "host" if host else "recording"
+        return {"frames": writer.frames, "contacts": writer.contacts, "clock": clock}
 
 
 def record_mcap(

@@ -108,8 +108,15 @@ def tactile_contact(
     force_n: float,
     frame_id: str = "finger",
 ) -> dict:
-    """One ``TactileContact``: where, the normal, and the force the object applies."""
+    """One ``TactileContact``: where, the normal, and the wrench the object applies.
+
+    The wrench is in the reference frame (``frame_id``), as upstream's message says
+    ("represented in reference frame, not in contact point frame"): the force, and the
+    torque of that force about the frame's origin, ``position x force`` [N m], as the
+    toolbox's contact merger writes it.
+    """
     force = -float(force_n) * np.asarray(normal, dtype=float)
+    torque = np.cross(np.asarray(point_m, dtype=float), force)
     return {
         "header": {"stamp": stamp(time_s), "frame_id": frame_id},
         "name": sensor.name,
@@ -117,6 +124,6 @@ def tactile_contact(
         "normal": dict(zip("xyz", map(float, normal), strict=True)),
         "wrench": {
             "force": dict(zip("xyz", map(float, force), strict=True)),
-            "torque": {"x": 0.0, "y": 0.0, "z": 0.0},
+            "torque": dict(zip("xyz", map(float, torque), strict=True)),
         },
     }

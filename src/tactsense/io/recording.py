@@ -626,6 +626,16 @@ class RecordingReader:
             return self._h5["time"][start : min(stop, self.n_frames)]
 
     @property
+    def has_host_time(self) -> bool:
+        """Whether the recording holds each frame's arrival on the host's clock."""
+        return "host_time" in self._h5
+
+    def host_time_s(self, start: int, stop: int) -> np.ndarray:
+        """Arrival of frames ``start`` to ``stop`` on the host, Unix time [s]."""
+        with _damage(self.path):
+            return self._h5["host_time"][start : min(stop, self.n_frames)]
+
+    @property
     def losses(self) -> dict[str, int]:
         """Frames lost by kind, as the recorder counted them (empty if none recorded)."""
         with _damage(self.path):
