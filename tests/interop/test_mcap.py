@@ -149,3 +149,55 @@ def test_export_stamps_on_the_host_clock_and_says_which(tmp_path):
     refused = runner.invoke(app, ["export", str(rec_path), "--out", str(tmp_path / "x.mcap"),
                                   "--start-time", "5"])  # fmt: skip
     assert refused.exit_code == 2 and "holds host times" in refused.output
+
+
+# upstream's message texts (ubi-agni/tactile_toolbox, tactile_msgs/msg/*.msg), verbatim
+UPSTREAM_TACTILE_CONTACT = """# Message describing the net effect of a single contact
+
+# specify link frame and timestamp of contact
+Header header
+
+# unique name of the contact
+string name
+# contact point location
+geometry_msgs/Point position
+# surface normal at contact point
+geometry_msgs/Vector3 normal
+# wrench applied through this contact point
+# this wrench should be represented in reference frame, not in contact point frame
+geometry_msgs/Wrench wrench
+"""
+UPSTREAM_TACTILE_STATE = """# specify the timestamp (frame not used)
+Header header
+
+# a list of individual, named sensor arrays
+sensor_msgs/ChannelFloat32[] sensors
+"""
+
+
+def test_rosbags_decodes_the_export_from_the_upstream_message_text(tmp_path, sweep):
+    """Issue 25: rosbags, given only upstream's .msg text (and ROS 2's standard types),
+    decodes every message of an exported file; each contact's torque is position x force."""
+    from mcap.reader import make_reader
+    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+    from typer.testing import CliRunner
+
+    from tactsense.cli import app
+
+    path, _ = sweep
+    out = tmp_path / "x.mcap"
+    assert CliRunner().invoke(app, ["export", str(path), "--out", str(out)]).exit_code == 0
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    store.register(get_types_from_msg(UPSTREAM_TACTILE_CONTACT, "tactile_msgs/msg/TactileContact"))
+    store.register(get_types_from_msg(UPSTREAM_TACTILE_STATE, "tactile_msgs/msg/TactileState"))
+    counts = {"/tactile_states": 0, "/tactile_contacts": 0}
+    with open(out, "rb") as stream:
+        for schema, channel, message in make_reader(stream).iter_messages():
+            decoded = store.deserialize_cdr(message.data, schema.name)
+            counts[channel.topic] += 1
+            if channel.topic == "/tactile_contacts":
+                p, f = decoded.position, decoded.wrench.force
+                expected = np.cross([p.x, p.y, p.z], [f.x, f.y, f.z])
+                t = decoded.wrench.torque
+                np.testing.assert_allclose([t.x, t.y, t.z], expected, rtol=1e-12, atol=1e-18)
+    assert counts["/tactile_states"] > 100 and counts["/tactile_contacts"] > 100

@@ -20,9 +20,14 @@ counts, rows x cols row-major, as float32) and one ``TactileContact`` per frame 
 contact: the point on the skin [m] in the finger's frame (x along the finger from the
 junction of tip and cylinder toward the base, angle 0 along +y, as
 :func:`tactsense.geometry.surface_to_xyz`), the outward normal there, and the force
-the object applies (-force x normal [N]; torque zero about the point). The header's
-``frame_id`` is the link of the URDF description (``finger``) and its stamp the
-frame's time on the device clock.
+the object applies (-force x normal [N]) with its torque about the frame's origin,
+``position x force`` [N m]: upstream's message says the wrench "should be represented in
+reference frame, not in contact point frame", and its contact merger writes the torque
+so. The contact's ``name`` is the sensor's name (upstream names contacts by sensor or
+group). The header's ``frame_id`` is the link the sensor is mounted on (``--frame-id``,
+default ``finger``, the link ``sensor export --urdf`` writes) and its stamp the frame's
+arrival on the host's clock for a recorded stream, else the recording's time plus
+``--start-time``.
 """
 
 from __future__ import annotations
