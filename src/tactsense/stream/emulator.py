@@ -34,7 +34,6 @@ from tactsense.stream.protocol import (
     encode_frame,
 )
 
-
 FORMAT_BOOT_S = 0.25
 """In another wire format, the device streams this long after a host connects [s] (as a
 board that resets when its port opens; pyserial discards what arrived while it opened)."""

@@ -21,6 +21,7 @@ import select
 import time
 from collections import deque
 from collections.abc import Iterator
+from typing import ClassVar
 
 import numpy as np
 import serial
@@ -57,7 +58,7 @@ def parse_hex(name: str, value: str, *, max_bytes: int = 8) -> bytes:
 
 def parse_options(name: str, text: str, allowed: dict[str, str]) -> dict[str, str]:
     """``key=value`` pairs separated by commas, each key one of ``allowed``."""
-    options: dict[str, str] = {}
+    options: ClassVar[dict[str, str]] = {}
     for item in filter(None, (part.strip() for part in text.split(","))):
         key, equals, value = item.partition("=")
         key = key.strip().lower()
@@ -72,7 +73,7 @@ class WireFormat:
     """What every format module provides (subclasses fill it in)."""
 
     name = ""
-    options: dict[str, str] = {}
+    options: ClassVar[dict[str, str]] = {}
     """Option names and what each takes (for messages and docs)."""
     noise_excluded = b""
     """Bytes the emulator's line noise avoids (so that injected faults count exactly)."""

@@ -9,6 +9,8 @@ above 65535 once scaled) is garbage.
 
 from __future__ import annotations
 
+from typing import ClassVar
+
 import numpy as np
 
 from tactsense.stream.framed import DelimitedFramer, FormatError, WireFormat, parse_hex
@@ -31,7 +33,7 @@ class JustFloat(WireFormat):
     """
 
     name = "justfloat"
-    options = {"tail": "hex bytes", "scale": "counts per unit"}
+    options: ClassVar[dict[str, str]] = {"tail": "hex bytes", "scale": "counts per unit"}
 
     def __init__(self, tail: str = "0000807F", scale: str | float = 1.0):
         self.tail = parse_hex("format justfloat: tail", str(tail))

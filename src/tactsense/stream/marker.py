@@ -9,6 +9,8 @@ one-byte start and a one-byte stop, not a multi-byte marker and a length).
 
 from __future__ import annotations
 
+from typing import ClassVar
+
 import numpy as np
 
 from tactsense.stream.framed import DelimitedFramer, FormatError, WireFormat, parse_hex
@@ -31,7 +33,11 @@ class MarkerFrames(WireFormat):
     """
 
     name = "marker"
-    options = {"start": "hex bytes", "width": "8|16", "order": "little|big"}
+    options: ClassVar[dict[str, str]] = {
+        "start": "hex bytes",
+        "width": "8|16",
+        "order": "little|big",
+    }
 
     def __init__(self, start: str = "AA55", width: str | int = 8, order: str = "little"):
         self.marker = parse_hex("format marker: start", str(start))

@@ -9,6 +9,8 @@ too. The lines are split by pyserial's :class:`serial.threaded.Packetizer`.
 
 from __future__ import annotations
 
+from typing import ClassVar
+
 import numpy as np
 from serial.threaded import Packetizer
 
@@ -38,7 +40,11 @@ class TextLines(WireFormat):
     """
 
     name = "text"
-    options = {"sep": "comma|space|tab|semicolon", "prefix": "text", "header": "lines"}
+    options: ClassVar[dict[str, str]] = {
+        "sep": "comma|space|tab|semicolon",
+        "prefix": "text",
+        "header": "lines",
+    }
     noise_excluded = bytes(range(0x80))  # line noise: bytes no ASCII parser takes
 
     def __init__(self, sep: str = "comma", prefix: str = "", header: str | int = 0):
