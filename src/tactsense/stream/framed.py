@@ -319,6 +319,14 @@ class FormatReader:
         if data is None:  # no END in these formats: the line closing ends the stream
             self.ended = True
             self._accept(self._decoder.finish(), time.time(), time.perf_counter())
+            if self._first_arrival is None:
+                seen = self.stats.summary().removeprefix("0 frames")
+                raise StreamError(
+                    f"{self.url}: the line closed before any frame arrived"
+                    f"{'; seen' + seen if seen else ''}; is the device sending "
+                    f"{self.format.name} frames of {self.sensor.shape[0]}x"
+                    f"{self.sensor.shape[1]}?"
+                )
             return True
         if not data:
             return False
