@@ -79,18 +79,17 @@ class JustFloatDecoder:
         )  # fmt: skip
 
     def _frames(self, raws):
-        out = []
-        for raw in raws:
-            values = np.frombuffer(raw, FLOAT).astype(np.float64) * self.scale
-            counts = np.rint(values)
-            with np.errstate(invalid="ignore"):
-                good = np.all(np.isfinite(counts)) and counts.min() >= 0 and counts.max() <= 65535
-            if not good:
-                self.stats.garbage += 1
-                self.stats.garbage_bytes += len(raw)
-                continue
-            out.append(counts.astype(np.uint16).reshape(self.shape))
-        return out
+        if not raws:
+            return []
+        values = np.frombuffer(b"".join(raws), FLOAT).reshape(len(raws), -1) * self.scale
+        counts = np.rint(values)
+        with np.errstate(invalid="ignore"):
+            good = np.isfinite(counts).all(1) & (counts >= 0).all(1) & (counts <= 65535).all(1)
+        bad = int(len(raws) - good.sum())
+        if bad:  # values that are no counts: not finite, negative or too large
+            self.stats.garbage += bad
+            self.stats.garbage_bytes += bad * len(raws[0])
+        return list(counts[good].astype(np.uint16).reshape(-1, *self.shape))
 
     def feed(self, data: bytes) -> list[np.ndarray]:
         return self._frames(self.framer.feed(data))

@@ -84,9 +84,10 @@ class MarkerDecoder:
         )
 
     def _frames(self, raws):
-        return [
-            np.frombuffer(raw, self.dtype).astype(np.uint16).reshape(self.shape) for raw in raws
-        ]
+        if not raws:
+            return []
+        joined = np.frombuffer(b"".join(raws), self.dtype).astype(np.uint16)
+        return list(joined.reshape(-1, *self.shape))
 
     def feed(self, data: bytes) -> list[np.ndarray]:
         return self._frames(self.framer.feed(data))
