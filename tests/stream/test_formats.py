@@ -2,6 +2,9 @@
 emulator format arrives bit-identical, and the faults each format can see are counted
 exactly (the emulator logs what it injected, independently of the reader)."""
 
+import re
+from pathlib import Path
+
 import numpy as np
 import pytest
 from typer.testing import CliRunner
@@ -205,3 +208,31 @@ def test_record_writes_the_frames_of_a_text_device(tmp_path):
     np.testing.assert_array_equal(rec.frames, FRAMES[:80])
     assert rec.sensor.name == "pad16"
     assert rec.losses["garbage"] == 0 and rec.losses["truncated"] == 0
+
+
+DOC = (Path(__file__).parents[2] / "docs" / "devices.md").read_text()
+
+
+def _example(name: str) -> list[str]:
+    block = re.search(rf"<!-- example-{name} -->\n```text\n(.*?)```", DOC, re.S)
+    return block.group(1).splitlines()
+
+
+def test_the_examples_in_devices_md_are_what_the_formats_send():
+    big = np.array([[2000, 2001], [2002, 4095]], np.uint16)
+    small = np.array([[1, 2], [3, 255]], np.uint16)
+    text = [line.replace("\\r", "\r").replace("\\n", "\n").replace("\\t", "\t") for line in
+            _example("text")]  # fmt: skip
+    assert text == [
+        parse_format("text").encode(big).decode(),
+        parse_format("text,sep=tab,prefix=F:").encode(big).decode(),
+    ]
+    assert [bytes.fromhex(line) for line in _example("marker")] == [
+        parse_format("marker").encode(small),
+        parse_format("marker,width=16,order=big").encode(big),
+        parse_format("marker,width=16").encode(big),
+    ]
+    (line,) = _example("justfloat")
+    assert bytes.fromhex(line) == parse_format("justfloat").encode(big)
+    # and each reads back as the frame it shows (an independent check of the bytes)
+    assert np.array_equal(np.frombuffer(bytes.fromhex(line)[:-4], "<f4"), big.ravel())
