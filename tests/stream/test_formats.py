@@ -83,6 +83,7 @@ def test_a_dropped_frame_is_invisible():
     assert emulator.log.drop > 10
     assert len(got) == len(FRAMES) - emulator.log.drop
     assert stream.stats.summary() == f"{len(got)} frames"
+    assert (emulator.log.drop, len(got)) == (31, 269)  # as docs/devices.md quotes
 
 
 def test_eight_bits_keep_the_top_bits_of_the_twin():
