@@ -109,11 +109,13 @@ class TextDecoder(Packetizer):
         self.skip = header
         self.limit = max(MAX_LINE_BYTES, 24 * self.size)
         self._out: list[np.ndarray] = []
+        self._pending: list[tuple[list[bytes], int]] = []
         self._framed = False
         self._wrong = (-1, 0)
 
     def feed(self, data: bytes) -> list[np.ndarray]:
         self.data_received(data)
+        self._parse()
         if len(self.buffer) > self.limit:  # no newline in sight
             self._garbage(len(self.buffer))
             self.buffer.clear()
@@ -125,6 +127,7 @@ class TextDecoder(Packetizer):
         if self.buffer.strip():
             self.handle_packet(bytes(self.buffer))
         self.buffer.clear()
+        self._parse()
         out, self._out = self._out, []
         return out
 
@@ -145,24 +148,45 @@ class TextDecoder(Packetizer):
                 return
             line = line[len(self.prefix) :]
         tokens = line.translate(_TO_SPACE).split()
+        if len(tokens) == self.size:
+            self._framed = True  # the right length: parsed with the others of this read
+            self._pending.append((tokens, len(packet)))
+            return
         try:
-            values = np.array(tokens, dtype=np.float64)
+            np.array(tokens, dtype=np.float64)
         except ValueError:
             self._garbage(len(packet))
             return
-        if len(values) != self.size:
-            self._wrong_length(len(values))
-            if len(values) < self.size:
-                self.stats.truncated += 1
-            else:
-                self._garbage(len(packet))
+        self._wrong_length(len(tokens))
+        if len(tokens) < self.size:
+            self.stats.truncated += 1
+        else:
+            self._garbage(len(packet))
+
+    def _parse(self) -> None:
+        """The lines of the right length, all at once (one float conversion); a line
+        whose values are not counts (fractions, negatives, inf, nan, words) is garbage."""
+        pending, self._pending = self._pending, []
+        if not pending:
             return
+        try:
+            values = np.array([t for tokens, _ in pending for t in tokens], dtype=np.float64)
+            values = values.reshape(len(pending), self.size)
+        except ValueError:  # a word among them: line by line
+            rows = []
+            for tokens, _size in pending:
+                try:
+                    rows.append(np.array(tokens, dtype=np.float64))
+                except ValueError:
+                    rows.append(np.full(self.size, np.nan))
+            values = np.stack(rows)
         counts = np.rint(values)
-        if not (np.all(counts == values) and counts.min() >= 0 and counts.max() <= 65535):
-            self._garbage(len(packet))  # not counts: fractions, negatives, inf, nan
-            return
-        self._framed = True
-        self._out.append(counts.astype(np.uint16).reshape(self.shape))
+        with np.errstate(invalid="ignore"):
+            good = (counts == values).all(1) & (counts >= 0).all(1) & (counts <= 65535).all(1)
+        for (_, size), ok in zip(pending, good, strict=True):
+            if not ok:
+                self._garbage(size)
+        self._out.extend(counts[good].astype(np.uint16).reshape(-1, *self.shape))
 
     def _wrong_length(self, n: int) -> None:
         if self._framed:
