@@ -526,7 +526,8 @@ def view(
         typer.Argument(
             help="A recording (.h5 from 'tactsense record' or 'simulate') to play back, or "
             "a device: a serial port, a pty path, socket://127.0.0.1:PORT or any pyserial "
-            "URL; or lsl:NAME, a Lab Streaming Layer frames outlet."
+            "URL; or lsl:NAME, a Lab Streaming Layer frames outlet; or FORMAT:URL for a "
+            "device speaking text lines, marker-framed bytes or JustFloat (docs/devices.md)."
         ),
     ],
     port: Annotated[
