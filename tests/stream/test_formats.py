@@ -2,6 +2,7 @@
 emulator format arrives bit-identical, and the faults each format can see are counted
 exactly (the emulator logs what it injected, independently of the reader)."""
 
+import json
 import re
 from pathlib import Path
 
@@ -237,3 +238,46 @@ def test_the_examples_in_devices_md_are_what_the_formats_send():
     assert bytes.fromhex(line) == parse_format("justfloat").encode(big)
     # and each reads back as the frame it shows (an independent check of the bytes)
     assert np.array_equal(np.frombuffer(bytes.fromhex(line)[:-4], "<f4"), big.ravel())
+
+
+def test_view_feeds_a_format_source():
+    """`tactsense view FORMAT:URL`: the live feed takes frames from a format reader and
+    ends when the line closes."""
+    from tactsense.view import LiveFeed, view_locator
+
+    fmt = parse_format("justfloat")
+    emulator = Emulator(SPEC, FRAMES[:60], speed=0, wire_format=fmt)
+    _, port = emulator.start_tcp()
+    messages = []
+    try:
+        reader = open_source(f"justfloat:socket://127.0.0.1:{port}", sensor=SPEC, start=False)
+        feed = LiveFeed(reader, view_locator(SPEC, baseline_frames=5))
+        feed.start(messages.append)
+        feed._thread.join(20)
+    finally:
+        emulator.stop()
+    assert feed.frames_in == 60 and feed.status == "ended", feed.health()
+    frames = [m for m in map(json.loads, messages) if m["type"] == "frame"]
+    assert len(frames) == 60 and frames[-1]["health"]["received"] == 60
+
+
+def test_live_estimates_from_a_text_device(tmp_path):
+    finger = load_sensor("initial")
+    rec = __import__("tactsense").simulate(
+        finger, __import__("tactsense").probe_sweep(finger), rng=0
+    )
+    emulator = Emulator(finger, rec.frames[:60], speed=0, wire_format=parse_format("text"))
+    _, port = emulator.start_tcp()
+    out = tmp_path / "live.jsonl"
+    try:
+        result = CliRunner().invoke(
+            app,
+            ["live", f"text:socket://127.0.0.1:{port}", "--sensor", "initial", "--frames",
+             "40", "-o", str(out)],
+        )  # fmt: skip
+    finally:
+        emulator.stop()
+    assert result.exit_code == 0, result.output
+    lines = [json.loads(line) for line in out.read_text().splitlines()]
+    assert len(lines) == 35  # 5 frames make the baseline
+    assert [e["sequence"] for e in lines] == list(range(5, 40))
