@@ -4,6 +4,9 @@ exactly (the emulator logs what it injected, independently of the reader)."""
 
 import json
 import re
+import signal
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -281,3 +284,39 @@ def test_live_estimates_from_a_text_device(tmp_path):
     lines = [json.loads(line) for line in out.read_text().splitlines()]
     assert len(lines) == 35  # 5 frames make the baseline
     assert [e["sequence"] for e in lines] == list(range(5, 40))
+
+
+def test_a_stall_counts_timeouts():
+    fmt = parse_format("text")
+    faults = FaultRates(stall=0.05, stall_s=0.3)
+    emulator = Emulator(SPEC, FRAMES[:100], speed=0, faults=faults, rng=3, wire_format=fmt)
+    _, port = emulator.start_tcp()
+    try:
+        with open_source(f"text:socket://127.0.0.1:{port}", sensor=SPEC, timeout_s=0.1) as s:
+            got = list(s.frames())
+    finally:
+        emulator.stop()
+    assert len(got) == 100 and emulator.log.stall >= 2
+    # each 0.3 s stall is at least 2 intervals of 0.1 s with no frame, at most 3
+    assert 2 * emulator.log.stall <= s.stats.timeouts <= 3 * emulator.log.stall
+
+
+def test_emulate_format_prints_a_source_that_record_reads(tmp_path):
+    """The command line end to end: the address `emulate --format` prints is the source."""
+    command = [
+        *(sys.executable, "-m", "tactsense.cli", "emulate", "--sensor", "pad16"),
+        *("--scenario", "press", "--format", "marker,width=16,order=big", "--port", "0"),
+    ]
+    device = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        source = device.stdout.readline().strip()
+        assert source.startswith("marker,start=AA55,width=16,order=big:socket://127.0.0.1:")
+        out = tmp_path / "pad.h5"
+        result = CliRunner().invoke(
+            app, ["record", source, "--sensor", "pad16", "-o", str(out), "--frames", "30"]
+        )
+        assert result.exit_code == 0, result.output
+        assert len(read_recording(out).frames) == 30
+    finally:
+        device.send_signal(signal.SIGINT)
+        device.wait(10)
