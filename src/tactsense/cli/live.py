@@ -59,7 +59,9 @@ SourceArgument = Annotated[
     typer.Argument(
         help="The device: a serial port (/dev/ttyUSB0), a pty path printed by 'tactsense "
         "emulate', socket://127.0.0.1:PORT, or any other pyserial URL; or lsl:NAME, a Lab "
-        "Streaming Layer frames outlet (its name or source_id)."
+        "Streaming Layer frames outlet (its name or source_id); or FORMAT:URL for a device "
+        "that speaks text lines, marker-framed bytes or JustFloat (text:/dev/ttyACM0, "
+        "marker,start=AA55,width=16:URL, justfloat:URL; docs/devices.md; --sensor needed)."
     ),
 ]
 StreamSensorOption = Annotated[
@@ -104,11 +106,18 @@ class RecordFormat(StrEnum):
 
 def _source_file(source: str) -> list[Path]:
     """A source that names a file or device (not an address): an input no output replaces."""
+    from tactsense.stream.sources import split_source
+
+    if not source.startswith(LSL_PREFIX):
+        try:
+            source = split_source(source)[1]
+        except TactsenseInputError as error:
+            fail(str(error))
     return [] if "://" in source or source.startswith(LSL_PREFIX) else [Path(source)]
 
 
 def _open_reader(source: str, sensor: str | None, timeout: float | None, *, start: bool = True):
-    from tactsense.stream import StreamReader
+    from tactsense.stream.sources import open_source
 
     spec = None if sensor is None else load_sensor(sensor)
     if source.startswith(LSL_PREFIX):
@@ -118,7 +127,7 @@ def _open_reader(source: str, sensor: str | None, timeout: float | None, *, star
         if not name:
             fail("lsl: needs an outlet name or source_id, e.g. lsl:fearing1990_initial-frames")
         return LslReader(name, sensor=spec, timeout_s=timeout or 5.0)
-    return StreamReader(source, sensor=spec, timeout_s=timeout, start=start)
+    return open_source(source, sensor=spec, timeout_s=timeout, start=start)
 
 
 def _stream_and_locator(
@@ -216,6 +225,16 @@ def emulate(
     fault_seed: Annotated[
         int, typer.Option(min=0, help="Seed of the fault draws, for a repeatable line.")
     ] = 0,
+    wire_format: Annotated[
+        str | None,
+        typer.Option(
+            "--format",
+            help="Speak another wire format instead of tactsense's: text, marker or "
+            "justfloat, with options (e.g. text,sep=tab; marker,start=AA55,width=16,"
+            "order=big; docs/devices.md). The address printed names it; the device "
+            "streams as soon as a host connects.",
+        ),
+    ] = None,
 ) -> None:
     """Play a sensor as a device: frames of the twin (a finger, a pad or a point set) in the
     wire protocol on a pty or TCP.
@@ -226,6 +245,7 @@ def emulate(
     """
     from tactsense.io.recording import read_recording
     from tactsense.stream import Emulator, FaultRates
+    from tactsense.stream.sources import parse_format
 
     if not 0 < speed <= 1e6:
         fail(
@@ -245,6 +265,8 @@ def emulate(
             )
     try:
         faults = FaultRates(garbage, bitflip, drop, truncate, stall, stall_s)
+        fmt = None if wire_format is None else parse_format(wire_format)
+        prefix = "" if fmt is None else fmt.spec() + ":"
         if recording is not None:
             source = read_recording(recording)
         else:
@@ -257,14 +279,14 @@ def emulate(
             )  # fmt: skip
             source = run_scenario(spec, scene, flaws=flaws, seed=seed)
         emulator = Emulator.from_recording(
-            source, speed=speed, faults=faults, repeat=loop, rng=fault_seed
+            source, speed=speed, faults=faults, repeat=loop, rng=fault_seed, wire_format=fmt
         )
     except TactsenseInputError as error:
         fail(str(error))
     try:
         if port is None:
             master, _slave, path = emulator.open_pty()  # the slave stays open: no EIO
-            typer.echo(path)
+            typer.echo(prefix + path)
             sys.stdout.flush()
             console.print(
                 f"emulating {source.sensor.name} on {path}: {len(source)} frames at "
@@ -274,7 +296,7 @@ def emulate(
         else:
 
             def ready(chosen: int) -> None:
-                typer.echo(f"socket://127.0.0.1:{chosen}")
+                typer.echo(f"{prefix}socket://127.0.0.1:{chosen}")
                 sys.stdout.flush()
                 console.print(
                     f"emulating {source.sensor.name} on 127.0.0.1:{chosen}: {len(source)} "
@@ -534,7 +556,8 @@ def view(
         typer.Argument(
             help="A recording (.h5 from 'tactsense record' or 'simulate') to play back, or "
             "a device: a serial port, a pty path, socket://127.0.0.1:PORT or any pyserial "
-            "URL; or lsl:NAME, a Lab Streaming Layer frames outlet."
+            "URL; or lsl:NAME, a Lab Streaming Layer frames outlet; or FORMAT:URL for a "
+            "device speaking text lines, marker-framed bytes or JustFloat (docs/devices.md)."
         ),
     ],
     port: Annotated[

@@ -10,9 +10,13 @@ This package imports the forward model and the estimation; neither imports it.
 >>> with StreamReader(f"socket://127.0.0.1:{port}") as stream:
 ...     for frame in stream.frames(max_frames=50):
 ...         ...
+
+Devices that speak other wire formats (text lines, marker-framed bytes, JustFloat;
+``docs/devices.md``): ``open_source("text:/dev/ttyACM0", sensor=...)``.
 """
 
 from tactsense.stream.emulator import Emulator, FaultLog, FaultRates
+from tactsense.stream.framed import FormatReader
 from tactsense.stream.live import LiveLocator
 from tactsense.stream.protocol import ProtocolError, decode_packet, encode_frame
 from tactsense.stream.reader import (
@@ -24,12 +28,15 @@ from tactsense.stream.reader import (
     open_port,
 )
 from tactsense.stream.recorder import record
+from tactsense.stream.sources import FORMATS, open_source
 
 __all__ = [
+    "FORMATS",
     "LOSS_KINDS",
     "Emulator",
     "FaultLog",
     "FaultRates",
+    "FormatReader",
     "LiveLocator",
     "LossCounters",
     "ProtocolError",
@@ -39,5 +46,6 @@ __all__ = [
     "decode_packet",
     "encode_frame",
     "open_port",
+    "open_source",
     "record",
 ]

@@ -34,6 +34,10 @@ from tactsense.stream.protocol import (
     encode_frame,
 )
 
+FORMAT_BOOT_S = 0.25
+"""In another wire format, the device streams this long after a host connects [s] (as a
+board that resets when its port opens; pyserial discards what arrived while it opened)."""
+
 
 @dataclass(frozen=True)
 class FaultRates:
@@ -100,6 +104,11 @@ class Emulator:
         Seed of the fault draws.
     serial_number : str
         Reported by IDENT; a stream consumer uses it to recognise the device.
+    wire_format : WireFormat, optional
+        Speak another wire format (``tactsense.stream.sources.FORMATS``,
+        ``docs/devices.md``) instead of tactsense's: the device then streams as soon as
+        a host connects, ignores what the host sends, and closes the line when its
+        frames run out. :attr:`frames` holds the frames as the format carries them.
     """
 
     def __init__(
@@ -112,6 +121,7 @@ class Emulator:
         repeat: bool = False,
         rng=None,
         serial_number: str = "twin-0001",
+        wire_format=None,
     ):
         frames = np.asarray(frames)
         if frames.ndim != 3 or frames.shape[1:] != sensor.shape or frames.shape[0] == 0:
@@ -123,6 +133,10 @@ class Emulator:
             raise TactsenseInputError(f"speed must be a finite number >= 0; got {speed!r}")
         self.sensor = sensor
         self.frames = np.clip(np.nan_to_num(frames), 0, 65535).astype(np.uint16)
+        self.format = wire_format
+        if wire_format is not None:
+            wire_format.check_shape(sensor.shape)
+            self.frames = wire_format.prepare(self.frames)
         self.speed = float(speed)
         self.faults = faults or FaultRates()
         self.repeat = repeat
@@ -181,7 +195,10 @@ class Emulator:
         k = self._next
         self._next += 1
         counts = self.frames[(k - self._start) % len(self.frames)]
-        wire = encode_frame(k, round(k * self.scan_period_s * 1e6), counts)
+        if self.format is None:
+            wire = encode_frame(k, round(k * self.scan_period_s * 1e6), counts)
+        else:
+            wire = self.format.encode(counts)
         rates, rng, log = self.faults, self._rng, self.log
         log.frames += 1
         stall = 0.0
@@ -196,16 +213,21 @@ class Emulator:
             log.bitflip += 1
             damaged = True
             data = bytearray(wire)
-            data[int(rng.integers(len(wire) - 1))] ^= 1 << int(rng.integers(8))
+            data[int(rng.integers(len(wire) - (self.format is None)))] ^= 1 << int(rng.integers(8))
             wire = bytes(data)
         if rates.truncate and rng.random() < rates.truncate:
             log.truncate += 1
             damaged = True
-            wire = wire[: int(rng.integers(1, len(wire) - 2))] + b"\x00"
+            if self.format is None:
+                wire = wire[: int(rng.integers(1, len(wire) - 2))] + b"\x00"
+            else:
+                wire = self.format.truncate(wire, rng)
         if rates.garbage and rng.random() < rates.garbage:
             log.garbage += 1
             noise = rng.integers(0, 256, int(rng.integers(1, 33)), dtype=np.uint8).tobytes()
-            damaged |= not noise.endswith(b"\x00")  # noise glued to the frame spoils it
+            if self.format is not None:  # noise that makes no false delimiter: exact counts
+                noise = noise.translate(None, self.format.noise_excluded) or b"\xff"
+            damaged |= self.format is not None or not noise.endswith(b"\x00")
             wire = noise + wire
         log.delivered_intact += not damaged
         return wire, stall
@@ -241,6 +263,9 @@ class Emulator:
         fileno : int
             File descriptor to wait on for the host's commands.
         """
+        if self.format is not None:
+            self._serve_format(read, write, fileno)
+            return
         splitter = PacketSplitter()
         streaming = False
         period = self.scan_period_s / self.speed if self.speed > 0 else 0.0
@@ -303,6 +328,40 @@ class Emulator:
                 write(self.end_packet())
                 streaming = False
 
+    def _serve_format(self, read, write, fileno: int) -> None:
+        """Stream in :attr:`format` from the first frame until the frames run out (then
+        return: the line closes) or the host goes away; what the host sends is ignored."""
+        self.rewind()
+        if self._stop.wait(FORMAT_BOOT_S):
+            return
+        write(self.format.preamble())
+        period = self.scan_period_s / self.speed if self.speed > 0 else 0.0
+        due = time.perf_counter()
+        while not self._stop.is_set() and not self.exhausted:
+            ready, _, _ = select.select([fileno], [], [], max(due - time.perf_counter(), 0.0))
+            if ready:
+                try:
+                    if not read():
+                        return
+                except OSError:
+                    return
+                continue
+            chunks = []
+            for _ in range(1 if period > 0 else 64):
+                if self.exhausted:
+                    break
+                wire, stall = self.next_packet()
+                if stall:
+                    if chunks:
+                        write(b"".join(chunks))
+                        chunks = []
+                    time.sleep(stall)
+                    due += stall
+                chunks.append(wire)
+            if chunks:
+                write(b"".join(chunks))
+            due += period
+
     def serve_tcp(self, port: int = 0, host: str = "127.0.0.1", *, ready=None) -> None:
         """Serve hosts one after another on a TCP port until :meth:`stop`.
 
@@ -342,6 +401,9 @@ class Emulator:
                     view = view[os.write(master, view) :]
 
         while not self._stop.is_set():
+            if self.format is not None and self.exhausted:
+                self._stop.wait(0.1)  # a pty never closes: the device is done
+                continue
             self.serve_fd(lambda: os.read(master, 1 << 16), write, master)
             time.sleep(0.05)  # the host closed the line; wait for the next one
 

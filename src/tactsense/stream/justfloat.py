@@ -1,0 +1,105 @@
+"""Float frames with a tail marker: rows x cols little-endian float32 values, then the
+4-byte tail ``00 00 80 7F`` (VOFA+ "JustFloat"; ``docs/devices.md``).
+
+Decoded with :func:`numpy.frombuffer`; framed by
+:class:`~tactsense.stream.framed.DelimitedFramer`. Values become counts as
+``rint(value * scale)``; a frame with a value that is no count (not finite, below 0 or
+above 65535 once scaled) is garbage.
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+import numpy as np
+
+from tactsense.stream.framed import DelimitedFramer, FormatError, WireFormat, parse_hex
+from tactsense.stream.reader import LossCounters, StreamError
+
+TAIL = bytes.fromhex("0000807f")
+"""VOFA+ JustFloat's tail: float32 +inf, little-endian."""
+FLOAT = np.dtype("<f4")
+
+
+class JustFloat(WireFormat):
+    """Little-endian float32 values, then a tail.
+
+    Parameters (``justfloat,tail=0000807F,scale=1``)
+    ----------
+    tail : str
+        The tail as hex digits [default ``0000807F``].
+    scale : float
+        Counts per unit of the values sent [default 1: the values are counts].
+    """
+
+    name = "justfloat"
+    options: ClassVar[dict[str, str]] = {"tail": "hex bytes", "scale": "counts per unit"}
+
+    def __init__(self, tail: str = "0000807F", scale: str | float = 1.0):
+        self.tail = parse_hex("format justfloat: tail", str(tail))
+        try:
+            self.scale = float(scale)
+        except ValueError:
+            self.scale = float("nan")
+        if not (np.isfinite(self.scale) and self.scale > 0):
+            raise FormatError(
+                f"format justfloat: scale={scale!r} must be a finite number above 0 "
+                "(counts per unit)"
+            )
+        self.noise_excluded = bytes(set(self.tail))
+
+    def spec(self) -> str:
+        parts = ["justfloat"]
+        if self.tail != TAIL:
+            parts.append(f"tail={self.tail.hex().upper()}")
+        if self.scale != 1.0:
+            parts.append(f"scale={self.scale:g}")
+        return ",".join(parts)
+
+    def decoder(self, shape, stats: LossCounters, url: str) -> JustFloatDecoder:
+        return JustFloatDecoder(self, tuple(shape), stats, url)
+
+    # ---- the emulator's side ------------------------------------------------------
+
+    def encode(self, counts: np.ndarray) -> bytes:
+        return (counts / self.scale).astype(FLOAT).tobytes() + self.tail
+
+    def truncate(self, wire: bytes, rng: np.random.Generator) -> bytes:
+        """Fewer values than a frame's, then the tail."""
+        body = wire[: -len(self.tail)]
+        return body[: int(rng.integers(0, len(body)))] + self.tail
+
+
+class JustFloatDecoder:
+    def __init__(self, fmt: JustFloat, shape, stats: LossCounters, url):
+        self.shape, self.url, self.stats, self.scale = shape, url, stats, fmt.scale
+        self.framer = DelimitedFramer(
+            fmt.tail, shape[0] * shape[1] * 4, leading=False, stats=stats,
+            on_shape=self._shape_error,
+        )  # fmt: skip
+
+    def _frames(self, raws):
+        if not raws:
+            return []
+        values = np.frombuffer(b"".join(raws), FLOAT).reshape(len(raws), -1) * self.scale
+        counts = np.rint(values)
+        with np.errstate(invalid="ignore"):
+            good = np.isfinite(counts).all(1) & (counts >= 0).all(1) & (counts <= 65535).all(1)
+        bad = int(len(raws) - good.sum())
+        if bad:  # values that are no counts: not finite, negative or too large
+            self.stats.garbage += bad
+            self.stats.garbage_bytes += bad * len(raws[0])
+        return list(counts[good].astype(np.uint16).reshape(-1, *self.shape))
+
+    def feed(self, data: bytes) -> list[np.ndarray]:
+        return self._frames(self.framer.feed(data))
+
+    def finish(self) -> list[np.ndarray]:
+        return self._frames(self.framer.finish())
+
+    def _shape_error(self, size: int) -> None:
+        rows, cols = self.shape
+        raise StreamError(
+            f"{self.url}: the device sends {size / 4:g} floats between tails, but the sensor "
+            f"has {rows}x{cols} = {rows * cols} tactels; give the sensor of the device (--sensor)"
+        )

@@ -1,0 +1,105 @@
+"""Marker-framed bytes: a fixed start marker, then rows x cols samples of 8 or 16 bits
+(``docs/devices.md``), the framing of several open-hardware piezoresistive pads (e.g.
+``AA 55`` then one ``uint8`` per taxel, row-major).
+
+Decoded with :func:`numpy.frombuffer`; framed by
+:class:`~tactsense.stream.framed.DelimitedFramer` (pyserial's ``FramedPacket`` takes a
+one-byte start and a one-byte stop, not a multi-byte marker and a length).
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+import numpy as np
+
+from tactsense.stream.framed import DelimitedFramer, FormatError, WireFormat, parse_hex
+from tactsense.stream.reader import LossCounters, StreamError
+
+ORDERS = {"little": "<", "big": ">"}
+
+
+class MarkerFrames(WireFormat):
+    """A start marker, then rows x cols unsigned samples.
+
+    Parameters (``marker,start=AA55,width=16,order=big``)
+    ----------
+    start : str
+        The marker as hex digits, 1 to 8 bytes [default ``AA55``].
+    width : {'8', '16'}
+        Bits per sample [default 8].
+    order : {'little', 'big'}
+        Byte order of 16-bit samples [default little].
+    """
+
+    name = "marker"
+    options: ClassVar[dict[str, str]] = {
+        "start": "hex bytes",
+        "width": "8|16",
+        "order": "little|big",
+    }
+
+    def __init__(self, start: str = "AA55", width: str | int = 8, order: str = "little"):
+        self.marker = parse_hex("format marker: start", str(start))
+        if str(width).strip() not in ("8", "16"):
+            raise FormatError(f"format marker: width={width!r} must be 8 or 16 bits a sample")
+        self.width = int(width)
+        if order not in ORDERS:
+            raise FormatError(f"format marker: order={order!r} must be little or big")
+        self.order = order
+        self.dtype = np.dtype(np.uint8) if self.width == 8 else np.dtype(ORDERS[order] + "u2")
+        self.noise_excluded = bytes(set(self.marker))
+
+    def spec(self) -> str:
+        order = f",order={self.order}" if self.width == 16 else ""
+        return f"marker,start={self.marker.hex().upper()},width={self.width}{order}"
+
+    def decoder(self, shape, stats: LossCounters, url: str) -> MarkerDecoder:
+        return MarkerDecoder(self, tuple(shape), stats, url)
+
+    # ---- the emulator's side ------------------------------------------------------
+
+    def prepare(self, frames: np.ndarray) -> np.ndarray:
+        """8 bits: the top 8 bits of the counts (an 8-bit converter), 16: as they are."""
+        if self.width == 16:
+            return frames
+        shift = max(int(frames.max()).bit_length() - 8, 0)
+        return (frames >> shift).astype(np.uint16)
+
+    def encode(self, counts: np.ndarray) -> bytes:
+        return self.marker + counts.astype(self.dtype).tobytes()
+
+    def truncate(self, wire: bytes, rng: np.random.Generator) -> bytes:
+        """The marker and the first samples, fewer than a frame's."""
+        return wire[: int(rng.integers(len(self.marker), len(wire)))]
+
+
+class MarkerDecoder:
+    def __init__(self, fmt: MarkerFrames, shape, stats, url):
+        self.shape, self.dtype, self.url = shape, fmt.dtype, url
+        self.fmt = fmt
+        length = shape[0] * shape[1] * fmt.dtype.itemsize
+        self.framer = DelimitedFramer(
+            fmt.marker, length, leading=True, stats=stats, on_shape=self._shape_error
+        )
+
+    def _frames(self, raws):
+        if not raws:
+            return []
+        joined = np.frombuffer(b"".join(raws), self.dtype).astype(np.uint16)
+        return list(joined.reshape(-1, *self.shape))
+
+    def feed(self, data: bytes) -> list[np.ndarray]:
+        return self._frames(self.framer.feed(data))
+
+    def finish(self) -> list[np.ndarray]:
+        return self._frames(self.framer.finish())
+
+    def _shape_error(self, size: int) -> None:
+        rows, cols = self.shape
+        samples = size / self.dtype.itemsize
+        raise StreamError(
+            f"{self.url}: the device sends {samples:g} samples of {self.fmt.width} bits between "
+            f"markers, but the sensor has {rows}x{cols} = {rows * cols} tactels; give the "
+            "sensor of the device (--sensor) or its width"
+        )

@@ -1,0 +1,81 @@
+"""Sources by name: one table from a format's name to its module (``docs/devices.md``).
+
+A source is a pyserial URL (the tactsense protocol), or ``FORMAT[,KEY=VALUE...]:URL``
+for a device that speaks another wire format, e.g. ``text:/dev/ttyACM0``,
+``marker,start=AA55,width=16:socket://127.0.0.1:5000``, ``justfloat:/dev/ttyUSB0``.
+
+>>> from tactsense.stream.sources import open_source            # doctest: +SKIP
+>>> with open_source("text:/dev/ttyACM0", sensor=load_sensor("pad16")) as stream:
+...     for frame in stream.frames(max_frames=100):
+...         ...
+"""
+
+from __future__ import annotations
+
+import re
+
+from tactsense.sensor import SensorSpec
+from tactsense.stream.framed import FormatError, FormatReader, WireFormat, parse_options
+from tactsense.stream.justfloat import JustFloat
+from tactsense.stream.marker import MarkerFrames
+from tactsense.stream.reader import StreamReader
+from tactsense.stream.textlines import TextLines
+
+FORMATS: dict[str, type[WireFormat]] = {
+    "text": TextLines,
+    "marker": MarkerFrames,
+    "justfloat": JustFloat,
+}
+"""Every wire format besides tactsense's own, by the name a source or --format gives."""
+
+
+def parse_format(spec: str) -> WireFormat:
+    """A format from ``NAME[,KEY=VALUE...]`` (``marker,start=AA55,width=16``)."""
+    name, _, rest = spec.strip().partition(",")
+    name = name.strip().lower()
+    if name not in FORMATS:
+        raise FormatError(
+            f"unknown wire format {name!r}; expected one of {', '.join(FORMATS)} "
+            "(with options, e.g. marker,start=AA55,width=16)"
+        )
+    cls = FORMATS[name]
+    return cls(**parse_options(name, rest, cls.options))
+
+
+_LINE = re.compile(r"[A-Za-z][\w+.-]*://|/|\.|COM\d|[A-Za-z]:\\", re.IGNORECASE)
+"""How a line begins: a URL, a path, a Windows port."""
+
+
+def split_source(source: str) -> tuple[WireFormat | None, str]:
+    """The format a source names (None: the tactsense protocol) and the line's URL.
+
+    The line starts after the first ``:`` that a URL or a path follows, so an option
+    may hold a colon: ``text,prefix=F::/dev/ttyACM0`` is the prefix ``F:``.
+    """
+    name = source.partition(",")[0].partition(":")[0].strip().lower()
+    if name not in FORMATS or source[len(name) : len(name) + 3] == "://":
+        return None, source
+    at = source.find(":")
+    while at >= 0:
+        if _LINE.match(source, at + 1):
+            return parse_format(source[:at]), source[at + 1 :]
+        at = source.find(":", at + 1)
+    raise FormatError(
+        f"{source}: no line after the format; expected e.g. {name}:/dev/ttyUSB0 or "
+        f"{name}:socket://127.0.0.1:5000"
+    )
+
+
+def open_source(
+    source: str,
+    *,
+    sensor: SensorSpec | None = None,
+    timeout_s: float | None = None,
+    start: bool = True,
+):
+    """A reader of any source: :class:`~tactsense.stream.StreamReader` for a URL,
+    :class:`~tactsense.stream.framed.FormatReader` for ``FORMAT:URL``."""
+    wire_format, url = split_source(source)
+    if wire_format is None:
+        return StreamReader(url, sensor=sensor, timeout_s=timeout_s, start=start)
+    return FormatReader(url, wire_format, sensor=sensor, timeout_s=timeout_s, start=start)

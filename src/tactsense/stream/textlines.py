@@ -1,0 +1,203 @@
+"""Text lines: one frame per line of numbers, as hand-built arrays print them
+(``Serial.println`` on an Arduino; ``docs/devices.md``).
+
+A line is rows x cols numbers, row-major, separated by commas, spaces, tabs or
+semicolons (any mix), optionally after a fixed prefix, ended by ``\\n`` (a ``\\r``
+before it is dropped). Blank lines are skipped; the first ``header`` lines are skipped
+too. The lines are split by pyserial's :class:`serial.threaded.Packetizer`.
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+import numpy as np
+from serial.threaded import Packetizer
+
+from tactsense.stream.framed import SHAPE_EVIDENCE, FormatError, WireFormat
+from tactsense.stream.reader import LossCounters, StreamError
+
+SEPARATORS = {"comma": ",", "space": " ", "tab": "\t", "semicolon": ";"}
+"""The separator the emulator prints, by name (the reader takes any of them)."""
+
+MAX_LINE_BYTES = 1 << 16
+"""A line longer than this (or 24 bytes a value) without its newline is garbage."""
+
+_TO_SPACE = bytes.maketrans(b",;\t", b"   ")
+
+
+class TextLines(WireFormat):
+    """One frame per line of numbers.
+
+    Parameters (``text,sep=tab,prefix=F:,header=1``)
+    ----------
+    sep : {'comma', 'space', 'tab', 'semicolon'}
+        What the emulator prints between values (the reader accepts any of them).
+    prefix : str
+        Every frame line starts with this (stripped; a line without it is garbage).
+    header : int
+        Lines the device prints first that are not frames (a header row of names).
+    """
+
+    name = "text"
+    options: ClassVar[dict[str, str]] = {
+        "sep": "comma|space|tab|semicolon",
+        "prefix": "text",
+        "header": "lines",
+    }
+    noise_excluded = bytes(range(0x80))  # line noise: bytes no ASCII parser takes
+
+    def __init__(self, sep: str = "comma", prefix: str = "", header: str | int = 0):
+        if sep not in SEPARATORS:
+            raise FormatError(
+                f"format text: sep={sep!r} is not a separator; expected one of "
+                f"{', '.join(SEPARATORS)}"
+            )
+        try:
+            header = int(header)
+        except ValueError:
+            header = -1
+        if header < 0:
+            raise FormatError(f"format text: header={header!r} must be a number of lines >= 0")
+        if not prefix.isascii() or "\n" in prefix or "\r" in prefix:
+            raise FormatError(f"format text: prefix={prefix!r} must be ASCII on one line")
+        self.sep, self.prefix, self.header = sep, prefix, header
+
+    def spec(self) -> str:
+        parts = ["text"]
+        if self.sep != "comma":
+            parts.append(f"sep={self.sep}")
+        if self.prefix:
+            parts.append(f"prefix={self.prefix}")
+        if self.header:
+            parts.append(f"header={self.header}")
+        return ",".join(parts)
+
+    def decoder(self, shape, stats: LossCounters, url: str) -> TextDecoder:
+        return TextDecoder(shape, stats, url, self.prefix.encode(), self.header)
+
+    # ---- the emulator's side ------------------------------------------------------
+
+    def preamble(self) -> bytes:
+        return b"".join(f"# header line {k + 1}\r\n".encode() for k in range(self.header))
+
+    def encode(self, counts: np.ndarray) -> bytes:
+        sep = SEPARATORS[self.sep]
+        return (self.prefix + sep.join(map(str, counts.ravel().tolist())) + "\r\n").encode()
+
+    def truncate(self, wire: bytes, rng: np.random.Generator) -> bytes:
+        """The line cut before its last separator (at least one value lost)."""
+        body = wire[:-2]
+        last = body.rfind(SEPARATORS[self.sep].encode())
+        start = len(self.prefix) + 1
+        cut = int(rng.integers(start, last + 1)) if last >= start else len(self.prefix)
+        return body[:cut] + b"\r\n"
+
+
+class TextDecoder(Packetizer):
+    """Lines into frames; counts what is no frame (pyserial's packetizer splits)."""
+
+    TERMINATOR = b"\n"
+
+    def __init__(self, shape, stats: LossCounters, url: str, prefix: bytes, header: int):
+        super().__init__()
+        self.shape = tuple(shape)
+        self.size = self.shape[0] * self.shape[1]
+        self.stats = stats
+        self.url = url
+        self.prefix = prefix
+        self.skip = header
+        self.limit = max(MAX_LINE_BYTES, 24 * self.size)
+        self._out: list[np.ndarray] = []
+        self._pending: list[tuple[list[bytes], int]] = []
+        self._framed = False
+        self._wrong = (-1, 0)
+
+    def feed(self, data: bytes) -> list[np.ndarray]:
+        self.data_received(data)
+        self._parse()
+        if len(self.buffer) > self.limit:  # no newline in sight
+            self._garbage(len(self.buffer))
+            self.buffer.clear()
+        out, self._out = self._out, []
+        return out
+
+    def finish(self) -> list[np.ndarray]:
+        """The line closed: a last line without its newline is taken as it is."""
+        if self.buffer.strip():
+            self.handle_packet(bytes(self.buffer))
+        self.buffer.clear()
+        self._parse()
+        out, self._out = self._out, []
+        return out
+
+    def _garbage(self, size: int) -> None:
+        self.stats.garbage += 1
+        self.stats.garbage_bytes += size
+
+    def handle_packet(self, packet) -> None:
+        line = bytes(packet).rstrip(b"\r")
+        if self.skip:
+            self.skip -= 1
+            return
+        if not line.strip():
+            return
+        if self.prefix:
+            if not line.startswith(self.prefix):
+                self._garbage(len(packet))
+                return
+            line = line[len(self.prefix) :]
+        tokens = line.translate(_TO_SPACE).split()
+        if len(tokens) == self.size:
+            self._framed = True  # the right length: parsed with the others of this read
+            self._pending.append((tokens, len(packet)))
+            return
+        try:
+            np.array(tokens, dtype=np.float64)
+        except ValueError:
+            self._garbage(len(packet))
+            return
+        self._wrong_length(len(tokens))
+        if len(tokens) < self.size:
+            self.stats.truncated += 1
+        else:
+            self._garbage(len(packet))
+
+    def _parse(self) -> None:
+        """The lines of the right length, all at once (one float conversion); a line
+        whose values are not counts (fractions, negatives, inf, nan, words) is garbage."""
+        pending, self._pending = self._pending, []
+        if not pending:
+            return
+        try:
+            values = np.array([t for tokens, _ in pending for t in tokens], dtype=np.float64)
+            values = values.reshape(len(pending), self.size)
+        except ValueError:  # a word among them: line by line
+            rows = []
+            for tokens, _size in pending:
+                try:
+                    rows.append(np.array(tokens, dtype=np.float64))
+                except ValueError:
+                    rows.append(np.full(self.size, np.nan))
+            values = np.stack(rows)
+        counts = np.rint(values)
+        with np.errstate(invalid="ignore"):
+            good = (counts == values).all(1) & (counts >= 0).all(1) & (counts <= 65535).all(1)
+        for (_, size), ok in zip(pending, good, strict=True):
+            if not ok:
+                self._garbage(size)
+        self._out.extend(counts[good].astype(np.uint16).reshape(-1, *self.shape))
+
+    def _wrong_length(self, n: int) -> None:
+        if self._framed:
+            return
+        size, times = self._wrong
+        times = times + 1 if size == n else 1
+        self._wrong = (n, times)
+        if times >= SHAPE_EVIDENCE:
+            rows, cols = self.shape
+            raise StreamError(
+                f"{self.url}: the device prints lines of {n} values, but the sensor has "
+                f"{rows}x{cols} = {self.size} tactels; give the sensor of the device "
+                "(--sensor)"
+            )
