@@ -35,6 +35,8 @@ from scipy.sparse.linalg import spsolve
 from skfem import Basis, BilinearForm, ElementHex2, FacetBasis, LinearForm, MeshHex, MeshHex2, asm
 from skfem.models.elasticity import lame_parameters
 
+from tactsense._validation import check_choice
+
 YOUNGS_PA = 2.5e5
 OUTER_M = 12.7e-3
 CORE_M = 8.85e-3
@@ -291,6 +293,7 @@ def solve_load(
     -------
     Solution
     """
+    check_choice(far_end, "far_end", ("clamped", "sliding"))
     shell = build_mesh(spec)
     basis = Basis(shell.mesh, ElementHex2(), intorder=4)
     lam, mu = lame_parameters(YOUNGS_PA, poisson_ratio)
