@@ -1,0 +1,336 @@
+"""Three-dimensional finite-element model of the finger skin (scikit-fem).
+
+The rubber skin is a thick cylindrical shell, outer radius ``b`` = 12.7 mm, bonded
+to the rigid Delrin core of radius ``a`` = 8.85 mm (section 2.3 of the paper): the
+displacement is zero on ``r = a``. Only the cylindrical part is modelled (no
+hemispherical tip); it is cut ``length`` from the load, where the cut face is
+clamped (the bonded layer's response has died out a few depths from the load).
+
+The load sits on top of the finger at ``x = 0, theta = 0`` and is symmetric about
+the planes ``x = 0`` and ``y = 0``, so one quarter is meshed: ``x`` in
+``[0, length]``, ``theta`` in ``[0, pi]``, ``r`` in ``[a, b]``, with ``u_x = 0`` on
+``x = 0`` and ``u_y = 0`` on ``y = 0``. Cartesian coordinates: ``x`` along the
+finger, ``(y, z) = r (sin theta, cos theta)``.
+
+The mesh is a structured tensor-product hexahedral mesh in ``(r, theta, x)``
+(``MeshHex.init_tensor``) mapped onto the shell, graded toward the load, with
+triquadratic elements (``ElementHex2``). Rubber is nearly incompressible
+(nu = 0.5 in the paper); a pure displacement formulation locks as nu -> 0.5, so
+the model uses nu = 0.49 by default with quadratic elements, which lock only
+mildly; :func:`poisson_study` quantifies the effect of nu = 0.45 / 0.48 / 0.49.
+
+Strain is the radial (normal) strain ``eps_rr = du_r/dr`` [-] (compressive
+negative), at the ring depth 3.2 mm under the outer surface by default.
+
+Forward model only: estimation code must never import this module.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+from scipy import sparse
+from scipy.sparse.linalg import spsolve
+from skfem import Basis, BilinearForm, ElementHex2, FacetBasis, LinearForm, MeshHex, MeshHex2, asm
+from skfem.models.elasticity import lame_parameters
+
+from tactsense._validation import check_choice
+
+YOUNGS_PA = 2.5e5
+OUTER_M = 12.7e-3
+CORE_M = 8.85e-3
+RING_DEPTH_M = 3.2e-3
+
+
+@dataclass(frozen=True)
+class MeshSpec:
+    """Structured mesh of the quarter shell.
+
+    Attributes
+    ----------
+    n_r : int
+        Elements through the thickness.
+    n_fine : int
+        Elements on the fine zone in theta and in x (each).
+    n_coarse : int
+        Graded elements from the fine zone to theta = pi and to ``length``.
+    fine_m : float
+        Half-size of the fine zone along the surface [m].
+    length_m : float
+        Distance from the load to the clamped cut [m].
+    """
+
+    n_r: int = 2
+    n_fine: int = 6
+    n_coarse: int = 6
+    fine_m: float = 6e-3
+    length_m: float = 25e-3
+
+
+LEVELS = (MeshSpec(3, 6, 6, 4e-3), MeshSpec(4, 9, 7, 4e-3), MeshSpec(5, 12, 8, 4e-3))
+
+
+def _graded(fine, end, n_fine, n_coarse):
+    """Uniform nodes on [0, fine], then geometrically growing ones to ``end``."""
+    head = np.linspace(0.0, fine, n_fine + 1)
+    h0 = fine / n_fine
+    # growth ratio q so that the n_coarse steps h0 q, h0 q^2, ... sum to end - fine
+    span = end - fine
+    lo, hi = 1.0 + 1e-9, 10.0
+    for _ in range(200):
+        q = 0.5 * (lo + hi)
+        total = h0 * q * (q**n_coarse - 1) / (q - 1)
+        lo, hi = (q, hi) if total < span else (lo, q)
+    steps = h0 * q ** np.arange(1, n_coarse + 1)
+    tail = fine + np.cumsum(steps * span / steps.sum())
+    return np.concatenate([head, tail])
+
+
+@dataclass
+class ShellMesh:
+    """The mapped quadratic mesh and its boundary facets (indices shared with the box)."""
+
+    mesh: MeshHex2
+    core: np.ndarray
+    outer: np.ndarray
+    sym_x: np.ndarray
+    sym_y: np.ndarray
+    end: np.ndarray
+    nodes: tuple
+    cell_of: np.ndarray
+
+    def find_cells(self, x, theta, r):
+        """Cell containing box coordinates (x, theta, r): exact on the structured box."""
+        idx = [
+            np.clip(np.searchsorted(n, q, side="right") - 1, 0, len(n) - 2)
+            for n, q in zip(self.nodes, (x, theta, r), strict=True)
+        ]
+        return self.cell_of[idx[0], idx[1], idx[2]]
+
+
+def build_mesh(spec: MeshSpec = LEVELS[0]) -> ShellMesh:
+    """Quarter shell mesh mapped from a tensor-product box in (x, theta, r).
+
+    The box is meshed with ``MeshHex.init_tensor``, promoted to triquadratic
+    geometry (``MeshHex2``) and its nodes mapped to ``(x, r sin theta, r cos theta)``,
+    so the curved faces are quadratic, not faceted. Boundary facets are found on the
+    box, where they are planes.
+    """
+    r = np.linspace(CORE_M, OUTER_M, spec.n_r + 1)
+    theta = _graded(spec.fine_m / OUTER_M, np.pi, spec.n_fine, spec.n_coarse)
+    x = _graded(spec.fine_m, spec.length_m, spec.n_fine, spec.n_coarse)
+    box = MeshHex.init_tensor(x, theta, r)
+    box2 = MeshHex2.from_mesh(box)
+    xx, th, rr = box2.doflocs
+    mesh = replace(box2, doflocs=np.vstack([xx, rr * np.sin(th), rr * np.cos(th)]))
+
+    def facets(axis, value):
+        return box.facets_satisfying(lambda q: np.isclose(q[axis], value, rtol=0, atol=1e-9))
+
+    centres = box.p[:, box.t].mean(axis=1)
+    cell_of = np.empty((len(x) - 1, len(theta) - 1, len(r) - 1), dtype=np.int64)
+    keys = [np.searchsorted(n, c) - 1 for n, c in zip((x, theta, r), centres, strict=True)]
+    cell_of[keys[0], keys[1], keys[2]] = np.arange(box.t.shape[1])
+    return ShellMesh(
+        mesh,
+        nodes=(x, theta, r),
+        cell_of=cell_of,
+        core=facets(2, CORE_M),
+        outer=facets(2, OUTER_M),
+        sym_x=facets(0, 0.0),
+        sym_y=np.concatenate([facets(1, 0.0), facets(1, np.pi)]),
+        end=facets(0, spec.length_m),
+    )
+
+
+def _polar(x):
+    """theta [rad] and radius [m] of points with Cartesian coordinates x (3, ...)."""
+    return np.arctan2(x[1], x[2]), np.hypot(x[1], x[2])
+
+
+def hertz_probe(force_n=0.05 * 9.80665, radius_m=1.6e-3, poisson_ratio=0.49):
+    """Hertz pressure of a rigid sphere on the skin, as a function of (x, s).
+
+    The contact radius ``a = (3 F R / (4 E*))^(1/3)`` with ``E* = E / (1 - nu^2)``
+    (flat skin, as in the twin's :class:`~tactsense.physics.indenters` probe).
+
+    Returns
+    -------
+    callable
+        ``p(x, s)`` [Pa] (unnormalised: the load is scaled to ``force_n``), where
+        ``s`` is the arc length from the load around the outer surface [m].
+    float
+        Contact radius [m].
+    """
+    e_star = YOUNGS_PA / (1 - poisson_ratio**2)
+    a = (3 * force_n * radius_m / (4 * e_star)) ** (1 / 3)
+
+    def p(x, s):
+        return np.sqrt(np.clip(1 - (x * x + s * s) / (a * a), 0.0, None))
+
+    return p, a
+
+
+def knife_edge(half_width_m=0.25e-3, half_arc_m=4e-3, across=True):
+    """Knife-edge pressure: parabolic over ``half_width_m``, uniform over ``half_arc_m``.
+
+    ``across=True``: the edge lies around the circumference (narrow in x), the
+    paper's section 4.1 set-up, moved along the finger. ``across=False``: the edge
+    lies along the finger (narrow in the arc length s).
+    """
+
+    def p(x, s):
+        narrow, wide = (x, s) if across else (s, x)
+        return np.clip(1 - (narrow / half_width_m) ** 2, 0.0, None) * (np.abs(wide) <= half_arc_m)
+
+    return p
+
+
+@dataclass
+class Solution:
+    """A solved load case: the scalar basis and the displacement, shape (3, N) [m]."""
+
+    basis: Basis
+    u: np.ndarray
+    shell: ShellMesh
+
+    def _probes(self, x, theta, r):
+        """Interpolation matrix at points given by (x, theta, r), cells from the box."""
+        cells = self.shell.find_cells(x, theta, r)
+        pts = np.vstack([x, r * np.sin(theta), r * np.cos(theta)])
+        ref = self.basis.mapping.invF(pts[:, :, np.newaxis], tind=cells)
+        nb = self.basis.Nbfun
+        phis = np.array(
+            [self.basis.elem.gbasis(self.basis.mapping, ref, k, tind=cells)[0] for k in range(nb)]
+        ).flatten()
+        rows = np.tile(np.arange(pts.shape[1]), nb)
+        cols = self.basis.element_dofs[:, cells].flatten()
+        return sparse.coo_matrix((phis, (rows, cols)), shape=(pts.shape[1], self.basis.N)).tocsr()
+
+    def radial_strain(self, x, theta, depth=RING_DEPTH_M, step=1e-6):
+        """eps_rr at axial position ``x`` [m], angle ``theta`` [rad], ``depth`` [m].
+
+        Central difference of the radial displacement over ``2 step`` [m]; inside
+        an element this is the derivative of the quadratic interpolant.
+        """
+        x, theta, depth = np.broadcast_arrays(
+            np.asarray(x, float), np.asarray(theta, float), np.asarray(depth, float)
+        )
+        r = OUTER_M - depth.ravel()
+        sin, cos = np.sin(theta.ravel()), np.cos(theta.ravel())
+        radial = []
+        for rr in (r + step, r - step):
+            probe = self._probes(x.ravel(), theta.ravel(), rr)
+            radial.append((probe @ self.u[1]) * sin + (probe @ self.u[2]) * cos)
+        return ((radial[0] - radial[1]) / (2 * step)).reshape(x.shape)
+
+
+def _stiffness(basis, lam, mu):
+    """Elasticity stiffness, component-major dofs [u_x; u_y; u_z].
+
+    Assembled from the six scalar blocks ``G_ij = int d_i(phi_a) d_j(phi_b)``
+    (much faster than the vector element's form): block (c, d) is
+    ``lam G_cd + mu delta_cd sum_i G_ii + mu G_dc``.
+    """
+    g = {}
+    for i in range(3):
+        for j in range(i, 3):
+            g[i, j] = asm(BilinearForm(lambda u, v, w, i=i, j=j: v.grad[i] * u.grad[j]), basis)
+            g[j, i] = g[i, j].T
+    trace = g[0, 0] + g[1, 1] + g[2, 2]
+    blocks = [
+        [lam * g[c, d] + mu * g[d, c] + (mu * trace if c == d else 0 * trace) for d in range(3)]
+        for c in range(3)
+    ]
+    return sparse.bmat(blocks, format="csr")
+
+
+def _fixed_dofs(basis, shell: ShellMesh, far_end):
+    n = basis.N
+    core = basis.get_dofs(facets=shell.core).all()
+    end = basis.get_dofs(facets=shell.end).all()
+    fixed = [
+        core,
+        core + n,
+        core + 2 * n,
+        basis.get_dofs(facets=shell.sym_x).all(),
+        basis.get_dofs(facets=shell.sym_y).all() + n,
+        end,
+    ]
+    if far_end == "clamped":
+        fixed += [end + n, end + 2 * n]
+    return np.unique(np.concatenate(fixed))
+
+
+def solve_load(
+    pressure,
+    force_n,
+    *,
+    spec: MeshSpec = LEVELS[0],
+    poisson_ratio=0.49,
+    far_end="clamped",
+):
+    """Solve the quarter shell under a surface pressure shape scaled to ``force_n`` [N].
+
+    Parameters
+    ----------
+    pressure : callable
+        ``p(x, s)``: pressure shape on the outer surface (compressive positive),
+        ``s = b theta`` the arc length [m]. It is scaled so that the pressure on the
+        whole finger sums to ``force_n`` [N] (the quarter model carries a quarter),
+        so only its shape matters.
+    force_n : float
+        Total pressure integral over the whole (unfolded) finger [N].
+    spec : MeshSpec
+    poisson_ratio : float
+        nu [-].
+    far_end : {"clamped", "sliding"}
+        The cut at ``x = length``: clamped, or free to slide in its plane
+        (``u_x = 0``: with a uniform pressure, plane strain, Lame's problem).
+
+    Returns
+    -------
+    Solution
+    """
+    check_choice(far_end, "far_end", ("clamped", "sliding"))
+    shell = build_mesh(spec)
+    basis = Basis(shell.mesh, ElementHex2(), intorder=4)
+    lam, mu = lame_parameters(YOUNGS_PA, poisson_ratio)
+    stiffness = _stiffness(basis, lam, mu)
+    top = FacetBasis(shell.mesh, ElementHex2(), facets=shell.outer, intorder=6)
+
+    def shape(w):
+        theta, _ = _polar(w.x)
+        return pressure(w.x[0], OUTER_M * theta)
+
+    scale = 0.25 * force_n / asm(LinearForm(lambda v, w: shape(w) * v), top).sum()
+    f = np.concatenate(
+        [asm(LinearForm(lambda v, w, c=c: -scale * shape(w) * w.n[c] * v), top) for c in range(3)]
+    )
+    fixed = _fixed_dofs(basis, shell, far_end)
+    u = np.zeros(3 * basis.N)
+    free = np.setdiff1d(np.arange(3 * basis.N), fixed)
+    u[free] = spsolve(stiffness[free][:, free].tocsc(), f[free])
+    return Solution(basis, u.reshape(3, -1), shell)
+
+
+def lame_radial_strain(r, pressure_pa, poisson_ratio, youngs_modulus=YOUNGS_PA):
+    """eps_rr in a shell bonded to a rigid core under uniform external pressure.
+
+    Plane strain (``eps_x = 0``), ``u_r = A r + B / r`` with ``u_r(a) = 0`` so
+    ``B = -A a^2``; ``sigma_rr = 2 (lam + mu) A - 2 mu B / r^2`` equals
+    ``-pressure`` at ``r = b``: ``A = -p / (2 (lam + mu) + 2 mu a^2 / b^2)``, and
+    ``eps_rr = A - B / r^2 = A (1 + a^2 / r^2)``.
+
+    Parameters
+    ----------
+    r : array_like
+        Radius [m].
+    pressure_pa : float
+        External pressure, compressive positive [Pa].
+    """
+    lam, mu = lame_parameters(youngs_modulus, poisson_ratio)
+    a2 = CORE_M**2
+    big_a = -pressure_pa / (2 * (lam + mu) + 2 * mu * a2 / OUTER_M**2)
+    return big_a * (1 + a2 / np.asarray(r, float) ** 2)
