@@ -23,8 +23,8 @@ def _love_on_axis_strain(p0, a, z, nu, modulus):
     return (sigma_z - 2 * nu * sigma_r) / modulus
 
 
-@pytest.mark.parametrize("nu", [0.3, 0.45, 0.5])
-@pytest.mark.parametrize("depth", [0.5, 1.0, 2.0])
+@pytest.mark.parametrize("nu", [0.3, 0.5])
+@pytest.mark.parametrize("depth", [0.5, 2.0])
 def test_thick_layer_is_the_half_space_of_boussinesq_and_love(nu, depth):
     """A layer 60 radii thick, read a few radii deep, is a half space: the on-axis strain
     under a uniform disc equals Love's closed form to 0.5 % (the grid of 0.1 radius, the
