@@ -223,3 +223,12 @@ def test_finger_exports_each_taxel_on_the_skin_and_imports_back(name, tmp_path):
     assert back.array.spacing_axial_mm == pytest.approx(spec.array.spacing_axial_mm, rel=1e-12)
     assert back.array.spacing_angle_deg == pytest.approx(spec.array.spacing_angle_deg, rel=1e-12)
     assert back.rings.ring_width_mm == pytest.approx(spec.rings.ring_width_mm, rel=1e-12)
+
+
+def test_extends_a_pad_preset_makes_a_pad_and_the_file_names_it(tmp_path):
+    """A description that extends pad16 is a pad without saying kind = "pad"; without a
+    name it takes its file's."""
+    path = tmp_path / "gripper.toml"
+    path.write_text('extends = "pad16"\n[grid]\nrows = 8\n')
+    spec = load_sensor(path)
+    assert isinstance(spec, PadSpec) and spec.shape == (8, 16) and spec.name == "gripper"

@@ -14,8 +14,12 @@ import math
 import numpy as np
 
 from tactsense._validation import TactsenseInputError, check_positive
+from tactsense.physics.contact import grams_force
 from tactsense.physics.indenters import INDENTERS, FlatPunch, Indenter, KnifeEdge, SphereProbe
 from tactsense.simulate import Scenario, Step
+
+FIFTY_GRAMS = grams_force(50.0)
+"""The default load of every scenario: the paper's 50-g probe [N]."""
 
 
 def _settle(settle_s: float) -> list[Step]:
@@ -60,7 +64,7 @@ def press(
     *,
     x_mm: float | None = None,
     y_mm: float | None = None,
-    force_n: float = 0.5,
+    force_n: float = FIFTY_GRAMS,
     indenter: str = "sphere",
     size_mm: float = 1.6,
     dwell_s: float = 0.5,
@@ -93,7 +97,7 @@ def press(
     )  # fmt: skip
 
 
-def hold(spec, *, force_n: float = 0.5, hold_s: float = 5.0, lift_s: float = 5.0, **where):
+def hold(spec, *, force_n: float = FIFTY_GRAMS, hold_s: float = 5.0, lift_s: float = 5.0, **where):
     """Press and hold, then lift: the delayed elastic response and creep of section 3.4."""
     return press(spec, force_n=force_n, dwell_s=hold_s, lift_s=lift_s, **where)
 
@@ -102,7 +106,7 @@ def two_probes(
     spec,
     *,
     separation_mm: float = 5.0,
-    force_n: float = 0.5,
+    force_n: float = FIFTY_GRAMS,
     size_mm: float = 1.6,
     dwell_s: float = 0.5,
     settle_s: float = 0.2,
@@ -130,7 +134,7 @@ def slide(
     *,
     start_mm: tuple[float, float] | None = None,
     end_mm: tuple[float, float] | None = None,
-    force_n: float = 0.5,
+    force_n: float = FIFTY_GRAMS,
     size_mm: float = 1.6,
     speed_mm_s: float = 10.0,
     increment_mm: float = 0.25,
@@ -172,7 +176,7 @@ def slide(
 def sweep(
     spec,
     *,
-    force_n: float = 0.5,
+    force_n: float = FIFTY_GRAMS,
     size_mm: float = 1.6,
     increment_mm: float = 0.5,
     dwell_s: float = 0.1,
@@ -202,7 +206,7 @@ def sweep(
     )
 
 
-def knife(spec, *, force_n: float = 1.0, length_mm: float = 10.0, angle_deg: float = 0.0,
+def knife(spec, *, force_n: float = FIFTY_GRAMS, length_mm: float = 10.0, angle_deg: float = 0.0,
           dwell_s: float = 0.5, settle_s: float = 0.2) -> Scenario:  # fmt: skip
     """A knife edge pressed across the middle at ``angle_deg`` from the x axis."""
     cx, cy = centre_mm(spec)
@@ -215,7 +219,7 @@ def knife(spec, *, force_n: float = 1.0, length_mm: float = 10.0, angle_deg: flo
     )
 
 
-def punch(spec, *, force_n: float = 1.0, radius_mm: float = 3.0, dwell_s: float = 0.5,
+def punch(spec, *, force_n: float = FIFTY_GRAMS, radius_mm: float = 3.0, dwell_s: float = 0.5,
           settle_s: float = 0.2) -> Scenario:  # fmt: skip
     """A rigid flat punch pressed in the middle (a uniform-press calibration load)."""
     cx, cy = centre_mm(spec)

@@ -17,6 +17,11 @@ def folder(tmp_path_factory):
     pad = ts.preset("pad4")
     ts.write_recording(where / "pad.h5", ts.simulate(pad, press(pad), rng=0, flaws="none"))
     (where / "taxels.json").write_text('[{"xyz": [0, 0, 0], "normal": [0, 0, 1]}]')
+    twin = '{"xyz": [1, 2, 3], "normal": [0, 0, 1], "area": 4}'
+    (where / "twins.json").write_text(f"[{twin}, {twin}]")
+    from tactsense.interop.urdf import sensor_to_urdf
+
+    (where / "pad.urdf").write_text(sensor_to_urdf(ts.preset("pad16")))
     return where
 
 
@@ -29,6 +34,12 @@ CASES = [
     ("design sweep --sensor dome12 --out OUT.nc", "fingers and pads; 'dome12' is a points"),
     ("sensor import pad.h5 --extends bogus", "--extends 'bogus' is not a preset"),
     ("sensor import taxels.json", "taxel 0 must be"),
+    ("sensor import twins.json", "repeats another taxel's position"),
+    ("sensor import pad.urdf", "a flat pad? give --extends pad16"),
+    (
+        "simulate --scenario repeated --repeats 1000000 --dwell-s 3600 --out OUT.h5",
+        "at most 100,000,000 frames",
+    ),
 ]
 
 

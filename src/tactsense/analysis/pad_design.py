@@ -13,7 +13,10 @@ taxels ``pitch_mm`` apart along both axes (electrodes scaled with the pitch):
   (root mean square over x and y) and on the force of a probe a quarter pitch off a
   taxel along both axes, with the pad's read noise and quantization (what any estimator
   could reach) [mm], [%]; ``inf`` where the position is not observable (the probe's
-  neighbours do not respond: no overlap between taxels).
+  neighbours do not respond: no overlap between taxels). The bound is for that one
+  position: on a thin incompressible layer a probe centred on a taxel moves no neighbour
+  (the bound there is infinite), while a quarter pitch off it two neighbours respond and
+  the bound is small; a map of the bound over positions within a taxel is still to do.
 """
 
 from __future__ import annotations

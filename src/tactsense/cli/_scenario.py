@@ -124,7 +124,8 @@ IncrementOption = Annotated[
         max=90.0,
         help="Step between probe positions: mm for sweep-axial, calibration and "
         "knife-edge (default 0.6), "
-        "deg for sweep-around (default 3).",
+        "deg for sweep-around (default 3); on a pad, mm for 'sweep' (default 0.5) and "
+        "'slide' (default 0.25).",
     ),
 ]
 DwellOption = Annotated[
@@ -364,8 +365,10 @@ def _flat_scenario(spec, scenario: ScenarioKind, given: dict):
              "y_mm": "y_mm", "separation_mm": "separation_mm", "indenter": "indenter",
              "speed_mm_s": "speed_mm_s", "angle_deg": "angle_deg"}  # fmt: skip
     options = {names[k]: v for k, v in given.items() if k in names and v is not None}
-    if given["force_g"] is not None:
-        options["force_n"] = grams_force(given["force_g"])
+    # the help's default, 50 g, for every scenario (a knife edge included)
+    options["force_n"] = grams_force(
+        DEFAULTS["force_g"] if given["force_g"] is None else given["force_g"]
+    )
     if given["increment"] is not None:
         options["increment_mm"] = given["increment"]
     if given["size_mm"] is not None:
@@ -380,6 +383,10 @@ def _flat_scenario(spec, scenario: ScenarioKind, given: dict):
     return SCENARIOS[scenario.value](spec, **options)
 
 
+MAX_FRAMES = 100_000_000
+"""Most frames one ``simulate`` or ``emulate`` run makes (about 13 GB of 8x8 counts)."""
+
+
 def run_scenario(spec: SensorSpec, scene, *, flaws: str, seed: int | None, path=None):
     """Simulate ``scene`` with a progress bar on the terminal.
 
@@ -388,6 +395,16 @@ def run_scenario(spec: SensorSpec, scene, *, flaws: str, seed: int | None, path=
     and the number of frames written is returned.
     """
     from tactsense.simulate import simulate, simulate_to_file
+
+    frames = scene.duration_s / spec.scan_period_s
+    if frames > MAX_FRAMES:
+        gigabytes = frames * spec.n_taxels * 2 / 1e9
+        raise TactsenseInputError(
+            f"the scenario lasts {scene.duration_s:.4g} s: {frames:.3g} frames of "
+            f"{spec.shape[0]}x{spec.shape[1]} (about {gigabytes:.3g} GB of counts); at most "
+            f"{MAX_FRAMES:,} frames are simulated in one run: shorten --repeats, --dwell-s "
+            "or --lift-s"
+        )
 
     with progress_bar("simulating", unit="frames") as bar:
         task = bar.add_task("frames", total=None)

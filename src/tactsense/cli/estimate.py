@@ -38,7 +38,8 @@ def locate(
             "--out",
             "-o",
             help="File to write, one row per frame; the extension sets the format: .csv "
-            "(units in the header, flags by name), .parquet or .h5 (flags as bits).",
+            "(units in the column names: _s, _mm, _deg, _n; flags as bits and by name), "
+            ".parquet or .h5 (flags as bits).",
         ),
     ] = Path("estimates.csv"),
     baseline_frames: BaselineFramesOption = 5,

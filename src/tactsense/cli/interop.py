@@ -141,6 +141,8 @@ def export(
     except (TactsenseInputError, FileExistsError) as error:
         fail(str(error))
     clock = f", {counts['clock']} clock" if "clock" in counts else ""
+    if counts.get("estimated") is False:
+        clock += "; contacts not estimated on a " + str(counts.get("kind"))
     console.print(
         f"wrote {out}: {counts['frames']} frames, {counts['contacts']} with a contact "
         f"({export_format.value}{clock})"
@@ -153,7 +155,10 @@ def _export_lerobot(recording, out, calibration, baseline_frames, threshold, epi
     from tactsense.interop.lerobot import export_lerobot
 
     if out.exists():
-        fail(f"{out} exists; a LeRobot dataset goes into a new folder")
+        fail(
+            f"{out} exists; a LeRobot dataset goes into a new folder (--force never replaces "
+            "a folder): remove it or choose another name"
+        )
     check_output(out, False, what="dataset folder", inputs=[recording, calibration])
     remove_stale_partials(out.parent)  # left by a run killed outright
     cal = None if calibration is None else Calibration.load(calibration)

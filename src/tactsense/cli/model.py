@@ -323,9 +323,9 @@ def sensor_export(
 ) -> None:
     """Write a sensor as a URDF tactile description for ROS (RViz's tactile display).
 
-    A finger or a pad as an <array> (a finger: rows along it, columns around it, the arc
-    at the skin's surface; a pad: rows along x, columns along y), a point set as a
-    <taxel idx xyz rpy> list; metres; the data vector is a tactsense frame, row-major.
+    A pad as an <array> (rows along x, columns along y); a finger or a point set as a
+    <taxel idx xyz rpy> list, each taxel on the skin at its real position and normal (a
+    finger: x along it); metres; the data vector is a tactsense frame, row-major.
     """
     from tactsense.interop.urdf import sensor_to_urdf
 

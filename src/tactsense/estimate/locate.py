@@ -287,7 +287,7 @@ def _for_blocks(work, n: int, workers: int) -> None:
 def write_estimates_csv(
     path: str | Path, estimates: Estimates, time_s=None, *, overwrite: bool = False
 ) -> Path:
-    """Write one row per frame, with the units in the header (full precision)."""
+    """Write one row per frame, units in the column names (full precision)."""
     from tactsense.estimate.output import EstimatesWriter
 
     path = Path(path)

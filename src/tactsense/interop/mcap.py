@@ -321,7 +321,10 @@ def export_mcap(
                     progress(start + len(time_s), reader.n_frames)
             writer.finish()
             clock = "host" if host else "recording"
-            return {"frames": writer.frames, "contacts": writer.contacts, "clock": clock}
+            return {
+                "frames": writer.frames, "contacts": writer.contacts, "clock": clock,
+                "estimated": False, "kind": reader.sensor.kind,
+            }  # fmt: skip
         pieces = iter_locate(
             reader,
             baseline_frames=baseline_frames,

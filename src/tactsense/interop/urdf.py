@@ -212,7 +212,11 @@ def sensor_from_urdf(
     try:
         return SensorSpec.from_dict(data, source=str(path))
     except SensorSpecError as error:
-        raise UrdfError(f"{path}: the array does not fit the {extends!r} finger: {error}") from None
+        first = str(error).splitlines()[1].strip(" -") if "\n" in str(error) else str(error)
+        raise UrdfError(
+            f"{path}: the array does not fit the {extends!r} finger ({first}); a flat pad? "
+            "give --extends pad16 (or another pad preset)"
+        ) from None
 
 
 def finger_array_to_urdf(

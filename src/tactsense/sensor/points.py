@@ -166,11 +166,24 @@ def _validate(spec: PointsSpec) -> list[str]:
             problems.append(f"[taxels] normals[{index}] is zero; expected a direction")
             break
     for index, area in enumerate(t.area_mm2):
-        if not (math.isfinite(area) and area > 0):
-            problems.append(f"[taxels] area_mm2[{index}] = {area!r} must be positive")
+        if not (math.isfinite(area) and 0 < area <= 1e4):
+            problems.append(
+                f"[taxels] area_mm2[{index}] = {area!r} must be positive and at most "
+                "1e4 mm^2 (a 10-cm square)"
+            )
             break
     if n > 65_536:
         problems.append(f"[taxels] {n} taxels: at most 65,536 are supported")
+    if not problems and n > 1:
+        points = np.asarray(t.positions_mm, dtype=float)
+        order = np.lexsort(points.T[::-1])
+        same = np.all(np.diff(points[order], axis=0) == 0, axis=1)
+        if same.any():
+            k = int(order[int(np.argmax(same)) + 1])
+            problems.append(
+                f"[taxels] positions_mm[{k}] = {list(points[k])} repeats another taxel's "
+                "position; every taxel needs its own point"
+            )
     check_layer(spec.layer, problems)
     check_transduction(spec.transduction, problems)
     check_electronics(spec.electronics, problems)

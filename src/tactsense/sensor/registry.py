@@ -168,7 +168,15 @@ def sensor_from_dict(
     """Any kind of sensor from TOML tables: ``kind`` picks the class (default finger)."""
     if not isinstance(data, dict):
         raise SensorSpecError(f"{source}: expected a table of sections, got {type(data).__name__}")
-    kind = data.get("kind", "finger")
+    kind = data.get("kind")
+    extends = data.get("extends")
+    if (
+        kind is None
+        and isinstance(extends, str)
+        and extends.removeprefix("fearing1990_") in PRESETS
+    ):
+        kind = preset(extends).kind  # extends = "pad16" says it is a pad
+    kind = kind or "finger"
     if kind not in KINDS:
         raise SensorSpecError(
             f"{source}: kind = {kind!r} is not a sensor kind; expected one of {', '.join(KINDS)}"
@@ -197,7 +205,10 @@ def load_sensor(source: str | Path | SpecBase | None = None) -> SpecBase:
         )
     if Path(text).is_dir():
         raise SensorSpecError(f"sensor {text} is a folder; expected a preset or a TOML file")
-    return sensor_from_dict(read_toml(text), source=text)
+    data = read_toml(text)
+    if isinstance(data, dict):
+        data.setdefault("name", Path(text).stem)  # a description without a name: its file's
+    return sensor_from_dict(data, source=text)
 
 
 def taxel_frame(spec: SpecBase) -> tuple[np.ndarray, np.ndarray]:
