@@ -307,26 +307,30 @@ class Emulator:
                 continue
             if not streaming:
                 continue
-            burst = 1 if period > 0 else 64
-            chunks = []
-            stall = 0.0
-            for _ in range(burst):
-                if self.exhausted:
-                    break
-                wire, stall = self.next_packet()
-                if stall:
-                    if chunks:
-                        write(b"".join(chunks))
-                        chunks = []
-                    time.sleep(stall)
-                    due += stall
-                chunks.append(wire)
-            if chunks:
-                write(b"".join(chunks))
-            due += period
+            due += self._send_burst(write, period) + period
             if self.exhausted:
                 write(self.end_packet())
                 streaming = False
+
+    def _send_burst(self, write, period: float) -> float:
+        """Send the next frame (64 at once when unpaced), pausing at injected stalls;
+        returns the seconds stalled, by which the next frame is due later."""
+        chunks = []
+        stalled = 0.0
+        for _ in range(1 if period > 0 else 64):
+            if self.exhausted:
+                break
+            wire, stall = self.next_packet()
+            if stall:
+                if chunks:
+                    write(b"".join(chunks))
+                    chunks = []
+                time.sleep(stall)
+                stalled += stall
+            chunks.append(wire)
+        if chunks:
+            write(b"".join(chunks))
+        return stalled
 
     def _serve_format(self, read, write, fileno: int) -> None:
         """Stream in :attr:`format` from the first frame until the frames run out (then
@@ -346,21 +350,7 @@ class Emulator:
                 except OSError:
                     return
                 continue
-            chunks = []
-            for _ in range(1 if period > 0 else 64):
-                if self.exhausted:
-                    break
-                wire, stall = self.next_packet()
-                if stall:
-                    if chunks:
-                        write(b"".join(chunks))
-                        chunks = []
-                    time.sleep(stall)
-                    due += stall
-                chunks.append(wire)
-            if chunks:
-                write(b"".join(chunks))
-            due += period
+            due += self._send_burst(write, period) + period
 
     def serve_tcp(self, port: int = 0, host: str = "127.0.0.1", *, ready=None) -> None:
         """Serve hosts one after another on a TCP port until :meth:`stop`.

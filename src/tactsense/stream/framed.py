@@ -28,7 +28,13 @@ import serial
 
 from tactsense._validation import TactsenseInputError
 from tactsense.sensor import SensorSpec
-from tactsense.stream.reader import LossCounters, StreamError, StreamFrame, open_port
+from tactsense.stream.reader import (
+    LossCounters,
+    StreamError,
+    StreamFrame,
+    open_port,
+    stream_timeouts,
+)
 
 RAW_PORTS = ("serial.urlhandler.protocol_socket", "serial.serialposix")
 """pyserial port classes whose file descriptor carries the bytes as they are."""
@@ -255,15 +261,8 @@ class FormatReader:
         self.unused = 0
         """Intact frames that arrived after the caller stopped taking them (not kept)."""
         self.frame_period_s = sensor.scan_period_s
-        self.timeout_s = (
-            float(timeout_s) if timeout_s is not None else 3 * self.frame_period_s + 0.05
-        )
-        if not self.timeout_s > 0:
-            raise StreamError(f"timeout_s must be positive; got {timeout_s!r}")
-        self.first_frame_timeout_s = (
-            float(first_frame_timeout_s)
-            if first_frame_timeout_s is not None
-            else max(5.0, self.timeout_s)
+        self.timeout_s, self.first_frame_timeout_s = stream_timeouts(
+            timeout_s, first_frame_timeout_s, self.frame_period_s
         )
         self._decoder = wire_format.decoder(sensor.shape, self.stats, self.url)
         self._ready: deque[StreamFrame] = deque()

@@ -102,6 +102,18 @@ class StreamFrame:
     a frame that did not come over the wire protocol)."""
 
 
+def stream_timeouts(
+    timeout_s: float | None, first_frame_timeout_s: float | None, frame_period_s: float
+) -> tuple[float, float]:
+    """The timeouts of a reader [s]: between frames (default three frame periods plus
+    50 ms) and before the first frame (default the longer of 5 s and that)."""
+    timeout = float(timeout_s) if timeout_s is not None else 3 * frame_period_s + 0.05
+    if not timeout > 0:
+        raise StreamError(f"timeout_s must be positive; got {timeout_s!r}")
+    first = float(first_frame_timeout_s) if first_frame_timeout_s is not None else max(5.0, timeout)
+    return timeout, first
+
+
 def open_port(url: str, *, baudrate: int = 921600) -> serial.SerialBase:
     """Open a pyserial port (device path, pty path, ``socket://HOST:PORT``, ``loop://``)."""
     _check_socket_url(url)
@@ -198,15 +210,8 @@ class StreamReader:
             rate = float(self.identity.get("frame_rate_hz") or sensor.electronics.scan_rate_hz)
             self.frame_period_s = 1.0 / rate if rate > 0 else 0.0
             self._scan_period_s = sensor.scan_period_s
-            self.timeout_s = (
-                float(timeout_s) if timeout_s is not None else 3 * self.frame_period_s + 0.05
-            )
-            if not self.timeout_s > 0:
-                raise StreamError(f"timeout_s must be positive; got {timeout_s!r}")
-            self.first_frame_timeout_s = (
-                float(first_frame_timeout_s)
-                if first_frame_timeout_s is not None
-                else max(5.0, self.timeout_s)
+            self.timeout_s, self.first_frame_timeout_s = stream_timeouts(
+                timeout_s, first_frame_timeout_s, self.frame_period_s
             )
             if start:
                 self.start()
