@@ -6,8 +6,10 @@ this module mounts them. A new command is a function in its group's module.
 
 from __future__ import annotations
 
+import sys
 from typing import Annotated
 
+import click
 import typer
 
 from tactsense.cli import design, estimate, imports, interop, live, model, reproduce
@@ -51,6 +53,28 @@ app.add_typer(interop.app)
 app.add_typer(imports.app)
 app.add_typer(model.sensor_app, name="sensor")
 app.add_typer(design.app, name="design")
+
+
+def _show_usage_error(self, file=None) -> None:
+    """A usage error (unknown option, value out of range, missing argument) as one line
+    ``error: ...`` naming the command's help, instead of click's usage block."""
+    command = self.ctx.command_path if self.ctx is not None else "tactsense"
+    message = " ".join(self.format_message().split())
+    cause = self.__cause__ or self.__context__
+    errors = cause.errors() if hasattr(cause, "errors") else []
+    given = [str(e.get("input", "")).strip().lower() for e in errors if isinstance(e, dict)]
+    if any(value in ("nan", "+nan", "-nan") for value in given):
+        # a range check fails on NaN with a misleading bound; say what it is
+        name = "/".join(getattr(getattr(self, "param", None), "opts", []) or ["the value"])
+        message = f"Invalid value for '{name}': NaN is not a number"
+    print(f"error: {message} (see '{command} --help')", file=file or sys.stderr)
+
+
+# typer >= 0.24 carries its own copy of click (typer._click): patch both
+for _module in (click, getattr(typer, "_click", None)):
+    _usage_error = getattr(getattr(_module, "exceptions", None), "UsageError", None)
+    if _usage_error is not None:
+        _usage_error.show = _show_usage_error
 
 
 def main() -> None:
