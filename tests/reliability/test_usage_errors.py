@@ -32,3 +32,19 @@ def test_usage_errors_are_one_line(args, names):
     assert names in lines[0]
     assert "--help')" in lines[0]
     assert "Usage:" not in done.stderr and "Traceback" not in done.stderr
+
+
+def test_tables_are_not_wrapped_when_piped(capsys):
+    """Piped, a table keeps every cell on one line (rich would wrap at 80 columns)."""
+    from rich.table import Table
+
+    from tactsense.cli._common import print_table
+
+    table = Table()
+    long_cell = "localization_circumference_deg_" + "x" * 60
+    for name in ("claim", "basis", "verdict"):
+        table.add_column(name)
+    table.add_row(long_cell, "a basis text that is long " * 3, "agrees")
+    print_table(table)
+    out = capsys.readouterr().out
+    assert any(long_cell in line and "agrees" in line for line in out.splitlines())

@@ -23,6 +23,18 @@ from tactsense._validation import TactsenseInputError
 console = Console(stderr=True)
 """Messages, progress and tables meant for a person go to standard error."""
 
+
+def print_table(table) -> None:
+    """Print a rich table on standard output: at the terminal's width on a terminal, and
+    at the table's natural width when piped or redirected (rich would otherwise wrap
+    every cell at 80 columns, breaking ids and numbers over lines)."""
+    out = Console()
+    if not out.is_terminal:
+        natural = Console(width=10_000).measure(table).maximum
+        out = Console(width=max(80, natural))
+    out.print(table)
+
+
 SensorOption = Annotated[
     str,
     typer.Option(

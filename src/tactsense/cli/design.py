@@ -8,11 +8,17 @@ from typing import Annotated
 
 import numpy as np
 import typer
-from rich.console import Console
 from rich.table import Table
 
 from tactsense._validation import TactsenseInputError
-from tactsense.cli._common import SensorOption, fail, new_group, progress_bar, same_file
+from tactsense.cli._common import (
+    SensorOption,
+    fail,
+    new_group,
+    print_table,
+    progress_bar,
+    same_file,
+)
 from tactsense.physics.contact import grams_force
 from tactsense.sensor import load_sensor
 
@@ -72,7 +78,7 @@ def design_aliasing(
     table.add_row(
         "worst peak-amplitude error, line load", f"{100 * summary['worst_amplitude_error']:.1f} %"
     )
-    Console().print(table)
+    print_table(table)
 
 
 @app.command("bound")
@@ -152,7 +158,7 @@ def design_bound(
     table.add_row(
         "force", f"{1e3 * bound['force_n']:.2f} mN ({100 * bound['force_relative']:.2f} %)"
     )
-    Console().print(table)
+    print_table(table)
 
 
 class ElasticModel(StrEnum):
@@ -269,7 +275,7 @@ def design_strip(
     table.add_row("top plate deflection", f"{1e6 * values['top_plate_deflection']:.2f} um")
     table.add_row("bottom plate deflection", f"{1e6 * values['bottom_plate_deflection']:.2f} um")
     table.add_row("surface deflection", f"{1e6 * values['surface_deflection']:.2f} um")
-    Console().print(table)
+    print_table(table)
 
 
 def _grid(text: str, option: str, *, low: float, high: float) -> list[float]:

@@ -7,7 +7,6 @@ from typing import Annotated
 
 import numpy as np
 import typer
-from rich.console import Console
 from rich.table import Table
 
 from tactsense._validation import TactsenseInputError
@@ -18,6 +17,7 @@ from tactsense.cli._common import (
     console,
     fail,
     new_group,
+    print_table,
     same_file,
     sensor_file,
 )
@@ -191,7 +191,7 @@ def info(recording: Annotated[Path, typer.Argument(help="HDF5 recording to descr
     table.add_row("scenario", str(scenario.get("description", "")))
     # a simulation lists the flaws it switched on; a device's flaws are not known
     table.add_row("flaws", ", ".join(flaws) or ("unknown (a device)" if source else "none"))
-    Console().print(table)
+    print_table(table)
 
 
 @sensor_app.command("show")
@@ -228,7 +228,7 @@ def sensor_check(
     table = Table(title=f"{spec.name}: valid", show_header=False)
     for label, value in spec.summary():
         table.add_row(label, value)
-    Console().print(table)
+    print_table(table)
 
 
 @sensor_app.command("import")

@@ -8,7 +8,6 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.console import Console
 from rich.table import Table
 
 from tactsense._validation import TactsenseInputError
@@ -18,6 +17,7 @@ from tactsense.cli._common import (
     fail,
     inside,
     new_group,
+    print_table,
     progress_bar,
     remove_stale_partials,
     sensor_file,
@@ -103,7 +103,7 @@ def reproduce(
     table = claims_table(
         claims, f"{len(result['figures'])} figures and {len(claims)} claims in {out}"
     )
-    Console().print(table)
+    print_table(table)
     console.print(
         f"{summary(claims)} Open {out / 'report.html'} for the figures and the reasons "
         "behind each difference."
