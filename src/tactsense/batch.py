@@ -153,3 +153,91 @@ def locate_file(
             writer.write(0, np.zeros(0), empty)
             writer.rows = 0
     return {"frames": total, **tally.summary()}
+
+
+def contacts_file(
+    recording: str | Path,
+    out: str | Path,
+    *,
+    baseline_frames: int = 5,
+    calibration=None,
+    threshold: float | None = None,
+    max_contacts: int = 8,
+    method: str = "interpolate",
+    chunk_frames: int | None = None,
+    events_path: str | Path | None = None,
+    tracker_options: dict | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> dict:
+    """Every contact of every frame of a recording, tracked, written as a long table.
+
+    :func:`~tactsense.estimate.contacts.find_contacts` and
+    :class:`~tactsense.estimate.track.ContactTracker` piece by piece (bounded memory;
+    the tracker's state carries across pieces), written by
+    :class:`~tactsense.estimate.output.ContactsWriter` (``events_path``: where a CSV's
+    events go, by default beside it).
+
+    Returns
+    -------
+    dict
+        ``frames``, ``rows`` (contacts over all frames), ``frames_with_contact``,
+        ``ids`` (distinct tracked contacts), ``most`` (largest number in one frame),
+        ``births``, ``deaths``, ``merges``, ``splits``.
+    """
+    from tactsense.estimate.contacts import find_contacts
+    from tactsense.estimate.output import ContactsWriter
+    from tactsense.estimate.track import ContactTracker
+
+    output_format(out)
+    counts = {"births": 0, "deaths": 0, "merges": 0, "splits": 0}
+    frames_with = most = 0
+    with RecordingReader(recording) as reader:
+        sensor = reader.sensor
+        total = reader.n_frames
+        compensator = None
+        baseline = None
+        if calibration is not None:
+            calibration.check_sensor(sensor)
+            compensator = calibration.compensator(sensor.scan_period_s, sensor.shape)
+        else:
+            if total < baseline_frames:
+                raise TactsenseInputError(
+                    f"{reader.path} has {total} frames; need {baseline_frames} "
+                    "untouched frames at the start for the baseline"
+                )
+            baseline = np.median(reader.frames(0, baseline_frames).astype(float), axis=0)
+        tracker = ContactTracker(sensor.scan_period_s, **(tracker_options or {}))
+        with ContactsWriter(out, events_path=events_path) as writer:
+            if progress is not None:
+                progress(0, total)
+            for start, frames, time_s in reader.chunks(chunk_frames):
+                table = find_contacts(
+                    frames, sensor, baseline=baseline, calibration=calibration,
+                    compensator=compensator, threshold=threshold, max_contacts=max_contacts,
+                    method=method, first_frame=start,
+                    frame_period_s=sensor.scan_period_s if calibration is not None else None,
+                )  # fmt: skip
+                tracked, events = tracker.update(table, first_frame=start)
+                writer.write_contacts(np.asarray(time_s)[tracked.frame - start], tracked, events)
+                per_frame = np.bincount(tracked.frame - start, minlength=len(frames))
+                frames_with += int(np.count_nonzero(per_frame))
+                most = max(most, int(per_frame.max(initial=0)))
+                for e in events:
+                    counts[e.kind + "s"] += 1
+                if progress is not None:
+                    progress(start + len(frames), total)
+            if writer.rows == 0:  # no contact at all: the file still gets its columns
+                empty, _ = tracker.update(
+                    find_contacts(np.zeros((0, *sensor.shape)), sensor, counts=False),
+                    first_frame=total,
+                )
+                writer.write_contacts(np.zeros(0), empty)
+            ids = tracker.next_id
+    return {
+        "frames": total,
+        "rows": writer.rows,
+        "frames_with_contact": frames_with,
+        "ids": ids,
+        "most": most,
+        **counts,
+    }

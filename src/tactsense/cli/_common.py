@@ -65,14 +65,27 @@ BaselineFramesOption = Annotated[
 ]
 
 
-def _threshold(value: float) -> float:
+def _threshold(value: float | None) -> float | None:
     """``--threshold``: a number in (0, 1]; NaN and infinities are refused by name."""
+    if value is None:
+        return None
     if not (math.isfinite(value) and 0.0 < value <= 1.0):
         raise typer.BadParameter(
             f"{value} is not a fraction: it must be a number in (0, 1], e.g. 0.005 for 0.5 %"
         )
     return value
 
+
+ContactThresholdOption = Annotated[
+    float | None,
+    typer.Option(
+        "--threshold",
+        callback=_threshold,
+        help="Smallest signal that counts as contact, as a fraction [default: 0.005 for "
+        "capacitive taxels (fractional deflection: 0.5 %, about 10 counts at 2000); 10 "
+        "counts' worth of strain for resistive ones (10 / counts_per_strain)].",
+    ),
+]
 
 ThresholdOption = Annotated[
     float,

@@ -15,6 +15,7 @@ from tactsense._validation import TactsenseInputError
 from tactsense.cli._common import (
     BaselineFramesOption,
     CalibrationOption,
+    ContactThresholdOption,
     ThresholdOption,
     atomic_output,
     check_output,
@@ -27,6 +28,36 @@ from tactsense.cli._common import (
 from tactsense.io.recording import read_recording
 
 app = new_group("Estimate contacts and calibrations from recordings.")
+
+
+def _locate_contacts(recording, out, force, quiet, **options) -> None:
+    """``locate`` writing the long table of tracked contacts (pads, point sets,
+    ``--contacts``)."""
+    from tactsense.batch import contacts_file
+    from tactsense.estimate.output import events_sidecar, output_format
+
+    sidecar = events_sidecar(out) if output_format(out) == "csv" else None
+    if sidecar is not None:
+        check_output(sidecar, force, inputs=[recording])
+    from contextlib import ExitStack
+
+    with ExitStack() as stack:
+        bar = stack.enter_context(progress_bar("locating contacts", unit="frames", quiet=quiet))
+        temporary = stack.enter_context(atomic_output(out))
+        events_temporary = stack.enter_context(atomic_output(sidecar)) if sidecar else None
+        task = bar.add_task("frames", total=None)
+        summary = contacts_file(
+            recording, temporary, events_path=events_temporary,
+            progress=lambda done, total: bar.update(task, completed=done, total=total),
+            **options,
+        )  # fmt: skip
+    also = f" (events in {sidecar})" if sidecar is not None else ""
+    console.print(
+        f"wrote {out}{also}: {summary['frames']} frames, {summary['rows']} contact rows in "
+        f"{summary['frames_with_contact']} frames (at most {summary['most']} at once), "
+        f"{summary['ids']} tracked ids; {summary['births']} births, {summary['deaths']} "
+        f"deaths, {summary['merges']} merges, {summary['splits']} splits"
+    )
 
 
 @app.command()
@@ -43,8 +74,32 @@ def locate(
         ),
     ] = Path("estimates.csv"),
     baseline_frames: BaselineFramesOption = 5,
-    threshold: ThresholdOption = 0.005,
+    threshold: ContactThresholdOption = None,
     calibration: CalibrationOption = None,
+    contacts: Annotated[
+        bool,
+        typer.Option(
+            "--contacts",
+            help="On a finger: write every contact, tracked, as a long table (one row per "
+            "contact per frame, docs/contacts.md) instead of one row per frame. Pads and "
+            "point sets always get the long table.",
+        ),
+    ] = False,
+    max_contacts: Annotated[
+        int,
+        typer.Option(
+            min=1,
+            max=64,
+            help="Long table: at most this many contacts per frame (the largest by force).",
+        ),
+    ] = 8,
+    method: Annotated[
+        str,
+        typer.Option(
+            help="Long table: how a contact's position is found: 'interpolate' (the "
+            "paper's windowed sinc and Newton, on the grid) or 'cop' (centre of pressure)."
+        ),
+    ] = "interpolate",
     chunk_frames: Annotated[
         int | None,
         typer.Option(
@@ -75,18 +130,30 @@ def locate(
     """
 
     from tactsense.batch import locate_file, output_format
+    from tactsense.estimate.contacts import METHODS
+    from tactsense.io.recording import RecordingReader
 
     try:
         check_output(out, force, inputs=[recording, calibration])
         output_format(out)
+        if method not in METHODS:
+            raise TactsenseInputError(f"--method {method!r}: expected one of {', '.join(METHODS)}")
+        with RecordingReader(recording) as reader:
+            sensor = reader.sensor
         calibrated = None
         if calibration is not None:
             from tactsense.estimate import Calibration
-            from tactsense.io.recording import RecordingReader
 
-            with RecordingReader(recording) as reader:
-                sensor = reader.sensor
             calibrated = Calibration.load(calibration, sensor)
+        if contacts or sensor.kind != "finger":
+            _locate_contacts(
+                recording, out, force, quiet, baseline_frames=baseline_frames,
+                calibration=calibrated, threshold=threshold, max_contacts=max_contacts,
+                method=method, chunk_frames=chunk_frames,
+            )  # fmt: skip
+            return
+        if threshold is None:
+            threshold = 0.005
         with (
             progress_bar("locating", unit="frames", quiet=quiet) as bar,
             atomic_output(out) as temporary,

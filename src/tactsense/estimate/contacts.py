@@ -13,10 +13,18 @@ set's and a finger's positions are points of the surface (``taxel_positions_mm``
 
 from __future__ import annotations
 
+import dataclasses
+import functools
+import math
 from dataclasses import dataclass, field, fields
 from typing import ClassVar
 
 import numpy as np
+
+from tactsense._signals import deferred_interrupts
+from tactsense._validation import TactsenseInputError, check_frames
+from tactsense.estimate.deflection import Flag
+from tactsense.geometry import tactel_to_surface
 
 _INT_COLUMNS = ("frame", "contact", "id", "taxels", "flags")
 
@@ -125,3 +133,590 @@ class ContactTable:
             dtype = np.int64 if f.name in _INT_COLUMNS else float
             kw[f.name] = np.zeros(0, dtype=dtype)
         return cls(**kw, n_frames=n_frames)
+
+
+# ---- finding the contacts of a batch of frames ---------------------------------------
+
+SADDLE_RATIO = 0.8
+"""Two maxima of a frame are two contacts only if the signal between them dips below
+this share of the lower one (and by more than the contact threshold) [-]; otherwise the
+lower is a bump on the same contact and the two regions are merged."""
+
+METHODS = ("interpolate", "cop")
+"""``interpolate``: the paper's method on the grid (Hann-windowed sinc over 3 taxels on
+each side of the maximum, Newton to 0.01 taxel); ``cop``: the centre of pressure (the
+signal-weighted mean position of the contact's taxels)."""
+
+BLOCK = 4096
+"""Frames per block of the compiled passes."""
+
+
+def default_threshold(sensor) -> float:
+    """Smallest signal that counts as contact [-]: 10 counts above the baseline.
+
+    Capacitive taxels: a fractional deflection of 0.005 (10 counts at the nominal
+    2000, the finger's rule); resistive ones: ``10 / counts_per_strain`` of strain.
+    """
+    transduction = getattr(sensor, "transduction", None)
+    if transduction is not None and transduction.kind == "resistive":
+        return 10.0 / transduction.counts_per_strain
+    return 0.005
+
+
+def signal_from_counts(frames, baseline, sensor, *, dead=None):
+    """The signal of every taxel from A/D counts, and the flags of each frame.
+
+    Capacitive taxels (the finger, capacitive pads and point sets): the fractional plate
+    deflection of eq. 4, ``(V - V_o) / V``; resistive ones: the strain,
+    ``(V - V_o) / counts_per_strain``. Unusable taxels (dead, NaN, reading zero) read 0
+    and set the frame's flags as in
+    :func:`~tactsense.estimate.deflection.deflection_from_counts`.
+
+    Returns
+    -------
+    signal : ndarray, shape (N, rows, cols) [-]
+    flags : ndarray of int64, shape (N,)
+    """
+    from tactsense.estimate._contacts_fast import prepare_signal
+
+    frames = check_frames(frames, sensor.shape)
+    baseline = check_frames(baseline, sensor.shape, "baseline").astype(float)
+    if baseline.ndim != 2:
+        raise TactsenseInputError(f"baseline has shape {baseline.shape}; expected {sensor.shape}")
+    unusable = ~np.isfinite(baseline) | (baseline <= 0)
+    if dead is not None:
+        dead = np.asarray(dead, dtype=bool)
+        if dead.shape != tuple(sensor.shape):
+            raise TactsenseInputError(f"dead has shape {dead.shape}; expected {sensor.shape}")
+        unusable = unusable | dead
+    transduction = getattr(sensor, "transduction", None)
+    resistive = transduction is not None and transduction.kind == "resistive"
+    per_count = 1.0 / transduction.counts_per_strain if resistive else 1.0
+    source = frames.reshape(-1, *sensor.shape)
+    if source.dtype not in (np.uint16, np.int32, np.int64, np.float64):
+        source = source.astype(np.float64)
+    with deferred_interrupts():
+        return prepare_signal(
+            np.ascontiguousarray(source),
+            np.where(unusable, 1.0, baseline),
+            unusable,
+            float(2**sensor.electronics.adc_bits - 1),
+            resistive,
+            per_count,
+            int(Flag.NAN_INPUT),
+            int(Flag.SATURATED),
+            int(Flag.DEAD_TACTEL),
+        )
+
+
+def find_contacts(
+    frames,
+    sensor,
+    *,
+    baseline=None,
+    counts: bool = True,
+    dead=None,
+    threshold: float | None = None,
+    calibration=None,
+    max_contacts: int = 8,
+    method: str = "interpolate",
+    first_frame: int = 0,
+    saddle: float = SADDLE_RATIO,
+    frame_period_s: float | None = None,
+    compensator=None,
+) -> ContactTable:
+    """Every contact of every frame, on any kind of array.
+
+    Each frame is segmented into contacts: the taxels above ``threshold`` are assigned
+    to a local maximum by steepest ascent (a watershed on the taxel grid, or on the
+    neighbour graph of a point set), and maxima separated by a shallow saddle (see
+    :data:`SADDLE_RATIO`) are merged into one contact. Each contact gets a position
+    (``method``), the interpolated peak, its force, its extent (second moments of its
+    taxels' signal) and its taxel count.
+
+    Force: on a pad, the least-squares amplitude of the layer's response to the
+    scenarios' probe (a 1.6-mm sphere, per newton; :func:`pad_force_kernel`) at the
+    contact's position, fitted to the taxels around it (other contacts' taxels left
+    out): the integral of the signal cannot give force, since an incompressible layer
+    bonded to a rigid base has no net normal strain under a load (nu = 0.5). On the
+    finger, the paper's integral (eq. 55) of the frame shared among the contacts in
+    proportion to their summed deflection (one contact: exactly
+    :func:`~tactsense.estimate.locate`'s force). On a point set, the amplitude of the
+    response to a load at the nearest taxel.
+
+    Parameters
+    ----------
+    frames : array_like, shape (N, rows, cols) or (rows, cols)
+        A/D readings [counts] (``counts=True``) or the signal [-] (``counts=False``:
+        fractional deflection for capacitive taxels, strain for resistive ones).
+    sensor : SensorSpec, PadSpec or PointsSpec
+    baseline : array_like, shape (rows, cols)
+        Untouched readings [counts]; required with counts unless ``calibration``.
+    dead : array_like of bool, shape (rows, cols), optional
+        Taxels to ignore.
+    threshold : float, optional
+        Smallest signal that counts as contact [-]; :func:`default_threshold`.
+    calibration : Calibration, optional
+        A finger's calibration (its baseline, gains, nonlinearity, creep).
+    max_contacts : int
+        At most this many contacts per frame, the largest kept (1-64).
+    method : {"interpolate", "cop"}
+        How a contact's position is found (:data:`METHODS`).
+    first_frame : int
+        Added to the ``frame`` column (pieces of a longer recording).
+    saddle : float
+        :data:`SADDLE_RATIO`, in (0, 1].
+
+    Returns
+    -------
+    ContactTable
+        One row per contact per frame; frames without contact have no row.
+    """
+    kind = getattr(sensor, "kind", None)
+    if kind not in ("finger", "pad", "points"):
+        raise TactsenseInputError(
+            f"sensor must be a finger, pad or point set; got {type(sensor).__name__}"
+        )
+    if method not in METHODS:
+        raise TactsenseInputError(f"method {method!r}: expected one of {', '.join(METHODS)}")
+    if not (isinstance(max_contacts, int | np.integer) and 1 <= max_contacts <= 64):
+        raise TactsenseInputError(f"max_contacts must be an integer in 1-64; got {max_contacts!r}")
+    if not (isinstance(saddle, float | int) and 0.0 < saddle <= 1.0):
+        raise TactsenseInputError(f"saddle must be in (0, 1]; got {saddle!r}")
+    threshold = default_threshold(sensor) if threshold is None else threshold
+    if not (isinstance(threshold, float | int) and math.isfinite(threshold) and threshold > 0):
+        raise TactsenseInputError(f"threshold must be a positive number; got {threshold!r}")
+    frames = check_frames(frames, sensor.shape)
+    lead_2d = frames.ndim == 2
+    frames = frames.reshape(-1, *sensor.shape)
+    if calibration is not None:
+        if not counts:
+            raise TactsenseInputError("a calibration applies to counts, not to the signal")
+        if kind != "finger":
+            raise TactsenseInputError(
+                f"a calibration applies to the paper's fingers; {sensor.name!r} is a {kind}"
+            )
+        signal, flags = calibration.apply(
+            frames, sensor, frame_period_s=frame_period_s, compensator=compensator
+        )
+        signal = np.ascontiguousarray(signal, dtype=np.float64)
+    elif counts:
+        if baseline is None:
+            raise TactsenseInputError(
+                "counts need a baseline (the untouched readings): pass baseline=, e.g. "
+                "tactsense.estimate.baseline_from(frames), or counts=False for the signal"
+            )
+        signal, flags = signal_from_counts(frames, baseline, sensor, dead=dead)
+    else:
+        signal = np.array(frames, dtype=np.float64)
+        bad = ~np.isfinite(signal)
+        flags = np.where(bad.any(axis=(-2, -1)), int(Flag.NAN_INPUT), 0).astype(np.int64)
+        signal[bad] = 0.0
+        if dead is not None:
+            signal[:, np.asarray(dead, dtype=bool)] = 0.0
+    saturated = None
+    if counts and (flags & int(Flag.SATURATED)).any():
+        saturated = frames >= 2**sensor.electronics.adc_bits - 1
+    if kind == "points":
+        table = _points_contacts(signal, sensor, threshold, saddle, max_contacts, method)
+    else:
+        table = _grid_contacts(signal, sensor, threshold, saddle, max_contacts, method)
+    table.flags |= flags[table.frame]
+    if saturated is not None:
+        _mark_saturated(table, saturated, sensor)
+    table.extra.pop("_labels", None)
+    table.extra.pop("_root", None)
+    table.n_frames = 1 if lead_2d else len(signal)
+    table.frame = table.frame + int(first_frame)
+    return table
+
+
+def _mark_saturated(table: ContactTable, saturated: np.ndarray, sensor) -> None:
+    """No force for a contact holding a clipped reading (it is only a lower bound)."""
+    labels = table.extra.pop("_labels", None)
+    for k in np.flatnonzero(table.flags & int(Flag.SATURATED)):
+        f = int(table.frame[k])
+        mine = labels[f] == table.extra["_root"][k] if labels is not None else True
+        if np.any(saturated[f] & mine):
+            table.force_n[k] = np.nan
+        else:
+            table.flags[k] &= ~int(Flag.SATURATED)
+
+
+def _segment(signal, threshold, saddle, periodic, max_contacts, refine):
+    """The compiled segmentation of (N, rows, cols) signal, block by block."""
+    from tactsense.estimate._contacts_fast import segment_into
+    from tactsense.estimate.localize import MAX_ITERATIONS, TOLERANCE
+
+    n, rows, cols = signal.shape
+    k = max_contacts
+    count = np.zeros(n, np.int64)
+    peak_row = np.empty((n, k), np.int64)
+    peak_col = np.empty((n, k), np.int64)
+    out = {name: np.empty((n, k)) for name in ("row", "col", "value", "total", "rr", "cc", "rc")}
+    taxels = np.empty((n, k), np.int64)
+    converged = np.empty((n, k), np.bool_)
+    root = np.empty((n, k), np.int64)
+    labels = np.empty((n, rows, cols), np.int64)
+    with deferred_interrupts():
+        for lo in range(0, n, BLOCK):
+            hi = min(lo + BLOCK, n)
+            segment_into(
+                signal[lo:hi], float(threshold), float(saddle), bool(periodic), k, bool(refine),
+                TOLERANCE, MAX_ITERATIONS, count[lo:hi], peak_row[lo:hi], peak_col[lo:hi],
+                out["row"][lo:hi], out["col"][lo:hi], out["value"][lo:hi], out["total"][lo:hi],
+                out["rr"][lo:hi], out["cc"][lo:hi], out["rc"][lo:hi], taxels[lo:hi],
+                converged[lo:hi], root[lo:hi], labels[lo:hi],
+            )  # fmt: skip
+    keep = np.arange(k)[np.newaxis, :] < count[:, np.newaxis]
+    frame = np.broadcast_to(np.arange(n)[:, np.newaxis], (n, k))[keep]
+    rank = np.broadcast_to(np.arange(k)[np.newaxis, :], (n, k))[keep]
+    rows_out = {name: value[keep] for name, value in out.items()}
+    rows_out.update(
+        frame=frame.astype(np.int64),
+        contact=rank.astype(np.int64),
+        taxels=taxels[keep],
+        converged=converged[keep],
+        root=root[keep],
+        peak_row=peak_row[keep],
+        peak_col=peak_col[keep],
+    )
+    return rows_out, labels
+
+
+def _extent(rr, cc, rc, scale_r: float, scale_c: float):
+    """Principal extents [mm] and the major axis' angle from the row axis [deg] of second
+    moments given in taxels^2 (scaled by the pitches)."""
+    a = rr * scale_r**2
+    b = cc * scale_c**2
+    c = rc * scale_r * scale_c
+    mean = 0.5 * (a + b)
+    half = np.sqrt((0.5 * (a - b)) ** 2 + c**2)
+    major = np.sqrt(np.maximum(mean + half, 0.0))
+    minor = np.sqrt(np.maximum(mean - half, 0.0))
+    angle = 0.5 * np.degrees(np.arctan2(2.0 * c, a - b))
+    angle = np.where(angle <= -90.0, angle + 180.0, angle)
+    return major, minor, angle
+
+
+def _grid_contacts(signal, sensor, threshold, saddle, max_contacts, method) -> ContactTable:
+    kind = sensor.kind
+    periodic = kind == "finger" and sensor.closes_circumference
+    refine = method == "interpolate" and kind == "pad"
+    seg, labels = _segment(signal, threshold, saddle, periodic, max_contacts, refine)
+    n = len(seg["frame"])
+    rows, cols = sensor.shape
+    flags = np.zeros(n, np.int64)
+    extra = {}
+    if kind == "pad":
+        g = sensor.grid
+        row, col = seg["row"], seg["col"]
+        x = row * g.row_pitch_mm
+        y = col * g.col_pitch_mm
+        z = np.zeros(n)
+        peak = seg["value"]
+        force = pad_contact_force(signal, labels, seg, sensor)
+        major, minor, angle = _extent(
+            seg["rr"], seg["cc"], seg["rc"], g.row_pitch_mm, g.col_pitch_mm
+        )
+        flags[(method == "interpolate") & ~seg["converged"]] |= int(Flag.NOT_CONVERGED)
+        with np.errstate(invalid="ignore"):
+            edge = (row < 0.5) | (row > rows - 1.5) | (col < 0.5) | (col > cols - 1.5)
+        flags[edge] |= int(Flag.EDGE)
+    else:
+        row, col, axial, angle_deg, peak, force, finger_flags = _finger_positions(
+            signal, labels, seg, sensor, threshold, method
+        )
+        flags |= finger_flags
+        from tactsense.geometry import surface_to_xyz
+
+        xyz = surface_to_xyz(sensor, np.nan_to_num(axial), np.nan_to_num(angle_deg))
+        x, y, z = xyz[..., 0], xyz[..., 1], xyz[..., 2]
+        step_axial = float(np.diff(tactel_to_surface(sensor, np.array([1.0, 2.0]), 0.0)[0])[0])
+        step_arc = sensor.radius_mm * math.radians(sensor.array.spacing_angle_deg)
+        major, minor, angle = _extent(seg["rr"], seg["cc"], seg["rc"], abs(step_axial), step_arc)
+        extra = {"axial_mm": axial, "angle_deg": angle_deg}
+    extra["_root"] = seg["root"]
+    extra["_labels"] = labels
+    table = ContactTable(
+        frame=seg["frame"], contact=seg["contact"], x_mm=x, y_mm=y, z_mm=z, row=row, col=col,
+        force_n=force, peak=peak, major_mm=major, minor_mm=minor, orientation_deg=angle,
+        taxels=seg["taxels"], flags=flags, n_frames=len(signal), extra=extra,
+    )  # fmt: skip
+    return table
+
+
+def _finger_positions(signal, labels, seg, sensor, threshold, method):
+    """Each contact of a finger frame located by :func:`~tactsense.estimate.locate` on
+    the frame with the other contacts' taxels zeroed (one contact: the frame as read,
+    so that the numbers are locate's own)."""
+    from tactsense.estimate.force import force_per_deflection
+    from tactsense.estimate.locate import locate
+
+    frame, root = seg["frame"], seg["root"]
+    n = len(frame)
+    if n == 0:
+        empty = np.zeros(0)
+        return empty, empty, empty, empty, empty, empty, np.zeros(0, np.int64)
+    own = labels[frame]
+    other = (own >= 0) & (own != root[:, np.newaxis, np.newaxis])
+    masked = np.where(other, 0.0, signal[frame])
+    est = locate(masked, sensor, counts=False, threshold=threshold)
+    flags = est.flags & ~int(Flag.NO_CONTACT) & ~int(Flag.MULTIPLE)
+    # the integral of the whole frame, shared in proportion to each contact's sum
+    rows_sum = signal[:, 1:, :] if sensor.array.tip_row else signal
+    frame_total = rows_sum.reshape(len(signal), -1).sum(axis=1)
+    share = np.ones(n)
+    counts_per_frame = np.bincount(frame, minlength=len(signal))
+    many = counts_per_frame[frame] > 1
+    if many.any():
+        by_frame = np.bincount(frame, weights=seg["total"], minlength=len(signal))
+        share[many] = seg["total"][many] / by_frame[frame[many]]
+    force = np.where(many, force_per_deflection(sensor) * frame_total[frame] * share, est.force_n)
+    force = np.where(np.isnan(est.force_n) & ~many, np.nan, force)
+    row, col = est.row, est.col
+    axial, angle = est.axial_mm, est.angle_deg
+    if method == "cop":
+        row, col = seg["row"], seg["col"]  # the centre of the contact's deflection
+        axial, angle = tactel_to_surface(sensor, row, col)
+        flags &= ~int(Flag.NOT_CONVERGED)
+    return row, col, axial, angle, est.peak_deflection, force, flags.astype(np.int64)
+
+
+@functools.lru_cache(maxsize=16)
+def pad_force_kernel(sensor, n_sub: int = 8):
+    """The signal of the taxels around the scenarios' probe (1.6-mm sphere) per newton,
+    for the probe at ``n_sub + 1`` sub-taxel offsets along each axis.
+
+    Returns ``(kernel, step, half)``: ``kernel[a, b, i, j]`` is the signal [-/N] of the
+    taxel at offset ``(i - half, j - half)`` from the taxel nearest below the probe, for
+    the probe at ``(a, b) * step`` taxels from that taxel. Computed on a pad of the same
+    pitch, electrodes, layer and transduction large enough for the window (the layer's
+    response does not depend on where it is applied).
+    """
+    from tactsense.estimate._contacts_fast import HALF_WINDOW
+    from tactsense.physics.indenters import SphereProbe
+    from tactsense.physics.pad_response import pad_strain
+
+    half = HALF_WINDOW
+    size = 2 * half + 2
+    grid = dataclasses.replace(sensor.grid, rows=size, cols=size)
+    from tactsense.sensor.common import Flaws
+
+    big = dataclasses.replace(sensor, grid=grid, flaws=Flaws())
+    g = big.grid
+    newtons = 0.49
+    kernel = np.empty((n_sub + 1, n_sub + 1, 2 * half + 1, 2 * half + 1))
+    step = 1.0 / n_sub
+    for a in range(n_sub + 1):
+        for b in range(n_sub + 1):
+            probe = SphereProbe(
+                (half + a * step) * g.row_pitch_mm, (half + b * step) * g.col_pitch_mm, newtons
+            )
+            strain = pad_strain(big, [probe])[: 2 * half + 1, : 2 * half + 1] / newtons
+            if sensor.transduction.kind == "resistive":
+                kernel[a, b] = np.maximum(strain, 0.0)
+            else:
+                kernel[a, b] = sensor.transduction.strain_gain * strain
+    return kernel, step, half
+
+
+def pad_contact_force(signal, labels, seg, sensor) -> np.ndarray:
+    """Force of each contact of a pad [N] (see :func:`find_contacts`)."""
+    from tactsense.estimate._contacts_fast import amplitude_fit
+
+    n = len(seg["frame"])
+    force = np.empty(n)
+    if n == 0:
+        return force
+    kernel, step, half = pad_force_kernel(sensor)
+    with deferred_interrupts():
+        amplitude_fit(
+            signal, labels, seg["frame"], seg["root"], seg["row"], seg["col"], kernel, step,
+            half, force,
+        )  # fmt: skip
+    return force
+
+
+# ---- point sets: no grid ----------------------------------------------------------------
+
+
+@functools.lru_cache(maxsize=16)
+def _points_geometry(sensor):
+    """Positions [mm], normals, and each taxel's neighbours: the taxels closer than 1.5
+    times the distance to its nearest one (at least its 3 nearest)."""
+    positions = np.asarray(sensor.taxel_positions_mm(), dtype=float)
+    normals = np.asarray(sensor.taxel_normals(), dtype=float)
+    distance = np.linalg.norm(positions[:, None, :] - positions[None, :, :], axis=-1)
+    np.fill_diagonal(distance, np.inf)
+    nearest = distance.min(axis=1)
+    neighbours = []
+    for i in range(len(positions)):
+        chosen = np.flatnonzero(distance[i] <= 1.5 * nearest[i])
+        if len(chosen) < 3:
+            chosen = np.argsort(distance[i])[: min(3, len(positions) - 1)]
+        neighbours.append(chosen)
+    # symmetric: a neighbour of a neighbour's list
+    links = [set(map(int, n)) for n in neighbours]
+    for i, n in enumerate(neighbours):
+        for j in n:
+            links[int(j)].add(i)
+    return positions, normals, tuple(np.array(sorted(x), dtype=np.int64) for x in links)
+
+
+@functools.lru_cache(maxsize=16)
+def points_force_kernel(sensor):
+    """The signal of every taxel per newton of the scenarios' probe (1.6-mm sphere)
+    centred on each taxel, shape (N, N) [-/N]: row i for the probe on taxel i."""
+    from tactsense.physics.indenters import SphereProbe
+    from tactsense.physics.pad_response import points_strain
+
+    newtons = 0.49
+    n = sensor.shape[1]
+    kernel = np.empty((n, n))
+    for i in range(n):
+        strain = points_strain(sensor, [SphereProbe(0.0, 0.0, newtons, at_taxel=i)])[0] / newtons
+        if sensor.transduction.kind == "resistive":
+            kernel[i] = np.maximum(strain, 0.0)
+        else:
+            kernel[i] = sensor.transduction.strain_gain * strain
+    return kernel
+
+
+def _points_segment(s, threshold, saddle, neighbours):
+    """Labels (the maximum each taxel climbs to, -1 below the threshold) of one frame."""
+    n = len(s)
+    parent = np.full(n, -1)
+    for i in range(n):
+        if not s[i] > threshold:
+            continue
+        best, value = i, s[i]
+        for j in neighbours[i]:
+            if s[j] > value or (s[j] == value and j > best):
+                best, value = int(j), s[j]
+        parent[i] = best
+    root = parent.copy()
+    for i in np.flatnonzero(parent >= 0):
+        q = i
+        while parent[q] != q:
+            q = parent[q]
+        root[i] = q
+    edges = []
+    for i in np.flatnonzero(parent >= 0):
+        for j in neighbours[i]:
+            if j > i and parent[j] >= 0 and root[j] != root[i]:
+                edges.append((min(s[i], s[j]), root[i], root[j]))
+    final = {int(r): int(r) for r in np.unique(root[root >= 0])}
+
+    def find(a):
+        while final[a] != a:
+            a = final[a]
+        return a
+
+    for value, a, b in sorted(edges, reverse=True):
+        a, b = find(int(a)), find(int(b))
+        if a == b:
+            continue
+        low = min(s[a], s[b])
+        if value >= saddle * low or low - value < threshold:
+            if s[a] >= s[b]:
+                final[b] = a
+            else:
+                final[a] = b
+    return np.array([find(int(r)) if r >= 0 else -1 for r in root])
+
+
+def _tangent_frame(normal):
+    helper = np.array([0.0, 0.0, 1.0]) if abs(normal[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
+    t1 = np.cross(normal, helper)
+    t1 /= np.linalg.norm(t1)
+    return t1, np.cross(normal, t1)
+
+
+def _points_peak(s, own, peak, positions, normals, neighbours):
+    """Peak of a weighted quadratic fit in the tangent plane of the contact's largest
+    taxel, over it and its neighbours: ``s = a + b u + c v + d u^2 + e v^2 + f u v``.
+
+    A point set has no grid for a sinc interpolation; a quadratic through the largest
+    reading and its neighbours is the smallest smooth surface with a peak (the
+    two-dimensional form of the three-point parabola), and the fit needs no spacing.
+    Returns the 3-D point, the fitted peak, and whether the fit had a peak within one
+    neighbour distance (else the centre of the contact's signal is used)."""
+    t1, t2 = _tangent_frame(normals[peak])
+    around = np.concatenate([[peak], neighbours[peak]])
+    around = around[own[around]]
+    offsets = positions[around] - positions[peak]
+    u, v = offsets @ t1, offsets @ t2
+    values = s[around]
+    if len(around) >= 6:
+        design = np.column_stack([np.ones_like(u), u, v, u * u, v * v, u * v])
+        coef, *_ = np.linalg.lstsq(design, values, rcond=None)
+        _, b, c, d, e, f = coef
+        hessian = np.array([[2 * d, f], [f, 2 * e]])
+        if d < 0 and np.linalg.det(hessian) > 0:
+            du, dv = np.linalg.solve(hessian, [-b, -c])
+            reach = np.max(np.hypot(u, v))
+            if math.hypot(du, dv) <= reach:
+                value = coef @ [1.0, du, dv, du * du, dv * dv, du * dv]
+                return positions[peak] + du * t1 + dv * t2, float(value), True
+    weights = np.clip(values, 0.0, None)
+    centre = weights @ positions[around] / weights.sum()
+    return centre, float(s[peak]), False
+
+
+def _points_contacts(signal, sensor, threshold, saddle, max_contacts, method) -> ContactTable:
+    positions, normals, neighbours = _points_geometry(sensor)
+    kernel = points_force_kernel(sensor)
+    rows = []
+    labels = np.full(signal.shape, -1, dtype=np.int64)
+    for f in range(len(signal)):
+        s = signal[f, 0]
+        label = _points_segment(s, threshold, saddle, neighbours)
+        labels[f, 0] = label
+        found = []
+        for r in np.unique(label[label >= 0]):
+            own = label == r
+            w = np.where(own, s, 0.0)
+            total = w.sum()
+            centre = w @ positions / total
+            d = positions[own] - centre
+            cov = (w[own, None] * d).T @ d / total
+            t1, t2 = _tangent_frame(normals[r])
+            plane = np.array([[t1 @ cov @ t1, t1 @ cov @ t2], [t2 @ cov @ t1, t2 @ cov @ t2]])
+            major, minor, angle = _extent(plane[0, 0], plane[1, 1], plane[0, 1], 1.0, 1.0)
+            ok = True
+            if method == "interpolate":
+                point, peak, ok = _points_peak(
+                    s, own | (label < 0), r, positions, normals, neighbours
+                )
+            else:
+                point, peak = centre, float(s[r])
+            nearest = int(np.argmin(np.linalg.norm(positions - point, axis=1)))
+            g = kernel[nearest]
+            use = own | (label < 0)
+            force = float(g[use] @ s[use] / (g[use] @ g[use]))
+            flag = 0 if ok else int(Flag.NOT_CONVERGED)
+            found.append(
+                (total, f, point, peak, force, major, minor, angle, int(own.sum()), flag, r)
+            )
+        found.sort(key=lambda item: -item[0])
+        for rank, item in enumerate(found[:max_contacts]):
+            rows.append((rank, *item))
+    if not rows:
+        table = ContactTable.empty(len(signal))
+        table.extra["_root"] = np.zeros(0, np.int64)
+        table.extra["_labels"] = labels
+        return table
+    rank, _, frame, point, peak, force, major, minor, angle, taxels, flag, root = zip(
+        *rows, strict=True
+    )
+    point = np.array(point)
+    nan = np.full(len(rows), np.nan)
+    return ContactTable(
+        frame=np.array(frame, np.int64), contact=np.array(rank, np.int64), x_mm=point[:, 0],
+        y_mm=point[:, 1], z_mm=point[:, 2], row=nan, col=nan.copy(), force_n=np.array(force),
+        peak=np.array(peak), major_mm=np.array(major, float), minor_mm=np.array(minor, float),
+        orientation_deg=np.array(angle, float), taxels=np.array(taxels, np.int64),
+        flags=np.array(flag, np.int64), n_frames=len(signal),
+        extra={"_root": np.array(root, np.int64), "_labels": labels},
+    )  # fmt: skip

@@ -136,3 +136,157 @@ class EstimatesWriter:
         if self._h5 is not None:
             self._h5.close()
             self._h5 = None
+
+
+class ContactsWriter(EstimatesWriter):
+    """Append a :class:`~tactsense.estimate.contacts.ContactTable` to a CSV, Parquet or
+    HDF5 file (by extension), piece by piece: the long table, one row per contact per
+    frame.
+
+    Columns: ``frame``, ``time_s``, ``id`` (the tracked identity; -1 when not tracked),
+    the table's columns (``x_mm``, ``y_mm``, ``z_mm``, ``row``, ``col``, ``force_n``,
+    ``peak``, ``major_mm``, ``minor_mm``, ``orientation_deg``, ``taxels``, ``flags``,
+    ``contact``, the velocities and ``slip`` when tracked, and any extra columns such as
+    a finger's ``axial_mm`` and ``angle_deg``), and ``event``: ``birth`` on the row where
+    an id is born, ``split:P`` where it splits off id P, empty otherwise. Deaths and
+    merges happen where an id has no row: they are kept in the file's metadata (Parquet
+    key ``events``, HDF5 dataset group ``events``, CSV: a sidecar ``NAME.events.csv``)
+    as (frame, kind, id, other) rows. CSV adds ``flag_names``.
+    """
+
+    def __init__(
+        self, path: str | Path, *, format: str | None = None, events_path: str | Path | None = None
+    ):
+        super().__init__(path, format=format)
+        self.events: list = []
+        self.events_path = Path(events_path) if events_path else events_sidecar(self.path)
+
+    def _contact_table(self, time_s, table) -> pa.Table:
+        n = len(table)
+        columns = {
+            "frame": np.asarray(table.frame, dtype=np.int64),
+            "time_s": np.asarray(time_s, dtype=float),
+            "id": (
+                np.full(n, -1, np.int64) if table.id is None else np.asarray(table.id, np.int64)
+            ),
+        }
+        for name, value in table.columns().items():
+            if name in columns:
+                continue
+            if name in ("taxels", "flags", "contact"):
+                value = value.astype(np.int64)
+            columns[name] = value
+        columns["event"] = np.full(n, "", dtype=object)
+        if self.format == "csv":
+            columns["flag_names"] = _flag_names(columns["flags"])
+        return pa.table(columns)
+
+    def write_contacts(self, time_s, table, events=()) -> None:
+        """Append a table of contacts, ``time_s`` per row [s], and its track events."""
+        arrow = self._contact_table(time_s, table)
+        events = list(events)
+        if events and table.id is not None and len(table):
+            marks = arrow.column("event").to_pylist()
+            where = {
+                (int(f), int(i)): k
+                for k, (f, i) in enumerate(zip(table.frame, table.id, strict=True))
+            }
+            for e in events:
+                k = where.get((int(e.frame), int(e.id)))
+                if k is not None and e.kind in ("birth", "split"):
+                    marks[k] = e.kind if e.kind == "birth" else f"split:{e.others[0]}"
+            arrow = arrow.set_column(
+                arrow.column_names.index("event"), "event", pa.array(marks, pa.string())
+            )
+        self.events.extend(events)
+        units = {"time_s": "s", **_contact_units(), "flags": "Flag bits"}
+        if self.format == "csv":
+            if self._writer is None:
+                self._writer = pa_csv.CSVWriter(str(self.path), arrow.schema)
+            self._writer.write_table(arrow)
+        elif self.format == "parquet":
+            if self._writer is None:
+                schema = arrow.schema.with_metadata({"units": str(units)})
+                self._writer = pq.ParquetWriter(str(self.path), schema)
+            self._writer.write_table(arrow.replace_schema_metadata(self._writer.schema.metadata))
+        else:
+            self._write_h5(arrow, units)
+        self.rows += arrow.num_rows
+
+    def _write_h5(self, table: pa.Table, units=None) -> None:
+        if self._h5 is None:
+            self._h5 = h5py.File(self.path, "w")
+            self._h5.attrs["format"] = "tactsense-contacts"
+            rows = min(65_536, max(1_024, table.num_rows))
+            for name in table.column_names:
+                column = table.column(name)
+                if pa.types.is_string(column.type):  # variable length: no filters
+                    data = self._h5.create_dataset(
+                        name, shape=(0,), maxshape=(None,), chunks=(rows,),
+                        dtype=h5py.string_dtype(),
+                    )  # fmt: skip
+                else:
+                    data = self._h5.create_dataset(
+                        name, shape=(0,), maxshape=(None,), chunks=(rows,), compression="gzip",
+                        compression_opts=4, shuffle=True, fletcher32=True,
+                        dtype=column.to_numpy().dtype,
+                    )  # fmt: skip
+                data.attrs["units"] = (units or {}).get(name, "1")
+        n = table.num_rows
+        for name in table.column_names:
+            data = self._h5[name]
+            data.resize((self.rows + n,))
+            column = table.column(name)
+            values = column.to_pylist() if pa.types.is_string(column.type) else column.to_numpy()
+            data[self.rows :] = values
+
+    def close(self) -> None:
+        events = _events_table(self.events)
+        if self.format == "parquet" and self._writer is not None:
+            # pyarrow writes key-value metadata with the footer: the events go there
+            self._writer.add_key_value_metadata({"events": _events_json(self.events)})
+        if self.format == "h5" and self._h5 is not None:
+            group = self._h5.create_group("events")
+            for name in events.column_names:
+                column = events.column(name)
+                values = (
+                    column.to_pylist() if pa.types.is_string(column.type) else column.to_numpy()
+                )
+                group.create_dataset(
+                    name, data=values,
+                    dtype=h5py.string_dtype() if pa.types.is_string(column.type) else None,
+                )  # fmt: skip
+        if self.format == "csv" and self._writer is not None:
+            pa_csv.write_csv(events, str(self.events_path))
+        super().close()
+
+
+def events_sidecar(path: str | Path) -> Path:
+    """The CSV file beside a CSV long table that holds its track events."""
+    path = Path(path)
+    return path.with_name(path.stem + ".events.csv")
+
+
+def _contact_units() -> dict:
+    from tactsense.estimate.contacts import ContactTable
+
+    return dict(ContactTable.UNITS)
+
+
+def _events_table(events) -> pa.Table:
+    return pa.table(
+        {
+            "frame": pa.array([int(e.frame) for e in events], pa.int64()),
+            "kind": pa.array([e.kind for e in events], pa.string()),
+            "id": pa.array([int(e.id) for e in events], pa.int64()),
+            "other": pa.array([int(e.others[0]) if e.others else -1 for e in events], pa.int64()),
+        }
+    )
+
+
+def _events_json(events) -> str:
+    import json
+
+    return json.dumps(
+        [[int(e.frame), e.kind, int(e.id), int(e.others[0]) if e.others else -1] for e in events]
+    )

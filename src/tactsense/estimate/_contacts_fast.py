@@ -1,0 +1,462 @@
+"""Compiled passes of :mod:`tactsense.estimate.contacts` (Numba): from counts to the signal
+of every taxel, segmentation of a grid frame into contacts, and each contact's position,
+moments and force.
+
+One loop over the frames of a block, each frame kept in cache; no temporary arrays per
+frame (the work arrays are made once per block). The NumPy reference of the same
+mathematics is in :mod:`tactsense.estimate.contacts` (``_segment_reference``); the test
+suite holds the two to rounding.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from tactsense._jit import jit
+
+HALF_WINDOW = 3
+"""Taxels on each side of the peak that the interpolation uses [taxel]."""
+_WINDOW = HALF_WINDOW + 1.0  # the Hann window reaches zero 4 taxels from the point
+_TAYLOR = 1e-4
+
+
+@jit(nogil=True)
+def prepare_signal(
+    frames, baseline, unusable, full_scale, resistive, per_count, nan_flag, sat_flag, dead_flag
+):
+    """Signal of every taxel and the flags of each frame, in one pass.
+
+    Capacitive taxels: eq. 4, ``(V - V_o) / V``; resistive ones: ``(V - V_o) * per_count``
+    (compression positive). Unusable taxels (dead, NaN, reading zero) read 0.
+    """
+    n, rows, cols = frames.shape
+    signal = np.empty((n, rows, cols), np.float64)
+    flags = np.zeros(n, np.int64)
+    any_unusable = False
+    for r in range(rows):
+        for c in range(cols):
+            if unusable[r, c]:
+                any_unusable = True
+    for f in range(n):
+        flag = dead_flag if any_unusable else 0
+        for r in range(rows):
+            for c in range(cols):
+                v = float(frames[f, r, c])
+                d = 0.0
+                if not math.isfinite(v):
+                    flag |= nan_flag
+                elif unusable[r, c]:
+                    pass
+                elif v <= 0.0:
+                    flag |= dead_flag
+                else:
+                    if v >= full_scale:
+                        flag |= sat_flag
+                    if resistive:
+                        d = (v - baseline[r, c]) * per_count
+                    else:
+                        d = (v - baseline[r, c]) / v
+                signal[f, r, c] = d
+        flags[f] = flag
+    return signal, flags
+
+
+@jit(inline="always")
+def _kernel(t):
+    """Hann-windowed sinc of width 2 * _WINDOW and its first two derivatives at t."""
+    if abs(t) >= _WINDOW:
+        return 0.0, 0.0, 0.0
+    pt = math.pi * t
+    if abs(t) < _TAYLOR:
+        s = 1.0 - pt * pt / 6.0
+        ds = -(math.pi**2) * t / 3.0
+        d2s = -(math.pi**2) / 3.0 + math.pi**4 * t * t / 10.0
+    else:
+        sp = math.sin(pt)
+        cp = math.cos(pt)
+        s = sp / pt
+        ds = (cp - s) / t
+        d2s = (-math.pi * sp - 2.0 * ds) / t
+    om = math.pi / _WINDOW
+    cw = math.cos(om * t)
+    sw = math.sin(om * t)
+    w = 0.5 * (1.0 + cw)
+    dw = -0.5 * om * sw
+    d2w = -0.5 * om * om * cw
+    return s * w, ds * w + s * dw, d2s * w + 2.0 * ds * dw + s * d2w
+
+
+@jit(inline="always")
+def _wrap(c, cols, periodic):
+    if periodic:
+        c %= cols
+        return c
+    return c if 0 <= c < cols else -1
+
+
+@jit(nogil=True)
+def _surface(s, label, own, u, v, periodic, kr0, kr1, kr2, kc0, kc1, kc2):
+    """Value, gradient and Hessian at (u, v) of the interpolated surface of the taxels
+    labelled ``own`` (other contacts' taxels count as 0; the rest as read)."""
+    rows, cols = s.shape
+    r0 = int(math.floor(u)) - HALF_WINDOW
+    c0 = int(math.floor(v)) - HALF_WINDOW
+    span = 2 * HALF_WINDOW + 2
+    for i in range(span):
+        kr0[i], kr1[i], kr2[i] = _kernel(u - (r0 + i))
+        kc0[i], kc1[i], kc2[i] = _kernel(v - (c0 + i))
+    f = 0.0
+    fu = 0.0
+    fv = 0.0
+    fuu = 0.0
+    fvv = 0.0
+    fuv = 0.0
+    for i in range(span):
+        r = r0 + i
+        if r < 0 or r >= rows or (kr0[i] == 0.0 and kr1[i] == 0.0):
+            continue
+        a0 = 0.0
+        a1 = 0.0
+        a2 = 0.0
+        for j in range(span):
+            c = _wrap(c0 + j, cols, periodic)
+            if c < 0:
+                continue
+            lab = label[r, c]
+            if lab >= 0 and lab != own:
+                continue
+            z = s[r, c]
+            a0 += kc0[j] * z
+            a1 += kc1[j] * z
+            a2 += kc2[j] * z
+        f += kr0[i] * a0
+        fu += kr1[i] * a0
+        fv += kr0[i] * a1
+        fuu += kr2[i] * a0
+        fvv += kr0[i] * a2
+        fuv += kr1[i] * a1
+    return f, fu, fv, fuu, fvv, fuv
+
+
+@jit(nogil=True)
+def segment_into(
+    signal, threshold, ratio, periodic, max_contacts, refine, tolerance, max_iterations,
+    count, peak_row, peak_col, row, col, value, total, mrr, mcc, mrc, taxels, converged,
+    root, labels,
+):  # fmt: skip
+    """Segment every frame into contacts and estimate each (see ``find_contacts``).
+
+    Per frame ``f`` and contact ``k < count[f]`` (by decreasing summed signal): the peak
+    taxel, the fractional peak (Newton on the interpolated surface when ``refine``,
+    else the centre of the region's signal), the interpolated peak value, the summed
+    signal of the region, its second central moments [taxel^2], its taxel count and
+    whether Newton converged; ``root[f, k]`` the flat index of its maximum, and
+    ``labels[f]`` (rows, cols) that index on every taxel of the contact (-1 elsewhere).
+    """
+    n, rows, cols = signal.shape
+    p_all = rows * cols
+    parent = np.empty(p_all, np.int64)
+    root_of = np.empty(p_all, np.int64)
+    edge_a = np.empty(4 * p_all, np.int64)
+    edge_b = np.empty(4 * p_all, np.int64)
+    edge_v = np.empty(4 * p_all, np.float64)
+    top = np.empty(p_all, np.float64)
+    sums = np.empty((p_all, 7), np.float64)  # w, w dr, w dc, w dr2, w dc2, w dr dc, count
+    final = np.empty(p_all, np.int64)
+    order = np.empty(p_all, np.int64)
+    kr0 = np.empty(2 * HALF_WINDOW + 2)
+    kr1 = np.empty_like(kr0)
+    kr2 = np.empty_like(kr0)
+    kc0 = np.empty_like(kr0)
+    kc1 = np.empty_like(kr0)
+    kc2 = np.empty_like(kr0)
+    for f in range(n):
+        s = signal[f]
+        label = labels[f]
+        for p in range(p_all):
+            label[p // cols, p % cols] = -1
+        # 1. every taxel above the threshold points to its highest neighbour (8 of them;
+        # ties go to the larger index, so that no chain closes on itself)
+        above = 0
+        for p in range(p_all):
+            r = p // cols
+            c = p - r * cols
+            v0 = s[r, c]
+            if not v0 > threshold:
+                parent[p] = -1
+                continue
+            above += 1
+            best = p
+            bv = v0
+            for dr in range(-1, 2):
+                rr = r + dr
+                if rr < 0 or rr >= rows:
+                    continue
+                for dc in range(-1, 2):
+                    if dr == 0 and dc == 0:
+                        continue
+                    cc = _wrap(c + dc, cols, periodic)
+                    if cc < 0:
+                        continue
+                    q = rr * cols + cc
+                    w = s[rr, cc]
+                    if w > bv or (w == bv and q > best):
+                        best = q
+                        bv = w
+            parent[p] = best
+        count[f] = 0
+        if above == 0:
+            continue
+        # 2. follow the chains to their maxima (steepest ascent = a watershed)
+        for p in range(p_all):
+            if parent[p] < 0:
+                continue
+            q = p
+            while parent[q] != q:
+                q = parent[q]
+            root_of[p] = q
+        # 3. merge maxima separated by a shallow saddle: the edges between regions,
+        # highest saddle first (a union-find over the maxima)
+        n_edges = 0
+        for p in range(p_all):
+            if parent[p] < 0:
+                continue
+            r = p // cols
+            c = p - r * cols
+            for k in range(4):  # forward neighbours: each pair once
+                dr = 0 if k == 0 else 1
+                dc = 1 if k == 0 else k - 2
+                rr = r + dr
+                if rr >= rows:
+                    continue
+                cc = _wrap(c + dc, cols, periodic)
+                if cc < 0:
+                    continue
+                q = rr * cols + cc
+                if q == p or parent[q] < 0 or root_of[q] == root_of[p]:
+                    continue
+                edge_a[n_edges] = root_of[p]
+                edge_b[n_edges] = root_of[q]
+                edge_v[n_edges] = min(s[r, c], s[rr, cc])
+                n_edges += 1
+        for p in range(p_all):
+            if parent[p] == p:
+                final[p] = p  # union-find parent among maxima
+                top[p] = s[p // cols, p % cols]
+        if n_edges > 0:
+            for e in np.argsort(-edge_v[:n_edges]):
+                a = edge_a[e]
+                while final[a] != a:
+                    a = final[a]
+                b = edge_b[e]
+                while final[b] != b:
+                    b = final[b]
+                if a == b:
+                    continue
+                low = min(top[a], top[b])
+                saddle = edge_v[e]
+                if saddle >= ratio * low or low - saddle < threshold:
+                    if top[a] >= top[b]:
+                        final[b] = a
+                    else:
+                        final[a] = b
+        # 4. label each taxel with its merged maximum and accumulate its moments about
+        # that maximum (columns unwrapped across the seam of a closed ring)
+        for p in range(p_all):
+            r = p // cols
+            c = p - r * cols
+            if parent[p] < 0:
+                continue
+            m = root_of[p]
+            while final[m] != m:
+                m = final[m]
+            root_of[p] = m
+        n_regions = 0
+        for p in range(p_all):
+            if parent[p] == p and final[p] == p:
+                order[n_regions] = p
+                for k in range(7):
+                    sums[p, k] = 0.0
+                n_regions += 1
+        for p in range(p_all):
+            if parent[p] < 0:
+                continue
+            r = p // cols
+            c = p - r * cols
+            m = root_of[p]
+            label[r, c] = m
+            mr = m // cols
+            mc = m - mr * cols
+            dr = float(r - mr)
+            dcol = c - mc
+            if periodic:
+                if dcol > cols // 2:
+                    dcol -= cols
+                elif dcol < -(cols // 2):
+                    dcol += cols
+            dc = float(dcol)
+            w = s[r, c]
+            sums[m, 0] += w
+            sums[m, 1] += w * dr
+            sums[m, 2] += w * dc
+            sums[m, 3] += w * dr * dr
+            sums[m, 4] += w * dc * dc
+            sums[m, 5] += w * dr * dc
+            sums[m, 6] += 1.0
+        # 5. the largest regions (by summed signal), at most max_contacts of them
+        keys = np.empty(n_regions)
+        for k in range(n_regions):
+            keys[k] = -sums[order[k], 0]
+        ranked = np.argsort(keys)
+        kept = min(n_regions, max_contacts)
+        count[f] = kept
+        for k in range(kept):
+            m = order[ranked[k]]
+            mr = m // cols
+            mc = m - mr * cols
+            w = sums[m, 0]
+            cr = sums[m, 1] / w
+            cc = sums[m, 2] / w
+            root[f, k] = m
+            peak_row[f, k] = mr
+            peak_col[f, k] = mc
+            total[f, k] = w
+            mrr[f, k] = max(sums[m, 3] / w - cr * cr, 0.0)
+            mcc[f, k] = max(sums[m, 4] / w - cc * cc, 0.0)
+            mrc[f, k] = sums[m, 5] / w - cr * cc
+            taxels[f, k] = int(sums[m, 6])
+            u = float(mr)
+            v = float(mc)
+            ok = False
+            if refine:
+                # Newton on the interpolated surface of this contact, from its maximum
+                for _ in range(max_iterations):
+                    f0, fu, fv, fuu, fvv, fuv = _surface(
+                        s, label, m, u, v, periodic, kr0, kr1, kr2, kc0, kc1, kc2
+                    )
+                    det = fuu * fvv - fuv * fuv
+                    if not (fuu < 0.0 and det > 0.0):
+                        break  # not concave here: keep the centre of the region
+                    du = -(fvv * fu - fuv * fv) / det
+                    dv = -(fuu * fv - fuv * fu) / det
+                    step = math.hypot(du, dv)
+                    if step > 0.5:
+                        du *= 0.5 / step
+                        dv *= 0.5 / step
+                    u += du
+                    v += dv
+                    if abs(u - mr) > 1.0 or abs(v - mc) > 1.0:
+                        break  # left the maximum's neighbourhood: not a peak of it
+                    if step < tolerance:
+                        ok = True
+                        break
+            if ok:
+                row[f, k] = u
+                col[f, k] = v
+            else:
+                row[f, k] = mr + cr
+                col[f, k] = mc + cc
+            f0, fu, fv, fuu, fvv, fuv = _surface(
+                s, label, m, row[f, k], col[f, k], periodic, kr0, kr1, kr2, kc0, kc1, kc2
+            )
+            value[f, k] = f0
+            converged[f, k] = ok
+            if periodic:
+                col[f, k] = col[f, k] % cols
+
+
+@jit(nogil=True)
+def amplitude_fit(signal, label_frames, frame_of, root, row, col, kernel, step, half, force):
+    """Least-squares force of each contact: the amplitude of the tabulated response to
+    1 N at its position, over the window of taxels around it (other contacts' taxels
+    left out).
+
+    ``kernel[a, b, i, j]`` is the signal of the taxel at offset ``(i - half, j - half)``
+    from the taxel nearest below a load at sub-taxel offset ``(a, b) * step``.
+    """
+    rows = signal.shape[1]
+    cols = signal.shape[2]
+    n_sub = kernel.shape[0] - 1
+    for k in range(row.shape[0]):
+        f = frame_of[k]
+        u = row[k]
+        v = col[k]
+        if not (math.isfinite(u) and math.isfinite(v)):
+            force[k] = np.nan
+            continue
+        r0 = int(math.floor(u))
+        c0 = int(math.floor(v))
+        a = (u - r0) / step
+        b = (v - c0) / step
+        ia = min(int(a), n_sub - 1)
+        ib = min(int(b), n_sub - 1)
+        ta = a - ia
+        tb = b - ib
+        num = 0.0
+        den = 0.0
+        for i in range(2 * half + 1):
+            r = r0 + i - half
+            if r < 0 or r >= rows:
+                continue
+            for j in range(2 * half + 1):
+                c = c0 + j - half
+                if c < 0 or c >= cols:
+                    continue
+                lab = label_frames[f, r, c]
+                if lab >= 0 and lab != root[k]:
+                    continue
+                g = (
+                    (1 - ta) * (1 - tb) * kernel[ia, ib, i, j]
+                    + ta * (1 - tb) * kernel[ia + 1, ib, i, j]
+                    + (1 - ta) * tb * kernel[ia, ib + 1, i, j]
+                    + ta * tb * kernel[ia + 1, ib + 1, i, j]
+                )
+                num += g * signal[f, r, c]
+                den += g * g
+        force[k] = num / den if den > 0.0 else np.nan
+
+
+@jit(nogil=True)
+def exhaustive_assignment(cost, far):
+    """The assignment of least total cost by trying every permutation (Heap's
+    algorithm): for the few tracks and contacts of a frame (at most 6 x 6, 720
+    permutations), faster than a general solver's call. ``match[i]`` is the column of
+    row ``i``, or -1 where its pair costs ``far`` or more (unmatched)."""
+    n, m = cost.shape
+    size = max(n, m)
+    square = np.full((size, size), far)
+    for i in range(n):
+        for j in range(m):
+            square[i, j] = cost[i, j]
+    perm = np.arange(size)
+    best = perm.copy()
+    best_total = 0.0
+    for i in range(size):
+        best_total += square[i, perm[i]]
+    c = np.zeros(size, np.int64)
+    i = 1
+    while i < size:
+        if c[i] < i:
+            if i % 2 == 0:
+                perm[0], perm[i] = perm[i], perm[0]
+            else:
+                perm[c[i]], perm[i] = perm[i], perm[c[i]]
+            total = 0.0
+            for k in range(size):
+                total += square[k, perm[k]]
+            if total < best_total:
+                best_total = total
+                best[:] = perm
+            c[i] += 1
+            i = 1
+        else:
+            c[i] = 0
+            i += 1
+    match = np.full(n, -1, np.int64)
+    for i in range(n):
+        j = best[i]
+        if j < m and square[i, j] < far:
+            match[i] = j
+    return match
