@@ -101,8 +101,8 @@ def _surface(s, label, own, u, v, periodic, kr0, kr1, kr2, kc0, kc1, kc2):
     """Value, gradient and Hessian at (u, v) of the interpolated surface of the taxels
     labelled ``own`` (other contacts' taxels count as 0; the rest as read)."""
     rows, cols = s.shape
-    r0 = int(math.floor(u)) - HALF_WINDOW
-    c0 = int(math.floor(v)) - HALF_WINDOW
+    r0 = math.floor(u) - HALF_WINDOW
+    c0 = math.floor(v) - HALF_WINDOW
     span = 2 * HALF_WINDOW + 2
     for i in range(span):
         kr0[i], kr1[i], kr2[i] = _kernel(u - (r0 + i))
@@ -386,8 +386,8 @@ def amplitude_fit(signal, label_frames, frame_of, root, row, col, kernel, step, 
         if not (math.isfinite(u) and math.isfinite(v)):
             force[k] = np.nan
             continue
-        r0 = int(math.floor(u))
-        c0 = int(math.floor(v))
+        r0 = math.floor(u)
+        c0 = math.floor(v)
         a = (u - r0) / step
         b = (v - c0) / step
         ia = min(int(a), n_sub - 1)
@@ -460,3 +460,89 @@ def exhaustive_assignment(cost, far):
         if j < m and square[i, j] < far:
             match[i] = j
     return match
+
+
+@jit(nogil=True)
+def fit_into(signal, labels, frame_of, root, peak_row, peak_col, kernel, half, row, col, force):
+    """Maximum-likelihood position and force of each contact under white Gaussian noise:
+    the tabulated response that, scaled by its least-squares amplitude, leaves the least
+    residual over the taxels around the contact's maximum (other contacts' taxels left
+    out), searched over every tabulated sub-taxel position in the four cells around the
+    maximum, then refined by a parabola through the best and its table neighbours.
+
+    ``kernel[a, b, i, j]`` as in :func:`amplitude_fit`; ``row``, ``col`` [taxel] and
+    ``force`` [N] are written.
+    """
+    rows = signal.shape[1]
+    cols = signal.shape[2]
+    n_sub = kernel.shape[0] - 1
+    step = 1.0 / n_sub
+    reach = half + 1
+    span = 2 * n_sub + 1  # sub-positions from the maximum - 1 to the maximum + 1
+    score = np.empty((span, span))
+    amp = np.empty((span, span))
+    for k in range(frame_of.shape[0]):
+        f = frame_of[k]
+        pr = peak_row[k]
+        pc = peak_col[k]
+        for ia in range(span):
+            for ib in range(span):
+                # position (pr - 1 + ia * step, pc - 1 + ib * step): the cell below it
+                # and the offset inside that cell
+                ua = ia if ia < span - 1 else ia - 1
+                ub = ib if ib < span - 1 else ib - 1
+                r0 = pr - 1 + ua // n_sub
+                c0 = pc - 1 + ub // n_sub
+                a = ia - (r0 - (pr - 1)) * n_sub
+                b = ib - (c0 - (pc - 1)) * n_sub
+                num = 0.0
+                den = 0.0
+                for i in range(2 * half + 1):
+                    r = r0 + i - half
+                    if r < 0 or r >= rows or abs(r - pr) > reach:
+                        continue
+                    for j in range(2 * half + 1):
+                        c = c0 + j - half
+                        if c < 0 or c >= cols or abs(c - pc) > reach:
+                            continue
+                        lab = labels[f, r, c]
+                        if lab >= 0 and lab != root[k]:
+                            continue
+                        g = kernel[a, b, i, j]
+                        num += g * signal[f, r, c]
+                        den += g * g
+                if den > 0.0 and num > 0.0:
+                    score[ia, ib] = num * num / den
+                    amp[ia, ib] = num / den
+                else:
+                    score[ia, ib] = 0.0
+                    amp[ia, ib] = np.nan
+        best_a = 0
+        best_b = 0
+        for ia in range(span):
+            for ib in range(span):
+                if score[ia, ib] > score[best_a, best_b]:
+                    best_a = ia
+                    best_b = ib
+        if not score[best_a, best_b] > 0.0:
+            row[k] = np.nan
+            col[k] = np.nan
+            force[k] = np.nan
+            continue
+        da = 0.0
+        db = 0.0
+        if 0 < best_a < span - 1:
+            lo = score[best_a - 1, best_b]
+            hi = score[best_a + 1, best_b]
+            curv = lo - 2.0 * score[best_a, best_b] + hi
+            if curv < 0.0:
+                da = min(max(0.5 * (lo - hi) / curv, -0.5), 0.5)
+        if 0 < best_b < span - 1:
+            lo = score[best_a, best_b - 1]
+            hi = score[best_a, best_b + 1]
+            curv = lo - 2.0 * score[best_a, best_b] + hi
+            if curv < 0.0:
+                db = min(max(0.5 * (lo - hi) / curv, -0.5), 0.5)
+        row[k] = pr - 1 + (best_a + da) * step
+        col[k] = pc - 1 + (best_b + db) * step
+        force[k] = amp[best_a, best_b]

@@ -142,10 +142,12 @@ SADDLE_RATIO = 0.8
 this share of the lower one (and by more than the contact threshold) [-]; otherwise the
 lower is a bump on the same contact and the two regions are merged."""
 
-METHODS = ("interpolate", "cop")
+METHODS = ("interpolate", "cop", "fit")
 """``interpolate``: the paper's method on the grid (Hann-windowed sinc over 3 taxels on
 each side of the maximum, Newton to 0.01 taxel); ``cop``: the centre of pressure (the
-signal-weighted mean position of the contact's taxels)."""
+signal-weighted mean position of the contact's taxels); ``fit`` (pads): the maximum-
+likelihood position and force under white noise, fitting the layer's tabulated response
+(:func:`pad_force_kernel`) to the taxels around the contact."""
 
 BLOCK = 4096
 """Frames per block of the compiled passes."""
@@ -401,6 +403,8 @@ def _extent(rr, cc, rc, scale_r: float, scale_c: float):
 
 def _grid_contacts(signal, sensor, threshold, saddle, max_contacts, method) -> ContactTable:
     kind = sensor.kind
+    if method == "fit" and kind != "pad":
+        raise TactsenseInputError(f"method 'fit' works on pads; {sensor.name!r} is a {kind}")
     periodic = kind == "finger" and sensor.closes_circumference
     refine = method == "interpolate" and kind == "pad"
     seg, labels = _segment(signal, threshold, saddle, periodic, max_contacts, refine)
@@ -415,7 +419,12 @@ def _grid_contacts(signal, sensor, threshold, saddle, max_contacts, method) -> C
         y = col * g.col_pitch_mm
         z = np.zeros(n)
         peak = seg["value"]
-        force = pad_contact_force(signal, labels, seg, sensor)
+        if method == "fit":
+            row, col, force = pad_fit(signal, labels, seg, sensor)
+            x = row * g.row_pitch_mm
+            y = col * g.col_pitch_mm
+        else:
+            force = pad_contact_force(signal, labels, seg, sensor)
         major, minor, angle = _extent(
             seg["rr"], seg["cc"], seg["rc"], g.row_pitch_mm, g.col_pitch_mm
         )
@@ -519,6 +528,23 @@ def pad_force_kernel(sensor, n_sub: int = 8):
             else:
                 kernel[a, b] = sensor.transduction.strain_gain * strain
     return kernel, step, half
+
+
+def pad_fit(signal, labels, seg, sensor):
+    """Maximum-likelihood row, column [taxel] and force [N] of each contact of a pad
+    (:func:`~tactsense.estimate._contacts_fast.fit_into`)."""
+    from tactsense.estimate._contacts_fast import fit_into
+
+    n = len(seg["frame"])
+    row, col, force = np.empty(n), np.empty(n), np.empty(n)
+    if n:
+        kernel, _, half = pad_force_kernel(sensor)
+        with deferred_interrupts():
+            fit_into(
+                signal, labels, seg["frame"], seg["root"], seg["peak_row"], seg["peak_col"],
+                kernel, half, row, col, force,
+            )  # fmt: skip
+    return row, col, force
 
 
 def pad_contact_force(signal, labels, seg, sensor) -> np.ndarray:

@@ -1,0 +1,223 @@
+"""Contacts on any array: segmentation, positions, force, extents; the finger's single
+contact equal to ``locate``; pads and point sets from the simulator."""
+
+import numpy as np
+import pytest
+from scipy import ndimage
+from skimage.morphology import local_maxima
+
+import tactsense as ts
+from tactsense import flat_scenarios as fs
+from tactsense._validation import TactsenseInputError
+from tactsense.estimate import locate
+from tactsense.estimate.contacts import ContactTable, find_contacts
+from tactsense.physics.indenters import SphereProbe
+from tactsense.physics.pad_response import pad_strain
+from tactsense.sensor.registry import load_sensor
+
+
+@pytest.fixture(scope="module")
+def pad16():
+    return load_sensor("pad16")
+
+
+@pytest.fixture(scope="module")
+def thick():
+    """pad16 under a 6-mm layer read 4 mm deep: a response several taxels wide, so that
+    sub-taxel positions are observable (on the preset's 2-mm layer a probe near a
+    taxel's centre moves no neighbour: docs/sensors.md)."""
+    return load_sensor("pad16").replace(layer__thickness_mm=6.0, layer__sensing_depth_mm=4.0)
+
+
+def _bumps(shape, centres, sigma=1.0, height=0.05):
+    r, c = np.mgrid[0 : shape[0], 0 : shape[1]]
+    return sum(height * np.exp(-((r - u) ** 2 + (c - v) ** 2) / (2 * sigma**2)) for u, v in centres)
+
+
+def test_regions_are_the_local_maxima_of_a_random_frame(pad16):
+    """With merging off (saddle 1, threshold tiny), each contact is one strict local
+    maximum (8-connected, as skimage finds them) and the regions cover every taxel
+    above the threshold."""
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        frame = ndimage.gaussian_filter(rng.uniform(0, 1, (16, 16)), 1.0)
+        table = find_contacts(frame, pad16, counts=False, threshold=1e-9, saddle=1.0,
+                              max_contacts=64, method="cop")  # fmt: skip
+        maxima = local_maxima(frame, connectivity=2, allow_borders=True)
+        assert len(table) == maxima.sum()
+        assert table.taxels.sum() == 256
+
+
+@pytest.mark.parametrize(
+    ("separation", "expected"),
+    [(6.0, 2), (2.0, 1)],
+)
+def test_two_bumps_split_or_merge_by_the_saddle_rule(pad16, separation, expected):
+    """Two equal Gaussian bumps (sigma 1 taxel): the dip midway is 2 exp(-d^2/8) of a
+    peak; 6 taxels apart it is 0.022 (two contacts), 2 apart 1.21 (no dip: one)."""
+    frame = _bumps((16, 16), [(8, 8 - separation / 2), (8, 8 + separation / 2)])
+    table = find_contacts(frame, pad16, counts=False)
+    assert len(table) == expected
+    if expected == 2:
+        np.testing.assert_allclose(
+            np.sort(table.col), [8 - separation / 2, 8 + separation / 2], atol=0.02
+        )
+        np.testing.assert_allclose(table.row, 8.0, atol=0.02)
+
+
+def test_a_shallow_dip_merges_and_a_deep_one_splits(pad16):
+    """Peaks 4 taxels apart, sigma 1.2: dip = 2 exp(-16/(8 1.44)) = 0.50 of a peak (< 0.8:
+    two); sigma 1.6: 2 exp(-16/(8 2.56)) = 0.92 (>= 0.8: one)."""
+    assert (
+        len(find_contacts(_bumps((16, 16), [(8, 6), (8, 10)], sigma=1.2), pad16, counts=False)) == 2
+    )
+    assert (
+        len(find_contacts(_bumps((16, 16), [(8, 6), (8, 10)], sigma=1.6), pad16, counts=False)) == 1
+    )
+
+
+def test_centre_of_pressure_equals_scipy_on_separate_blobs(pad16):
+    frame = _bumps((16, 16), [(3.3, 4.6), (11.2, 10.7), (4.0, 12.4)], sigma=0.8)
+    threshold = 0.005
+    table = find_contacts(frame, pad16, counts=False, method="cop", threshold=threshold)
+    labels, n = ndimage.label(frame > threshold, structure=np.ones((3, 3)))
+    assert n == 3 and len(table) == 3
+    centres = ndimage.center_of_mass(np.where(labels > 0, frame, 0), labels, range(1, n + 1))
+    sums = ndimage.sum(frame, labels, range(1, n + 1))
+    order = np.argsort(-np.asarray(sums))
+    np.testing.assert_allclose(table.row, [centres[k][0] for k in order], atol=1e-9)
+    np.testing.assert_allclose(table.col, [centres[k][1] for k in order], atol=1e-9)
+    assert list(table.contact) == [0, 1, 2]
+
+
+def test_extent_of_an_elongated_blob(pad16):
+    """A Gaussian ridge with sd 2 taxels along x and 0.7 across, turned 30 degrees: the
+    second moments give major ~ 2 x 2.5 mm, minor ~ 0.7 x 2.5 mm (sampling and the
+    threshold trim the tails: 10 %), orientation 30 deg (2 deg)."""
+    r, c = np.mgrid[0:16, 0:16].astype(float)
+    t = np.radians(30)
+    u = (r - 8) * np.cos(t) + (c - 8) * np.sin(t)
+    v = -(r - 8) * np.sin(t) + (c - 8) * np.cos(t)
+    frame = 0.05 * np.exp(-(u**2) / (2 * 2.0**2) - v**2 / (2 * 0.7**2))
+    table = find_contacts(frame, pad16, counts=False, threshold=1e-4)
+    assert len(table) == 1
+    np.testing.assert_allclose(table.major_mm[0], 2.0 * 2.5, rtol=0.1)
+    np.testing.assert_allclose(table.minor_mm[0], 0.7 * 2.5, rtol=0.1)
+    np.testing.assert_allclose(table.orientation_deg[0], 30.0, atol=2.0)
+
+
+@pytest.mark.parametrize("offset", [(0.0, 0.0), (0.25, 0.0), (0.5, 0.5), (0.3, 0.7)])
+def test_pad_round_trip_from_the_layer(thick, offset):
+    """The layer's own (noise-free) response to a 50-g probe: the ML fit places it within
+    0.02 taxel and within 1 % of its force (the table's 1/8-taxel step, bilinear); the
+    sinc interpolation within 0.1 taxel, the centre of pressure within 0.05 taxel (a
+    response 3-4 taxels wide, sampled at every taxel)."""
+    g = thick.grid
+    x, y = (7 + offset[0]) * g.row_pitch_mm, (8 + offset[1]) * g.col_pitch_mm
+    strain = np.maximum(pad_strain(thick, [SphereProbe(x, y, 0.49)]), 0.0)
+    for method, tol in (("fit", 0.02), ("interpolate", 0.1), ("cop", 0.05)):
+        table = find_contacts(strain, thick, counts=False, method=method)
+        assert len(table) == 1
+        error = np.hypot(table.x_mm[0] - x, table.y_mm[0] - y) / g.row_pitch_mm
+        assert error < tol, (method, error)
+    fit = find_contacts(strain, thick, counts=False, method="fit")
+    np.testing.assert_allclose(fit.force_n, 0.49, rtol=0.01)
+
+
+def test_force_is_linear_in_the_load(thick):
+    """Twice the signal, twice the force (the layer is linear; the fit's amplitude too)."""
+    g = thick.grid
+    strain = np.maximum(
+        pad_strain(thick, [SphereProbe(7.3 * g.row_pitch_mm, 8.6 * g.col_pitch_mm, 0.49)]), 0
+    )
+    one = find_contacts(strain, thick, counts=False)
+    two = find_contacts(2 * strain, thick, counts=False, threshold=0.01)
+    np.testing.assert_allclose(two.force_n, 2 * one.force_n, rtol=1e-9)
+
+
+def test_two_probes_on_pad16_from_counts(pad16):
+    """The simulated two-probes scenario (every flaw on): two contacts in each loaded
+    frame, 5 mm apart along y (2 taxels) within one taxel each: the preset's 35 % gain
+    spread is not calibrated out, so positions are good to a taxel, not better."""
+    rec = ts.simulate(pad16, fs.two_probes(pad16), rng=0)
+    base = np.median(rec.frames[:5], axis=0)
+    table = find_contacts(rec.frames, pad16, baseline=base)
+    counts = table.per_frame_counts()
+    assert table.n_frames == len(rec.frames)
+    loaded = counts[25:75]
+    assert (loaded == 2).all()
+    cx = cy = 7.5 * 2.5
+    for f in range(25, 75, 10):
+        rows = table.frame == f
+        ys = np.sort(table.y_mm[rows])
+        np.testing.assert_allclose(ys, [cy - 2.5, cy + 2.5], atol=2.5)
+        np.testing.assert_allclose(table.x_mm[rows], cx, atol=2.5)
+
+
+def test_finger_single_contact_equals_locate(initial):
+    rec = ts.simulate(initial, ts.probe_sweep(initial), rng=0)
+    base = np.median(rec.frames[:5], axis=0)
+    est = locate(rec.frames, initial, baseline=base)
+    table = find_contacts(rec.frames, initial, baseline=base)
+    single = np.flatnonzero(table.per_frame_counts() == 1)
+    assert len(single) > 100
+    rows = np.isin(table.frame, single)
+    frames = table.frame[rows]
+    np.testing.assert_array_equal(table.row[rows], est.row[frames])
+    np.testing.assert_array_equal(table.extra["axial_mm"][rows], est.axial_mm[frames])
+    np.testing.assert_array_equal(table.force_n[rows], est.force_n[frames])
+    # frames locate calls contact-free have no row
+    none = np.flatnonzero(np.isnan(est.row))
+    assert not np.isin(table.frame, none).any()
+
+
+def test_point_set_press_at_a_taxel():
+    """dome12: a 50-g probe on taxel 5 is found nearest to taxel 5 (the weighted
+    quadratic fit on its neighbours), with a force within 35 % (uncalibrated gains)."""
+    spec = load_sensor("dome12")
+    positions = spec.taxel_positions_mm()
+    rec = ts.simulate(
+        spec, fs.press(spec, x_mm=float(positions[5, 0]), y_mm=float(positions[5, 1])), rng=0
+    )
+    base = np.median(rec.frames[:5], axis=0)
+    table = find_contacts(rec.frames, spec, baseline=base)
+    loaded = table.frame[(table.frame > 30) & (table.frame < 50)]
+    assert len(loaded)
+    rows = np.isin(table.frame, loaded) & (table.contact == 0)
+    points = np.column_stack([table.x_mm[rows], table.y_mm[rows], table.z_mm[rows]])
+    nearest = np.argmin(np.linalg.norm(points[:, None, :] - positions[None], axis=-1), axis=1)
+    assert (nearest == 5).all()
+    assert np.all(np.isnan(table.row[rows]))
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"method": "bogus"}, "method 'bogus'"),
+        ({"max_contacts": 0}, "max_contacts"),
+        ({"saddle": 0.0}, "saddle"),
+        ({"threshold": float("nan")}, "threshold"),
+        ({"threshold": -1.0}, "threshold"),
+    ],
+)
+def test_bad_arguments(pad16, kwargs, message):
+    with pytest.raises(TactsenseInputError, match=message):
+        find_contacts(np.zeros((16, 16)), pad16, counts=False, **kwargs)
+
+
+def test_bad_shapes_and_inputs(pad16, initial):
+    with pytest.raises(TactsenseInputError, match=r"expected \(\.\.\., 16, 16\)"):
+        find_contacts(np.zeros((8, 8)), pad16, counts=False)
+    with pytest.raises(TactsenseInputError, match="baseline"):
+        find_contacts(np.zeros((16, 16)), pad16)
+    with pytest.raises(TactsenseInputError, match="works on pads"):
+        find_contacts(np.zeros((8, 8)), initial, counts=False, method="fit")
+    frame = _bumps((16, 16), [(8, 8)])
+    frame[0, 0] = np.nan
+    table = find_contacts(frame, pad16, counts=False)
+    assert len(table) == 1 and table.flags[0] & ts.estimate.Flag.NAN_INPUT
+
+
+def test_empty_table():
+    table = ContactTable.empty(4)
+    assert len(table) == 0 and list(table.per_frame_counts()) == [0, 0, 0, 0]

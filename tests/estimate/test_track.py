@@ -1,0 +1,163 @@
+"""Tracking contacts over frames: ids, births, deaths, merges, splits, velocity, slip."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+from scipy.optimize import linear_sum_assignment
+
+import tactsense as ts
+from tactsense import flat_scenarios as fs
+from tactsense._validation import TactsenseInputError
+from tactsense.estimate.contacts import ContactTable, find_contacts
+from tactsense.estimate.track import _FAR, ContactTracker, assign, track
+from tactsense.sensor.registry import load_sensor
+
+PERIOD = 0.01
+
+
+def table_of(rows, n_frames):
+    """A ContactTable from (frame, x, y, force) rows."""
+    rows = sorted(rows, key=lambda r: r[0])
+    n = len(rows)
+    frame = np.array([r[0] for r in rows], np.int64)
+    rank = np.zeros(n, np.int64)
+    for k in range(1, n):
+        rank[k] = rank[k - 1] + 1 if frame[k] == frame[k - 1] else 0
+    col = lambda i: np.array([r[i] for r in rows], float)  # noqa: E731
+    zeros = np.zeros(n)
+    return ContactTable(
+        frame=frame, contact=rank, x_mm=col(1), y_mm=col(2), z_mm=zeros, row=zeros, col=zeros,
+        force_n=col(3), peak=zeros, major_mm=zeros, minor_mm=zeros, orientation_deg=zeros,
+        taxels=np.ones(n, np.int64), flags=np.zeros(n, np.int64), n_frames=n_frames,
+    )  # fmt: skip
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    arrays(
+        np.float64,
+        st.tuples(st.integers(1, 6), st.integers(1, 6)),
+        elements=st.floats(0, 100, allow_nan=False),
+    ),  # fmt: skip
+    st.floats(1, 120),
+)
+def test_assignment_matches_scipy(cost, limit):
+    """The compiled exhaustive search finds an assignment of scipy's cost and size."""
+    pairs = assign(cost, limit)
+    capped = np.where(cost < limit, cost, _FAR)
+    rows, cols = linear_sum_assignment(capped)
+    ref = [(i, j) for i, j in zip(rows, cols, strict=True) if capped[i, j] < _FAR]
+    assert len(pairs) == len(ref)
+    assert sum(cost[i, j] for i, j in pairs) == pytest.approx(sum(cost[i, j] for i, j in ref))
+    assert all(cost[i, j] < limit for i, j in pairs)
+
+
+def test_crossing_paths_keep_their_ids():
+    """Two contacts pass each other along x at 100 mm/s, 1 mm apart in y at the
+    crossing: the velocity prediction keeps each on its own line."""
+    rows = []
+    for f in range(40):
+        rows.append((f, f * 1.0, 0.0, 1.0))
+        rows.append((f, 39 - f * 1.0, 1.0, 1.0))
+    out, events = track(table_of(rows, 40), PERIOD, gate_mm=3.0)
+    ids_a = out.id[out.y_mm == 0.0]
+    ids_b = out.id[out.y_mm == 1.0]
+    assert len(set(ids_a)) == 1 and len(set(ids_b)) == 1 and ids_a[0] != ids_b[0]
+    assert [e.kind for e in events] == ["birth", "birth"]
+    # the smoothed velocity starts at 0 and approaches 100 mm/s by (1 - 0.3)^k: 0.1 %
+    # after 20 frames
+    np.testing.assert_allclose(out.vx_mm_s[(out.y_mm == 0.0) & (out.frame > 20)], 100.0, rtol=1e-3)
+
+
+def test_birth_death_and_grace():
+    """A contact missing for max_missing frames keeps its id; one frame more ends it; a
+    track still alive when the table ends is not dead (the next piece may continue it)."""
+    rows = [(f, 5.0, 5.0, 1.0) for f in (0, 1, 2, 5, 6)] + [(f, 5.0, 5.0, 1.0) for f in (10, 11)]
+    out, events = track(table_of(rows, 12), PERIOD, max_missing=2)
+    assert list(out.id) == [0, 0, 0, 0, 0, 1, 1]
+    assert [(e.frame, e.kind, e.id) for e in events] == [
+        (0, "birth", 0), (9, "death", 0), (10, "birth", 1),
+    ]  # fmt: skip
+
+
+def test_merge_and_split():
+    """Two contacts 4 mm apart come together into one (a merge naming the survivor),
+    then part again (a split naming the parent)."""
+    rows = []
+    for f in range(10):
+        rows += [(f, 0.0, 0.0, 1.0), (f, 4.0, 0.0, 1.0)]
+    for f in range(10, 20):
+        rows.append((f, 2.0, 0.0, 2.0))
+    for f in range(20, 30):
+        rows += [(f, 0.0, 0.0, 1.0), (f, 4.0, 0.0, 1.0)]
+    out, events = track(table_of(rows, 30), PERIOD, gate_mm=5.0, max_missing=2, smoothing=1.0)
+    kinds = [(e.frame, e.kind) for e in events]
+    assert (10, "merge") in kinds and (20, "split") in kinds
+    merge = next(e for e in events if e.kind == "merge")
+    split = next(e for e in events if e.kind == "split")
+    survivor = merge.others[0]
+    assert set(out.id[out.frame == 15]) == {survivor}
+    assert split.others == (survivor,)
+    assert split.id not in (0, 1)
+
+
+def test_chunks_give_the_same_result():
+    rng = np.random.default_rng(0)
+    rows = []
+    for f in range(200):
+        for k in range(3):
+            if rng.uniform() < 0.9:
+                rows.append((f, 10 * k + np.sin(f / 20) + rng.normal(0, 0.1), k * 3.0, 1.0))
+    whole, events = track(table_of(rows, 200), PERIOD)
+    tracker = ContactTracker(PERIOD)
+    ids, evs = [], []
+    for lo in range(0, 200, 37):
+        hi = min(lo + 37, 200)
+        piece = table_of([r for r in rows if lo <= r[0] < hi], hi - lo)
+        out, e = tracker.update(piece, first_frame=lo)
+        ids.append(out.id)
+        evs += e
+    np.testing.assert_array_equal(np.concatenate(ids), whole.id)
+    assert evs == events
+
+
+def test_slide_slips_and_hold_does_not():
+    """pad16, from counts: a probe sliding at 10 mm/s under 50 g is flagged as slip in
+    some frames of its path; a press and hold in none. The slide's id stays one for most
+    of the path (the gate is 5 mm; the taxel pitch 2.5 mm)."""
+    spec = load_sensor("pad16")
+    for scenario, slips in ((fs.slide(spec), True), (fs.hold(spec), False)):
+        rec = ts.simulate(spec, scenario, rng=0)
+        base = np.median(rec.frames[:5], axis=0)
+        table = find_contacts(rec.frames, spec, baseline=base)
+        out, _ = track(table, spec.scan_period_s)
+        main = out.contact == 0
+        assert out.slip[main].any() == slips
+        values, counts = np.unique(out.id[main], return_counts=True)
+        assert counts.max() >= 0.9 * main.sum()
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"frame_period_s": 0}, "frame_period_s"),
+        ({"frame_period_s": float("nan")}, "frame_period_s"),
+        ({"frame_period_s": 0.01, "gate_mm": -1}, "gate_mm"),
+        ({"frame_period_s": 0.01, "smoothing": 2}, "smoothing"),
+        ({"frame_period_s": 0.01, "max_missing": -1}, "max_missing"),
+    ],
+)
+def test_bad_options(kwargs, message):
+    with pytest.raises(TactsenseInputError, match=message):
+        ContactTracker(**kwargs)
+
+
+def test_frames_going_backwards():
+    tracker = ContactTracker(PERIOD)
+    tracker.update(table_of([(0, 1.0, 1.0, 1.0)], 10))
+    with pytest.raises(TactsenseInputError, match="backwards"):
+        tracker.update(table_of([(3, 1.0, 1.0, 1.0)], 10), first_frame=3)
+    with pytest.raises(TactsenseInputError, match="outside"):
+        tracker.update(table_of([(30, 1.0, 1.0, 1.0)], 5))
