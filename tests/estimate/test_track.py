@@ -40,7 +40,7 @@ def table_of(rows, n_frames):
         np.float64,
         st.tuples(st.integers(1, 6), st.integers(1, 6)),
         elements=st.floats(0, 100, allow_nan=False),
-    ),  # fmt: skip
+    ),
     st.floats(1, 120),
 )
 def test_assignment_matches_scipy(cost, limit):
@@ -135,7 +135,7 @@ def test_slide_slips_and_hold_does_not():
         out, _ = track(table, spec.scan_period_s)
         main = out.contact == 0
         assert out.slip[main].any() == slips
-        values, counts = np.unique(out.id[main], return_counts=True)
+        _, counts = np.unique(out.id[main], return_counts=True)
         assert counts.max() >= 0.9 * main.sum()
 
 

@@ -432,9 +432,15 @@ def exhaustive_assignment(cost, far):
             square[i, j] = cost[i, j]
     perm = np.arange(size)
     best = perm.copy()
+    # compare (unmatched pairs, cost of the matched ones): a sum with `far` in it would
+    # lose the small costs to rounding
+    best_far = 0
     best_total = 0.0
     for i in range(size):
-        best_total += square[i, perm[i]]
+        if square[i, perm[i]] >= far:
+            best_far += 1
+        else:
+            best_total += square[i, perm[i]]
     c = np.zeros(size, np.int64)
     i = 1
     while i < size:
@@ -443,10 +449,15 @@ def exhaustive_assignment(cost, far):
                 perm[0], perm[i] = perm[i], perm[0]
             else:
                 perm[c[i]], perm[i] = perm[i], perm[c[i]]
+            n_far = 0
             total = 0.0
             for k in range(size):
-                total += square[k, perm[k]]
-            if total < best_total:
+                if square[k, perm[k]] >= far:
+                    n_far += 1
+                else:
+                    total += square[k, perm[k]]
+            if n_far < best_far or (n_far == best_far and total < best_total):
+                best_far = n_far
                 best_total = total
                 best[:] = perm
             c[i] += 1
