@@ -1,0 +1,86 @@
+"""``tactsense locate`` on pads and with ``--contacts``: the long table of tracked
+contacts, its events, and the summary line equal to what the file holds."""
+
+import re
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+import pandas as pd
+import pyarrow.parquet as pq
+import pytest
+
+import tactsense as ts
+
+
+def run(*args, cwd):
+    done = subprocess.run(
+        [sys.executable, "-m", "tactsense.cli", *args],
+        capture_output=True, text=True, cwd=cwd, timeout=600,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    return " ".join(done.stderr.split())
+
+
+@pytest.fixture(scope="module")
+def two(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("two")
+    run("simulate", "--sensor", "pad16", "--scenario", "two-probes", "--out", "two.h5", cwd=folder)
+    return folder
+
+
+def _summary(line):
+    numbers = re.search(
+        r"(\d+) frames, (\d+) contact rows in (\d+) frames \(at most (\d+) at once\), (\d+) "
+        r"tracked ids; (\d+) births, (\d+) deaths, (\d+) merges, (\d+) splits",
+        line,
+    )
+    assert numbers, line
+    return [int(x) for x in numbers.groups()]
+
+
+def test_the_issue_line_two_probes_two_ids(two):
+    """The done-when line of issue 24: two contacts with stable ids."""
+    line = run("locate", "two.h5", "--out", "est.parquet", cwd=two)
+    frames, rows, with_contact, most, ids, births, deaths, merges, splits = _summary(line)
+    table = pd.read_parquet(two / "est.parquet")
+    assert len(table) == rows and table["frame"].nunique() == with_contact
+    assert table.groupby("frame").size().max() == most == 2
+    assert table["id"].nunique() == ids
+    events = pq.read_metadata(two / "est.parquet").metadata[b"events"]
+    assert events.count(b'"birth"') == births and events.count(b'"death"') == deaths
+    # while both probes press (0.2-0.7 s), the same two ids in every frame, 5 mm apart
+    loaded = table[(table.time_s > 0.25) & (table.time_s < 0.65)]
+    assert loaded.groupby("frame").size().eq(2).all()
+    assert loaded["id"].nunique() == 2
+    per_id = loaded.groupby("id")["y_mm"].mean().sort_values()
+    assert per_id.diff().iloc[1] == pytest.approx(5.0, abs=2.5)
+    assert (table["event"] == "birth").sum() == births
+    assert frames == ts.read_recording(two / "two.h5").frames.shape[0]
+
+
+def test_csv_has_an_events_file_and_h5_an_events_group(two):
+    run("locate", "two.h5", "--out", "est.csv", cwd=two)
+    table = pd.read_csv(two / "est.csv")
+    events = pd.read_csv(two / "est.events.csv")
+    assert set(events["kind"]) <= {"birth", "death", "merge", "split"}
+    assert (events["kind"] == "birth").sum() == table["id"].nunique()
+    assert {"x_mm", "y_mm", "force_n", "major_mm", "slip", "flag_names"} <= set(table.columns)
+    run("locate", "two.h5", "--out", "est.h5", cwd=two)
+    with h5py.File(two / "est.h5") as h5:
+        assert h5.attrs["format"] == "tactsense-contacts"
+        np.testing.assert_array_equal(h5["id"][:], table["id"].to_numpy())
+        np.testing.assert_allclose(h5["x_mm"][:], table["x_mm"].to_numpy())
+        assert list(h5["events"]["kind"].asstr()[:]) == list(events["kind"])
+
+
+def test_finger_contacts_option(tmp_path):
+    run("simulate", "--out", "rec.h5", cwd=tmp_path)
+    run("locate", "rec.h5", "--out", "one.csv", cwd=tmp_path)
+    line = run("locate", "rec.h5", "--contacts", "--out", "long.csv", cwd=tmp_path)
+    one = pd.read_csv(tmp_path / "one.csv")
+    long = pd.read_csv(tmp_path / "long.csv")
+    assert {"axial_mm", "angle_deg", "id", "x_mm"} <= set(long.columns)
+    assert "axial_mm" in one.columns and "id" not in one.columns
+    assert _summary(line)[1] == len(long)
