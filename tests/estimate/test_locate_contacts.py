@@ -50,6 +50,7 @@ def test_the_issue_line_two_probes_two_ids(two):
     assert table["id"].nunique() == ids
     events = pq.read_metadata(two / "est.parquet").metadata[b"events"]
     assert events.count(b'"birth"') == births and events.count(b'"death"') == deaths
+    assert events.count(b'"merge"') == merges and events.count(b'"split"') == splits
     # while both probes press (0.2-0.7 s), the same two ids in every frame, 5 mm apart
     loaded = table[(table.time_s > 0.25) & (table.time_s < 0.65)]
     assert loaded.groupby("frame").size().eq(2).all()
