@@ -11,7 +11,7 @@ import tactsense as ts
 from tactsense import flat_scenarios as fs
 from tactsense._validation import TactsenseInputError
 from tactsense.estimate.contacts import ContactTable, find_contacts
-from tactsense.estimate.track import _FAR, ContactTracker, assign, track
+from tactsense.estimate.track import _FAR, ContactTracker, ReferenceTracker, assign, track
 from tactsense.sensor.registry import load_sensor
 
 PERIOD = 0.01
@@ -161,3 +161,28 @@ def test_frames_going_backwards():
         tracker.update(table_of([(3, 1.0, 1.0, 1.0)], 10), first_frame=3)
     with pytest.raises(TactsenseInputError, match="outside"):
         tracker.update(table_of([(30, 1.0, 1.0, 1.0)], 5))
+
+
+def test_compiled_tracker_equals_the_reference():
+    """The compiled tracker gives the ids, velocities, slip flags and events of the
+    plain-Python reference (scipy's assignment each frame), on random contacts that
+    appear, vanish, wander and cross, tracked in pieces."""
+    rng = np.random.default_rng(5)
+    rows = []
+    for f in range(600):
+        for k in range(4):
+            if rng.uniform() < 0.8:
+                x = 6 * k + 3 * np.sin(f / 30 + k) + rng.normal(0, 0.3)
+                rows.append((f, x, 2.0 * np.cos(f / 50 + k), 0.5 + 0.1 * k))
+    table = table_of(rows, 600)
+    fast, ref = ContactTracker(PERIOD, max_missing=1), ReferenceTracker(PERIOD, max_missing=1)
+    for lo in range(0, 600, 128):
+        hi = min(lo + 128, 600)
+        piece = table_of([r for r in rows if lo <= r[0] < hi], hi - lo)
+        a, ea = fast.update(piece, first_frame=lo)
+        b, eb = ref.update(piece, first_frame=lo)
+        np.testing.assert_array_equal(a.id, b.id)
+        np.testing.assert_allclose(a.vx_mm_s, b.vx_mm_s, atol=1e-12)
+        np.testing.assert_array_equal(a.slip, b.slip)
+        assert ea == eb
+    assert len(table) > 1000 and fast.next_id > 4

@@ -26,7 +26,6 @@ def folder(tmp_path_factory):
 
 
 CASES = [
-    ("locate pad.h5 --out OUT.csv", "contact estimation works on fingers so far; 'pad4' is a pad"),
     ("calibrate pad.h5 --out OUT.json", "calibrate works on finger sensors; 'pad4' is a pad"),
     ("reproduce --sensor pad16 --out OUT", "works on finger sensors; 'pad16' is a pad"),
     ("export pad.h5 --out OUT.rrd", "contact estimation works on fingers so far; 'pad4'"),

@@ -63,29 +63,46 @@ def prepare_signal(
     return signal, flags
 
 
+_OMEGA = math.pi / _WINDOW
+_COS_J = np.cos(_OMEGA * np.arange(2 * HALF_WINDOW + 2))
+_SIN_J = np.sin(_OMEGA * np.arange(2 * HALF_WINDOW + 2))
+
+
 @jit(inline="always")
-def _kernel(t):
-    """Hann-windowed sinc of width 2 * _WINDOW and its first two derivatives at t."""
-    if abs(t) >= _WINDOW:
-        return 0.0, 0.0, 0.0
-    pt = math.pi * t
-    if abs(t) < _TAYLOR:
-        s = 1.0 - pt * pt / 6.0
-        ds = -(math.pi**2) * t / 3.0
-        d2s = -(math.pi**2) / 3.0 + math.pi**4 * t * t / 10.0
-    else:
-        sp = math.sin(pt)
-        cp = math.cos(pt)
-        s = sp / pt
-        ds = (cp - s) / t
-        d2s = (-math.pi * sp - 2.0 * ds) / t
-    om = math.pi / _WINDOW
-    cw = math.cos(om * t)
-    sw = math.sin(om * t)
-    w = 0.5 * (1.0 + cw)
-    dw = -0.5 * om * sw
-    d2w = -0.5 * om * om * cw
-    return s * w, ds * w + s * dw, d2s * w + 2.0 * ds * dw + s * d2w
+def _axis_kernel(d, span, k0, k1, k2):
+    """:func:`_kernel` at ``d - j`` for j = 0 .. span - 1 with four trigonometric calls
+    in all: sin(pi (d - j)) = (-1)^j sin(pi d), and the window's cos(w (d - j)) by the
+    angle-difference identity from tabulated cos(w j), sin(w j)."""
+    sd = math.sin(math.pi * d)
+    cd = math.cos(math.pi * d)
+    swd = math.sin(_OMEGA * d)
+    cwd = math.cos(_OMEGA * d)
+    for j in range(span):
+        t = d - j
+        if abs(t) >= _WINDOW:
+            k0[j] = 0.0
+            k1[j] = 0.0
+            k2[j] = 0.0
+            continue
+        sign = -1.0 if j % 2 else 1.0
+        sp = sign * sd
+        cp = sign * cd
+        if abs(t) < _TAYLOR:
+            sv = 1.0 - (math.pi * t) ** 2 / 6.0
+            ds = -(math.pi**2) * t / 3.0
+            d2s = -(math.pi**2) / 3.0 + math.pi**4 * t * t / 10.0
+        else:
+            sv = sp / (math.pi * t)
+            ds = (cp - sv) / t
+            d2s = (-math.pi * sp - 2.0 * ds) / t
+        cw = cwd * _COS_J[j] + swd * _SIN_J[j]
+        sw = swd * _COS_J[j] - cwd * _SIN_J[j]
+        w = 0.5 * (1.0 + cw)
+        dw = -0.5 * _OMEGA * sw
+        d2w = -0.5 * _OMEGA * _OMEGA * cw
+        k0[j] = sv * w
+        k1[j] = ds * w + sv * dw
+        k2[j] = d2s * w + 2.0 * ds * dw + sv * d2w
 
 
 @jit(inline="always")
@@ -104,9 +121,8 @@ def _surface(s, label, own, u, v, periodic, kr0, kr1, kr2, kc0, kc1, kc2):
     r0 = math.floor(u) - HALF_WINDOW
     c0 = math.floor(v) - HALF_WINDOW
     span = 2 * HALF_WINDOW + 2
-    for i in range(span):
-        kr0[i], kr1[i], kr2[i] = _kernel(u - (r0 + i))
-        kc0[i], kc1[i], kc2[i] = _kernel(v - (c0 + i))
+    _axis_kernel(u - r0, span, kr0, kr1, kr2)
+    _axis_kernel(v - c0, span, kc0, kc1, kc2)
     f = 0.0
     fu = 0.0
     fv = 0.0
@@ -172,22 +188,31 @@ def segment_into(
     kc0 = np.empty_like(kr0)
     kc1 = np.empty_like(kr0)
     kc2 = np.empty_like(kr0)
+    active = np.empty(p_all, np.int64)
+    edge_order = np.empty(4 * p_all, np.int64)
+    ranked = np.empty(p_all, np.int64)
     for f in range(n):
         s = signal[f]
         label = labels[f]
-        for p in range(p_all):
-            label[p // cols, p % cols] = -1
-        # 1. every taxel above the threshold points to its highest neighbour (8 of them;
-        # ties go to the larger index, so that no chain closes on itself)
+        # 1. the taxels above the threshold (the later passes visit only these) ...
         above = 0
-        for p in range(p_all):
+        p = 0
+        for r in range(rows):
+            for c in range(cols):
+                label[r, c] = -1
+                if s[r, c] > threshold:
+                    active[above] = p
+                    above += 1
+                else:
+                    parent[p] = -1
+                p += 1
+        # ... each pointing to its highest neighbour (8 of them; ties go to the larger
+        # index, so that no chain closes on itself)
+        for t in range(above):
+            p = active[t]
             r = p // cols
             c = p - r * cols
             v0 = s[r, c]
-            if not v0 > threshold:
-                parent[p] = -1
-                continue
-            above += 1
             best = p
             bv = v0
             for dr in range(-1, 2):
@@ -210,9 +235,8 @@ def segment_into(
         if above == 0:
             continue
         # 2. follow the chains to their maxima (steepest ascent = a watershed)
-        for p in range(p_all):
-            if parent[p] < 0:
-                continue
+        for t in range(above):
+            p = active[t]
             q = p
             while parent[q] != q:
                 q = parent[q]
@@ -220,9 +244,8 @@ def segment_into(
         # 3. merge maxima separated by a shallow saddle: the edges between regions,
         # highest saddle first (a union-find over the maxima)
         n_edges = 0
-        for p in range(p_all):
-            if parent[p] < 0:
-                continue
+        for t in range(above):
+            p = active[t]
             r = p // cols
             c = p - r * cols
             for k in range(4):  # forward neighbours: each pair once
@@ -241,12 +264,24 @@ def segment_into(
                 edge_b[n_edges] = root_of[q]
                 edge_v[n_edges] = min(s[r, c], s[rr, cc])
                 n_edges += 1
-        for p in range(p_all):
+        for t in range(above):
+            p = active[t]
             if parent[p] == p:
                 final[p] = p  # union-find parent among maxima
                 top[p] = s[p // cols, p % cols]
         if n_edges > 0:
-            for e in np.argsort(-edge_v[:n_edges]):
+            # highest saddle first: an insertion sort (few edges), no allocation
+            for t in range(n_edges):
+                edge_order[t] = t
+            for t in range(1, n_edges):
+                e = edge_order[t]
+                q = t - 1
+                while q >= 0 and edge_v[edge_order[q]] < edge_v[e]:
+                    edge_order[q + 1] = edge_order[q]
+                    q -= 1
+                edge_order[q + 1] = e
+            for t in range(n_edges):
+                e = edge_order[t]
                 a = edge_a[e]
                 while final[a] != a:
                     a = final[a]
@@ -264,25 +299,22 @@ def segment_into(
                         final[a] = b
         # 4. label each taxel with its merged maximum and accumulate its moments about
         # that maximum (columns unwrapped across the seam of a closed ring)
-        for p in range(p_all):
-            r = p // cols
-            c = p - r * cols
-            if parent[p] < 0:
-                continue
+        for t in range(above):
+            p = active[t]
             m = root_of[p]
             while final[m] != m:
                 m = final[m]
             root_of[p] = m
         n_regions = 0
-        for p in range(p_all):
+        for t in range(above):
+            p = active[t]
             if parent[p] == p and final[p] == p:
                 order[n_regions] = p
                 for k in range(7):
                     sums[p, k] = 0.0
                 n_regions += 1
-        for p in range(p_all):
-            if parent[p] < 0:
-                continue
+        for t in range(above):
+            p = active[t]
             r = p // cols
             c = p - r * cols
             m = root_of[p]
@@ -306,10 +338,15 @@ def segment_into(
             sums[m, 5] += w * dr * dc
             sums[m, 6] += 1.0
         # 5. the largest regions (by summed signal), at most max_contacts of them
-        keys = np.empty(n_regions)
-        for k in range(n_regions):
-            keys[k] = -sums[order[k], 0]
-        ranked = np.argsort(keys)
+        for t in range(n_regions):
+            ranked[t] = t
+        for t in range(1, n_regions):  # by decreasing summed signal
+            e = ranked[t]
+            q = t - 1
+            while q >= 0 and sums[order[ranked[q]], 0] < sums[order[e], 0]:
+                ranked[q + 1] = ranked[q]
+                q -= 1
+            ranked[q + 1] = e
         kept = min(n_regions, max_contacts)
         count[f] = kept
         for k in range(kept):
@@ -419,58 +456,219 @@ def amplitude_fit(signal, label_frames, frame_of, root, row, col, kernel, step, 
 
 
 @jit(nogil=True)
-def exhaustive_assignment(cost, far):
-    """The assignment of least total cost by trying every permutation (Heap's
-    algorithm): for the few tracks and contacts of a frame (at most 6 x 6, 720
-    permutations), faster than a general solver's call. ``match[i]`` is the column of
-    row ``i``, or -1 where its pair costs ``far`` or more (unmatched)."""
-    n, m = cost.shape
-    size = max(n, m)
-    square = np.full((size, size), far)
-    for i in range(n):
-        for j in range(m):
-            square[i, j] = cost[i, j]
-    perm = np.arange(size)
-    best = perm.copy()
-    # compare (unmatched pairs, cost of the matched ones): a sum with `far` in it would
-    # lose the small costs to rounding
-    best_far = 0
-    best_total = 0.0
-    for i in range(size):
-        if square[i, perm[i]] >= far:
-            best_far += 1
-        else:
-            best_total += square[i, perm[i]]
-    c = np.zeros(size, np.int64)
-    i = 1
-    while i < size:
-        if c[i] < i:
-            if i % 2 == 0:
-                perm[0], perm[i] = perm[i], perm[0]
-            else:
-                perm[c[i]], perm[i] = perm[i], perm[c[i]]
-            n_far = 0
-            total = 0.0
-            for k in range(size):
-                if square[k, perm[k]] >= far:
-                    n_far += 1
+def hungarian(cost, far):
+    """Least-cost assignment of a rectangular cost matrix (the shortest augmenting path
+    form of the Hungarian method, O(n^2 m)); ``match[i]`` is the column of row ``i``, or
+    -1 when it is unmatched or its pair costs ``far`` or more."""
+    n0, m0 = cost.shape
+    transpose = n0 > m0
+    n = m0 if transpose else n0
+    m = n0 if transpose else m0
+    u = np.zeros(n + 1)
+    v = np.zeros(m + 1)
+    p = np.zeros(m + 1, np.int64)
+    way = np.zeros(m + 1, np.int64)
+    minv = np.empty(m + 1)
+    used = np.empty(m + 1, np.bool_)
+    for i in range(1, n + 1):
+        p[0] = i
+        j0 = 0
+        minv[:] = np.inf
+        used[:] = False
+        while True:
+            used[j0] = True
+            i0 = p[j0]
+            delta = np.inf
+            j1 = 0
+            for j in range(1, m + 1):
+                if not used[j]:
+                    a = cost[j - 1, i0 - 1] if transpose else cost[i0 - 1, j - 1]
+                    cur = a - u[i0] - v[j]
+                    if cur < minv[j]:
+                        minv[j] = cur
+                        way[j] = j0
+                    if minv[j] < delta:
+                        delta = minv[j]
+                        j1 = j
+            for j in range(m + 1):
+                if used[j]:
+                    u[p[j]] += delta
+                    v[j] -= delta
                 else:
-                    total += square[k, perm[k]]
-            if n_far < best_far or (n_far == best_far and total < best_total):
-                best_far = n_far
-                best_total = total
-                best[:] = perm
-            c[i] += 1
-            i = 1
-        else:
-            c[i] = 0
-            i += 1
-    match = np.full(n, -1, np.int64)
-    for i in range(n):
-        j = best[i]
-        if j < m and square[i, j] < far:
-            match[i] = j
+                    minv[j] -= delta
+            j0 = j1
+            if p[j0] == 0:
+                break
+        while True:
+            j1 = way[j0]
+            p[j0] = p[j1]
+            j0 = j1
+            if j0 == 0:
+                break
+    match = np.full(n0, -1, np.int64)
+    for j in range(1, m + 1):
+        if p[j] != 0:
+            row = j - 1 if transpose else p[j] - 1
+            col = p[j] - 1 if transpose else j - 1
+            if cost[row, col] < far:
+                match[row] = col
     return match
+
+
+@jit(nogil=True)
+def track_into(
+    frame, pos, force, start, end, t_pos, t_vel, t_force, t_dforce, t_last, t_id, counters,
+    dt, gate, weight, max_missing, smoothing, slip_speed, slip_rate, far,
+    out_id, out_vel, out_slip, ev_frame, ev_kind, ev_id, ev_other,
+):  # fmt: skip
+    """The compiled :class:`~tactsense.estimate.track.ContactTracker` (same rules, same
+    order of events as its Python reference ``ReferenceTracker``).
+
+    Tracks live in ``t_*[:counters[0]]``; ``counters`` = (tracks alive, next id,
+    events written). Event kinds: 0 birth, 1 death, 2 merge, 3 split. Returns -1 when
+    the track or event arrays are full (the caller grows them and runs again from its
+    saved state), else 0.
+    """
+    n = frame.shape[0]
+    cap = t_id.shape[0]
+    cap_ev = ev_id.shape[0]
+    lo = 0
+    while lo <= n:
+        f = frame[lo] if lo < n else end
+        hi = lo
+        while hi < n and frame[hi] == f:
+            hi += 1
+        # tracks unseen for more than max_missing frames die
+        alive = 0
+        for i in range(counters[0]):
+            if f - 1 - t_last[i] > max_missing:
+                if counters[2] >= cap_ev:
+                    return -1
+                e = counters[2]
+                ev_frame[e] = t_last[i] + max_missing + 1
+                ev_kind[e] = 1
+                ev_id[e] = t_id[i]
+                ev_other[e] = -1
+                counters[2] += 1
+            else:
+                if alive != i:
+                    t_pos[alive] = t_pos[i]
+                    t_vel[alive] = t_vel[i]
+                    t_force[alive] = t_force[i]
+                    t_dforce[alive] = t_dforce[i]
+                    t_last[alive] = t_last[i]
+                    t_id[alive] = t_id[i]
+                alive += 1
+        counters[0] = alive
+        if lo == n:
+            break
+        n_t = alive
+        n_c = hi - lo
+        distance = np.empty((n_t, n_c))
+        cost = np.empty((n_t, n_c))
+        for i in range(n_t):
+            elapsed = f - t_last[i]
+            for j in range(n_c):
+                d2 = 0.0
+                for a in range(3):
+                    diff = t_pos[i, a] + t_vel[i, a] * dt * elapsed - pos[lo + j, a]
+                    d2 += diff * diff
+                d = math.sqrt(d2)
+                distance[i, j] = d
+                if d <= gate:
+                    cost[i, j] = d + weight * abs(t_force[i] - force[lo + j])
+                else:
+                    cost[i, j] = far
+        match = hungarian(cost, far) if n_t > 0 and n_c > 0 else np.full(n_t, -1, np.int64)
+        owner = np.full(n_c, -1, np.int64)
+        for i in range(n_t):
+            j = match[i]
+            if j < 0:
+                continue
+            owner[j] = i
+            elapsed = dt * (f - t_last[i])
+            speed2 = 0.0
+            for a in range(3):
+                step = (pos[lo + j, a] - t_pos[i, a]) / elapsed
+                t_vel[i, a] = smoothing * step + (1.0 - smoothing) * t_vel[i, a]
+                t_pos[i, a] = pos[lo + j, a]
+                out_vel[lo + j, a] = t_vel[i, a]
+                speed2 += t_vel[i, a] ** 2
+            rate = (force[lo + j] - t_force[i]) / elapsed
+            t_dforce[i] = smoothing * rate + (1.0 - smoothing) * t_dforce[i]
+            t_force[i] = force[lo + j]
+            t_last[i] = f
+            out_id[lo + j] = t_id[i]
+            steady = abs(t_dforce[i]) <= slip_rate * max(abs(t_force[i]), 1e-12)
+            out_slip[lo + j] = math.sqrt(speed2) > slip_speed and steady
+        # unmatched tracks that fell into another track's contact: merges
+        keep = np.ones(n_t, np.bool_)
+        for i in range(n_t):
+            if match[i] >= 0:
+                continue
+            best = -1
+            for j in range(n_c):
+                if owner[j] >= 0 and distance[i, j] <= gate:
+                    if best < 0 or distance[i, j] < distance[i, best]:
+                        best = j
+            if best >= 0:
+                if counters[2] >= cap_ev:
+                    return -1
+                e = counters[2]
+                ev_frame[e] = f
+                ev_kind[e] = 2
+                ev_id[e] = t_id[i]
+                ev_other[e] = t_id[owner[best]]
+                counters[2] += 1
+                keep[i] = False
+        # unmatched contacts: births, or splits off the nearest matched track
+        parents = np.full(n_c, -1, np.int64)
+        for j in range(n_c):
+            if owner[j] >= 0:
+                continue
+            best = -1
+            for i in range(n_t):
+                if match[i] >= 0 and distance[i, j] <= gate:
+                    if best < 0 or distance[i, j] < distance[best, j]:
+                        best = i
+            parents[j] = t_id[best] if best >= 0 else -1
+        alive = 0
+        for i in range(n_t):
+            if keep[i]:
+                if alive != i:
+                    t_pos[alive] = t_pos[i]
+                    t_vel[alive] = t_vel[i]
+                    t_force[alive] = t_force[i]
+                    t_dforce[alive] = t_dforce[i]
+                    t_last[alive] = t_last[i]
+                    t_id[alive] = t_id[i]
+                alive += 1
+        for j in range(n_c):
+            if owner[j] >= 0:
+                continue
+            if alive >= cap or counters[2] >= cap_ev:
+                return -1
+            t_pos[alive] = pos[lo + j]
+            t_vel[alive] = 0.0
+            t_force[alive] = force[lo + j]
+            t_dforce[alive] = 0.0
+            t_last[alive] = f
+            t_id[alive] = counters[1]
+            e = counters[2]
+            ev_frame[e] = f
+            ev_kind[e] = 3 if parents[j] >= 0 else 0
+            ev_id[e] = counters[1]
+            ev_other[e] = parents[j]
+            counters[2] += 1
+            out_id[lo + j] = counters[1]
+            for a in range(3):
+                out_vel[lo + j, a] = 0.0
+            out_slip[lo + j] = False
+            counters[1] += 1
+            alive += 1
+        counters[0] = alive
+        lo = hi
+    return 0
 
 
 @jit(nogil=True)

@@ -124,6 +124,26 @@ class ContactTable:
         return np.bincount(np.asarray(self.frame, dtype=np.int64), minlength=self.n_frames)
 
     @classmethod
+    def concatenate(cls, tables) -> ContactTable:
+        """The tables of consecutive pieces as one: rows joined, ``n_frames`` summed
+        (every piece's ``frame`` column is already numbered for the whole)."""
+        tables = list(tables)
+        if not tables:
+            return cls.empty(0)
+        kw = {}
+        for f in fields(cls):
+            if f.name in ("n_frames", "extra"):
+                continue
+            values = [getattr(t, f.name) for t in tables]
+            kw[f.name] = None if any(v is None for v in values) else np.concatenate(values)
+        extra = {
+            key: np.concatenate([t.extra[key] for t in tables])
+            for key in tables[0].extra
+            if all(key in t.extra for t in tables)
+        }
+        return cls(**kw, n_frames=sum(t.n_frames for t in tables), extra=extra)
+
+    @classmethod
     def empty(cls, n_frames: int = 0) -> ContactTable:
         """A table with no contact over ``n_frames`` frames."""
         kw = {}
@@ -291,6 +311,15 @@ def find_contacts(
     frames = check_frames(frames, sensor.shape)
     lead_2d = frames.ndim == 2
     frames = frames.reshape(-1, *sensor.shape)
+    if len(frames) > BLOCK and calibration is None:
+        # cache-sized pieces: the signal and the labels of a piece only (a calibration's
+        # creep state runs through the whole batch, so it is applied in one piece)
+        options = dict(baseline=baseline, counts=counts, dead=dead, threshold=threshold,
+                       max_contacts=max_contacts, method=method, saddle=saddle)  # fmt: skip
+        return ContactTable.concatenate(
+            find_contacts(frames[lo : lo + BLOCK], sensor, first_frame=first_frame + lo, **options)
+            for lo in range(0, len(frames), BLOCK)
+        )
     if calibration is not None:
         if not counts:
             raise TactsenseInputError("a calibration applies to counts, not to the signal")

@@ -7,9 +7,8 @@ the next frame number) carries over from one piece to the next, so a recording t
 in pieces gives the same result as tracked whole.
 
 Each frame, the live tracks are matched to the frame's contacts by the assignment of
-least total cost (:func:`scipy.optimize.linear_sum_assignment` on few contacts, a
-compiled exhaustive search when at most :data:`EXHAUSTIVE` on either side; the two are
-checked against each other in the tests)::
+least total cost (the Hungarian method, compiled; the tests hold it to
+:func:`scipy.optimize.linear_sum_assignment`)::
 
     cost(track, contact) = |predicted position - position| [mm]
                            + force_weight_mm_per_n * |force - track's force| [N]
@@ -46,9 +45,10 @@ import numpy as np
 from tactsense._validation import TactsenseInputError
 from tactsense.estimate.contacts import ContactTable
 
-EXHAUSTIVE = 6
-"""Largest number of tracks or contacts matched by the compiled exhaustive search."""
-_FAR = 1e12
+_FAR = 1e9
+"""The cost of a forbidden pair [mm]: far above any real cost, small enough that sums
+with it keep the real costs' digits."""
+_KINDS = ("birth", "death", "merge", "split")
 
 
 class TrackEvent(NamedTuple):
@@ -79,27 +79,23 @@ class _Track:
 
 
 def assign(cost: np.ndarray, limit: float) -> list[tuple[int, int]]:
-    """Pairs (row, col) of least total cost among those below ``limit``.
+    """Pairs (row, col) of least total cost, none at or above ``limit`` (a row may stay
+    unmatched rather than take such a pair): the compiled Hungarian method
+    (:func:`~tactsense.estimate._contacts_fast.hungarian`)."""
+    from tactsense.estimate._contacts_fast import hungarian
 
-    Pairs at or above ``limit`` are never made (a row may stay unmatched rather than
-    take a pair above the limit)."""
-    n, m = cost.shape
-    if n == 0 or m == 0:
+    cost = np.asarray(cost, dtype=float)
+    if cost.shape[0] == 0 or cost.shape[1] == 0:
         return []
     capped = np.where(cost < limit, cost, _FAR)
-    if n <= EXHAUSTIVE and m <= EXHAUSTIVE:
-        from tactsense.estimate._contacts_fast import exhaustive_assignment
-
-        match = exhaustive_assignment(capped, _FAR)
-        return [(i, int(j)) for i, j in enumerate(match) if j >= 0]
-    from scipy.optimize import linear_sum_assignment
-
-    rows, cols = linear_sum_assignment(capped)
-    return [(int(i), int(j)) for i, j in zip(rows, cols, strict=True) if capped[i, j] < _FAR]
+    match = hungarian(capped, _FAR)
+    return [(i, int(j)) for i, j in enumerate(match) if j >= 0]
 
 
-class ContactTracker:
-    """Stable ids for the contacts of consecutive frames.
+class ReferenceTracker:
+    """The tracker's rules in plain Python with :func:`scipy.optimize.linear_sum_assignment`
+    each frame: the readable reference of :class:`ContactTracker` (the tests hold the two
+    equal; ``benchmarks/bench_contacts.py`` times both).
 
     Parameters
     ----------
@@ -178,23 +174,7 @@ class ContactTracker:
         table, events
             The table with ``id``, velocity and ``slip`` set (a copy), and the events.
         """
-        if not isinstance(table, ContactTable):
-            raise TactsenseInputError(f"expected a ContactTable; got {type(table).__name__}")
-        start = self.next_frame if first_frame is None else int(first_frame)
-        if start < self.next_frame:
-            raise TactsenseInputError(
-                f"frames go backwards: this piece starts at frame {start}, the tracker is "
-                f"at frame {self.next_frame}"
-            )
-        frames = np.asarray(table.frame, dtype=np.int64)
-        end = start + int(table.n_frames)
-        if len(frames) and (frames.min() < start or frames.max() >= end):
-            raise TactsenseInputError(
-                f"the table's frames {frames.min()}-{frames.max()} lie outside the "
-                f"{table.n_frames} frames from {start} that it says it covers (n_frames)"
-            )
-        if len(frames) and np.any(np.diff(frames) < 0):
-            raise TactsenseInputError("the table's rows are not in frame order")
+        start, end, frames = self._check(table, first_frame)
         n = len(frames)
         ids = np.full(n, -1, np.int64)
         vel = np.zeros((n, 3))
@@ -216,6 +196,27 @@ class ContactTracker:
             extra=dict(table.extra),
         )  # fmt: skip
         return out, events
+
+    def _check(self, table, first_frame):
+        """The first and end frame a table covers, and its frame column, checked."""
+        if not isinstance(table, ContactTable):
+            raise TactsenseInputError(f"expected a ContactTable; got {type(table).__name__}")
+        start = self.next_frame if first_frame is None else int(first_frame)
+        if start < self.next_frame:
+            raise TactsenseInputError(
+                f"frames go backwards: this piece starts at frame {start}, the tracker is "
+                f"at frame {self.next_frame}"
+            )
+        frames = np.asarray(table.frame, dtype=np.int64)
+        end = start + int(table.n_frames)
+        if len(frames) and (frames.min() < start or frames.max() >= end):
+            raise TactsenseInputError(
+                f"the table's frames {frames.min()}-{frames.max()} lie outside the "
+                f"{table.n_frames} frames from {start} that it says it covers (n_frames)"
+            )
+        if len(frames) and np.any(np.diff(frames) < 0):
+            raise TactsenseInputError("the table's rows are not in frame order")
+        return start, end, frames
 
     def _age_until(self, frame: int, events: list[TrackEvent]) -> None:
         """End the tracks unseen for more than max_missing frames before ``frame``."""
@@ -241,7 +242,10 @@ class ContactTracker:
                 np.array([t.force for t in tracks])[:, None] - force[None, :]
             )
             cost = np.where(distance <= self.gate_mm, cost, _FAR)
-            pairs = assign(cost, _FAR)
+            from scipy.optimize import linear_sum_assignment
+
+            rows, cols = linear_sum_assignment(cost)
+            pairs = [(int(i), int(j)) for i, j in zip(rows, cols, strict=True) if cost[i, j] < _FAR]
         else:
             distance = np.zeros((0, n_c))
             pairs = []
@@ -288,6 +292,100 @@ class ContactTracker:
                 events.append(TrackEvent(f, "birth", track.id, ()))
             self.tracks.append(track)
             ids[j] = track.id
+
+
+class ContactTracker(ReferenceTracker):
+    """Stable ids for the contacts of consecutive frames (compiled).
+
+    The rules of the module's docstring; parameters as :class:`ReferenceTracker`. The
+    state (the live tracks, the next id and frame) carries over from one
+    :meth:`update` to the next.
+
+    Examples
+    --------
+    >>> tracker = ContactTracker(0.01)                         # doctest: +SKIP
+    >>> for start, frames in pieces:                           # doctest: +SKIP
+    ...     table = find_contacts(frames, sensor, baseline=b, first_frame=start)
+    ...     tracked, events = tracker.update(table)
+    """
+
+    def __init__(self, frame_period_s: float, **options):
+        super().__init__(frame_period_s, **options)
+        self._grow(64)
+        self._alive = 0
+
+    def _grow(self, capacity: int) -> None:
+        old = getattr(self, "_t_id", None)
+        n = 0 if old is None else self._alive
+        arrays = {
+            "_t_pos": np.zeros((capacity, 3)),
+            "_t_vel": np.zeros((capacity, 3)),
+            "_t_force": np.zeros(capacity),
+            "_t_dforce": np.zeros(capacity),
+            "_t_last": np.zeros(capacity, np.int64),
+            "_t_id": np.zeros(capacity, np.int64),
+        }
+        for name, array in arrays.items():
+            if old is not None:
+                array[:n] = getattr(self, name)[:n]
+            setattr(self, name, array)
+
+    def update(
+        self, table: ContactTable, first_frame: int | None = None
+    ) -> tuple[ContactTable, list[TrackEvent]]:
+        """Track the contacts of the next ``table.n_frames`` frames.
+
+        Parameters
+        ----------
+        table : ContactTable
+            Its ``frame`` column holds frame numbers from ``first_frame`` on.
+        first_frame : int, optional
+            The first frame the table covers; by default the frame after the previous
+            piece (0 for the first).
+
+        Returns
+        -------
+        table, events
+            The table with ``id``, velocity and ``slip`` set (a copy), and the events.
+        """
+        from tactsense._signals import deferred_interrupts
+        from tactsense.estimate._contacts_fast import track_into
+
+        start, end, frames = self._check(table, first_frame)
+        n = len(frames)
+        pos = np.ascontiguousarray(np.column_stack([table.x_mm, table.y_mm, table.z_mm]), float)
+        force = np.nan_to_num(np.asarray(table.force_n, dtype=float))
+        ids = np.full(n, -1, np.int64)
+        vel = np.zeros((n, 3))
+        slip = np.zeros(n, bool)
+        most = int(np.bincount(frames - start).max(initial=0)) if n else 0
+        need = self._alive + (self.max_missing + 2) * most + 8
+        if need > len(self._t_id):
+            self._grow(need)
+        cap_ev = 2 * n + self._alive + 8
+        ev = [np.empty(cap_ev, np.int64) for _ in range(4)]
+        counters = np.array([self._alive, self.next_id, 0], np.int64)
+        with deferred_interrupts():
+            status = track_into(
+                frames, pos, force, start, end, self._t_pos, self._t_vel, self._t_force,
+                self._t_dforce, self._t_last, self._t_id, counters, self.frame_period_s,
+                self.gate_mm, self.force_weight, self.max_missing, self.smoothing,
+                self.slip_speed, self.slip_force_rate, _FAR, ids, vel, slip, *ev,
+            )  # fmt: skip
+        if status != 0:  # pragma: no cover - the capacities above are upper bounds
+            raise RuntimeError("tracker capacity exceeded")
+        self._alive, self.next_id = int(counters[0]), int(counters[1])
+        self.next_frame = end
+        k = int(counters[2])
+        events = [
+            TrackEvent(int(f), _KINDS[kind], int(i), () if other < 0 else (int(other),))
+            for f, kind, i, other in zip(*(e[:k] for e in ev), strict=True)
+        ]
+        out = dataclasses.replace(
+            table, id=ids, vx_mm_s=vel[:, 0], vy_mm_s=vel[:, 1], vz_mm_s=vel[:, 2], slip=slip,
+            extra=dict(table.extra),
+        )  # fmt: skip
+        return out, events
 
 
 def track(table: ContactTable, frame_period_s: float, **options):

@@ -1,0 +1,118 @@
+"""Contacts on a 16x16 pad from counts: throughput of find_contacts (and the tracker)
+against a straightforward implementation measured in the same run.
+
+Frames: pad16's layer response (tactsense.estimate.contacts.pad_force_kernel, the same
+tabulated physics) to 1 or 3 probes of 0.3-0.7 N at random positions moving slowly,
+turned into resistive counts (100 + 20000 x strain) with 0.3 counts of read noise and
+quantized to uint16. The reference: scipy.ndimage.label (8-connected) + centre of
+pressure and summed signal per region in NumPy, frame by frame (what taxel-array
+middleware does today).
+
+    python benchmarks/bench_contacts.py [N_FRAMES]
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+
+import numpy as np
+from scipy import ndimage
+
+from tactsense.estimate.contacts import find_contacts, pad_force_kernel
+from tactsense.estimate.track import ContactTracker, ReferenceTracker
+from tactsense.sensor.registry import load_sensor
+
+
+def make_frames(spec, n, n_probes, rng):
+    kernel, step, half = pad_force_kernel(spec)
+    rows, cols = spec.shape
+    strain = np.zeros((n, rows, cols))
+    n_sub = kernel.shape[0] - 1
+    # slowly moving probes, kept 4 taxels apart
+    centres = np.array([[4.0 + 4 * (k % 2) + 3.5 * (k // 2), 3.0 + 5.0 * k] for k in range(n_probes)])
+    t = np.arange(n)
+    for k in range(n_probes):
+        u = centres[k, 0] + 1.5 * np.sin(2 * np.pi * t / 5000 + k)
+        v = centres[k, 1] + 1.5 * np.cos(2 * np.pi * t / 7000 + k)
+        force = 0.5 + 0.2 * np.sin(2 * np.pi * t / 3000 + k)
+        r0, c0 = np.floor(u).astype(int), np.floor(v).astype(int)
+        a = np.round((u - r0) / step).astype(int)
+        b = np.round((v - c0) / step).astype(int)
+        for i in range(2 * half + 1):
+            for j in range(2 * half + 1):
+                r, c = r0 + i - half, c0 + j - half
+                ok = (r >= 0) & (r < rows) & (c >= 0) & (c < cols)
+                np.add.at(strain, (t[ok], r[ok], c[ok]), force[ok] * kernel[a[ok], b[ok], i, j])
+    counts = 100 + 20000 * strain + rng.normal(0, 0.3, strain.shape)
+    return np.clip(np.round(counts), 0, 65535).astype(np.uint16)
+
+
+def reference(frames, baseline, per_count, threshold):
+    """scipy.ndimage.label + centre of pressure per region, frame by frame."""
+    out = []
+    structure = np.ones((3, 3))
+    rows, cols = np.mgrid[0 : frames.shape[1], 0 : frames.shape[2]]
+    for frame in frames:
+        signal = (frame.astype(float) - baseline) * per_count
+        labels, n = ndimage.label(signal > threshold, structure=structure)
+        index = np.arange(1, n + 1)
+        total = ndimage.sum(signal, labels, index)
+        r = ndimage.sum(signal * rows, labels, index) / total
+        c = ndimage.sum(signal * cols, labels, index) / total
+        out.append((r, c, total))
+    return out
+
+
+def best_of(repeats, work):
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        work()
+        times.append(time.perf_counter() - start)
+    return min(times)
+
+
+def main(n=100_000):
+    spec = load_sensor("pad16")
+    rng = np.random.default_rng(0)
+    baseline = np.full(spec.shape, 100.0)
+    per_count = 1 / spec.transduction.counts_per_strain
+    threshold = 10 * per_count
+    rows = []
+    for n_probes in (1, 3):
+        frames = make_frames(spec, n, n_probes, rng)
+        find_contacts(frames[:100], spec, baseline=baseline)  # compile
+        single = n_probes == 1
+        k = 1 if single else 8
+        t_find = best_of(3, lambda: find_contacts(frames, spec, baseline=baseline, max_contacts=k))
+        table = find_contacts(frames, spec, baseline=baseline, max_contacts=k)
+
+        def tracked():
+            table = find_contacts(frames, spec, baseline=baseline, max_contacts=k)
+            ContactTracker(spec.scan_period_s).update(table)
+
+        t_track = best_of(3, tracked)
+        t_tracker_only = best_of(3, lambda: ContactTracker(spec.scan_period_s).update(table))
+        m_ref = min(n, 20_000)
+        part = find_contacts(frames[:m_ref], spec, baseline=baseline, max_contacts=k)
+        t_ref_tracker = best_of(1, lambda: ReferenceTracker(spec.scan_period_s).update(part))
+        t_ref_tracker *= n / m_ref
+        m = min(n, 20_000)
+        t_ref = best_of(1, lambda: reference(frames[:m], baseline, per_count, threshold)) * n / m
+        found = np.bincount(table.per_frame_counts())
+        rows.append((n_probes, n / t_find, n / t_track, n / t_ref, t_ref / t_find, found,
+                     n / t_tracker_only, n / t_ref_tracker))
+    print(f"{n:,} frames of 16 x 16 counts, one core (best of 3; reference on 20,000 frames)")
+    print("| probes | find_contacts [frames/s] | find_contacts + ContactTracker [frames/s] "
+          "| reference: ndimage.label + centre of pressure [frames/s] | ratio | "
+          "ContactTracker alone [frames/s] | ReferenceTracker (scipy each frame) [frames/s] "
+          "| contacts per frame found |")
+    print("|---|---|---|---|---|---|---|---|")
+    for n_probes, fast, track_rate, ref, ratio, found, tracker, ref_tracker in rows:
+        print(f"| {n_probes} | {fast:,.0f} | {track_rate:,.0f} | {ref:,.0f} | {ratio:.0f}x | "
+              f"{tracker:,.0f} | {ref_tracker:,.0f} | {dict(enumerate(found.tolist()))} |")
+
+
+if __name__ == "__main__":
+    main(int(sys.argv[1]) if len(sys.argv) > 1 else 100_000)
