@@ -15,6 +15,7 @@ Examples
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Iterator
 from dataclasses import fields
 from pathlib import Path
@@ -167,9 +168,14 @@ def contacts_file(
     chunk_frames: int | None = None,
     events_path: str | Path | None = None,
     tracker_options: dict | None = None,
+    drift_s: float | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> dict:
     """Every contact of every frame of a recording, tracked, written as a long table.
+
+    Without a calibration the baseline is the median of the first ``baseline_frames``
+    frames; with ``drift_s`` [s] it then follows slow drift of untouched taxels with that
+    time constant (:class:`~tactsense.estimate.baseline.DriftBaseline`).
 
     :func:`~tactsense.estimate.contacts.find_contacts` and
     :class:`~tactsense.estimate.track.ContactTracker` piece by piece (bounded memory;
@@ -182,9 +188,12 @@ def contacts_file(
     dict
         ``frames``, ``rows`` (contacts over all frames), ``frames_with_contact``,
         ``ids`` (distinct tracked contacts), ``most`` (largest number in one frame),
-        ``births``, ``deaths``, ``merges``, ``splits``.
+        ``births``, ``deaths``, ``merges``, ``splits``, ``below_baseline`` (frames with a
+        taxel below its baseline by more than the threshold: the first frames were
+        probably touched).
     """
-    from tactsense.estimate.contacts import find_contacts
+    from tactsense.estimate.baseline import DriftBaseline
+    from tactsense.estimate.contacts import default_threshold, find_contacts
     from tactsense.estimate.output import ContactsWriter
     from tactsense.estimate.track import ContactTracker
 
@@ -206,6 +215,11 @@ def contacts_file(
                     "untouched frames at the start for the baseline"
                 )
             baseline = np.median(reader.frames(0, baseline_frames).astype(float), axis=0)
+            baseline = DriftBaseline(
+                baseline, sensor, frame_period_s=sensor.scan_period_s,
+                threshold=default_threshold(sensor) if threshold is None else threshold,
+                time_constant_s=math.inf if drift_s is None else drift_s,
+            )  # fmt: skip
         tracker = ContactTracker(sensor.scan_period_s, **(tracker_options or {}))
         with ContactsWriter(out, events_path=events_path) as writer:
             if progress is not None:
@@ -240,4 +254,5 @@ def contacts_file(
         "ids": ids,
         "most": most,
         **counts,
+        "below_baseline": 0 if baseline is None else baseline.below_frames,
     }

@@ -33,6 +33,9 @@ BAD = [
     ("locate PAD --out PAD", "an output never replaces an input"),
     ("locate REC --contacts --method fit --out OUT", "method 'fit' works on pads"),
     ("locate PAD --calibration DIR/cal.json --out OUT", "is not a tactsense calibration"),
+    ("locate PAD --drift-s -1 --out OUT", "--drift-s"),
+    ("locate PAD --drift-s nan --out OUT", "--drift-s"),
+    ("locate PAD --drift-s inf --out OUT", "--drift-s"),
 ]
 
 

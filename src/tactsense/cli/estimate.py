@@ -58,6 +58,12 @@ def _locate_contacts(recording, out, force, quiet, **options) -> None:
         f"{summary['ids']} tracked ids; {summary['births']} births, {summary['deaths']} "
         f"deaths, {summary['merges']} merges, {summary['splits']} splits"
     )
+    if summary["below_baseline"]:
+        console.print(
+            f"warning: {summary['below_baseline']} frames read below the baseline by more "
+            "than the threshold (flag BELOW_BASELINE): the first frames, which make the "
+            "baseline, were probably touched; record untouched frames first"
+        )
 
 
 @app.command()
@@ -100,6 +106,18 @@ def locate(
             "paper's windowed sinc and Newton, on the grid) or 'cop' (centre of pressure)."
         ),
     ] = "interpolate",
+    drift_s: Annotated[
+        float,
+        typer.Option(
+            "--drift-s",
+            min=0.0,
+            max=1e6,
+            help="Long table: time constant [s] with which the baseline follows slow "
+            "drift where taxels are untouched (held while touched, as iCub's skin does; "
+            "docs/contacts.md); 0 keeps the first frames' baseline. Not used with "
+            "--calibration.",
+        ),
+    ] = 2.0,
     chunk_frames: Annotated[
         int | None,
         typer.Option(
@@ -150,6 +168,7 @@ def locate(
                 recording, out, force, quiet, baseline_frames=baseline_frames,
                 calibration=calibrated, threshold=threshold, max_contacts=max_contacts,
                 method=method, chunk_frames=chunk_frames,
+                drift_s=drift_s if drift_s > 0 else None,
             )  # fmt: skip
             return
         if threshold is None:

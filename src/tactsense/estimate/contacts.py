@@ -272,8 +272,10 @@ def find_contacts(
         A/D readings [counts] (``counts=True``) or the signal [-] (``counts=False``:
         fractional deflection for capacitive taxels, strain for resistive ones).
     sensor : SensorSpec, PadSpec or PointsSpec
-    baseline : array_like, shape (rows, cols)
-        Untouched readings [counts]; required with counts unless ``calibration``.
+    baseline : array_like, shape (rows, cols), or DriftBaseline
+        Untouched readings [counts]; required with counts unless ``calibration``. A
+        :class:`~tactsense.estimate.baseline.DriftBaseline` follows slow drift where taxels
+        are untouched (it moves on with every frame given).
     dead : array_like of bool, shape (rows, cols), optional
         Taxels to ignore.
     threshold : float, optional
@@ -331,6 +333,8 @@ def find_contacts(
             frames, sensor, frame_period_s=frame_period_s, compensator=compensator
         )
         signal = np.ascontiguousarray(signal, dtype=np.float64)
+    elif counts and hasattr(baseline, "signal"):  # a DriftBaseline: follows slow drift
+        signal, flags = baseline.signal(frames, dead=dead)
     elif counts:
         if baseline is None:
             raise TactsenseInputError(

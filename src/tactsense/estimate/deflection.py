@@ -31,6 +31,9 @@ class Flag(IntFlag):
     """The peak lies toward the tip row, where the half-plane model does not hold."""
     MULTIPLE = 128
     """A second, separate contact was seen; the fields describe the largest one."""
+    BELOW_BASELINE = 256
+    """A taxel read below its baseline by more than the contact threshold: the baseline
+    was taken under load, or has drifted (see :class:`~tactsense.estimate.baseline.DriftBaseline`)."""
 
     @classmethod
     def describe(cls, value: int) -> str:
