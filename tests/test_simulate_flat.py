@@ -1,13 +1,14 @@
 """`tactsense simulate` on pads and point sets, from the command line to the recording."""
 
 import numpy as np
+import pandas as pd
 import pytest
 from typer.testing import CliRunner
 
 import tactsense as ts
 import tactsense.flat_scenarios
 from tactsense.cli import app
-from tactsense.flat_scenarios import press
+from tactsense.flat_scenarios import press, two_probes
 
 runner = CliRunner()
 
@@ -71,27 +72,40 @@ def test_bad_pad_scenarios_are_one_line(tmp_path, monkeypatch, line, message):
     assert not (tmp_path / "x.h5").exists()
 
 
-def test_a_pad_exports_its_frames_to_mcap_as_tactile_state(tmp_path):
-    """No contacts yet on pads: every frame as a TactileState, values equal to the counts
-    (read back with mcap's reader and the ROS 2 decoder)."""
+def test_a_pad_exports_its_frames_and_contacts_to_mcap(tmp_path):
+    """Every frame as a TactileState, values equal to the counts, and every contact of
+    every frame as a TactileContact at the position and force ``locate`` gives (read back
+    with mcap's reader and the ROS 2 decoder)."""
     from mcap.reader import make_reader
     from mcap_ros2.decoder import DecoderFactory
 
-    pad = ts.preset("pad4")
+    pad = ts.preset("pad16")
     rec_path, out = tmp_path / "pad.h5", tmp_path / "pad.mcap"
-    ts.write_recording(rec_path, ts.simulate(pad, press(pad), rng=2))
+    ts.write_recording(rec_path, ts.simulate(pad, two_probes(pad), rng=2))
     result = runner.invoke(app, ["export", str(rec_path), "--out", str(out)])
     assert result.exit_code == 0, result.output
     recording = ts.read_recording(rec_path)
     with open(out, "rb") as stream:
         reader = make_reader(stream, decoder_factories=[DecoderFactory()])
-        values = [
-            np.asarray(message.sensors[0].values)
-            for _, _, _, message in reader.iter_decoded_messages(topics=["/tactile_states"])
-        ]
+        values, contacts = [], []
+        for _, channel, _, message in reader.iter_decoded_messages():
+            if channel.topic == "/tactile_states":
+                values.append(np.asarray(message.sensors[0].values))
+            else:
+                contacts.append(message)
     assert len(values) == len(recording.frames)
     np.testing.assert_array_equal(np.stack(values), recording.frames.reshape(len(values), -1))
-    assert f"{len(values)} frames, 0 with a contact" in result.output
+    # the contacts are locate's long table, row for row (metres in the message)
+    assert runner.invoke(app, ["locate", str(rec_path), "--out", str(tmp_path / "c.csv")]).exit_code == 0
+    table = pd.read_csv(tmp_path / "c.csv")
+    assert len(contacts) == len(table) > 0
+    got = np.array([[m.position.x, m.position.y, m.wrench.force.z] for m in contacts])
+    np.testing.assert_allclose(got[:, 0], table["x_mm"] * 1e-3, rtol=1e-9)
+    np.testing.assert_allclose(got[:, 1], table["y_mm"] * 1e-3, rtol=1e-9)
+    np.testing.assert_allclose(-got[:, 2], table["force_n"], rtol=1e-9)  # along -normal
+    assert all(m.normal.z == 1.0 for m in contacts)
+    said = " ".join(result.output.split())
+    assert f"{len(values)} frames, {len(contacts)} contacts" in said
 
 
 def test_an_emulated_pad_records_bit_identical_to_its_simulation(tmp_path):

@@ -156,6 +156,71 @@ def locate_file(
     return {"frames": total, **tally.summary()}
 
 
+class iter_contacts:  # noqa: N801  (a generator with state the caller reads)
+    """The tracked contacts of an open recording, a piece at a time: yields
+    ``(start, n_frames, time_s, table, events)`` with the table's ``frame`` column
+    counting from the recording's first frame.
+
+    The baseline, as :func:`contacts_file` describes it, and the tracker are kept in
+    :attr:`baseline` (None with a calibration) and :attr:`tracker` for the caller.
+    """
+
+    def __init__(
+        self,
+        reader,
+        *,
+        baseline_frames: int = 5,
+        calibration=None,
+        threshold: float | None = None,
+        max_contacts: int = 8,
+        method: str = "interpolate",
+        chunk_frames: int | None = None,
+        tracker_options: dict | None = None,
+        drift_s: float | None = None,
+    ):
+        from tactsense.estimate.baseline import DriftBaseline
+        from tactsense.estimate.contacts import default_threshold
+        from tactsense.estimate.track import ContactTracker
+
+        sensor = reader.sensor
+        self.reader = reader
+        self.compensator = None
+        self.baseline = None
+        if calibration is not None:
+            calibration.check_sensor(sensor)
+            self.compensator = calibration.compensator(sensor.scan_period_s, sensor.shape)
+        else:
+            if reader.n_frames < baseline_frames:
+                raise TactsenseInputError(
+                    f"{reader.path} has {reader.n_frames} frames; need {baseline_frames} "
+                    "untouched frames at the start for the baseline"
+                )
+            start = np.median(reader.frames(0, baseline_frames).astype(float), axis=0)
+            self.baseline = DriftBaseline(
+                start, sensor, frame_period_s=sensor.scan_period_s,
+                threshold=default_threshold(sensor) if threshold is None else threshold,
+                time_constant_s=math.inf if drift_s is None else drift_s,
+            )  # fmt: skip
+        self.tracker = ContactTracker(sensor.scan_period_s, **(tracker_options or {}))
+        self._options = dict(calibration=calibration, threshold=threshold,
+                             max_contacts=max_contacts, method=method)  # fmt: skip
+        self._chunk_frames = chunk_frames
+
+    def __iter__(self):
+        from tactsense.estimate.contacts import find_contacts
+
+        sensor = self.reader.sensor
+        calibrated = self._options["calibration"] is not None
+        for start, frames, time_s in self.reader.chunks(self._chunk_frames):
+            table = find_contacts(
+                frames, sensor, baseline=self.baseline, compensator=self.compensator,
+                first_frame=start,
+                frame_period_s=sensor.scan_period_s if calibrated else None, **self._options,
+            )  # fmt: skip
+            tracked, events = self.tracker.update(table, first_frame=start)
+            yield start, len(frames), time_s, tracked, events
+
+
 def contacts_file(
     recording: str | Path,
     out: str | Path,
@@ -192,10 +257,8 @@ def contacts_file(
         taxel below its baseline by more than the threshold: the first frames were
         probably touched).
     """
-    from tactsense.estimate.baseline import DriftBaseline
-    from tactsense.estimate.contacts import default_threshold, find_contacts
+    from tactsense.estimate.contacts import find_contacts
     from tactsense.estimate.output import ContactsWriter
-    from tactsense.estimate.track import ContactTracker
 
     output_format(out)
     counts = {"births": 0, "deaths": 0, "merges": 0, "splits": 0}
@@ -203,50 +266,31 @@ def contacts_file(
     with RecordingReader(recording) as reader:
         sensor = reader.sensor
         total = reader.n_frames
-        compensator = None
-        baseline = None
-        if calibration is not None:
-            calibration.check_sensor(sensor)
-            compensator = calibration.compensator(sensor.scan_period_s, sensor.shape)
-        else:
-            if total < baseline_frames:
-                raise TactsenseInputError(
-                    f"{reader.path} has {total} frames; need {baseline_frames} "
-                    "untouched frames at the start for the baseline"
-                )
-            baseline = np.median(reader.frames(0, baseline_frames).astype(float), axis=0)
-            baseline = DriftBaseline(
-                baseline, sensor, frame_period_s=sensor.scan_period_s,
-                threshold=default_threshold(sensor) if threshold is None else threshold,
-                time_constant_s=math.inf if drift_s is None else drift_s,
-            )  # fmt: skip
-        tracker = ContactTracker(sensor.scan_period_s, **(tracker_options or {}))
+        pieces = iter_contacts(
+            reader, baseline_frames=baseline_frames, calibration=calibration,
+            threshold=threshold, max_contacts=max_contacts, method=method,
+            chunk_frames=chunk_frames, tracker_options=tracker_options, drift_s=drift_s,
+        )  # fmt: skip
         with ContactsWriter(out, events_path=events_path) as writer:
             if progress is not None:
                 progress(0, total)
-            for start, frames, time_s in reader.chunks(chunk_frames):
-                table = find_contacts(
-                    frames, sensor, baseline=baseline, calibration=calibration,
-                    compensator=compensator, threshold=threshold, max_contacts=max_contacts,
-                    method=method, first_frame=start,
-                    frame_period_s=sensor.scan_period_s if calibration is not None else None,
-                )  # fmt: skip
-                tracked, events = tracker.update(table, first_frame=start)
+            for start, n, time_s, tracked, events in pieces:
                 writer.write_contacts(np.asarray(time_s)[tracked.frame - start], tracked, events)
-                per_frame = np.bincount(tracked.frame - start, minlength=len(frames))
+                per_frame = np.bincount(tracked.frame - start, minlength=n)
                 frames_with += int(np.count_nonzero(per_frame))
                 most = max(most, int(per_frame.max(initial=0)))
                 for e in events:
                     counts[e.kind + "s"] += 1
                 if progress is not None:
-                    progress(start + len(frames), total)
+                    progress(start + n, total)
             if writer.rows == 0:  # no contact at all: the file still gets its columns
-                empty, _ = tracker.update(
+                empty, _ = pieces.tracker.update(
                     find_contacts(np.zeros((0, *sensor.shape)), sensor, counts=False),
                     first_frame=total,
                 )
                 writer.write_contacts(np.zeros(0), empty)
-            ids = tracker.next_id
+            ids = pieces.tracker.next_id
+            baseline = pieces.baseline
     return {
         "frames": total,
         "rows": writer.rows,

@@ -122,6 +122,9 @@ def _wait_loaded(view):
     view.wait_for_function(
         "() => window.tactsenseView.drawnIndex === window.tactsenseView.lastIndex", timeout=5000
     )
+    # the colours are read with the contacts' rings and ids off the map
+    view.uncheck("#show-marker")
+    view.wait_for_function("() => !window.tactsenseView.showMarker && !window.tactsenseView.dirty")
 
 
 def _ticks(labels, map_, axis):
@@ -140,12 +143,15 @@ def _ticks(labels, map_, axis):
     return out
 
 
-def _no_contact_panel(view, what):
+def _contacts_panel(view, n=None):
+    """The side panel of a pad or point set: the contacts' table, not the finger's."""
     assert view.locator("#contact").is_hidden()
-    assert view.locator("#no-estimation").is_visible()
-    assert view.text_content("#no-estimation") == f"contact estimation: not yet for {what}"
-    assert view.locator("#force-trace").is_hidden()
-    assert view.locator("#show-marker").is_hidden()
+    assert view.locator("#no-estimation").is_hidden()
+    assert view.locator("#contacts").is_visible()
+    assert view.locator("#force-trace").is_visible()
+    if n is not None:
+        assert view.text_content("#n-contacts") == str(n)
+        assert view.locator("#contact-rows tr").count() == n
 
 
 @pytest.mark.parametrize("kind", ["resistive", "capacitive"])
@@ -227,7 +233,7 @@ def test_pad_is_a_grid_in_millimetres_hottest_at_the_touch(page, tmp_path, kind)
         assert np.unravel_index(np.argmax(counts_seen), counts_seen.shape) == (row, col)
         assert between[1] < 6 and between[0] > 120, between
         assert far_seen[1] < 6 and abs(far_seen[0] - counts_seen[0, 0]) <= 3, far_seen
-        _no_contact_panel(page, "pads")
+        _contacts_panel(page, 1)
     finally:
         server.stop()
 
@@ -266,7 +272,7 @@ def test_point_set_is_dots_at_their_positions(page, tmp_path):  # noqa: F811
         texts = [lab["text"] for lab in state["labels"]]
         assert "x [mm]" in texts and "y [mm]" in texts
         assert page.locator("#show-surface").is_hidden()
-        _no_contact_panel(page, "point sets")
+        _contacts_panel(page, 1)
     finally:
         server.stop()
 
@@ -303,6 +309,7 @@ def test_command_line_emulate_and_view_a_pad(page, tmp_path):  # noqa: F811
         )
         assert page.text_content("#status") == "streaming"
         assert page.text_content("#sensor") == "pad4"
+        page.uncheck("#show-marker")  # the dots' colours are read without the rings
         # the frames keep coming (untouched ones each turn of the loop): read the dots'
         # pixels and the frame they were drawn from in one synchronous call
         for _ in range(50):
@@ -314,7 +321,7 @@ def test_command_line_emulate_and_view_a_pad(page, tmp_path):  # noqa: F811
             pytest.fail("no frame of the bump drawn")
         seen = np.median(np.asarray(snap["seen"]).reshape(4, 4, 5), axis=2)
         assert np.unravel_index(np.argmax(seen), seen.shape) == (row, col)
-        _no_contact_panel(page, "pads")
+        _contacts_panel(page)
     finally:
         for process in (view, emulate):
             if process is not None:
@@ -326,3 +333,88 @@ def test_command_line_emulate_and_view_a_pad(page, tmp_path):  # noqa: F811
     err = view.stderr.read()
     assert view.returncode == 0, err
     assert "frames shown" in err and "Traceback" not in err
+
+
+def _two_bumps_recording(spec, path, *, n_frames=60):
+    """Two Gaussian bumps on a pad: one still at A, one moving along y from B, both from
+    frame UNTOUCHED on; returns the path and each frame's two centres [mm]."""
+    positions = spec.taxel_positions_mm()[:, :2]
+    v0 = spec.electronics.nominal_counts
+    frames = np.full((n_frames, *spec.shape), v0, dtype=float)
+    centres = []
+    for k in range(n_frames):
+        a = np.array([8.0, 8.0])
+        b = np.array([28.0, 14.0 + 0.25 * max(0, k - UNTOUCHED)])  # 0.25 mm a frame
+        centres.append((a, b))
+        if k < UNTOUCHED:
+            continue
+        d = sum(0.04 * np.exp(-((positions - c) ** 2).sum(axis=1) / (2 * 2.5**2)) for c in (a, b))
+        frames[k] = v0 + spec.transduction.counts_per_strain * d.reshape(spec.shape)
+    rec = Recording(
+        frames=np.round(frames).astype(np.uint16),
+        time_s=np.arange(n_frames) * spec.scan_period_s,
+        sample_offset_s=np.zeros(spec.shape),
+        sensor=spec,
+    )
+    write_recording(path, rec)
+    return path, centres
+
+
+def test_pad_contacts_with_ids_trails_and_rezero(page, tmp_path):  # noqa: F811
+    """Two contacts on a 16x16 pad: a ring and an id each at its position, a trail behind
+    the moving one, a row each in the side panel; re-zero takes the next frames as the
+    baseline, after which the (still pressed) pad reads no contact."""
+    spec = ts.preset("pad16")  # resistive, 2.5 mm pitch
+    path, centres = _two_bumps_recording(spec, tmp_path / "two.h5")
+    server = _serve(path)
+    try:
+        page.goto(server.url)
+        page.wait_for_function(
+            f"() => {{ const s = window.tactsenseView; return s.latest && s.latest.index >= 40"
+            f" && s.drawnIndex === s.latest.index; }}",
+            timeout=15000,
+        )
+        page.click("#play")  # pause
+        page.wait_for_function("() => document.getElementById('play').textContent === 'play'")
+        page.wait_for_function(
+            "() => { const s = window.tactsenseView; return s.drawnIndex === s.lastIndex"
+            " && !s.dirty; }"
+        )
+        state = page.evaluate(
+            "() => { const s = window.tactsenseView; return {marks: s.contactMarks, map: s.map,"
+            " index: s.latest.index, est: s.latest.estimate,"
+            " trails: Array.from(s.tracks, ([id, t]) => [id, t.points.length])}; }"
+        )
+        m, marks = state["map"], state["marks"]
+        assert len(marks) == 2 and {mark["id"] for mark in marks} == {0, 1}
+        a, b = centres[state["index"]]
+        for mark in marks:
+            contact = next(c for c in state["est"]["contacts"] if c["id"] == mark["id"])
+            # drawn where the estimate says, in the page's millimetres
+            assert mark["x"] == pytest.approx(m["left"] + (contact["u_mm"] - m["u0"]) * m["scale"])
+            assert mark["y"] == pytest.approx(m["top"] + (m["v1"] - contact["v_mm"]) * m["scale"])
+            # and the estimate within half a taxel (1.25 mm) of the bump's centre: the
+            # bumps are sampled at 2.5 mm with sigma 2.5 mm, which the windowed sinc
+            # interpolates to about 0.1 mm (test_contacts.py); half a taxel is the bound
+            # that tells a right answer from a wrong taxel
+            truth = a if np.hypot(*(np.array([contact["x_mm"], contact["y_mm"]]) - a)) < 5 else b
+            assert np.hypot(contact["x_mm"] - truth[0], contact["y_mm"] - truth[1]) < 1.25
+        # both ids followed since they appeared: trails of the last 24 positions
+        assert sorted(state["trails"]) == [[0, 24], [1, 24]]
+        _contacts_panel(page, 2)
+        rows = page.locator("#contact-rows tr").all_inner_texts()
+        assert any(r.startswith("#0") for r in rows) and any(r.startswith("#1") for r in rows)
+        # re-zero, then step 6 frames: 5 make the new baseline, the 6th reads nothing
+        page.click("#rezero")
+        for _ in range(6):
+            page.click("#step-fwd")
+            page.wait_for_timeout(60)
+        page.wait_for_function(
+            "() => { const e = window.tactsenseView.latest.estimate;"
+            " return e && !e.rezeroing && e.n_contacts === 0; }",
+            timeout=5000,
+        )
+        assert page.text_content("#n-contacts") == "0"
+        assert not page.errors
+    finally:
+        server.stop()

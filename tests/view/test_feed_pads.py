@@ -1,6 +1,7 @@
 """The view's server side for pads and point sets: the deflection sent with each frame
-(from counts, by the sensor's transduction), no contact estimate, and the layout's
-geometry (millimetres, the projection of a point set, the pad's surface weights)."""
+(from counts, by the sensor's transduction), the tracked contacts, re-zeroing, and the
+layout's geometry (millimetres, the projection of a point set, the pad's surface
+weights)."""
 
 import json
 
@@ -13,7 +14,8 @@ from tactsense.estimate.interpolate import reconstruct_row
 from tactsense.io.recording import Recording, write_recording
 from tactsense.sensor import Electronics, Grid, PadSpec, PointsSpec, Taxels, Transduction
 from tactsense.stream.reader import StreamFrame
-from tactsense.view import DeflectionOnly, RecordingFeed, layout_message, view_locator
+from tactsense.stream.live import LiveContacts
+from tactsense.view import RecordingFeed, layout_message, view_locator
 from tactsense.view.feed import MAX_FINE, SURFACE_STEPS, project_points
 
 SOURCE = {"kind": "test", "name": "x"}
@@ -52,14 +54,20 @@ def test_resistive_pad_deflection_is_the_strain_above_the_baseline():
     rng = np.random.default_rng(1)
     v0 = 100.0 + rng.integers(-10, 10, spec.shape)  # each taxel its own untouched reading
     locator = view_locator(spec, baseline_frames=5)
-    assert isinstance(locator, DeflectionOnly)
+    assert isinstance(locator, LiveContacts)
     for k, counts in enumerate(_baseline_frames(rng, v0, spec.shape)):
         assert locator(_frame(counts, k)) is None
         assert locator.last_deflection is None  # no deflection before the baseline
+    # the median of the baseline frames, then followed through them (DriftBaseline, as
+    # locate does): within a count of the median
+    np.testing.assert_allclose(locator.baseline, v0, atol=1.0)
+    base = locator.baseline.copy()
     strain = rng.uniform(0.0, 0.08, spec.shape)
     counts = v0 + 12000.0 * strain  # the resistive law of docs/sensors.md
-    assert locator(_frame(counts, 5)) is None  # frames, deflection, and no estimate
-    np.testing.assert_allclose(locator.last_deflection, strain, rtol=0, atol=1e-12)
+    assert locator(_frame(counts, 5)) is not None  # the estimate of the first frame
+    expected = (counts - base) / 12000.0
+    np.testing.assert_allclose(locator.last_deflection, expected, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(locator.last_deflection, strain, rtol=0, atol=1e-4)
 
 
 def test_capacitive_pad_deflection_is_eq_4():
@@ -69,19 +77,22 @@ def test_capacitive_pad_deflection_is_eq_4():
     locator = view_locator(spec, baseline_frames=5)
     for k, counts in enumerate(_baseline_frames(rng, v0, spec.shape)):
         locator(_frame(counts, k))
+    np.testing.assert_allclose(locator.baseline, v0, atol=1.0)
+    base = locator.baseline.copy()
     d = rng.uniform(0.0, 0.2, spec.shape)
     counts = v0 / (1.0 - d)  # eq. 4, (V - V0) / V = d, solved for V
     locator(_frame(counts, 5))
-    np.testing.assert_allclose(locator.last_deflection, d, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(locator.last_deflection, (counts - base) / counts, atol=1e-12)
+    np.testing.assert_allclose(locator.last_deflection, d, rtol=0, atol=1e-3)
     # not the resistive law on the same counts
     assert not np.allclose(locator.last_deflection, (counts - v0) / 12000.0, atol=1e-3)
 
 
-def test_pad_recording_feed_sends_deflection_and_no_estimate(tmp_path):
+def test_pad_recording_feed_sends_deflection_contacts_and_rezeroes(tmp_path):
     spec = _pad("resistive", nominal_counts=100.0, scan_rate_hz=50.0)
-    frames = np.full((8, *spec.shape), 100, dtype=np.uint16)
+    frames = np.full((16, *spec.shape), 100, dtype=np.uint16)
     frames[5:, 1, 2] = 700  # 600 counts = strain 0.05
-    rec = Recording(frames=frames, time_s=np.arange(8) / 50.0,
+    rec = Recording(frames=frames, time_s=np.arange(16) / 50.0,
                     sample_offset_s=np.zeros(spec.shape), sensor=spec)  # fmt: skip
     path = write_recording(tmp_path / "pad.h5", rec)
     feed = RecordingFeed(path, lambda s, f: view_locator(s, baseline_frames=5))
@@ -90,17 +101,34 @@ def test_pad_recording_feed_sends_deflection_and_no_estimate(tmp_path):
     try:
         for index in range(8):
             feed._show(index, 0.0)
+        # the page's re-zero (its button, key z): the next 5 frames, still pressed,
+        # make the baseline; the press then reads as nothing
+        feed.command({"command": "rezero"})
+        for index in range(8, 16):
+            feed._show(index, 0.0)
         layout = feed.layout()
     finally:
         feed.stop()
     messages = [json.loads(t) for t in sent]
-    assert [m["estimate"] for m in messages] == [None] * 8
-    assert [m["deflection"] is None for m in messages] == [True] * 5 + [False] * 3
-    d = np.asarray(messages[-1]["deflection"])
+    assert [m["estimate"] is None for m in messages[:8]] == [True] * 5 + [False] * 3
+    assert [m["deflection"] is None for m in messages[:8]] == [True] * 5 + [False] * 3
+    d = np.asarray(messages[7]["deflection"])
     expected = np.zeros(spec.shape)
     expected[1, 2] = 600 / 12000.0
     np.testing.assert_allclose(d, expected, atol=1e-6)
-    assert layout["estimation"] == "contact estimation: not yet for pads"
+    for m in messages[5:8]:  # one contact, at the taxel, with the same id
+        (contact,) = m["estimate"]["contacts"]
+        assert (round(contact["row"]), round(contact["col"])) == (1, 2)
+        assert contact["id"] == 0
+        # the page draws it at (u, v) = (x, y) [mm] (a pad seen from +z)
+        assert contact["u_mm"] == pytest.approx(contact["x_mm"])
+        assert contact["v_mm"] == pytest.approx(contact["y_mm"])
+        assert m["estimate"]["n_contacts"] == 1
+    # while re-zeroing the old baseline still applies; after it, no contact
+    assert [m["estimate"]["rezeroing"] for m in messages[8:13]] == [True] * 4 + [False]
+    assert all(m["estimate"]["n_contacts"] == 0 for m in messages[13:])
+    np.testing.assert_allclose(np.asarray(messages[-1]["deflection"]), 0.0, atol=1e-9)
+    assert layout["estimation"] is None and layout["multi_contact"] is True
     assert layout["kind"] == "pad" and layout["geometry"] == "plane"
 
 
@@ -154,7 +182,7 @@ def test_point_set_projection_is_x_y_when_the_normals_average_to_z():
     np.testing.assert_allclose(layout["u_mm"], positions[:, 0], atol=1e-12)
     np.testing.assert_allclose(layout["v_mm"], positions[:, 1], atol=1e-12)
     assert layout["u_label"] == "x [mm]" and layout["surface"] is None
-    assert layout["estimation"] == "contact estimation: not yet for point sets"
+    assert layout["estimation"] is None and layout["multi_contact"] is True
 
 
 def test_point_set_projection_is_an_isometry_of_a_tilted_flat_set():

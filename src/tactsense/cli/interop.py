@@ -12,7 +12,7 @@ from tactsense._validation import TactsenseInputError
 from tactsense.cli._common import (
     BaselineFramesOption,
     CalibrationOption,
-    ThresholdOption,
+    ContactThresholdOption,
     atomic_output,
     check_output,
     console,
@@ -81,7 +81,7 @@ def export(
     ] = None,
     calibration: CalibrationOption = None,
     baseline_frames: BaselineFramesOption = 5,
-    threshold: ThresholdOption = 0.005,
+    threshold: ContactThresholdOption = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,
     force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
 ) -> None:
@@ -141,8 +141,12 @@ def export(
     except (TactsenseInputError, FileExistsError) as error:
         fail(str(error))
     clock = f", {counts['clock']} clock" if "clock" in counts else ""
-    if counts.get("estimated") is False:
-        clock += "; contacts not estimated on a " + str(counts.get("kind"))
+    if counts.get("kind", "finger") != "finger":  # every contact of every frame
+        console.print(
+            f"wrote {out}: {counts['frames']} frames, {counts['contacts']} contacts (one "
+            f"TactileContact per contact per frame; {export_format.value}{clock})"
+        )
+        return
     console.print(
         f"wrote {out}: {counts['frames']} frames, {counts['contacts']} with a contact "
         f"({export_format.value}{clock})"

@@ -19,7 +19,7 @@ from tactsense.cli._common import (
     BaselineFramesOption,
     CalibrationOption,
     SensorOption,
-    ThresholdOption,
+    ContactThresholdOption,
     atomic_output,
     check_output,
     console,
@@ -133,14 +133,34 @@ def _open_reader(source: str, sensor: str | None, timeout: float | None, *, star
 def _stream_and_locator(
     source, sensor, timeout, calibration, baseline_frames, threshold, *, keep_deflection=False
 ):
-    """The device, opened but not started, and a compiled :class:`LiveLocator` for it.
+    """The device, opened but not started, and a compiled locator for it: the finger's
+    :class:`LiveLocator`, or :class:`LiveContacts` (every contact, tracked) for a pad or a
+    point set.
 
     The calibration was checked before the line was opened; whether it belongs to the
     device's sensor can only be checked once the device has said which.
     """
     from tactsense.stream import LiveLocator
+    from tactsense.stream.live import LiveContacts
 
     reader = _open_reader(source, sensor, timeout, start=False)
+    if reader.sensor.kind != "finger":
+        if calibration is not None:
+            raise TactsenseInputError(
+                f"--calibration applies to fingers; {reader.sensor.name!r} is a "
+                f"{reader.sensor.kind}, whose calibration does not exist yet: leave "
+                "--calibration out"
+            )
+        locator = LiveContacts(
+            reader.sensor,
+            baseline_frames=baseline_frames,
+            threshold=threshold,
+            frame_period_s=None,  # the sensor's scan period: device time, not the wire's
+            keep_deflection=keep_deflection,
+        )
+        return reader, locator
+    if threshold is None:
+        threshold = 0.005
     if calibration is not None:
         calibration.check_sensor(reader.sensor)
     locator = LiveLocator(
@@ -148,7 +168,7 @@ def _stream_and_locator(
         calibration=calibration,
         baseline_frames=baseline_frames,
         threshold=threshold,
-        frame_period_s=reader.frame_period_s or None,
+        frame_period_s=None,  # the sensor's scan period: device time, not the wire's
         keep_deflection=keep_deflection,
     )
     return reader, locator
@@ -443,7 +463,7 @@ def live(
     frames: FramesLimit = None,
     duration: DurationLimit = None,
     baseline_frames: BaselineFramesOption = 5,
-    threshold: ThresholdOption = 0.005,
+    threshold: ContactThresholdOption = None,
     sensor: StreamSensorOption = None,
     timeout: TimeoutOption = None,
     lsl: Annotated[
@@ -459,10 +479,20 @@ def live(
     """Estimate the contact of every frame as it arrives: position, force, skew, flags and
     latency (from the frame's last byte to its estimate), until --frames, --duration,
     the end of the stream or Ctrl-C.
+
+    A pad or a point set gets every contact of every frame, tracked (ids, velocity,
+    slip; docs/contacts.md): one JSON object per frame with a "contacts" list, or with
+    --format csv one row per contact (a frame without contact: one row, n_contacts 0).
+    The baseline follows slow drift where taxels are untouched. Re-zero (take the
+    baseline anew from the next frames, the sensor untouched): type z and Enter on a
+    terminal, or send SIGUSR1 (kill -USR1 PID).
     """
+    import signal
+    import threading
+
     from tactsense.estimate import Calibration
     from tactsense.stream import StreamError
-    from tactsense.stream.live import FIELDS
+    from tactsense.stream.live import CONTACT_FIELDS, FIELDS
 
     _check_duration(duration)
     if out is not None:
@@ -483,14 +513,22 @@ def live(
         fail(str(error))
     latencies: list[float] = []
     used = [0]  # frames given to the locator
+    multi = reader.sensor.kind != "finger"
+    rezero = threading.Event()
+    _listen_for_rezero(rezero, signal)
 
     def run(stream) -> None:
         writer = None
         if output_format is LiveFormat.csv:
-            writer = csv.DictWriter(stream, fieldnames=FIELDS, lineterminator="\n")
+            fields = LIVE_CONTACT_COLUMNS if multi else FIELDS
+            writer = csv.DictWriter(stream, fieldnames=fields, lineterminator="\n")
             writer.writeheader()
         for frame in reader.frames(max_frames=frames, duration_s=duration):
             used[0] += 1
+            if rezero.is_set():
+                rezero.clear()
+                locator.rezero()
+                print("re-zeroing: the baseline from the next frames", file=sys.stderr)
             estimate = locator(frame)
             if outlets is not None:
                 outlets.push(frame, estimate)
@@ -503,6 +541,9 @@ def live(
                     for k, v in estimate.items()
                 }
                 stream.write(json.dumps(clean) + "\n")
+            elif multi:
+                for row in _contact_rows(estimate, CONTACT_FIELDS):
+                    writer.writerow(row)
             else:
                 writer.writerow(
                     {k: repr(v) if isinstance(v, float) else v for k, v in estimate.items()}
@@ -546,6 +587,43 @@ def live(
     console.print(f"{len(latencies)} estimates{stopped} from {summary}")
 
 
+LIVE_CONTACT_COLUMNS = (
+    "sequence", "device_time_s", "host_time_s", "n_contacts", "id", "x_mm", "y_mm", "z_mm",
+    "row", "col", "force_n", "peak", "major_mm", "minor_mm", "orientation_deg", "taxels",
+    "vx_mm_s", "vy_mm_s", "vz_mm_s", "slip", "flags", "flag_names", "rezeroing", "latency_ms",
+)  # fmt: skip
+"""Columns of ``live --format csv`` on a pad or a point set: one row per contact."""
+
+
+def _contact_rows(estimate: dict, fields) -> list[dict]:
+    """The CSV rows of one frame's contacts (one row with n_contacts 0 when none)."""
+    head = {k: estimate[k] for k in ("sequence", "device_time_s", "host_time_s", "n_contacts",
+                                     "flag_names", "rezeroing", "latency_ms")}  # fmt: skip
+    rows = []
+    for contact in estimate["contacts"] or [{}]:
+        row = dict(head)
+        row.update({k: contact.get(k, "") for k in fields})
+        row["flags"] = contact.get("flags", estimate["flags"])
+        rows.append({k: repr(v) if isinstance(v, float) else v for k, v in row.items()})
+    return rows
+
+
+def _listen_for_rezero(event, signal) -> None:
+    """Set ``event`` on SIGUSR1, and on a line 'z' typed at a terminal."""
+    import threading
+
+    if hasattr(signal, "SIGUSR1") and threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGUSR1, lambda *_: event.set())
+    if sys.stdin is not None and sys.stdin.isatty():
+
+        def listen() -> None:
+            for line in sys.stdin:
+                if line.strip().lower() in ("z", "rezero", "re-zero"):
+                    event.set()
+
+        threading.Thread(target=listen, daemon=True, name="rezero-keys").start()
+
+
 RECORDING_SUFFIXES = (".h5", ".hdf5")
 
 
@@ -576,7 +654,7 @@ def view(
     ] = False,
     calibration: CalibrationOption = None,
     baseline_frames: BaselineFramesOption = 5,
-    threshold: ThresholdOption = 0.005,
+    threshold: ContactThresholdOption = None,
     speed: Annotated[
         float,
         typer.Option(
@@ -640,7 +718,7 @@ def view(
                     calibration=cal,
                     baseline_frames=baseline_frames,
                     threshold=threshold,
-                    frame_period_s=reader.frame_period_s or None,
+                    frame_period_s=None,  # the sensor's scan period: device time, not the wire's
                 )
             except BaseException:
                 reader.close()

@@ -672,68 +672,70 @@ def track_into(
 
 
 @jit(nogil=True)
+def _fit_score(signal, labels, f, own, pr, pc, kernel, half, n_sub, ia, ib):
+    """Least-squares amplitude and score ``<g, s>^2 / <g, g>`` of the tabulated response
+    for the probe at ``(pr - 1 + ia / n_sub, pc - 1 + ib / n_sub)`` [taxel], over the
+    fixed taxels within ``half - 1`` of the maximum ``(pr, pc)`` (other contacts' taxels
+    left out). The same taxels for every position: the score is smooth in it."""
+    rows = signal.shape[1]
+    cols = signal.shape[2]
+    span = 2 * n_sub + 1
+    ua = ia if ia < span - 1 else ia - 1
+    ub = ib if ib < span - 1 else ib - 1
+    r0 = pr - 1 + ua // n_sub  # the taxel below the position, and the offset from it
+    c0 = pc - 1 + ub // n_sub
+    a = ia - (r0 - (pr - 1)) * n_sub
+    b = ib - (c0 - (pc - 1)) * n_sub
+    reach = half - 1
+    num = 0.0
+    den = 0.0
+    for r in range(max(0, pr - reach), min(rows, pr + reach + 1)):
+        i = r - r0 + half
+        for c in range(max(0, pc - reach), min(cols, pc + reach + 1)):
+            lab = labels[f, r, c]
+            if lab >= 0 and lab != own:
+                continue
+            g = kernel[a, b, i, c - c0 + half]
+            num += g * signal[f, r, c]
+            den += g * g
+    if den > 0.0 and num > 0.0:
+        return num * num / den, num / den
+    return 0.0, np.nan
+
+
+@jit(nogil=True)
 def fit_into(signal, labels, frame_of, root, peak_row, peak_col, kernel, half, row, col, force):
     """Maximum-likelihood position and force of each contact under white Gaussian noise:
     the tabulated response that, scaled by its least-squares amplitude, leaves the least
-    residual over the taxels around the contact's maximum (other contacts' taxels left
-    out), searched over every tabulated sub-taxel position in the four cells around the
-    maximum, then refined by a parabola through the best and its table neighbours.
+    residual over the taxels around the contact's maximum (:func:`_fit_score`), searched
+    over every tabulated sub-taxel position in the four cells around the maximum, then
+    refined by a parabola through the best and its table neighbours.
 
     ``kernel[a, b, i, j]`` as in :func:`amplitude_fit`; ``row``, ``col`` [taxel] and
     ``force`` [N] are written.
     """
-    rows = signal.shape[1]
-    cols = signal.shape[2]
     n_sub = kernel.shape[0] - 1
     step = 1.0 / n_sub
-    reach = half + 1
-    span = 2 * n_sub + 1  # sub-positions from the maximum - 1 to the maximum + 1
-    score = np.empty((span, span))
-    amp = np.empty((span, span))
+    span = 2 * n_sub + 1
     for k in range(frame_of.shape[0]):
         f = frame_of[k]
         pr = peak_row[k]
         pc = peak_col[k]
+        own = root[k]
+        # start at the maximum's taxel and move only for a clearly better score: where
+        # the score is flat (a probe near a taxel's centre that moves no neighbour: the
+        # data cannot tell where it is) the answer stays at the taxel, not at the first
+        # position searched. Every tabulated position is tried: where few taxels respond
+        # the score peaks within a fraction of a table step, which a coarse search misses
+        best_a = n_sub
+        best_b = n_sub
+        best, _ = _fit_score(signal, labels, f, own, pr, pc, kernel, half, n_sub, n_sub, n_sub)
         for ia in range(span):
             for ib in range(span):
-                # position (pr - 1 + ia * step, pc - 1 + ib * step): the cell below it
-                # and the offset inside that cell
-                ua = ia if ia < span - 1 else ia - 1
-                ub = ib if ib < span - 1 else ib - 1
-                r0 = pr - 1 + ua // n_sub
-                c0 = pc - 1 + ub // n_sub
-                a = ia - (r0 - (pr - 1)) * n_sub
-                b = ib - (c0 - (pc - 1)) * n_sub
-                num = 0.0
-                den = 0.0
-                for i in range(2 * half + 1):
-                    r = r0 + i - half
-                    if r < 0 or r >= rows or abs(r - pr) > reach:
-                        continue
-                    for j in range(2 * half + 1):
-                        c = c0 + j - half
-                        if c < 0 or c >= cols or abs(c - pc) > reach:
-                            continue
-                        lab = labels[f, r, c]
-                        if lab >= 0 and lab != root[k]:
-                            continue
-                        g = kernel[a, b, i, j]
-                        num += g * signal[f, r, c]
-                        den += g * g
-                if den > 0.0 and num > 0.0:
-                    score[ia, ib] = num * num / den
-                    amp[ia, ib] = num / den
-                else:
-                    score[ia, ib] = 0.0
-                    amp[ia, ib] = np.nan
-        best_a = 0
-        best_b = 0
-        for ia in range(span):
-            for ib in range(span):
-                if score[ia, ib] > score[best_a, best_b]:
-                    best_a = ia
-                    best_b = ib
-        if not score[best_a, best_b] > 0.0:
+                sc, _ = _fit_score(signal, labels, f, own, pr, pc, kernel, half, n_sub, ia, ib)
+                if sc > best * (1.0 + 1e-9):
+                    best, best_a, best_b = sc, ia, ib
+        if not best > 0.0:
             row[k] = np.nan
             col[k] = np.nan
             force[k] = np.nan
@@ -741,17 +743,18 @@ def fit_into(signal, labels, frame_of, root, peak_row, peak_col, kernel, half, r
         da = 0.0
         db = 0.0
         if 0 < best_a < span - 1:
-            lo = score[best_a - 1, best_b]
-            hi = score[best_a + 1, best_b]
-            curv = lo - 2.0 * score[best_a, best_b] + hi
+            lo, _ = _fit_score(signal, labels, f, own, pr, pc, kernel, half, n_sub, best_a - 1, best_b)
+            hi, _ = _fit_score(signal, labels, f, own, pr, pc, kernel, half, n_sub, best_a + 1, best_b)
+            curv = lo - 2.0 * best + hi
             if curv < 0.0:
                 da = min(max(0.5 * (lo - hi) / curv, -0.5), 0.5)
         if 0 < best_b < span - 1:
-            lo = score[best_a, best_b - 1]
-            hi = score[best_a, best_b + 1]
-            curv = lo - 2.0 * score[best_a, best_b] + hi
+            lo, _ = _fit_score(signal, labels, f, own, pr, pc, kernel, half, n_sub, best_a, best_b - 1)
+            hi, _ = _fit_score(signal, labels, f, own, pr, pc, kernel, half, n_sub, best_a, best_b + 1)
+            curv = lo - 2.0 * best + hi
             if curv < 0.0:
                 db = min(max(0.5 * (lo - hi) / curv, -0.5), 0.5)
+        _, amp = _fit_score(signal, labels, f, own, pr, pc, kernel, half, n_sub, best_a, best_b)
         row[k] = pr - 1 + (best_a + da) * step
         col[k] = pc - 1 + (best_b + db) * step
-        force[k] = amp[best_a, best_b]
+        force[k] = amp

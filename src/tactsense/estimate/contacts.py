@@ -563,6 +563,10 @@ def pad_force_kernel(sensor, n_sub: int = 8):
     return kernel, step, half
 
 
+FIT_STEPS = 32
+"""Sub-taxel positions per taxel of the model-based fit's table (1/32 taxel apart)."""
+
+
 def pad_fit(signal, labels, seg, sensor):
     """Maximum-likelihood row, column [taxel] and force [N] of each contact of a pad
     (:func:`~tactsense.estimate._contacts_fast.fit_into`)."""
@@ -571,7 +575,7 @@ def pad_fit(signal, labels, seg, sensor):
     n = len(seg["frame"])
     row, col, force = np.empty(n), np.empty(n), np.empty(n)
     if n:
-        kernel, _, half = pad_force_kernel(sensor)
+        kernel, _, half = pad_force_kernel(sensor, FIT_STEPS)
         with deferred_interrupts():
             fit_into(
                 signal, labels, seg["frame"], seg["root"], seg["peak_row"], seg["peak_col"],

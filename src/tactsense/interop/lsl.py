@@ -17,6 +17,13 @@ Outlets (``tactsense live SOURCE --lsl``):
   (NaN without a contact), one sample per frame; each channel has a ``label``, a
   ``unit`` and a ``type`` (:data:`CONTACT_UNITS`, :data:`CONTACT_TYPES`).
 
+A pad or a point set (several contacts a frame, tracked) gets a contacts outlet of fixed
+width instead: ``n_contacts, force_n, flags, latency_ms`` (the frame: how many contacts,
+their summed force [N], the flags of the frame, the latency) then :data:`SLOTS` slots of
+``id, x_mm, y_mm, z_mm, force_n`` (slot ``k``'s channels are labelled ``c<k>_id`` ...),
+filled in the order of the estimate (largest force first), NaN in the slots left over;
+a contact keeps its ``id`` from frame to frame, not its slot (:data:`SLOT_CHANNELS`).
+
 Both carry a ``source_id`` made from the device's serial number (``tactsense:<serial>:
 frames``), so a consumer recovers the stream after the device or tactsense restarts.
 Sample timestamps are LSL's clock at the frame's arrival.
@@ -64,6 +71,31 @@ CONTACT_TYPES = (
     "Latency",
 )
 """XDF channel ``type`` of each contact channel."""
+
+
+SLOTS = 8
+"""Contact slots of a pad's or point set's contacts outlet (the estimate's default
+``max_contacts``)."""
+SLOT_FRAME = ("n_contacts", "force_n", "flags", "latency_ms")
+SLOT_FRAME_UNITS = ("1", "N", "1", "ms")
+SLOT_FRAME_TYPES = ("Count", "Force", "Flags", "Latency")
+SLOT_FIELDS = ("id", "x_mm", "y_mm", "z_mm", "force_n")
+SLOT_UNITS = ("1", "mm", "mm", "mm", "N")
+SLOT_TYPES = ("Id", "Position", "Position", "Position", "Force")
+SLOT_CHANNELS = SLOT_FRAME + tuple(
+    f"c{k}_{name}" for k in range(SLOTS) for name in SLOT_FIELDS
+)
+"""Channels of the fixed-width contacts outlet of a pad or point set."""
+
+
+def slot_sample(estimate: dict) -> list[float]:
+    """One sample of the fixed-width contacts outlet from a :class:`LiveContacts` estimate."""
+    sample = [float(estimate[name]) for name in SLOT_FRAME]
+    contacts = estimate["contacts"][:SLOTS]
+    for contact in contacts:
+        sample += [float(contact[name]) for name in SLOT_FIELDS]
+    sample += [float("nan")] * (len(SLOT_FIELDS) * (SLOTS - len(contacts)))
+    return sample
 
 
 def _acquisition(desc, identity: dict) -> None:
@@ -140,21 +172,42 @@ def frames_info(sensor: SensorSpec, identity: dict, rate_hz: float):
     return info
 
 
+def _slot_channels():
+    """(label, unit, type) of each channel of the fixed-width contacts outlet."""
+    out = list(zip(SLOT_FRAME, SLOT_FRAME_UNITS, SLOT_FRAME_TYPES, strict=True))
+    for k in range(SLOTS):
+        out += [(f"c{k}_{n}", u, t) for n, u, t in zip(SLOT_FIELDS, SLOT_UNITS, SLOT_TYPES,
+                                                         strict=True)]  # fmt: skip
+    return out
+
+
 def contacts_info(sensor: SensorSpec, identity: dict, rate_hz: float):
-    """The ``StreamInfo`` of the contacts outlet."""
+    """The ``StreamInfo`` of the contacts outlet: the finger's one contact, or the slots
+    of a pad's or point set's contacts."""
     pylsl = _pylsl()
+    if sensor.kind == "finger":
+        described = list(zip(CONTACT_CHANNELS, CONTACT_UNITS, CONTACT_TYPES, strict=True))
+    else:
+        described = _slot_channels()
     info = pylsl.StreamInfo(
         f"{sensor.name}-contacts",
         "TactileContact",
-        len(CONTACT_CHANNELS),
+        len(described),
         float(rate_hz),
         pylsl.cf_double64,
         source_id(identity, sensor, "contacts"),
     )
     desc = info.desc()
     _acquisition(desc, identity)
+    if sensor.kind != "finger":
+        meta = desc.append_child("tactsense")
+        meta.append_child_value("slots", str(SLOTS))
+        meta.append_child_value(
+            "layout", "n_contacts, force_n, flags, latency_ms, then per slot k: "
+            "c<k>_id, c<k>_x_mm, c<k>_y_mm, c<k>_z_mm, c<k>_force_n (NaN when empty)",
+        )  # fmt: skip
     channels = desc.append_child("channels")
-    for name, unit, kind in zip(CONTACT_CHANNELS, CONTACT_UNITS, CONTACT_TYPES, strict=True):
+    for name, unit, kind in described:
         channel = channels.append_child("channel")
         channel.append_child_value("label", name)
         channel.append_child_value("unit", unit)
@@ -163,7 +216,7 @@ def contacts_info(sensor: SensorSpec, identity: dict, rate_hz: float):
 
 
 class LslOutlets:
-    """Publish frames and contact estimates of one finger on two LSL outlets."""
+    """Publish frames and contact estimates of one sensor on two LSL outlets."""
 
     def __init__(self, sensor: SensorSpec, identity: dict | None = None, rate_hz: float = 0.0):
         pylsl = _pylsl()
@@ -180,7 +233,10 @@ class LslOutlets:
         stamp = frame.arrival + self._offset
         self.frames.push_sample(np.asarray(frame.counts, dtype=np.float32).ravel(), stamp)
         if estimate is not None:
-            sample = [float(estimate[name]) for name in CONTACT_CHANNELS]
+            if "contacts" in estimate:
+                sample = slot_sample(estimate)
+            else:
+                sample = [float(estimate[name]) for name in CONTACT_CHANNELS]
             self.contacts.push_sample(sample, stamp)
 
     def close(self) -> None:

@@ -190,22 +190,35 @@ class McapTactileWriter:
         self.frames += len(time_s)
 
     def contacts_of(self, time_s, axial_mm, angle_deg, force_n, has_contact) -> None:
-        """Contacts of many frames at once (vectorised geometry)."""
+        """A finger's contacts of many frames at once (vectorised geometry)."""
         chosen = np.flatnonzero(has_contact)
         if len(chosen) == 0:
             return
         points, normals = contact_geometry(
             self.sensor, np.asarray(axial_mm)[chosen], np.asarray(angle_deg)[chosen]
         )
+        self.contacts_at(
+            np.asarray(time_s, dtype=float)[chosen], points, normals,
+            np.asarray(force_n, dtype=float)[chosen],
+        )  # fmt: skip
+
+    def contacts_at(self, time_s, points_m, normals, force_n) -> None:
+        """One ``TactileContact`` per row: its time [s], point [m] and outward unit
+        normal in the sensor's frame, and the normal force [N] (pressing inward)."""
+        if len(time_s) == 0:
+            return
+        points = np.asarray(points_m, dtype=float).reshape(-1, 3)
+        normals = np.asarray(normals, dtype=float).reshape(-1, 3)
+        force_n = np.asarray(force_n, dtype=float)
         if self._fast:
             channel = self._channel(CONTACTS_TOPIC, self._contact)
-            force = -np.asarray(force_n, dtype=float)[chosen, None] * normals
-            numbers = np.zeros((len(chosen), 12), dtype="<f8")
+            force = -force_n[:, None] * normals
+            numbers = np.zeros((len(time_s), 12), dtype="<f8")
             numbers[:, 0:3], numbers[:, 3:6], numbers[:, 6:9] = points, normals, force
             numbers[:, 9:12] = np.cross(points, force)  # about the frame's origin [N m]
             head, middle = self._contact_bytes.head, self._contact_bytes.middle
-        for k, i in enumerate(chosen):
-            t = float(time_s[i])
+        for k in range(len(time_s)):
+            t = float(time_s[k])
             ns = round(t * 1e9)
             if self._fast:
                 stamp = _STAMP.pack(ns // 1_000_000_000, ns % 1_000_000_000)
@@ -215,7 +228,7 @@ class McapTactileWriter:
                 )  # fmt: skip
             else:
                 message = tactile_contact(
-                    self.sensor, t, points[k], normals[k], force_n[i], self.frame_id
+                    self.sensor, t, points[k], normals[k], force_n[k], self.frame_id
                 )
                 self._writer.write_message(
                     CONTACTS_TOPIC, self._contact, message, log_time=ns, publish_time=ns,
@@ -246,6 +259,7 @@ def export_mcap(
     start_time_s: float | None = None,
     progress=None,
     fast: bool = True,
+    drift_s: float | None = 2.0,
 ) -> dict:
     """Write a recording's frames and contacts to MCAP, a piece at a time.
 
@@ -254,8 +268,9 @@ def export_mcap(
     lab's other bags; otherwise the recording's own times plus ``start_time_s`` (Unix
     time of its first frame; default 0, i.e. 1970). The file's metadata record
     ``tactsense`` says which clock (``clock``: ``host`` or ``recording``), the sensor and
-    the frame id. A pad's or a point set's recording gives its frames only (contacts are
-    estimated on fingers so far).
+    the frame id. On a pad or a point set every contact of every frame is a message (as
+    ``locate`` finds and tracks them, the baseline following drift with ``drift_s``);
+    its normal is the nearest taxel's.
 
     Parameters
     ----------
@@ -312,18 +327,36 @@ def export_mcap(
                 "source": str(Path(recording).name),
             },
         )
-        if reader.sensor.kind != "finger":  # no contact estimation yet: frames only
-            for start, frames, time_s in reader.chunks():
-                writer.frames_of(
-                    frames, stamps(start, time_s), np.arange(start, start + len(time_s))
-                )
+        if reader.sensor.kind != "finger":  # every contact, tracked: one message each
+            from tactsense.batch import iter_contacts
+
+            sensor = reader.sensor
+            positions = sensor.taxel_positions_mm()
+            taxel_normals = sensor.taxel_normals()
+            pieces = iter_contacts(reader, baseline_frames=baseline_frames,
+                                   threshold=threshold, drift_s=drift_s)  # fmt: skip
+            for start, n, time_s, table, _ in pieces:
+                frames = reader.frames(start, start + n)
+                when = stamps(start, time_s)
+                writer.frames_of(frames, when, np.arange(start, start + n))
+                xyz = np.column_stack([table.x_mm, table.y_mm, table.z_mm])
+                keep = np.isfinite(xyz).all(axis=1) & np.isfinite(table.force_n)
+                xyz = xyz[keep]
+                # the normal of the taxel nearest each contact (+z everywhere on a pad)
+                nearest = np.argmin(
+                    ((xyz[:, None, :] - positions[None, :, :]) ** 2).sum(axis=-1), axis=1
+                ) if len(xyz) else np.zeros(0, int)  # fmt: skip
+                writer.contacts_at(
+                    when[table.frame[keep] - start], xyz * 1e-3, taxel_normals[nearest],
+                    table.force_n[keep],
+                )  # fmt: skip
                 if progress is not None:
-                    progress(start + len(time_s), reader.n_frames)
+                    progress(start + n, reader.n_frames)
             writer.finish()
             clock = "host" if host else "recording"
             return {
                 "frames": writer.frames, "contacts": writer.contacts, "clock": clock,
-                "estimated": False, "kind": reader.sensor.kind,
+                "kind": reader.sensor.kind,
             }  # fmt: skip
         pieces = iter_locate(
             reader,

@@ -116,6 +116,16 @@ class LiveLocator:
         """True once estimates come out (the baseline is known)."""
         return self.calibration is not None or self._locator is not None
 
+    def rezero(self) -> None:
+        """Take the baseline anew from the next ``baseline_frames`` frames (untouched).
+
+        With a calibration its baseline stands (it was measured with the gains): nothing
+        changes."""
+        if self.calibration is None:
+            self._locator = None
+            self._baseline = None
+            self._collected = []
+
     def __call__(self, frame: StreamFrame) -> dict | None:
         """The estimate of one frame (a dict of :data:`FIELDS`), or None while the
         baseline is being collected."""
@@ -169,3 +179,195 @@ class LiveLocator:
             float(est.angle_deg[0]), float(est.force_n[0]), float(est.skew[0]),
             float(est.peak_deflection[0]), flags,
         )  # fmt: skip
+
+
+CONTACT_FIELDS = (
+    "id",
+    "x_mm",
+    "y_mm",
+    "z_mm",
+    "row",
+    "col",
+    "force_n",
+    "peak",
+    "major_mm",
+    "minor_mm",
+    "orientation_deg",
+    "taxels",
+    "vx_mm_s",
+    "vy_mm_s",
+    "vz_mm_s",
+    "slip",
+    "flags",
+)
+"""Fields of each contact in :class:`LiveContacts`' estimates (``docs/contacts.md``)."""
+
+
+class LiveContacts:
+    """Every contact of every frame of a stream, tracked, on any kind of array.
+
+    The first ``baseline_frames`` frames (untouched) make the baseline, which then
+    follows slow drift where taxels are untouched
+    (:class:`~tactsense.estimate.baseline.DriftBaseline`, time constant ``drift_s``);
+    :meth:`rezero` takes a new one from the next frames. Each frame goes through
+    :func:`~tactsense.estimate.contacts.find_contacts` and a
+    :class:`~tactsense.estimate.track.ContactTracker`, so ids stay with their contacts
+    from frame to frame.
+
+    Parameters
+    ----------
+    sensor : SensorSpec, PadSpec or PointsSpec
+    baseline_frames : int
+        Untouched frames that make the baseline.
+    threshold : float, optional
+        Smallest signal that counts as contact [-]; by default the sensor's
+        (:func:`~tactsense.estimate.contacts.default_threshold`).
+    frame_period_s : float, optional
+        Time between frames [s]; default the sensor's scan period.
+    baseline : array_like, shape (rows, cols), optional
+        The untouched readings [counts], known in advance (no frames spent on it).
+    keep_deflection : bool
+        Keep the signal of the last frame in :attr:`last_deflection` (for a display).
+    drift_s : float or None
+        Time constant of the drift-following baseline [s]; None keeps it fixed.
+    max_contacts : int
+        At most this many contacts per frame (1-64).
+    method : str
+        How positions are found (:data:`~tactsense.estimate.contacts.METHODS`).
+    """
+
+    calibration = None
+
+    def __init__(
+        self,
+        sensor,
+        *,
+        baseline_frames: int = 5,
+        threshold: float | None = None,
+        frame_period_s: float | None = None,
+        baseline=None,
+        keep_deflection: bool = False,
+        drift_s: float | None = 2.0,
+        max_contacts: int = 8,
+        method: str = "interpolate",
+    ):
+        from tactsense.estimate.contacts import default_threshold, find_contacts
+        from tactsense.estimate.track import ContactTracker
+
+        self.sensor = sensor
+        self.threshold = default_threshold(sensor) if threshold is None else float(threshold)
+        self.frame_period_s = float(frame_period_s or sensor.scan_period_s)
+        self._baseline_frames = max(1, int(baseline_frames))
+        self._drift_s = drift_s
+        self._keep = bool(keep_deflection)
+        self._options = {"max_contacts": max_contacts, "method": method,
+                         "threshold": self.threshold}  # fmt: skip
+        self._collected: list[np.ndarray] = []
+        self._drift = None
+        self._tracker = ContactTracker(self.frame_period_s)
+        self._serial = 0
+        self.last_deflection: np.ndarray | None = None
+        """The signal of the last frame [-] (with ``keep_deflection``)."""
+        # compile (or load from Numba's cache) now, not while frames queue up
+        find_contacts(np.zeros((1, *sensor.shape)), sensor, counts=False, **self._options)
+        if baseline is not None:
+            self._set_baseline(np.asarray(baseline, dtype=float))
+
+    def _set_baseline(self, baseline: np.ndarray) -> None:
+        from tactsense.estimate.baseline import DriftBaseline
+
+        self._drift = DriftBaseline(
+            baseline, self.sensor, frame_period_s=self.frame_period_s,
+            threshold=self.threshold,
+            time_constant_s=float("inf") if self._drift_s is None else self._drift_s,
+            rezero_frames=self._baseline_frames,
+        )  # fmt: skip
+
+    @property
+    def ready(self) -> bool:
+        """True once estimates come out (the baseline is known)."""
+        return self._drift is not None
+
+    @property
+    def baseline(self) -> np.ndarray | None:
+        """The current baseline [counts] (None while it is being collected)."""
+        return None if self._drift is None else self._drift.baseline
+
+    @property
+    def below_frames(self) -> int:
+        """Frames so far with a taxel below the baseline by more than the threshold."""
+        return 0 if self._drift is None else self._drift.below_frames
+
+    def reset(self) -> None:
+        """Forget the tracks (after a jump in time, e.g. a seek in a recording)."""
+        from tactsense.estimate.track import ContactTracker
+
+        self._tracker = ContactTracker(self.frame_period_s)
+        self._serial = 0
+
+    def rezero(self) -> None:
+        """Take the baseline anew from the next ``baseline_frames`` frames (untouched)."""
+        if self._drift is None:
+            self._collected = []
+        else:
+            self._drift.rezero()
+
+    def __call__(self, frame: StreamFrame) -> dict | None:
+        """The contacts of one frame, or None while the baseline is being collected.
+
+        Returns
+        -------
+        dict
+            ``sequence``, ``device_time_s``, ``host_time_s``, ``n_contacts``, ``force_n``
+            (their sum [N]), ``flags`` (of the frame), ``flag_names``, ``rezeroing``,
+            ``latency_ms`` and ``contacts``: a list of dicts of :data:`CONTACT_FIELDS`.
+        """
+        from tactsense.estimate.contacts import find_contacts
+
+        counts = np.asarray(frame.counts)
+        if self._drift is None:
+            self._collected.append(np.asarray(counts, dtype=float))
+            if len(self._collected) >= self._baseline_frames:
+                collected = np.stack(self._collected)
+                self._set_baseline(np.median(collected, axis=0))
+                # the baseline's frames pass through it as they do in a recording's
+                # locate (batch.contacts_file): live and batch give the same numbers
+                self._drift.signal(collected)
+                self._collected = []
+            return None
+        before = self._drift.baseline.copy() if self._keep else None
+        table = find_contacts(counts[None], self.sensor, baseline=self._drift, **self._options)
+        table.frame[:] = self._serial
+        tracked, _ = self._tracker.update(table, first_frame=self._serial)
+        self._serial += 1
+        if self._keep:
+            from tactsense.estimate.contacts import signal_from_counts
+
+            self.last_deflection = signal_from_counts(counts[None], before, self.sensor)[0][0]
+        columns = tracked.columns()
+        contacts = [
+            {name: _plain(columns[name][k]) for name in CONTACT_FIELDS if name in columns}
+            for k in range(len(tracked))
+        ]
+        flags = int(np.bitwise_or.reduce(tracked.flags)) if len(tracked) else int(Flag.NO_CONTACT)
+        return {
+            "sequence": frame.sequence,
+            "device_time_s": frame.device_time_s,
+            "host_time_s": frame.host_time_s,
+            "n_contacts": len(contacts),
+            "force_n": float(np.nansum(tracked.force_n)) if len(tracked) else 0.0,
+            "flags": flags,
+            "flag_names": flag_names(flags),
+            "rezeroing": self._drift.rezeroing,
+            "contacts": contacts,
+            "latency_ms": 1e3 * (time.perf_counter() - frame.arrival),
+        }
+
+
+def _plain(value):
+    """A NumPy scalar as the Python number JSON writers expect."""
+    if isinstance(value, np.bool_ | bool):
+        return bool(value)
+    if isinstance(value, np.integer):
+        return int(value)
+    return float(value)

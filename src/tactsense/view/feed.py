@@ -30,7 +30,7 @@ from tactsense.estimate.deflection import deflection_from_counts
 from tactsense.estimate.interpolate import col_weights, row_weights
 from tactsense.io.recording import RecordingReader
 from tactsense.sensor import SensorSpec, SpecBase
-from tactsense.stream.live import LiveLocator
+from tactsense.stream.live import LiveContacts, LiveLocator
 from tactsense.stream.reader import LOSS_KINDS, StreamError, StreamFrame, StreamReader
 
 SURFACE_STEPS = 9
@@ -50,9 +50,14 @@ Publish = Callable[[str], None]
 
 
 def _finite(value):
-    """JSON has no NaN: None stands for a value that does not exist."""
+    """JSON has no NaN: None stands for a value that does not exist (in lists and dicts
+    too, e.g. the contacts of a pad's frame)."""
     if isinstance(value, float) and not math.isfinite(value):
         return None
+    if isinstance(value, list):
+        return [_finite(v) for v in value]
+    if isinstance(value, dict):
+        return {k: _finite(v) for k, v in value.items()}
     return value
 
 
@@ -271,6 +276,8 @@ def layout_message(sensor: SpecBase, source: dict) -> dict:
         "rows": rows,
         "cols": cols,
         "estimation": not_estimated_note(sensor),
+        # several tracked contacts a frame (pads, point sets), or the finger's one
+        "multi_contact": LOCATORS.get(sensor.kind) is LiveContacts,
     }
     message.update(GEOMETRY.get(sensor.kind, _points_geometry)(sensor))
     message.update(
@@ -342,9 +349,10 @@ class DeflectionOnly:
         return None
 
 
-LOCATORS = {"finger": LiveLocator}
-"""Sensor kind -> what estimates its contacts frame by frame; other kinds get
-:class:`DeflectionOnly` (the next issue makes estimation general)."""
+LOCATORS = {"finger": LiveLocator, "pad": LiveContacts, "points": LiveContacts}
+"""Sensor kind -> what estimates its contacts frame by frame: the paper's finger its one
+contact (:class:`LiveLocator`), pads and point sets every contact, tracked
+(:class:`LiveContacts`); a kind not listed gets :class:`DeflectionOnly`."""
 
 
 def view_locator(
@@ -352,14 +360,32 @@ def view_locator(
     *,
     calibration=None,
     baseline_frames: int = 5,
-    threshold: float = 0.005,
+    threshold: float | None = None,
     frame_period_s: float | None = None,
     baseline=None,
 ):
     """What the view runs on each frame of ``sensor``: a contact locator where one exists
-    for its kind, else :class:`DeflectionOnly` (which takes no calibration yet)."""
+    for its kind, else :class:`DeflectionOnly` (which takes no calibration yet).
+    ``threshold`` None: the sensor's default (0.005 on the finger)."""
     locator = LOCATORS.get(sensor.kind)
+    if locator is LiveContacts:
+        if calibration is not None:
+            raise TactsenseInputError(
+                f"--calibration applies to fingers, not to "
+                f"{PLURAL.get(sensor.kind, sensor.kind)} (sensor {sensor.name!r}), whose "
+                "calibration does not exist yet: leave --calibration out"
+            )
+        return LiveContacts(
+            sensor,
+            baseline_frames=baseline_frames,
+            threshold=threshold,
+            frame_period_s=frame_period_s,
+            baseline=baseline,
+            keep_deflection=True,
+        )
     if locator is not None:
+        if threshold is None:
+            threshold = 0.005
         return locator(
             sensor,
             calibration=calibration,
@@ -413,6 +439,10 @@ class Feed:
         self._thread: threading.Thread | None = None
         self._rate = _Rate()
         self._lock = threading.Lock()
+        self._plane = None
+        if LOCATORS.get(sensor.kind) is LiveContacts:  # contacts drawn on the plane
+            plane = project_points(sensor.taxel_positions_mm(), sensor.taxel_normals())
+            self._plane = (plane["e_u"], plane["e_v"])
 
     # ---- what pages receive --------------------------------------------------------
 
@@ -449,6 +479,16 @@ class Feed:
             else {k: _finite(v) for k, v in estimate.items() if k != "sequence"},
             "health": health,
         }
+        if self._plane is not None and message["estimate"] is not None:
+            e_u, e_v = self._plane
+            for contact in message["estimate"].get("contacts", []):
+                xyz = [contact.get(k) for k in ("x_mm", "y_mm", "z_mm")]
+                if xyz[0] is None or xyz[1] is None:
+                    contact["u_mm"] = contact["v_mm"] = None
+                    continue
+                p = np.array([v if v is not None else 0.0 for v in xyz], dtype=float)
+                contact["u_mm"] = round(float(p @ e_u), 4)
+                contact["v_mm"] = round(float(p @ e_v), 4)
         return message
 
     def _emit(self, message: dict, *, keep: bool = True) -> None:
@@ -493,7 +533,18 @@ class Feed:
         raise NotImplementedError
 
     def command(self, message: dict) -> None:
-        """A control message from a page (playback); live streams ignore them."""
+        """A control message from a page: ``{"command": "rezero"}`` takes the baseline
+        anew from the next frames (the sensor must be untouched); a recording also
+        takes playback commands."""
+        if message.get("command") == "rezero":
+            self.rezero()
+
+    def rezero(self) -> None:
+        """Take the baseline anew from the next frames, where the locator can."""
+        rezero = getattr(self.locator, "rezero", None)
+        if rezero is not None:
+            with self._lock:
+                rezero()
 
     def health(self) -> dict:
         return {"frames_in": self.frames_in, "status": self.status, "error": self.error}
@@ -625,9 +676,12 @@ class RecordingFeed(Feed):
         self._emit(message)
 
     def command(self, message: dict) -> None:
-        """``{"command": "play"|"pause"|"step"|"seek"|"speed", "value": ...}``."""
+        """``{"command": "play"|"pause"|"step"|"seek"|"speed"|"rezero", "value": ...}``."""
         command = message.get("command")
         value = message.get("value")
+        if command == "rezero":
+            self.rezero()
+            return
         with self._lock:
             if command == "play":
                 if self.position >= self.n_frames - 1:

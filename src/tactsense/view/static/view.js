@@ -23,6 +23,8 @@ const state = {
   centre: 0,              // display angle at the middle of the map [deg]
   touching: false,
   trail: [],
+  tracks: new Map(),      // pads, point sets: contact id -> {points [{u, v}], seen, c}
+  contactMarks: [],       // canvas pixels of each contact drawn: {id, x, y} (for tests)
   selected: null,         // [row, col] followed by the tactel trace
   vmax: 0.01,             // deflection colour scale, decaying running maximum
   framesReceived: 0,
@@ -448,7 +450,46 @@ function drawPlane(frame) {
   }
   drawPlaneAxes();
   drawColourBar(lo, hi, unit, m.left + m.width, m.height);
+  if (state.showMarker && L.multi_contact) drawPlaneContacts();
   state.drawnIndex = frame.index;
+}
+
+// each tracked contact: its trail (older points fainter), a white ring at its position
+// with a radius from its extent, and its id beside it
+const TRACK_COLOURS = ["#ffffff", "#ffeb3b", "#ff80ab", "#80d8ff", "#b9f6ca", "#ffd180"];
+
+function drawPlaneContacts() {
+  const est = state.latest && state.latest.estimate;
+  state.contactMarks = [];
+  ctx.save();
+  for (const [id, track] of state.tracks) {
+    const colour = TRACK_COLOURS[id % TRACK_COLOURS.length];
+    const pts = track.points;
+    for (let k = 1; k < pts.length; k++) {
+      ctx.strokeStyle = colour; ctx.globalAlpha = (k + 1) / pts.length; ctx.lineWidth = 2;
+      ctx.beginPath();
+      ctx.moveTo(xOfU(pts[k - 1].u), yOfV(pts[k - 1].v));
+      ctx.lineTo(xOfU(pts[k].u), yOfV(pts[k].v));
+      ctx.stroke();
+    }
+  }
+  ctx.globalAlpha = 1;
+  for (const c of (est && est.contacts) || []) {
+    if (c.u_mm === null || c.v_mm === null) continue;
+    const x = xOfU(c.u_mm), y = yOfV(c.v_mm);
+    const size = Number.isFinite(c.major_mm) ? Math.max(7, c.major_mm * state.plane.scale) : 7;
+    ctx.lineWidth = 3; ctx.strokeStyle = "#000";
+    ctx.beginPath(); ctx.arc(x, y, size, 0, 2 * Math.PI); ctx.stroke();
+    ctx.lineWidth = 2; ctx.strokeStyle = TRACK_COLOURS[c.id % TRACK_COLOURS.length];
+    ctx.beginPath(); ctx.arc(x, y, size, 0, 2 * Math.PI); ctx.stroke();
+    ctx.font = "bold 13px system-ui, sans-serif"; ctx.textAlign = "left";
+    ctx.lineWidth = 3; ctx.strokeStyle = "#000";
+    ctx.strokeText(`#${c.id}`, x + size + 3, y - size);
+    ctx.fillStyle = TRACK_COLOURS[c.id % TRACK_COLOURS.length];
+    ctx.fillText(`#${c.id}`, x + size + 3, y - size);
+    state.contactMarks.push({ id: c.id, x, y });
+  }
+  ctx.restore();
 }
 
 // a tick every 1, 2 or 5 x 10^k mm, at least 36 px apart
@@ -493,13 +534,34 @@ function drawPlaneAxes() {
 // ---- readouts -----------------------------------------------------------------------
 
 function isContact(est) {
+  if (state.layout.multi_contact) return Boolean(est && est.n_contacts > 0);
   const noContact = state.layout.flags.NO_CONTACT;
   return est && !(est.flags & noContact) && Number.isFinite(est.row) && Number.isFinite(est.col);
 }
 
 const fixed = (v, d) => (v === null || v === undefined || !Number.isFinite(v) ? "–" : v.toFixed(d));
 
+// pads and point sets: the number of contacts, their total force and one row each
+function showContacts(est) {
+  $("n-contacts").textContent = est ? est.n_contacts : "–";
+  $("total-force-n").textContent = est ? fixed(est.force_n, 4) : "–";
+  $("contact-flags").textContent = est ? (est.rezeroing ? "re-zeroing…" : est.flag_names || "none") : "baseline…";
+  const body = $("contact-rows");
+  body.replaceChildren();
+  for (const c of (est && est.contacts) || []) {
+    const tr = document.createElement("tr");
+    for (const text of [`#${c.id}`, fixed(c.x_mm, 2), fixed(c.y_mm, 2), fixed(c.force_n, 4),
+      c.slip ? "slip" : ""]) {
+      const td = document.createElement("td");
+      td.textContent = text;
+      tr.appendChild(td);
+    }
+    body.appendChild(tr);
+  }
+}
+
 function showEstimate(est) {
+  if (state.layout.multi_contact) { showContacts(est); return; }
   const touching = est && isContact(est);
   $("axial").textContent = touching ? fixed(est.axial_mm, 2) : "–";
   $("angle").textContent = touching ? fixed(est.angle_deg, 1) : "–";
@@ -563,7 +625,13 @@ function tactelValue(frame) {
 function pushTrace(frame) {
   const T = state.traces, est = frame.estimate;
   T.t.push(frame.time_s);
-  T.force.push(est && isContact(est) && est.force_g !== null ? est.force_g : 0);
+  // grams: the finger's force_g, or the sum of a pad's contacts (force_n / g_n)
+  let grams = 0;
+  if (est && isContact(est)) {
+    if (est.force_g !== undefined) grams = est.force_g ?? 0;
+    else if (est.force_n !== null) grams = est.force_n / 0.00980665;
+  }
+  T.force.push(grams);
   T.tactel.push(tactelValue(frame));
   while (T.t.length && T.t[0] < frame.time_s - TRACE_S) { T.t.shift(); T.force.shift(); T.tactel.shift(); }
   if (T.t.length > 4000) { T.t.shift(); T.force.shift(); T.tactel.shift(); }
@@ -598,7 +666,8 @@ function onLayout(L) {
     ? "calibrated"
     : "uncalibrated: per-tactel gains not corrected (tactsense calibrate)";
   // no contact estimate for this kind of sensor (yet): one line instead of the numbers
-  $("contact").hidden = Boolean(L.estimation);
+  $("contact").hidden = Boolean(L.estimation) || Boolean(L.multi_contact);
+  $("contacts").hidden = !L.multi_contact;
   $("no-estimation").hidden = !L.estimation;
   $("no-estimation").textContent = L.estimation || "";
   $("force-trace").hidden = Boolean(L.estimation);
@@ -620,6 +689,7 @@ function onLayout(L) {
     state.selected = [L.first_row + Math.floor(cylinderRows() / 2), 0];
   }
   state.history = []; state.traces = { t: [], force: [], tactel: [] }; state.trail = [];
+  state.tracks = new Map();
   state.lastIndex = null; state.lastSerial = null;   // a (re)connection starts afresh
   if (!forcePlot) makePlots();
   onStatus(L.status);
@@ -646,6 +716,7 @@ function onFrame(f, fromHistory) {
   }
   if (state.lastIndex !== null && f.index < state.lastIndex) {   // a seek back
     state.history = []; state.traces = { t: [], force: [], tactel: [] }; state.trail = [];
+    state.tracks = new Map();
   }
   state.lastIndex = f.index;
   state.latest = f;
@@ -656,7 +727,8 @@ function onFrame(f, fromHistory) {
   }
   const est = f.estimate;
   const touching = est && isContact(est);
-  if (touching) {
+  if (state.layout.multi_contact) updateTracks(f);
+  else if (touching) {
     const L = state.layout;
     if (L.closes && !state.touching) {
       // a new touch near the top or bottom edge: centre the map on it, so a contact
@@ -677,6 +749,22 @@ function onFrame(f, fromHistory) {
   showHealth(f);
   showPlayback(f.playback);
   state.dirty = true;
+}
+
+// each contact id's trail; an id unseen for TRAIL frames is dropped
+function updateTracks(f) {
+  const est = f.estimate;
+  for (const c of (est && est.contacts) || []) {
+    if (c.u_mm === null || c.v_mm === null) continue;
+    const track = state.tracks.get(c.id) || { points: [], seen: f.index };
+    track.points.push({ u: c.u_mm, v: c.v_mm });
+    if (track.points.length > TRAIL) track.points.shift();
+    track.seen = f.index;
+    state.tracks.set(c.id, track);
+  }
+  for (const [id, track] of state.tracks) {
+    if (f.index - track.seen > TRAIL) state.tracks.delete(id);
+  }
 }
 
 function connect() {
@@ -719,6 +807,11 @@ canvas.addEventListener("click", (e) => {
   const rect = canvas.getBoundingClientRect();
   const t = tactelAt(e.clientX - rect.left, e.clientY - rect.top);
   if (t) { state.selected = t; refillTactelTrace(); state.dirty = true; }
+});
+$("rezero").addEventListener("click", () => send("rezero"));
+document.addEventListener("keydown", (e) => {
+  // z: re-zero (take the baseline anew from the next frames; lift everything first)
+  if (e.key === "z" && !e.ctrlKey && !e.metaKey && !e.altKey && e.target.tagName !== "INPUT") send("rezero");
 });
 $("play").addEventListener("click", () => send($("play").textContent === "pause" ? "pause" : "play"));
 $("step-back").addEventListener("click", () => send("step", -1));

@@ -1,0 +1,294 @@
+"""The numbers and the figure of docs/contacts.md: the two-contact resolution limit of every
+pad preset and the paper's finger, position and force errors against separation beside
+the Cramer-Rao bound, and single-contact accuracy of the three position methods.
+
+Run: ``python scripts/contacts_numbers.py`` prints the Markdown block that
+docs/contacts.md holds (``tests/estimate/test_contacts_doc.py`` checks that it does) and
+writes ``docs/images/contacts_resolution.png``.
+
+How the numbers are made (all seeded, so a run repeats them):
+
+* **Frames**: the twin (``tactsense.simulate``) with read noise and quantization only
+  (``FLAWS``): no gain spread (a calibrated array), no creep, no jitter, so the errors
+  are those of the estimators at the noise limit. Each placement is held three scans
+  and the last is used (a scan samples the taxels in turn).
+* **Two contacts**: two equal 1.6-mm spheres of 50 g each, ``s`` apart along the
+  columns (y; along the finger's axis for the finger), their midpoint at ``PHASES``
+  sub-taxel offsets from the middle of the array. A frame *resolves* them when
+  :func:`~tactsense.estimate.contacts.find_contacts` reports exactly two contacts; the
+  resolution limit is the smallest separation from which on at least 90 % of
+  placements do. Errors: each true contact matched to the nearer estimate.
+* **Cramer-Rao bound** (two contacts): the Fisher information of the noise-free
+  response ``F1 k(p1) + F2 k(p2)`` (six parameters: two positions, two forces) under
+  independent Gaussian noise of the readings (read noise and quantization, in the
+  signal's units), with ``k`` the twin's response to one sphere (central differences of
+  noise-free simulations, step 0.05 mm); the bound on one contact's y position.
+* **One contact**: 100 random positions inside the array (a taxel from the edge), 50 g;
+  errors of the windowed-sinc interpolation, the centre of pressure and the
+  model-based fit (pads), in taxels and percent of force.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+import tactsense as ts
+from tactsense.estimate.contacts import find_contacts
+from tactsense.physics.contact import grams_force
+from tactsense.physics.indenters import SphereProbe
+from tactsense.simulate import Scenario, Step
+
+FLAWS = ["noise", "quantization"]
+PADS = ("pad4", "pad16", "pad12x32")
+PHASES = 6
+SEPARATIONS_TAXEL = np.round(np.arange(0.6, 4.01, 0.2), 2)
+FORCE_N = grams_force(50.0)
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _pitch(spec) -> float:
+    """Spacing along the separation [mm]: columns (y) on a pad, rings on the finger."""
+    return spec.grid.col_pitch_mm if spec.kind == "pad" else float(np.diff(spec.row_axial_mm)[1])
+
+
+def _probe(spec, along_mm: float, across_mm: float, force_n: float = FORCE_N):
+    if spec.kind == "pad":
+        return SphereProbe(across_mm, along_mm, force_n)
+    return ts.Probe(along_mm, across_mm, force_n)
+
+
+def _middle(spec) -> tuple[float, float]:
+    if spec.kind == "pad":
+        g = spec.grid
+        return 0.5 * (g.cols - 1) * g.col_pitch_mm, 0.5 * (g.rows - 1) * g.row_pitch_mm
+    # the finger: the middle of the cylinder's rings, between two columns' angles
+    rings = spec.row_axial_mm[1:]  # row 0 is the tip's
+    return float(np.mean(rings)), 0.5 * float(spec.col_angle_deg[0] + spec.col_angle_deg[1])
+
+
+def _frames(spec, placements, rng):
+    """The last of three scans of each placement (a tuple of probes; a scan samples the
+    taxels one after another, so the first scan of a placement mixes it with the one
+    before), after half a second untouched."""
+    period = spec.scan_period_s
+    steps = [Step((), 0.5, "baseline")]
+    steps += [Step(tuple(p), 3 * period, "") for p in placements]
+    rec = ts.simulate(spec, Scenario(tuple(steps)), flaws=FLAWS, rng=rng)
+    step = rec.truth["frame_step"]
+    last = np.flatnonzero((step > 0) & np.r_[step[1:] != step[:-1], True])
+    base = np.median(rec.frames[: int(0.4 / period)].astype(float), axis=0)
+    return rec.frames[last], base
+
+
+def _noise_sigma(spec) -> float:
+    """Standard deviation of one reading in the signal's units [-]: read noise and
+    quantization [counts] over counts per unit strain (resistive) or over the untouched
+    reading (capacitive: eq. 4 at small deflection)."""
+    counts = float(np.sqrt(spec.flaws.read_noise_counts**2 + 1.0 / 12.0))
+    if spec.kind == "pad" and spec.transduction.kind == "resistive":
+        return counts / spec.transduction.counts_per_strain
+    return counts / spec.electronics.nominal_counts
+
+
+def _signal(spec, probes) -> np.ndarray:
+    """Noise-free, unquantized signal of one placement [-]: the physics alone (the
+    layer's strain on a pad, eqs. 1-2 on the finger), no converter."""
+    if spec.kind == "pad":
+        from tactsense.physics.pad_response import pad_strain
+
+        strain = pad_strain(spec, list(probes))
+        if spec.transduction.kind == "resistive":
+            return strain
+        return spec.transduction.strain_gain * strain
+    from tactsense.physics.array_response import tactel_deflection
+
+    return tactel_deflection(spec, list(probes))
+
+
+def two_contact_bound(spec, separation_mm: float) -> float:
+    """Cramer-Rao bound on one contact's position along the separation [mm]."""
+    mid_a, mid_c = _middle(spec)
+    a1, a2 = mid_a - separation_mm / 2, mid_a + separation_mm / 2
+    h = 0.05
+    columns = []
+    for k, (a, f) in enumerate(((a1, FORCE_N), (a2, FORCE_N))):
+        other = [_probe(spec, a2 if k == 0 else a1, mid_c)]
+        plus = _signal(spec, [_probe(spec, a + h, mid_c, f), *other])
+        minus = _signal(spec, [_probe(spec, a - h, mid_c, f), *other])
+        columns.append(((plus - minus) / (2 * h)).ravel())
+        across = _signal(spec, [_probe(spec, a, mid_c + h, f), *other]) - _signal(
+            spec, [_probe(spec, a, mid_c - h, f), *other]
+        )
+        columns.append((across / (2 * h)).ravel())
+        one = _signal(spec, [_probe(spec, a, mid_c, f)])
+        columns.append((one / f).ravel())  # linear in force (flaws off)
+    jac = np.column_stack(columns)
+    sigma = _noise_sigma(spec)
+    fisher = jac.T @ jac / sigma**2
+    try:
+        cov = np.linalg.inv(fisher)
+    except np.linalg.LinAlgError:
+        return float("inf")
+    return float(np.sqrt(max(cov[0, 0], 0.0)))
+
+
+def resolution(spec, rng):
+    """Per separation [taxel]: share resolved, RMS position error [mm], mean |force
+    error| [%] over the placements resolved as two."""
+    pitch = _pitch(spec)
+    mid_a, mid_c = _middle(spec)
+    offsets = (np.arange(PHASES) + 0.5) / PHASES - 0.5
+    placements, truths = [], []
+    for s in SEPARATIONS_TAXEL:
+        for o in offsets:
+            centre = mid_a + o * pitch
+            a1, a2 = centre - s * pitch / 2, centre + s * pitch / 2
+            placements.append((_probe(spec, a1, mid_c), _probe(spec, a2, mid_c)))
+            truths.append((a1, a2))
+    frames, base = _frames(spec, placements, rng)
+    method = "fit" if spec.kind == "pad" else "interpolate"
+    table = find_contacts(frames, spec, baseline=base, method=method, max_contacts=4)
+    along = table.y_mm if spec.kind == "pad" else table.extra["axial_mm"]
+    n = table.per_frame_counts()
+    out = []
+    for i, s in enumerate(SEPARATIONS_TAXEL):
+        sel = range(i * PHASES, (i + 1) * PHASES)
+        two = [k for k in sel if n[k] == 2]
+        errors, forces = [], []
+        for k in two:
+            rows = np.flatnonzero(table.frame == k)
+            est = along[rows]
+            for t in truths[k]:
+                j = int(np.argmin(np.abs(est - t)))
+                errors.append(est[j] - t)
+                forces.append(table.force_n[rows[j]] / FORCE_N - 1)
+        out.append(
+            (
+                float(s),
+                len(two) / PHASES,
+                float(np.sqrt(np.mean(np.square(errors)))) if errors else float("nan"),
+                float(100 * np.mean(np.abs(forces))) if forces else float("nan"),
+            )
+        )
+    return out
+
+
+def limit(rows) -> float:
+    """Smallest separation [taxel] from which on at least 90 % of placements resolve."""
+    ok = [r[1] >= 0.9 for r in rows]
+    for k in range(len(rows)):
+        if all(ok[k:]):
+            return rows[k][0]
+    return float("nan")
+
+
+def single(spec, rng, n=100):
+    """Mean / worst |position error| [taxel] and |force error| [%] per method (pads)."""
+    g = spec.grid
+    r = np.random.default_rng(rng)
+    xs = r.uniform(1.0, g.rows - 2.0, n) * g.row_pitch_mm
+    ys = r.uniform(1.0, g.cols - 2.0, n) * g.col_pitch_mm
+    placements = [(SphereProbe(x, y, FORCE_N),) for x, y in zip(xs, ys, strict=True)]
+    frames, base = _frames(spec, placements, rng)
+    out = {}
+    for method in ("interpolate", "cop", "fit"):
+        t = find_contacts(frames, spec, baseline=base, method=method, max_contacts=1)
+        k = t.frame
+        dx = (t.x_mm - xs[k]) / g.row_pitch_mm
+        dy = (t.y_mm - ys[k]) / g.col_pitch_mm
+        pos = np.hypot(dx, dy)
+        force = 100 * np.abs(t.force_n / FORCE_N - 1)
+        out[method] = (float(np.mean(pos)), float(np.max(pos)), float(np.mean(force)),
+                       float(np.max(force)), len(t) / n)  # fmt: skip
+    return out
+
+
+def compute(rng: int = 0):
+    results = {}
+    for name in (*PADS, "initial"):
+        spec = ts.preset(name)
+        rows = resolution(spec, rng)
+        pitch = _pitch(spec)
+        bounds = {s: two_contact_bound(spec, s * pitch) for s in (1.0, 2.0, 3.0)}
+        results[name] = {"rows": rows, "pitch": pitch, "bounds": bounds,
+                         "single": single(spec, rng) if spec.kind == "pad" else None}  # fmt: skip
+    return results
+
+
+def block(results=None) -> str:
+    results = compute() if results is None else results
+    lines = [
+        "<!-- generated by scripts/contacts_numbers.py: do not edit by hand -->",
+        "",
+        "| sensor | pitch [mm] | resolved from [taxel] | RMS position error at 1 / 2 / 3 "
+        "taxels [mm] | CRB at 1 / 2 / 3 taxels [mm] | mean force error at 2 / 3 taxels [%] |",
+        "|---|---|---|---|---|---|",
+    ]
+    for name, r in results.items():
+        by = {row[0]: row for row in r["rows"]}
+
+        def cell(s, k, fmt, by=by):
+            row = by.get(s)
+            return "–" if row is None or not np.isfinite(row[k]) else format(row[k], fmt)
+
+        lines.append(
+            f"| {name} | {r['pitch']:.3g} | {limit(r['rows']):.1f} | "
+            f"{cell(1.0, 2, '.2f')} / {cell(2.0, 2, '.2f')} / {cell(3.0, 2, '.2f')} | "
+            + " / ".join(f"{r['bounds'][s]:.3f}" for s in (1.0, 2.0, 3.0))
+            + f" | {cell(2.0, 3, '.0f')} / {cell(3.0, 3, '.0f')} |"
+        )
+    lines += [
+        "",
+        "| pad | method | position mean / worst [taxel] | force mean / worst [%] | found |",
+        "|---|---|---|---|---|",
+    ]
+    for name, r in results.items():
+        if r["single"] is None:
+            continue
+        for method, (pm, pw, fm, fw, found) in r["single"].items():
+            lines.append(
+                f"| {name} | {method} | {pm:.3f} / {pw:.3f} | {fm:.1f} / {fw:.1f} | "
+                f"{100 * found:.0f} % |"
+            )
+    return "\n".join(lines) + "\n"
+
+
+def figure(results, path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 3, figsize=(13, 3.8))
+    for name, r in results.items():
+        rows = np.array(r["rows"])
+        axes[0].plot(rows[:, 0], 100 * rows[:, 1], marker="o", ms=3, label=name)
+        line = axes[1].plot(rows[:, 0], rows[:, 2] / r["pitch"], marker="o", ms=3, label=name)
+        seps = sorted(r["bounds"])
+        axes[1].plot(seps, [r["bounds"][s] / r["pitch"] for s in seps], ls="--",
+                     color=line[0].get_color())  # fmt: skip
+        axes[2].plot(rows[:, 0], rows[:, 3], marker="o", ms=3, label=name)
+    axes[0].set(xlabel="separation [taxel pitches]", ylabel="placements seen as two [%]",
+                title="two equal 50-g probes")  # fmt: skip
+    axes[0].axhline(90, color="grey", lw=0.8)
+    axes[1].set(xlabel="separation [taxel pitches]", ylabel="RMS position error [taxel]",
+                title="position (dashed: Cramer-Rao bound)", yscale="log")  # fmt: skip
+    axes[2].set(xlabel="separation [taxel pitches]", ylabel="mean |force error| [%]",
+                title="force")  # fmt: skip
+    axes[0].legend()
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+
+
+def main() -> None:
+    results = compute()
+    sys.stdout.write(block(results))
+    figure(results, ROOT / "docs" / "images" / "contacts_resolution.png")
+
+
+if __name__ == "__main__":
+    main()
