@@ -101,38 +101,50 @@ def _signal(spec, probes) -> np.ndarray:
 
         strain = pad_strain(spec, list(probes))
         if spec.transduction.kind == "resistive":
-            return strain
+            return np.maximum(strain, 0.0)  # a resistive taxel reads compression only
         return spec.transduction.strain_gain * strain
     from tactsense.physics.array_response import tactel_deflection
 
     return tactel_deflection(spec, list(probes))
 
 
-def two_contact_bound(spec, separation_mm: float) -> float:
-    """Cramer-Rao bound on one contact's position along the separation [mm]."""
+def two_contact_bound(spec, separation_mm: float, centre_offset_mm: float = 0.0) -> float:
+    """Cramer-Rao bound on one contact's position along the separation [mm], for the pair
+    centred ``centre_offset_mm`` from the middle of the array (inf where the readings do
+    not change with it: a probe on a taxel's centre that moves no neighbour)."""
     mid_a, mid_c = _middle(spec)
-    a1, a2 = mid_a - separation_mm / 2, mid_a + separation_mm / 2
+    centre = mid_a + centre_offset_mm
+    a1, a2 = centre - separation_mm / 2, centre + separation_mm / 2
     h = 0.05
     columns = []
-    for k, (a, f) in enumerate(((a1, FORCE_N), (a2, FORCE_N))):
+    for k, a in enumerate((a1, a2)):
         other = [_probe(spec, a2 if k == 0 else a1, mid_c)]
-        plus = _signal(spec, [_probe(spec, a + h, mid_c, f), *other])
-        minus = _signal(spec, [_probe(spec, a - h, mid_c, f), *other])
+        plus = _signal(spec, [_probe(spec, a + h, mid_c), *other])
+        minus = _signal(spec, [_probe(spec, a - h, mid_c), *other])
         columns.append(((plus - minus) / (2 * h)).ravel())
-        across = _signal(spec, [_probe(spec, a, mid_c + h, f), *other]) - _signal(
-            spec, [_probe(spec, a, mid_c - h, f), *other]
-        )
-        columns.append((across / (2 * h)).ravel())
-        one = _signal(spec, [_probe(spec, a, mid_c, f)])
-        columns.append((one / f).ravel())  # linear in force (flaws off)
-    jac = np.column_stack(columns)
-    sigma = _noise_sigma(spec)
-    fisher = jac.T @ jac / sigma**2
-    try:
-        cov = np.linalg.inv(fisher)
-    except np.linalg.LinAlgError:
+        up = _signal(spec, [_probe(spec, a, mid_c + h), *other])
+        down = _signal(spec, [_probe(spec, a, mid_c - h), *other])
+        columns.append(((up - down) / (2 * h)).ravel())
+        f_up = _signal(spec, [_probe(spec, a, mid_c, FORCE_N * 1.01), *other])
+        f_down = _signal(spec, [_probe(spec, a, mid_c, FORCE_N * 0.99), *other])
+        columns.append(((f_up - f_down) / (0.02 * FORCE_N)).ravel())
+    jac = np.column_stack(columns) / _noise_sigma(spec)
+    fisher = jac.T @ jac
+    if np.linalg.cond(fisher) > 1e14:
         return float("inf")
-    return float(np.sqrt(max(cov[0, 0], 0.0)))
+    return float(np.sqrt(max(np.linalg.inv(fisher)[0, 0], 0.0)))
+
+
+def bounds(spec, separations=(1.0, 2.0, 3.0)) -> dict:
+    """Median over the placements' sub-taxel offsets of the two-contact bound [mm], and
+    the share of offsets where it is finite, per separation [taxel]."""
+    pitch = _pitch(spec)
+    offsets = ((np.arange(PHASES) + 0.5) / PHASES - 0.5) * pitch
+    out = {}
+    for s in separations:
+        values = np.array([two_contact_bound(spec, s * pitch, o) for o in offsets])
+        out[s] = (float(np.median(values)), float(np.mean(np.isfinite(values))))
+    return out
 
 
 def resolution(spec, rng):
@@ -142,7 +154,9 @@ def resolution(spec, rng):
     mid_a, mid_c = _middle(spec)
     offsets = (np.arange(PHASES) + 0.5) / PHASES - 0.5
     placements, truths = [], []
-    for s in SEPARATIONS_TAXEL:
+    n_along = spec.shape[1] if spec.kind == "pad" else spec.shape[0] - 1
+    fits = [s for s in SEPARATIONS_TAXEL if s + 1.0 <= n_along - 1]  # both on the array
+    for s in fits:
         for o in offsets:
             centre = mid_a + o * pitch
             a1, a2 = centre - s * pitch / 2, centre + s * pitch / 2
@@ -154,7 +168,7 @@ def resolution(spec, rng):
     along = table.y_mm if spec.kind == "pad" else table.extra["axial_mm"]
     n = table.per_frame_counts()
     out = []
-    for i, s in enumerate(SEPARATIONS_TAXEL):
+    for i, s in enumerate(fits):
         sel = range(i * PHASES, (i + 1) * PHASES)
         two = [k for k in sel if n[k] == 2]
         errors, forces = [], []
@@ -170,7 +184,8 @@ def resolution(spec, rng):
                 float(s),
                 len(two) / PHASES,
                 float(np.sqrt(np.mean(np.square(errors)))) if errors else float("nan"),
-                float(100 * np.mean(np.abs(forces))) if forces else float("nan"),
+                float(100 * np.nanmean(np.abs(forces))) if np.isfinite(forces).any()
+                else float("nan"),
             )
         )
     return out
@@ -200,9 +215,14 @@ def single(spec, rng, n=100):
         dx = (t.x_mm - xs[k]) / g.row_pitch_mm
         dy = (t.y_mm - ys[k]) / g.col_pitch_mm
         pos = np.hypot(dx, dy)
-        force = 100 * np.abs(t.force_n / FORCE_N - 1)
-        out[method] = (float(np.mean(pos)), float(np.max(pos)), float(np.mean(force)),
-                       float(np.max(force)), len(t) / n)  # fmt: skip
+        force = 100 * np.abs(t.force_n / FORCE_N - 1)  # NaN where a taxel saturated
+        finite = np.isfinite(force)
+        out[method] = (
+            float(np.mean(pos)), float(np.max(pos)),
+            float(np.mean(force[finite])) if finite.any() else float("nan"),
+            float(np.max(force[finite])) if finite.any() else float("nan"),
+            len(t) / n, float(np.mean(~finite)),
+        )  # fmt: skip
     return out
 
 
@@ -212,10 +232,16 @@ def compute(rng: int = 0):
         spec = ts.preset(name)
         rows = resolution(spec, rng)
         pitch = _pitch(spec)
-        bounds = {s: two_contact_bound(spec, s * pitch) for s in (1.0, 2.0, 3.0)}
-        results[name] = {"rows": rows, "pitch": pitch, "bounds": bounds,
+        results[name] = {"rows": rows, "pitch": pitch, "bounds": bounds(spec),
                          "single": single(spec, rng) if spec.kind == "pad" else None}  # fmt: skip
     return results
+
+
+def _bound_cell(bound) -> str:
+    """The median bound, with the share of offsets where it is finite when not all."""
+    median, finite = bound
+    text = "inf" if not np.isfinite(median) else f"{median:.3g}"
+    return text if finite == 1.0 else f"{text} ({round(finite * PHASES)}/{PHASES} finite)"
 
 
 def block(results=None) -> str:
@@ -234,24 +260,27 @@ def block(results=None) -> str:
             row = by.get(s)
             return "–" if row is None or not np.isfinite(row[k]) else format(row[k], fmt)
 
+        lim = limit(r["rows"])
         lines.append(
-            f"| {name} | {r['pitch']:.3g} | {limit(r['rows']):.1f} | "
+            f"| {name} | {r['pitch']:.3g} | {'–' if not np.isfinite(lim) else f'{lim:.1f}'} | "
             f"{cell(1.0, 2, '.2f')} / {cell(2.0, 2, '.2f')} / {cell(3.0, 2, '.2f')} | "
-            + " / ".join(f"{r['bounds'][s]:.3f}" for s in (1.0, 2.0, 3.0))
+            + " / ".join(_bound_cell(r["bounds"][s]) for s in (1.0, 2.0, 3.0))
             + f" | {cell(2.0, 3, '.0f')} / {cell(3.0, 3, '.0f')} |"
         )
     lines += [
         "",
-        "| pad | method | position mean / worst [taxel] | force mean / worst [%] | found |",
-        "|---|---|---|---|---|",
+        "| pad | method | position mean / worst [taxel] | force mean / worst [%] | found "
+        "| saturated (force NaN) |",
+        "|---|---|---|---|---|---|",
     ]
     for name, r in results.items():
         if r["single"] is None:
             continue
-        for method, (pm, pw, fm, fw, found) in r["single"].items():
+        for method, (pm, pw, fm, fw, found, saturated) in r["single"].items():
+            force = "–" if not np.isfinite(fm) else f"{fm:.1f} / {fw:.1f}"
             lines.append(
-                f"| {name} | {method} | {pm:.3f} / {pw:.3f} | {fm:.1f} / {fw:.1f} | "
-                f"{100 * found:.0f} % |"
+                f"| {name} | {method} | {pm:.3f} / {pw:.3f} | {force} | "
+                f"{100 * found:.0f} % | {100 * saturated:.0f} % |"
             )
     return "\n".join(lines) + "\n"
 
@@ -268,7 +297,7 @@ def figure(results, path: Path) -> None:
         axes[0].plot(rows[:, 0], 100 * rows[:, 1], marker="o", ms=3, label=name)
         line = axes[1].plot(rows[:, 0], rows[:, 2] / r["pitch"], marker="o", ms=3, label=name)
         seps = sorted(r["bounds"])
-        axes[1].plot(seps, [r["bounds"][s] / r["pitch"] for s in seps], ls="--",
+        axes[1].plot(seps, [r["bounds"][s][0] / r["pitch"] for s in seps], ls="--",
                      color=line[0].get_color())  # fmt: skip
         axes[2].plot(rows[:, 0], rows[:, 3], marker="o", ms=3, label=name)
     axes[0].set(xlabel="separation [taxel pitches]", ylabel="placements seen as two [%]",
@@ -277,7 +306,7 @@ def figure(results, path: Path) -> None:
     axes[1].set(xlabel="separation [taxel pitches]", ylabel="RMS position error [taxel]",
                 title="position (dashed: Cramer-Rao bound)", yscale="log")  # fmt: skip
     axes[2].set(xlabel="separation [taxel pitches]", ylabel="mean |force error| [%]",
-                title="force")  # fmt: skip
+                title="force", yscale="log")  # fmt: skip
     axes[0].legend()
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)

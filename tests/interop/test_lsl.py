@@ -166,6 +166,64 @@ def test_stream_metadata_follows_the_xdf_meta_data_conventions(kind):
     assert contacts.findtext("desc/acquisition/model") == "tactsense twin"
     rows = [(c.findtext("label"), c.findtext("unit"), c.findtext("type"))
             for c in contacts.findall("desc/channels/channel")]  # fmt: skip
-    assert [r[0] for r in rows] == list(CONTACT_CHANNELS)
+    # the finger's one contact; a pad's or point set's fixed slots of tracked contacts
+    from tactsense.interop.lsl import SLOT_CHANNELS, SLOTS
+
+    expected = CONTACT_CHANNELS if sensor.kind == "finger" else SLOT_CHANNELS
+    assert [r[0] for r in rows] == list(expected)
     assert all(unit and kind for _, unit, kind in rows)
     assert dict((r[0], r[1]) for r in rows)["force_n"] == "N"
+    if sensor.kind != "finger":
+        units = dict((r[0], r[1]) for r in rows)
+        assert units[f"c{SLOTS - 1}_y_mm"] == "mm" and units["c0_force_n"] == "N"
+        assert contacts.findtext("desc/tactsense/slots") == str(SLOTS)
+
+
+def test_a_pad_contacts_outlet_carries_the_slots():
+    """A pad's tracked contacts on pylsl's own inlet: per frame the count, total force,
+    flags and latency, then each contact's id, position and force in its slot, NaN in the
+    slots left over."""
+    from tactsense import flat_scenarios as fs
+    from tactsense.interop.lsl import SLOT_CHANNELS, SLOTS
+    from tactsense.stream.live import LiveContacts
+
+    pylsl = _pylsl()
+    pad = ts.preset("pad16")
+    rec = ts.simulate(pad, fs.two_probes(pad), rng=0)
+    sensor = _unique_sensor(rec)
+    identity = {"serial": f"pad-{uuid.uuid4().hex[:6]}"}
+    outlets = LslOutlets(sensor, identity, 100.0)
+    try:
+        (found,) = pylsl.resolve_byprop(
+            "source_id", f"tactsense:{identity['serial']}:contacts", 1, 5
+        )
+        inlet = pylsl.StreamInlet(found)
+        inlet.open_stream(timeout=5)
+        time.sleep(0.3)
+        locator = LiveContacts(sensor)
+        estimates = []
+        for frame in _frames(rec):
+            estimate = locator(frame)
+            outlets.push(frame, estimate)
+            if estimate is not None:
+                estimates.append(estimate)
+        got = []
+        deadline = time.time() + 10
+        while len(got) < len(estimates) and time.time() < deadline:
+            samples, _ = inlet.pull_chunk(timeout=0.2)
+            got.extend(samples)
+        got = np.asarray(got)
+        assert got.shape == (len(estimates), len(SLOT_CHANNELS))
+        column = {name: k for k, name in enumerate(SLOT_CHANNELS)}
+        for sample, estimate in zip(got, estimates, strict=True):
+            assert sample[column["n_contacts"]] == estimate["n_contacts"]
+            for k in range(SLOTS):
+                if k < estimate["n_contacts"]:
+                    c = estimate["contacts"][k]
+                    assert sample[column[f"c{k}_id"]] == c["id"]
+                    assert sample[column[f"c{k}_y_mm"]] == pytest.approx(c["y_mm"])
+                else:
+                    assert np.isnan(sample[column[f"c{k}_id"]])
+        assert got[:, column["n_contacts"]].max() == 2
+    finally:
+        outlets.close()

@@ -1,0 +1,76 @@
+"""docs/contacts.md holds what its commands and scripts give: the generated resolution and
+accuracy block, the summary line of its example, and a pandas example that runs."""
+
+import importlib.util
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+DOC = ROOT / "docs" / "contacts.md"
+
+
+def _script():
+    spec = importlib.util.spec_from_file_location(
+        "contacts_numbers", ROOT / "scripts" / "contacts_numbers.py"
+    )
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _cli(*args, cwd):
+    done = subprocess.run([sys.executable, "-m", "tactsense.cli", *args], cwd=cwd,
+                          capture_output=True, text=True, timeout=300)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    return " ".join(done.stderr.split())
+
+
+@pytest.fixture(scope="module")
+def example(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("doc")
+    _cli("simulate", "--sensor", "pad16", "--scenario", "two-probes", "--out", "two.h5",
+         cwd=folder)  # fmt: skip
+    return folder
+
+
+def test_the_generated_block_is_what_the_script_gives():
+    doc = DOC.read_text(encoding="utf-8")
+    assert _script().block() in doc
+
+
+def test_the_example_lines_are_what_locate_prints(example):
+    doc = " ".join(DOC.read_text(encoding="utf-8").split())
+    line = _cli("locate", "two.h5", "--out", "est.parquet", cwd=example)
+    said = re.search(r"wrote est\.parquet: .* splits", line).group(0)
+    assert said in doc
+    warning = _cli("locate", "two.h5", "--baseline-frames", "60", "--out", "late.csv",
+                   cwd=example)  # fmt: skip
+    said = re.search(r"warning: .* untouched frames first", warning).group(0)
+    assert said in doc
+
+
+def test_the_pandas_example_runs(example):
+    _cli("locate", "two.h5", "--out", "est.parquet", "--force", cwd=example)
+    text = DOC.read_text(encoding="utf-8")
+    code = re.search(r"### Loading it in pandas\n\n```python\n(.*?)```", text, re.S).group(1)
+    done = subprocess.run([sys.executable, "-c", code], cwd=example, capture_output=True,
+                          text=True, timeout=120)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert re.fullmatch(r"3 ids, at most 2 at once, 3 births\n", done.stdout), done.stdout
+
+
+def test_the_column_table_names_every_column(example):
+    import pandas as pd
+
+    _cli("locate", "two.h5", "--out", "cols.parquet", cwd=example)
+    text = DOC.read_text(encoding="utf-8")
+    table = text.split("## The long table", 1)[1].split("### Loading", 1)[0]
+    named = set()
+    for row in table.splitlines():
+        if row.startswith("| `"):
+            named |= set(re.findall(r"`([a-z_]+)`", row.split("|")[1]))
+    assert named == set(pd.read_parquet(example / "cols.parquet").columns)
