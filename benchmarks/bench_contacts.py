@@ -80,6 +80,7 @@ def main(n=100_000):
     per_count = 1 / spec.transduction.counts_per_strain
     threshold = 10 * per_count
     rows = []
+    methods = []
     for n_probes in (1, 3):
         frames = make_frames(spec, n, n_probes, rng)
         find_contacts(frames[:100], spec, baseline=baseline)  # compile
@@ -103,6 +104,12 @@ def main(n=100_000):
         found = np.bincount(table.per_frame_counts())
         rows.append((n_probes, n / t_find, n / t_track, n / t_ref, t_ref / t_find, found,
                      n / t_tracker_only, n / t_ref_tracker))
+        m_fit = min(n, 20_000)
+        for method in ("cop", "fit"):
+            find_contacts(frames[:10], spec, baseline=baseline, method=method)  # compile
+            t = best_of(1, lambda method=method: find_contacts(
+                frames[:m_fit], spec, baseline=baseline, max_contacts=k, method=method))
+            methods.append((n_probes, method, m_fit / t))
     print(f"{n:,} frames of 16 x 16 counts, one core (best of 3; reference on 20,000 frames)")
     print("| probes | find_contacts [frames/s] | find_contacts + ContactTracker [frames/s] "
           "| reference: ndimage.label + centre of pressure [frames/s] | ratio | "
@@ -112,6 +119,11 @@ def main(n=100_000):
     for n_probes, fast, track_rate, ref, ratio, found, tracker, ref_tracker in rows:
         print(f"| {n_probes} | {fast:,.0f} | {track_rate:,.0f} | {ref:,.0f} | {ratio:.0f}x | "
               f"{tracker:,.0f} | {ref_tracker:,.0f} | {dict(enumerate(found.tolist()))} |")
+    print("\nOther position methods (find_contacts only, 20,000 frames):\n")
+    print("| probes | method | frames/s |")
+    print("|---|---|---|")
+    for n_probes, method, rate in methods:
+        print(f"| {n_probes} | {method} | {rate:,.0f} |")
 
 
 if __name__ == "__main__":
