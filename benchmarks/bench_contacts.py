@@ -28,9 +28,10 @@ def make_frames(spec, n, n_probes, rng):
     kernel, step, half = pad_force_kernel(spec)
     rows, cols = spec.shape
     strain = np.zeros((n, rows, cols))
-    n_sub = kernel.shape[0] - 1
     # slowly moving probes, kept 4 taxels apart
-    centres = np.array([[4.0 + 4 * (k % 2) + 3.5 * (k // 2), 3.0 + 5.0 * k] for k in range(n_probes)])
+    centres = np.array(
+        [[4.0 + 4 * (k % 2) + 3.5 * (k // 2), 3.0 + 5.0 * k] for k in range(n_probes)]
+    )
     t = np.arange(n)
     for k in range(n_probes):
         u = centres[k, 0] + 1.5 * np.sin(2 * np.pi * t / 5000 + k)
@@ -73,6 +74,36 @@ def best_of(repeats, work):
     return min(times)
 
 
+def measure(spec, frames, n_probes, baseline, per_count, threshold):
+    """One row of the table, and the other methods' rates, for frames of n_probes."""
+    n = len(frames)
+    find_contacts(frames[:100], spec, baseline=baseline)  # compile
+    k = 1 if n_probes == 1 else 8
+    t_find = best_of(3, lambda: find_contacts(frames, spec, baseline=baseline, max_contacts=k))
+    table = find_contacts(frames, spec, baseline=baseline, max_contacts=k)
+
+    def tracked():
+        found = find_contacts(frames, spec, baseline=baseline, max_contacts=k)
+        ContactTracker(spec.scan_period_s).update(found)
+
+    t_track = best_of(3, tracked)
+    t_tracker_only = best_of(3, lambda: ContactTracker(spec.scan_period_s).update(table))
+    m = min(n, 20_000)
+    part = find_contacts(frames[:m], spec, baseline=baseline, max_contacts=k)
+    t_ref_tracker = best_of(1, lambda: ReferenceTracker(spec.scan_period_s).update(part)) * n / m
+    t_ref = best_of(1, lambda: reference(frames[:m], baseline, per_count, threshold)) * n / m
+    found = np.bincount(table.per_frame_counts())
+    row = (n_probes, n / t_find, n / t_track, n / t_ref, t_ref / t_find, found,
+           n / t_tracker_only, n / t_ref_tracker)  # fmt: skip
+    timed = []
+    for method in ("cop", "fit"):
+        find_contacts(frames[:10], spec, baseline=baseline, method=method)  # compile
+        t = best_of(1, lambda method=method: find_contacts(
+            frames[:m], spec, baseline=baseline, max_contacts=k, method=method))  # fmt: skip
+        timed.append((n_probes, method, m / t))
+    return row, timed
+
+
 def main(n=100_000):
     spec = load_sensor("pad16")
     rng = np.random.default_rng(0)
@@ -83,42 +114,22 @@ def main(n=100_000):
     methods = []
     for n_probes in (1, 3):
         frames = make_frames(spec, n, n_probes, rng)
-        find_contacts(frames[:100], spec, baseline=baseline)  # compile
-        single = n_probes == 1
-        k = 1 if single else 8
-        t_find = best_of(3, lambda: find_contacts(frames, spec, baseline=baseline, max_contacts=k))
-        table = find_contacts(frames, spec, baseline=baseline, max_contacts=k)
-
-        def tracked():
-            table = find_contacts(frames, spec, baseline=baseline, max_contacts=k)
-            ContactTracker(spec.scan_period_s).update(table)
-
-        t_track = best_of(3, tracked)
-        t_tracker_only = best_of(3, lambda: ContactTracker(spec.scan_period_s).update(table))
-        m_ref = min(n, 20_000)
-        part = find_contacts(frames[:m_ref], spec, baseline=baseline, max_contacts=k)
-        t_ref_tracker = best_of(1, lambda: ReferenceTracker(spec.scan_period_s).update(part))
-        t_ref_tracker *= n / m_ref
-        m = min(n, 20_000)
-        t_ref = best_of(1, lambda: reference(frames[:m], baseline, per_count, threshold)) * n / m
-        found = np.bincount(table.per_frame_counts())
-        rows.append((n_probes, n / t_find, n / t_track, n / t_ref, t_ref / t_find, found,
-                     n / t_tracker_only, n / t_ref_tracker))
-        m_fit = min(n, 20_000)
-        for method in ("cop", "fit"):
-            find_contacts(frames[:10], spec, baseline=baseline, method=method)  # compile
-            t = best_of(1, lambda method=method: find_contacts(
-                frames[:m_fit], spec, baseline=baseline, max_contacts=k, method=method))
-            methods.append((n_probes, method, m_fit / t))
+        row, timed = measure(spec, frames, n_probes, baseline, per_count, threshold)
+        rows.append(row)
+        methods += timed
     print(f"{n:,} frames of 16 x 16 counts, one core (best of 3; reference on 20,000 frames)")
-    print("| probes | find_contacts [frames/s] | find_contacts + ContactTracker [frames/s] "
-          "| reference: ndimage.label + centre of pressure [frames/s] | ratio | "
-          "ContactTracker alone [frames/s] | ReferenceTracker (scipy each frame) [frames/s] "
-          "| contacts per frame found |")
+    print(
+        "| probes | find_contacts [frames/s] | find_contacts + ContactTracker [frames/s] "
+        "| reference: ndimage.label + centre of pressure [frames/s] | ratio | "
+        "ContactTracker alone [frames/s] | ReferenceTracker (scipy each frame) [frames/s] "
+        "| contacts per frame found |"
+    )
     print("|---|---|---|---|---|---|---|---|")
     for n_probes, fast, track_rate, ref, ratio, found, tracker, ref_tracker in rows:
-        print(f"| {n_probes} | {fast:,.0f} | {track_rate:,.0f} | {ref:,.0f} | {ratio:.0f}x | "
-              f"{tracker:,.0f} | {ref_tracker:,.0f} | {dict(enumerate(found.tolist()))} |")
+        print(
+            f"| {n_probes} | {fast:,.0f} | {track_rate:,.0f} | {ref:,.0f} | {ratio:.0f}x | "
+            f"{tracker:,.0f} | {ref_tracker:,.0f} | {dict(enumerate(found.tolist()))} |"
+        )
     print("\nOther position methods (find_contacts only, 20,000 frames):\n")
     print("| probes | method | frames/s |")
     print("|---|---|---|")

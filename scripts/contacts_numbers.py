@@ -184,7 +184,8 @@ def resolution(spec, rng):
                 float(s),
                 len(two) / PHASES,
                 float(np.sqrt(np.mean(np.square(errors)))) if errors else float("nan"),
-                float(100 * np.nanmean(np.abs(forces))) if np.isfinite(forces).any()
+                float(100 * np.nanmean(np.abs(forces)))
+                if np.isfinite(forces).any()
                 else float("nan"),
             )
         )

@@ -8,7 +8,7 @@ from typer.testing import CliRunner
 import tactsense as ts
 import tactsense.flat_scenarios
 from tactsense.cli import app
-from tactsense.flat_scenarios import press, two_probes
+from tactsense.flat_scenarios import two_probes
 
 runner = CliRunner()
 
@@ -96,7 +96,10 @@ def test_a_pad_exports_its_frames_and_contacts_to_mcap(tmp_path):
     assert len(values) == len(recording.frames)
     np.testing.assert_array_equal(np.stack(values), recording.frames.reshape(len(values), -1))
     # the contacts are locate's long table, row for row (metres in the message)
-    assert runner.invoke(app, ["locate", str(rec_path), "--out", str(tmp_path / "c.csv")]).exit_code == 0
+    assert (
+        runner.invoke(app, ["locate", str(rec_path), "--out", str(tmp_path / "c.csv")]).exit_code
+        == 0
+    )
     table = pd.read_csv(tmp_path / "c.csv")
     assert len(contacts) == len(table) > 0
     got = np.array([[m.position.x, m.position.y, m.wrench.force.z] for m in contacts])

@@ -156,7 +156,7 @@ def locate_file(
     return {"frames": total, **tally.summary()}
 
 
-class iter_contacts:  # noqa: N801  (a generator with state the caller reads)
+class iter_contacts:
     """The tracked contacts of an open recording, a piece at a time: yields
     ``(start, n_frames, time_s, table, events)`` with the table's ``frame`` column
     counting from the recording's first frame.
@@ -178,6 +178,7 @@ class iter_contacts:  # noqa: N801  (a generator with state the caller reads)
         tracker_options: dict | None = None,
         drift_s: float | None = None,
     ):
+        from tactsense.estimate.array_calibration import ArrayCalibration
         from tactsense.estimate.baseline import DriftBaseline
         from tactsense.estimate.contacts import default_threshold
         from tactsense.estimate.track import ContactTracker
@@ -186,16 +187,21 @@ class iter_contacts:  # noqa: N801  (a generator with state the caller reads)
         self.reader = reader
         self.compensator = None
         self.baseline = None
-        if calibration is not None:
+        array_calibration = isinstance(calibration, ArrayCalibration)
+        if calibration is not None and not array_calibration:
             calibration.check_sensor(sensor)
             self.compensator = calibration.compensator(sensor.scan_period_s, sensor.shape)
         else:
-            if reader.n_frames < baseline_frames:
+            if array_calibration:  # its baseline, then following drift
+                calibration.check_sensor(sensor)
+                start = calibration.baseline
+            elif reader.n_frames < baseline_frames:
                 raise TactsenseInputError(
                     f"{reader.path} has {reader.n_frames} frames; need {baseline_frames} "
                     "untouched frames at the start for the baseline"
                 )
-            start = np.median(reader.frames(0, baseline_frames).astype(float), axis=0)
+            else:
+                start = np.median(reader.frames(0, baseline_frames).astype(float), axis=0)
             self.baseline = DriftBaseline(
                 start, sensor, frame_period_s=sensor.scan_period_s,
                 threshold=default_threshold(sensor) if threshold is None else threshold,
@@ -210,7 +216,7 @@ class iter_contacts:  # noqa: N801  (a generator with state the caller reads)
         from tactsense.estimate.contacts import find_contacts
 
         sensor = self.reader.sensor
-        calibrated = self._options["calibration"] is not None
+        calibrated = self.compensator is not None
         for start, frames, time_s in self.reader.chunks(self._chunk_frames):
             table = find_contacts(
                 frames, sensor, baseline=self.baseline, compensator=self.compensator,

@@ -232,6 +232,38 @@ def punch(spec, *, force_n: float = FIFTY_GRAMS, radius_mm: float = 3.0, dwell_s
     )
 
 
+def raster(
+    spec,
+    *,
+    force_n: float = FIFTY_GRAMS,
+    size_mm: float = 1.6,
+    dwell_s: float = 0.1,
+    settle_s: float = 0.2,
+) -> Scenario:
+    """A sphere pressed on the centre of every taxel in turn, lifted between presses: the
+    probe sweep a pad's or a point set's gains are calibrated from (``tactsense
+    calibrate``; the finger's 'calibration' sweep on an array)."""
+    check_positive(dwell_s, "dwell_s")
+    steps = _settle(settle_s)
+    if spec.kind == "pad":
+        g = spec.grid
+        for r in range(g.rows):
+            for c in range(g.cols):
+                x, y = r * g.row_pitch_mm, c * g.col_pitch_mm
+                probe = SphereProbe(x, y, force_n, radius_mm=size_mm)
+                steps += [Step((probe,), dwell_s, f"taxel ({r}, {c})"), Step((), dwell_s, "lifted")]
+    else:
+        for k in range(spec.n_taxels):
+            probe = make_indenter("sphere", 0.0, 0.0, force_n, size_mm, at_taxel=k)
+            steps += [Step((probe,), dwell_s, f"taxel {k}"), Step((), dwell_s, "lifted")]
+    return Scenario(
+        tuple(steps),
+        "calibration",
+        f"{size_mm:g}-mm sphere of {force_n:g} N pressed on every taxel in turn",
+        {"force_n": force_n, "size_mm": size_mm},
+    )
+
+
 SCENARIOS = {
     "press": press,
     "hold": hold,
@@ -240,5 +272,6 @@ SCENARIOS = {
     "sweep": sweep,
     "knife-edge": knife,
     "punch": punch,
+    "calibration": raster,
 }
 """Scenario builders for pads and point sets, by the name ``--scenario`` takes."""

@@ -6,11 +6,9 @@ import io
 import json
 import signal
 import subprocess
-import sys
 import time
 
 import numpy as np
-import pytest
 
 import tactsense as ts
 from tactsense import flat_scenarios as fs
@@ -50,9 +48,7 @@ def test_live_pad_two_probes_jsonl_and_csv(emulator, tmp_path):  # noqa: F811
     ts.write_recording(tmp_path / "two.h5", truth)
     contacts_file(tmp_path / "two.h5", tmp_path / "two.parquet", drift_s=2.0)
     batch = pd.read_parquet(tmp_path / "two.parquet")
-    live = pd.DataFrame(
-        [{"frame": r["sequence"], **c} for r in rows for c in r["contacts"]]
-    )
+    live = pd.DataFrame([{"frame": r["sequence"], **c} for r in rows for c in r["contacts"]])
     assert len(live) == len(batch)
     np.testing.assert_array_equal(live["frame"], batch["frame"])
     np.testing.assert_array_equal(live["id"], batch["id"])
@@ -105,9 +101,10 @@ def test_live_rezero_on_sigusr1(emulator):  # noqa: F811
 def test_lsl_slots_of_a_pad_estimate():
     from tactsense.interop.lsl import SLOT_CHANNELS, SLOTS, slot_sample
 
+    first = {"id": 4, "x_mm": 1.0, "y_mm": 2.0, "z_mm": 0.0, "force_n": 0.2}
+    second = {"id": 7, "x_mm": 5.0, "y_mm": 6.0, "z_mm": 0.0, "force_n": 0.1}
     estimate = {"n_contacts": 2, "force_n": 0.3, "flags": 0, "latency_ms": 0.1,
-                "contacts": [{"id": 4, "x_mm": 1.0, "y_mm": 2.0, "z_mm": 0.0, "force_n": 0.2},
-                             {"id": 7, "x_mm": 5.0, "y_mm": 6.0, "z_mm": 0.0, "force_n": 0.1}]}  # fmt: skip
+                "contacts": [first, second]}  # fmt: skip
     sample = slot_sample(estimate)
     assert len(sample) == len(SLOT_CHANNELS) == 4 + 5 * SLOTS
     named = dict(zip(SLOT_CHANNELS, sample, strict=True))

@@ -370,8 +370,8 @@ def test_pad_contacts_with_ids_trails_and_rezero(page, tmp_path):  # noqa: F811
     try:
         page.goto(server.url)
         page.wait_for_function(
-            f"() => {{ const s = window.tactsenseView; return s.latest && s.latest.index >= 40"
-            f" && s.drawnIndex === s.latest.index; }}",
+            "() => { const s = window.tactsenseView; return s.latest && s.latest.index >= 40"
+            " && s.drawnIndex === s.latest.index; }",
             timeout=15000,
         )
         page.click("#play")  # pause

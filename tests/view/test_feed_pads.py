@@ -13,8 +13,8 @@ from tactsense._validation import TactsenseInputError
 from tactsense.estimate.interpolate import reconstruct_row
 from tactsense.io.recording import Recording, write_recording
 from tactsense.sensor import Electronics, Grid, PadSpec, PointsSpec, Taxels, Transduction
-from tactsense.stream.reader import StreamFrame
 from tactsense.stream.live import LiveContacts
+from tactsense.stream.reader import StreamFrame
 from tactsense.view import RecordingFeed, layout_message, view_locator
 from tactsense.view.feed import MAX_FINE, SURFACE_STEPS, project_points
 
@@ -133,7 +133,7 @@ def test_pad_recording_feed_sends_deflection_contacts_and_rezeroes(tmp_path):
 
 
 def test_calibration_is_refused_for_a_pad():
-    with pytest.raises(TactsenseInputError, match="--calibration applies to fingers"):
+    with pytest.raises(TactsenseInputError, match="a finger's calibration does not apply"):
         view_locator(ts.preset("pad16"), calibration=object())
 
 

@@ -30,7 +30,8 @@ class ScenarioKind(StrEnum):
 
 
 FINGER_SCENARIOS = ("sweep-axial", "sweep-around", "repeated", "calibration", "knife-edge")
-FLAT_SCENARIOS = ("press", "hold", "two-probes", "slide", "sweep", "knife-edge", "punch")
+FLAT_SCENARIOS = ("press", "hold", "two-probes", "slide", "sweep", "knife-edge", "punch",
+                  "calibration")  # fmt: skip
 """The scenarios of a finger, and of a pad or a point set (``tactsense.flat_scenarios``)."""
 
 ScenarioOption = Annotated[
@@ -46,7 +47,8 @@ ScenarioOption = Annotated[
         "(creep, section 3.4), 'two-probes' presses two spheres --separation-mm apart, "
         "'slide' slides a sphere across at --speed-mm-s, 'sweep' presses a sphere every "
         "--increment mm along y (Fig. 7 on a pad), 'knife-edge' presses a knife edge "
-        "across the middle, 'punch' a flat punch (a uniform press)."
+        "across the middle, 'punch' a flat punch (a uniform press), 'calibration' a "
+        "sphere on every taxel in turn (for 'calibrate')."
     ),
 ]
 XOption = Annotated[
@@ -197,9 +199,15 @@ FLAT_KNIFE_USES = ("force_g", "size_mm", "angle_deg", "dwell_s")
 """'knife-edge' on a pad or a point set (on a finger it is section 4.1's sweep)."""
 
 
+FLAT_CALIBRATION_USES = ("force_g", "size_mm", "dwell_s")
+"""'calibration' on a pad or a point set: a sphere on every taxel in turn."""
+
+
 def _uses(scenario: ScenarioKind, kind: str) -> tuple[str, ...]:
     if scenario is ScenarioKind.knife and kind != "finger":
         return FLAT_KNIFE_USES
+    if scenario is ScenarioKind.calibration and kind != "finger":
+        return FLAT_CALIBRATION_USES
     return USES[scenario]
 
 

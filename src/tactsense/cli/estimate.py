@@ -160,9 +160,9 @@ def locate(
             sensor = reader.sensor
         calibrated = None
         if calibration is not None:
-            from tactsense.estimate import Calibration
+            from tactsense.estimate.array_calibration import load_calibration
 
-            calibrated = Calibration.load(calibration, sensor)
+            calibrated = load_calibration(calibration, sensor)
         if contacts or sensor.kind != "finger":
             _locate_contacts(
                 recording, out, force, quiet, baseline_frames=baseline_frames,
@@ -251,6 +251,31 @@ def calibrate(
             "(they keep gain 1 and are listed in the JSON's notes).",
         ),
     ] = False,
+    press: Annotated[
+        bool,
+        typer.Option(
+            "--press",
+            help="Pads and point sets: the recording is a uniform press of the whole array "
+            "(a bladder, a foam block) rather than a probe on every taxel in turn.",
+        ),
+    ] = False,
+    force_log: Annotated[
+        Path | None,
+        typer.Option(
+            "--force-log",
+            help="Pads and point sets: a reference load cell's log of the same recording, "
+            "CSV with columns time_s [s, the recording's clock] and force_n [N]; fits the "
+            "piecewise-linear force curve (docs/contacts.md).",
+        ),
+    ] = None,
+    loads: Annotated[
+        Path | None,
+        typer.Option(
+            "--loads",
+            help="Pads and point sets: the recording --force-log was logged with (presses "
+            "of varied force) [default: the sweep itself].",
+        ),
+    ] = None,
     force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
 ) -> None:
     """Build a calibration (gains, baseline, dead/weak/noisy tactels, creep, model fit).
@@ -258,13 +283,35 @@ def calibrate(
     A sweep that misses more than 10 % of the tactels, and a creep or knife-edge fit
     that stops at a bound of its parameters or leaves a residual above 10 % of full
     scale, is an error: such a calibration would be applied without anyone knowing.
+
+    A pad or a point set: per-taxel gains from a probe on every taxel in turn
+    (simulate --scenario calibration) or a uniform press (--press), dead taxels, and a
+    force curve from a load cell's log (--force-log); applied by locate, live and view
+    with --calibration.
     """
     from tactsense.estimate import calibrate as cal
 
     try:
-        check_output(out, force, inputs=[sweep, steps, knife])
+        check_output(out, force, inputs=[sweep, steps, knife, force_log, loads])
         from tactsense.io.recording import RecordingReader
 
+        with RecordingReader(sweep) as reader:
+            kind = reader.sensor.kind
+        if kind != "finger":
+            for name, value in (("--steps", steps), ("--knife", knife)):
+                if value is not None:
+                    raise TactsenseInputError(f"{name} is for fingers; {sweep} holds a {kind}")
+            if loads is not None and force_log is None:
+                raise TactsenseInputError("--loads goes with --force-log (the load cell's log)")
+            _calibrate_array(sweep, out, press=press, force_log=force_log, loads=loads,
+                             baseline_frames=baseline_frames, partial=partial)  # fmt: skip
+            return
+        for name, value in (("--press", press or None), ("--force-log", force_log),
+                            ("--loads", loads)):  # fmt: skip
+            if value is not None:
+                raise TactsenseInputError(
+                    f"{name} is for pads and point sets; {sweep} holds a finger"
+                )
         # the sweep is read in pieces: any length fits in memory
         with RecordingReader(sweep) as reader:
             sensor = reader.sensor
@@ -345,6 +392,40 @@ def calibrate(
                     else "give --steps)"
                 )
             ),
+        )
+    Console(stderr=True).print(table)
+
+
+def _calibrate_array(recording, out, *, press, force_log, loads, baseline_frames, partial):
+    """``calibrate`` on a pad or a point set (tactsense.estimate.array_calibration)."""
+    from tactsense.estimate.array_calibration import calibrate_array, read_force_log
+
+    log = read_force_log(force_log) if force_log is not None else None
+    rec = read_recording(recording)
+    load_rec = rec
+    if loads is not None:
+        load_rec = read_recording(loads)
+        if load_rec.sensor != rec.sensor:
+            raise TactsenseInputError(f"{loads} comes from another sensor than {recording}")
+    calibration = calibrate_array(
+        rec.frames, rec.sensor, method="press" if press else "sweep",
+        baseline_frames=baseline_frames, force_log=log,
+        loads=(load_rec.frames, load_rec.time_s), partial=partial,
+    )  # fmt: skip
+    with atomic_output(out) as temporary:
+        calibration.save(temporary)
+    table = Table(title=f"wrote {out}", show_header=False)
+    gains, dead = calibration.gains, calibration.dead
+    used = gains[~dead]
+    table.add_row("gains from", calibration.notes["method"])
+    table.add_row("gain spread (max/min)", f"{used.max() / used.min():.2f}")
+    table.add_row("dead taxels", f"{int(dead.sum())} of {dead.size}")
+    if calibration.force_curve is not None:
+        x, y = calibration.force_curve
+        table.add_row(
+            "force curve",
+            f"{len(x)} knots from {calibration.notes['force_pairs']} frames, "
+            f"{x[0]:.3g}-{x[-1]:.3g} N estimated -> {y[0]:.3g}-{y[-1]:.3g} N measured",
         )
     Console(stderr=True).print(table)
 

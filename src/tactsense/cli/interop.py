@@ -21,6 +21,7 @@ from tactsense.cli._common import (
     progress_bar,
     remove_stale_partials,
 )
+from tactsense.estimate.array_calibration import load_calibration
 
 app = new_group("Other tools' formats: MCAP (ROS 2, Foxglove) and Rerun.")
 
@@ -90,7 +91,6 @@ def export(
     Frames and contacts are estimated a piece at a time, as 'locate' does; the file is
     written to a temporary name and moved into place when complete.
     """
-    from tactsense.estimate import Calibration
 
     if export_format is None:
         by_suffix = {suffix: kind for kind, suffix in SUFFIXES.items()}
@@ -111,7 +111,7 @@ def export(
         fail(f"--frame-id {frame_id!r}: give a link name without spaces")
     check_output(out, force, inputs=[recording, calibration])
     try:
-        cal = None if calibration is None else Calibration.load(calibration)
+        cal = None if calibration is None else load_calibration(calibration)
         if export_format is ExportFormat.mcap:
             from tactsense.interop.mcap import _writer_class
             from tactsense.interop.mcap import export_mcap as run

@@ -18,8 +18,8 @@ from tactsense._validation import TactsenseInputError
 from tactsense.cli._common import (
     BaselineFramesOption,
     CalibrationOption,
-    SensorOption,
     ContactThresholdOption,
+    SensorOption,
     atomic_output,
     check_output,
     console,
@@ -48,6 +48,7 @@ from tactsense.cli._scenario import (
     build_scenario,
     run_scenario,
 )
+from tactsense.estimate.array_calibration import load_calibration
 from tactsense.sensor import load_sensor
 
 app = new_group("The live system: an emulated finger, recording and live estimates.")
@@ -145,20 +146,20 @@ def _stream_and_locator(
 
     reader = _open_reader(source, sensor, timeout, start=False)
     if reader.sensor.kind != "finger":
-        if calibration is not None:
-            raise TactsenseInputError(
-                f"--calibration applies to fingers; {reader.sensor.name!r} is a "
-                f"{reader.sensor.kind}, whose calibration does not exist yet: leave "
-                "--calibration out"
-            )
         locator = LiveContacts(
             reader.sensor,
             baseline_frames=baseline_frames,
             threshold=threshold,
             frame_period_s=None,  # the sensor's scan period: device time, not the wire's
             keep_deflection=keep_deflection,
+            calibration=calibration,
         )
         return reader, locator
+    if calibration is not None and not hasattr(calibration, "apply"):
+        raise TactsenseInputError(
+            f"an array's calibration does not apply to {reader.sensor.name!r}, a finger: "
+            "calibrate it with 'tactsense calibrate' on a probe sweep of the finger"
+        )
     if threshold is None:
         threshold = 0.005
     if calibration is not None:
@@ -490,7 +491,6 @@ def live(
     import signal
     import threading
 
-    from tactsense.estimate import Calibration
     from tactsense.stream import StreamError
     from tactsense.stream.live import CONTACT_FIELDS, FIELDS
 
@@ -498,7 +498,7 @@ def live(
     if out is not None:
         check_output(out, force, inputs=[calibration, *sensor_file(sensor), *_source_file(source)])
     try:
-        cal = None if calibration is None else Calibration.load(calibration)
+        cal = None if calibration is None else load_calibration(calibration)
         reader, locator = _stream_and_locator(
             source, sensor, timeout, cal, baseline_frames, threshold
         )
@@ -680,7 +680,6 @@ def view(
     """
     import webbrowser
 
-    from tactsense.estimate import Calibration
     from tactsense.estimate.deflection import baseline_from
     from tactsense.view import LiveFeed, RecordingFeed, ViewServer, view_locator
     from tactsense.view.server import is_loopback
@@ -699,7 +698,7 @@ def view(
     if not is_recording and speed != 1.0:
         fail("--speed applies to recordings; a device sends at its own rate")
     try:
-        cal = None if calibration is None else Calibration.load(calibration)
+        cal = None if calibration is None else load_calibration(calibration)
         if is_recording:
 
             def locator_for(spec, file):

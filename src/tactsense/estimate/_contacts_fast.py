@@ -743,14 +743,22 @@ def fit_into(signal, labels, frame_of, root, peak_row, peak_col, kernel, half, r
         da = 0.0
         db = 0.0
         if 0 < best_a < span - 1:
-            lo, _ = _fit_score(signal, labels, f, own, pr, pc, kernel, half, n_sub, best_a - 1, best_b)
-            hi, _ = _fit_score(signal, labels, f, own, pr, pc, kernel, half, n_sub, best_a + 1, best_b)
+            lo, _ = _fit_score(
+                signal, labels, f, own, pr, pc, kernel, half, n_sub, best_a - 1, best_b
+            )
+            hi, _ = _fit_score(
+                signal, labels, f, own, pr, pc, kernel, half, n_sub, best_a + 1, best_b
+            )
             curv = lo - 2.0 * best + hi
             if curv < 0.0:
                 da = min(max(0.5 * (lo - hi) / curv, -0.5), 0.5)
         if 0 < best_b < span - 1:
-            lo, _ = _fit_score(signal, labels, f, own, pr, pc, kernel, half, n_sub, best_a, best_b - 1)
-            hi, _ = _fit_score(signal, labels, f, own, pr, pc, kernel, half, n_sub, best_a, best_b + 1)
+            lo, _ = _fit_score(
+                signal, labels, f, own, pr, pc, kernel, half, n_sub, best_a, best_b - 1
+            )
+            hi, _ = _fit_score(
+                signal, labels, f, own, pr, pc, kernel, half, n_sub, best_a, best_b + 1
+            )
             curv = lo - 2.0 * best + hi
             if curv < 0.0:
                 db = min(max(0.5 * (lo - hi) / curv, -0.5), 0.5)

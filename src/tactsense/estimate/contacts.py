@@ -280,8 +280,11 @@ def find_contacts(
         Taxels to ignore.
     threshold : float, optional
         Smallest signal that counts as contact [-]; :func:`default_threshold`.
-    calibration : Calibration, optional
-        A finger's calibration (its baseline, gains, nonlinearity, creep).
+    calibration : Calibration or ArrayCalibration, optional
+        A finger's calibration (its baseline, gains, nonlinearity, creep), or a pad's or
+        point set's (:class:`~tactsense.estimate.array_calibration.ArrayCalibration`:
+        baseline, gains, dead taxels, force curve); ``baseline`` may then be a
+        :class:`~tactsense.estimate.baseline.DriftBaseline` started from its baseline.
     max_contacts : int
         At most this many contacts per frame, the largest kept (1-64).
     method : {"interpolate", "cop"}
@@ -313,21 +316,34 @@ def find_contacts(
     frames = check_frames(frames, sensor.shape)
     lead_2d = frames.ndim == 2
     frames = frames.reshape(-1, *sensor.shape)
-    if len(frames) > BLOCK and calibration is None:
+    if len(frames) > BLOCK and (calibration is None or not hasattr(calibration, "apply")):
         # cache-sized pieces: the signal and the labels of a piece only (a calibration's
         # creep state runs through the whole batch, so it is applied in one piece)
         options = dict(baseline=baseline, counts=counts, dead=dead, threshold=threshold,
-                       max_contacts=max_contacts, method=method, saddle=saddle)  # fmt: skip
+                       max_contacts=max_contacts, method=method, saddle=saddle,
+                       calibration=calibration)  # fmt: skip
         return ContactTable.concatenate(
             find_contacts(frames[lo : lo + BLOCK], sensor, first_frame=first_frame + lo, **options)
             for lo in range(0, len(frames), BLOCK)
         )
-    if calibration is not None:
-        if not counts:
-            raise TactsenseInputError("a calibration applies to counts, not to the signal")
+    from tactsense.estimate.array_calibration import ArrayCalibration
+
+    array_calibration = isinstance(calibration, ArrayCalibration)
+    if calibration is not None and not counts:
+        raise TactsenseInputError("a calibration applies to counts, not to the signal")
+    if array_calibration:
+        if kind == "finger":
+            raise TactsenseInputError(
+                f"{sensor.name!r} is a finger: calibrate it with 'tactsense calibrate' (a "
+                "finger's calibration), not with an array calibration"
+            )
+        calibration.check_sensor(sensor)
+        signal, flags = calibration.signal(frames, sensor, baseline=baseline)
+    elif calibration is not None:
         if kind != "finger":
             raise TactsenseInputError(
-                f"a calibration applies to the paper's fingers; {sensor.name!r} is a {kind}"
+                f"a finger's calibration does not apply to {sensor.name!r}, a {kind}: "
+                "calibrate it with 'tactsense calibrate' on the array's own recording"
             )
         signal, flags = calibration.apply(
             frames, sensor, frame_period_s=frame_period_s, compensator=compensator
@@ -357,6 +373,8 @@ def find_contacts(
     else:
         table = _grid_contacts(signal, sensor, threshold, saddle, max_contacts, method)
     table.flags |= flags[table.frame]
+    if array_calibration:
+        table.force_n = calibration.force(table.force_n)
     if saturated is not None:
         _mark_saturated(table, saturated, sensor)
     table.extra.pop("_labels", None)

@@ -33,7 +33,8 @@ class Flag(IntFlag):
     """A second, separate contact was seen; the fields describe the largest one."""
     BELOW_BASELINE = 256
     """A taxel read below its baseline by more than the contact threshold: the baseline
-    was taken under load, or has drifted (see :class:`~tactsense.estimate.baseline.DriftBaseline`)."""
+    was taken under load, or has drifted
+    (:class:`~tactsense.estimate.baseline.DriftBaseline`)."""
 
     @classmethod
     def describe(cls, value: int) -> str:

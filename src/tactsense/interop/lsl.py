@@ -82,9 +82,7 @@ SLOT_FRAME_TYPES = ("Count", "Force", "Flags", "Latency")
 SLOT_FIELDS = ("id", "x_mm", "y_mm", "z_mm", "force_n")
 SLOT_UNITS = ("1", "mm", "mm", "mm", "N")
 SLOT_TYPES = ("Id", "Position", "Position", "Position", "Force")
-SLOT_CHANNELS = SLOT_FRAME + tuple(
-    f"c{k}_{name}" for k in range(SLOTS) for name in SLOT_FIELDS
-)
+SLOT_CHANNELS = SLOT_FRAME + tuple(f"c{k}_{name}" for k in range(SLOTS) for name in SLOT_FIELDS)
 """Channels of the fixed-width contacts outlet of a pad or point set."""
 
 

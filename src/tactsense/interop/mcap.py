@@ -334,7 +334,8 @@ def export_mcap(
             positions = sensor.taxel_positions_mm()
             taxel_normals = sensor.taxel_normals()
             pieces = iter_contacts(reader, baseline_frames=baseline_frames,
-                                   threshold=threshold, drift_s=drift_s)  # fmt: skip
+                                   calibration=calibration, threshold=threshold,
+                                   drift_s=drift_s)  # fmt: skip
             for start, n, time_s, table, _ in pieces:
                 frames = reader.frames(start, start + n)
                 when = stamps(start, time_s)

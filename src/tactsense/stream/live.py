@@ -6,6 +6,7 @@ import time
 
 import numpy as np
 
+from tactsense._validation import TactsenseInputError
 from tactsense.estimate import Flag, locate
 from tactsense.estimate.creep import CreepCompensator
 from tactsense.estimate.deflection import deflection_from_counts
@@ -234,9 +235,10 @@ class LiveContacts:
         At most this many contacts per frame (1-64).
     method : str
         How positions are found (:data:`~tactsense.estimate.contacts.METHODS`).
+    calibration : ArrayCalibration, optional
+        The array's calibration: its baseline (no frames are spent on one), gains, dead
+        taxels and force curve apply from the first frame.
     """
-
-    calibration = None
 
     def __init__(
         self,
@@ -250,10 +252,20 @@ class LiveContacts:
         drift_s: float | None = 2.0,
         max_contacts: int = 8,
         method: str = "interpolate",
+        calibration=None,
     ):
+        from tactsense.estimate.array_calibration import ArrayCalibration
         from tactsense.estimate.contacts import default_threshold, find_contacts
         from tactsense.estimate.track import ContactTracker
 
+        if calibration is not None:
+            if not isinstance(calibration, ArrayCalibration):
+                raise TactsenseInputError(
+                    f"a finger's calibration does not apply to {sensor.name!r}, a "
+                    f"{sensor.kind}: calibrate it with 'tactsense calibrate' on its own recording"
+                )
+            calibration.check_sensor(sensor)
+        self.calibration = calibration
         self.sensor = sensor
         self.threshold = default_threshold(sensor) if threshold is None else float(threshold)
         self.frame_period_s = float(frame_period_s or sensor.scan_period_s)
@@ -270,7 +282,9 @@ class LiveContacts:
         """The signal of the last frame [-] (with ``keep_deflection``)."""
         # compile (or load from Numba's cache) now, not while frames queue up
         find_contacts(np.zeros((1, *sensor.shape)), sensor, counts=False, **self._options)
-        if baseline is not None:
+        if calibration is not None:
+            self._set_baseline(np.asarray(calibration.baseline, dtype=float))
+        elif baseline is not None:
             self._set_baseline(np.asarray(baseline, dtype=float))
 
     def _set_baseline(self, baseline: np.ndarray) -> None:
@@ -336,14 +350,19 @@ class LiveContacts:
                 self._collected = []
             return None
         before = self._drift.baseline.copy() if self._keep else None
-        table = find_contacts(counts[None], self.sensor, baseline=self._drift, **self._options)
+        table = find_contacts(counts[None], self.sensor, baseline=self._drift,
+                              calibration=self.calibration, **self._options)  # fmt: skip
         table.frame[:] = self._serial
         tracked, _ = self._tracker.update(table, first_frame=self._serial)
         self._serial += 1
         if self._keep:
             from tactsense.estimate.contacts import signal_from_counts
 
-            self.last_deflection = signal_from_counts(counts[None], before, self.sensor)[0][0]
+            signal = signal_from_counts(counts[None], before, self.sensor)[0][0]
+            if self.calibration is not None:
+                c = self.calibration
+                signal = np.where(c.dead, 0.0, signal / np.where(c.dead, 1.0, c.gains))
+            self.last_deflection = signal
         columns = tracked.columns()
         contacts = [
             {name: _plain(columns[name][k]) for name in CONTACT_FIELDS if name in columns}

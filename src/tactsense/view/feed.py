@@ -369,12 +369,6 @@ def view_locator(
     ``threshold`` None: the sensor's default (0.005 on the finger)."""
     locator = LOCATORS.get(sensor.kind)
     if locator is LiveContacts:
-        if calibration is not None:
-            raise TactsenseInputError(
-                f"--calibration applies to fingers, not to "
-                f"{PLURAL.get(sensor.kind, sensor.kind)} (sensor {sensor.name!r}), whose "
-                "calibration does not exist yet: leave --calibration out"
-            )
         return LiveContacts(
             sensor,
             baseline_frames=baseline_frames,
@@ -382,6 +376,12 @@ def view_locator(
             frame_period_s=frame_period_s,
             baseline=baseline,
             keep_deflection=True,
+            calibration=calibration,
+        )
+    if locator is not None and calibration is not None and not hasattr(calibration, "apply"):
+        raise TactsenseInputError(
+            f"an array's calibration does not apply to {sensor.name!r}, a finger: "
+            "calibrate it with 'tactsense calibrate' on a probe sweep of the finger"
         )
     if locator is not None:
         if threshold is None:
