@@ -5,6 +5,10 @@ paper's Fig. 13 sweep around the finger at row 4 on a loopback socket with 2 % o
 frames dropped, ``tactsense.view`` shows it, and headless Chromium takes the picture
 after 12 s (the probe then sits near 60 deg; the trail shows where it came from).
 
+``python scripts/view_screenshot.py --contacts`` writes docs/images/view_contacts.png: the
+twin of ``pad16`` under two 50-g spheres, one still and one sliding along y, played back
+with every contact tracked (ids, rings, trails, the contacts' table).
+
 ``python scripts/view_screenshot.py --sensor pad16`` writes docs/images/view_pad.png
 instead (``--sensor dome12``: view_points.png): a recording of that pad or point set
 pressed by a 5-mm sphere (1 N, ramped over 0.5 s, then held), its strains from the
@@ -138,6 +142,42 @@ def flat_main(name: str) -> None:
     print(f"wrote {out}")
 
 
+def contacts_main() -> None:
+    """Two contacts on pad16, one sliding: their ids, rings and trails."""
+    from tactsense.physics.indenters import SphereProbe
+    from tactsense.simulate import Scenario, Step
+
+    spec = ts.preset("pad16")
+    out = IMAGES / "view_contacts.png"
+    still = SphereProbe(12.0, 10.0, 0.49)
+    steps = [Step((), 0.3, "untouched")]
+    for k in range(60):  # 0.02 s a step: 10 mm along y in 1.2 s
+        steps.append(Step((still, SphereProbe(26.0, 12.0 + k / 6.0, 0.49)), 0.02, ""))
+    rec = ts.simulate(spec, Scenario(tuple(steps)), rng=5)
+    with tempfile.TemporaryDirectory() as folder:
+        path = ts.write_recording(Path(folder) / "contacts.h5", rec)
+        feed = RecordingFeed(path, lambda s, file: view_locator(s), speed=0.5)
+        server = ViewServer(feed)
+        server.start()
+        try:
+            with sync_playwright() as playwright:
+                browser = playwright.chromium.launch(
+                    executable_path=shutil.which("chromium") or "/usr/bin/chromium"
+                )
+                page = browser.new_page(viewport={"width": 1180, "height": 860})
+                page.goto(server.url)
+                page.wait_for_function(
+                    f"() => window.tactsenseView.drawnIndex >= {feed.n_frames - 1}",
+                    timeout=60000,
+                )
+                time.sleep(1.0)
+                page.screenshot(path=str(out))
+                browser.close()
+        finally:
+            server.stop()
+    print(f"wrote {out}")
+
+
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
@@ -145,8 +185,13 @@ if __name__ == "__main__":
         default=None,
         help="a pad or point-set preset (pad16, dome12, ...): its picture instead of the finger's",
     )
+    parser.add_argument(
+        "--contacts", action="store_true", help="two tracked contacts on pad16 instead"
+    )
     args = parser.parse_args()
-    if args.sensor is None:
+    if args.contacts:
+        contacts_main()
+    elif args.sensor is None:
         main()
     else:
         flat_main(args.sensor)
