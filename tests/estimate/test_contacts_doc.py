@@ -42,6 +42,11 @@ def test_the_generated_block_is_what_the_script_gives():
     assert _script().block() in doc
 
 
+def test_the_accuracy_block_is_what_the_script_gives():
+    doc = (ROOT / "docs" / "accuracy.md").read_text(encoding="utf-8")
+    assert _script().accuracy_block() in doc
+
+
 def test_the_example_lines_are_what_locate_prints(example):
     doc = " ".join(DOC.read_text(encoding="utf-8").split())
     line = _cli("locate", "two.h5", "--out", "est.parquet", cwd=example)
