@@ -426,7 +426,8 @@ def accuracy_block(results=None) -> str:
         "centre along y, 12 placements at random offsets across; mean / worst |position "
         "error| in taxels; bound at the offset, x on the taxel's row):",
         "",
-        "| pad | offset [taxel] | interpolate | centre of pressure | model-based fit | bound [taxel] |",
+        "| pad | offset [taxel] | interpolate | centre of pressure | model-based fit "
+        "| bound [taxel] |",
         "|---|---|---|---|---|---|",
     ]
     for name, (_, by_offset) in results.items():

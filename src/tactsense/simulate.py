@@ -500,8 +500,10 @@ class _ElasticWindow:
     :func:`deflection_batch` chooses it, so a window gives the numbers the whole would.
     """
 
-    def __init__(self, spec: SensorSpec, applied: list[tuple], gains: np.ndarray):
-        self.spec, self.applied, self.gains = spec, applied, gains
+    def __init__(
+        self, spec: SensorSpec, applied: list[tuple], gains: np.ndarray, forward: str = "twin"
+    ):
+        self.spec, self.applied, self.gains, self.forward = spec, applied, gains, forward
         probes = [s[0] for s in applied if len(s) == 1 and type(s[0]) is Probe]
         self.compiled = (
             len(probes) == len(applied) and len({p.contact_diameter_mm for p in probes}) == 1
@@ -515,6 +517,10 @@ class _ElasticWindow:
             states = list(self.applied[lo:stop])
             if self.spec.kind != "finger":  # a pad or a point set: the layer model
                 elastic = deflection_batch_flat(self.spec, states)
+            elif self.forward == "finger3d":  # the 3-D skin's tabulated response
+                from tactsense.physics.finger3d_table import deflection_batch_3d
+
+                elastic = deflection_batch_3d(self.spec, states)
             elif self.compiled:
                 elastic = deflection_batch(self.spec, states)
             else:  # an empty state keeps a window of probes alone on the path of the whole
@@ -534,9 +540,10 @@ class _Run:
     n_frames: int
     boundaries: np.ndarray
     offsets: np.ndarray
+    forward: str = "twin"
 
 
-def _prepare(spec, scenario, flaws, rng, gains) -> _Run:
+def _prepare(spec, scenario, flaws, rng, gains, forward="twin") -> _Run:
     if not isinstance(spec, SpecBase):
         raise TactsenseInputError(
             "spec must be a sensor description (SensorSpec, PadSpec, PointsSpec); "
@@ -544,6 +551,9 @@ def _prepare(spec, scenario, flaws, rng, gains) -> _Run:
         )
     if not isinstance(scenario, Scenario):
         raise TactsenseInputError(f"scenario must be a Scenario; got {type(scenario).__name__}")
+    from tactsense.physics.finger3d_table import check_forward
+
+    forward = check_forward(forward, spec)
     active = _resolve_flaws(flaws)
     rng = np.random.default_rng(rng)
     n_frames = max(1, math.floor(scenario.duration_s / spec.scan_period_s + 1e-9))
@@ -561,7 +571,13 @@ def _prepare(spec, scenario, flaws, rng, gains) -> _Run:
         else [step.contacts for step in scenario.steps]
     )
     boundaries = np.cumsum([0.0] + [s.duration_s for s in scenario.steps])
-    return _Run(active, rng, gains, applied, n_frames, boundaries, sample_offsets(spec))
+    if forward == "finger3d":  # every contact must be tabulated: say so before the work
+        from tactsense.physics.finger3d_table import _tabulated
+
+        for state in applied:
+            for contact in state:
+                _tabulated(contact)
+    return _Run(active, rng, gains, applied, n_frames, boundaries, sample_offsets(spec), forward)
 
 
 def _frame_blocks(spec: SensorSpec, run: _Run):
@@ -573,7 +589,7 @@ def _frame_blocks(spec: SensorSpec, run: _Run):
     ticks_per_frame = rows * cols
     dt = period / ticks_per_frame
     n_steps = len(run.applied)
-    elastic = _ElasticWindow(spec, run.applied, run.gains)
+    elastic = _ElasticWindow(spec, run.applied, run.gains, run.forward)
     flat_index = np.arange(ticks_per_frame)
     row_of_tick, col_of_tick = np.divmod(flat_index, cols)
     dead = np.zeros(spec.shape, dtype=bool)
@@ -650,6 +666,7 @@ def simulate(
     rng=None,
     gains: np.ndarray | None = None,
     progress: Callable[[int, int], None] | None = None,
+    forward: str = "twin",
 ) -> Recording:
     """Run a scenario through the forward model and return the recorded frames.
 
@@ -673,6 +690,10 @@ def simulate(
         those are drawn from ``spec.flaws.gain_seed``, the same in every run).
     progress : callable(done, total), optional
         Called after each chunk of frames.
+    forward : {"twin", "finger3d"}
+        The finger's elastic model: the paper's 2-D twin, or the 3-D skin's tabulated
+        finite-element response (:mod:`tactsense.physics.finger3d_table`; probes only),
+        recorded in the scenario's ``forward_model``.
 
     Returns
     -------
@@ -680,7 +701,7 @@ def simulate(
         ``frames`` (T, rows, cols) A/D counts, timestamps, the truth of
         every step, the sensor and the scenario.
     """
-    run = _prepare(spec, scenario, flaws, rng, gains)
+    run = _prepare(spec, scenario, flaws, rng, gains, forward)
     dtype = np.uint16 if "quantization" in run.active else np.float64
     frames = np.empty((run.n_frames, *spec.shape), dtype=dtype)
     for first, last, counts in _frame_blocks(spec, run):
@@ -693,7 +714,7 @@ def simulate(
         time_s=np.arange(run.n_frames) * spec.scan_period_s,
         sample_offset_s=run.offsets,
         sensor=spec,
-        scenario=scenario.to_dict(),
+        scenario={**scenario.to_dict(), "forward_model": run.forward},
         flaws=run.active,
         truth=truth,
         gains=run.gains,
@@ -714,6 +735,7 @@ def simulate_to_file(
     rng=None,
     gains: np.ndarray | None = None,
     progress: Callable[[int, int], None] | None = None,
+    forward: str = "twin",
 ) -> int:
     """Run a scenario and write the recording to a new HDF5 file as its frames are made.
 
@@ -746,7 +768,7 @@ def simulate_to_file(
     path = Path(path)
     if path.exists():
         raise FileExistsError(f"{path} exists; choose a new name")
-    run = _prepare(spec, scenario, flaws, rng, gains)
+    run = _prepare(spec, scenario, flaws, rng, gains, forward)
     n, shape = run.n_frames, spec.shape
     dtype = np.uint16 if "quantization" in run.active else np.float64
     chunk = max(1, min(n, _WRITE_FRAMES))
@@ -757,7 +779,9 @@ def simulate_to_file(
             h5.attrs["tactsense_version"] = __version__
             h5.attrs["created"] = _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds")
             h5.attrs["sensor_toml"] = spec.to_toml_string()
-            h5.attrs["scenario_json"] = json.dumps(scenario.to_dict())
+            h5.attrs["scenario_json"] = json.dumps(
+                {**scenario.to_dict(), "forward_model": run.forward}
+            )
             h5.attrs["flaws"] = ",".join(run.active)
             h5.attrs["scan_rate_hz"] = spec.electronics.scan_rate_hz
             h5.attrs["source"] = ""

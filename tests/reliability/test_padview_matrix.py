@@ -37,9 +37,12 @@ BAD = [
     # (command line, what the message must say)
     (
         "view DIR/pad16.h5 --calibration DIR/finger_cal.json",
-        "--calibration applies to fingers, not to pads",
+        "a finger's calibration does not apply to 'pad16', a pad",
     ),
-    ("view DIR/dome12.h5 --calibration DIR/finger_cal.json", "not to point sets (sensor 'dome12')"),
+    (
+        "view DIR/dome12.h5 --calibration DIR/finger_cal.json",
+        "does not apply to 'dome12', a point set",
+    ),
     ("view DIR/pad16.h5 --sensor pad16", "--sensor applies to a device"),
 ]
 

@@ -36,6 +36,11 @@ from tactsense.sensor import SensorSpec
 from tactsense.simulate import Scenario, Step, calibration_sweep, knife_edge_sweep, simulate
 
 FLAWS = ["noise", "quantization"]
+ALL_FLAWS = ["gain_spread", "jitter", "noise", "quantization", "nonlinearity", "viscoelastic"]
+FORWARD = "_forward"
+"""Key of a true finger made by another forward model (``simulate(forward=...)``)."""
+FLAWS_KEY = "_flaws"
+"""Key of a true finger's own flaws (default: read noise and quantization)."""
 
 
 def perturbations(spec: SensorSpec) -> dict[str, dict]:
@@ -49,6 +54,15 @@ def perturbations(spec: SensorSpec) -> dict[str, dict]:
         "modulus +20 %": {"elastic__youngs_modulus_pa": 1.2 * e.youngs_modulus_pa},
         "ring stiffness +20 %": {"rings__copper_modulus_pa": 1.2 * r.copper_modulus_pa},
         "gain spread": {},  # the sensor's gain spread switched on (the others: off)
+        "depth +15 %, nu -15 %, modulus +20 %": {
+            "elastic__effective_depth_mm": 1.15 * e.effective_depth_mm,
+            "elastic__effective_poisson_ratio": 0.85 * e.effective_poisson_ratio,
+            "elastic__youngs_modulus_pa": 1.2 * e.youngs_modulus_pa,
+        },
+        "softer rubber (modulus -30 %)": {"elastic__youngs_modulus_pa": 0.7 * e.youngs_modulus_pa},
+        # not the 2-D model with other numbers: the 3-D skin's finite-element response
+        "3-D skin": {FORWARD: "finger3d"},
+        "3-D skin, every flaw": {FORWARD: "finger3d", FLAWS_KEY: ALL_FLAWS},
     }
 
 
@@ -78,9 +92,10 @@ def _positions(spec: SensorSpec, n: int, rng) -> list[tuple[float, float]]:
     return list(zip(axial.tolist(), angle.tolist(), strict=True))
 
 
-def _calibrate(assumed: SensorSpec, truth: SensorSpec, flaws, seed: int):
-    """The two calibration steps run on the true finger; the estimator's corrected model."""
-    knife = simulate(truth, knife_edge_sweep(truth), flaws=flaws, rng=seed)
+def _calibrate(assumed: SensorSpec, truth: SensorSpec, flaws, seed: int, forward: str = "twin"):
+    """The two calibration steps run on the true finger (made by ``forward``); the
+    estimator's corrected model."""
+    knife = simulate(truth, knife_edge_sweep(truth), flaws=flaws, rng=seed, forward=forward)
     base = baseline_from(knife.frames, 5)
     signal = (knife.frames[:, 4, 0] - base[4, 0]) / knife.frames[:, 4, 0]
     last, steps = knife.last_loaded_frames(4, 0)
@@ -88,7 +103,7 @@ def _calibrate(assumed: SensorSpec, truth: SensorSpec, flaws, seed: int):
     corrected = assumed.replace(
         elastic__effective_depth_mm=fit.depth_mm, elastic__effective_poisson_ratio=fit.poisson_ratio
     )
-    sweep = simulate(truth, calibration_sweep(truth), flaws=flaws, rng=seed + 1)
+    sweep = simulate(truth, calibration_sweep(truth), flaws=flaws, rng=seed + 1, forward=forward)
     calibration = cal.calibrate_sweep(sweep.frames, corrected)
     return corrected, calibration, fit
 
@@ -137,9 +152,11 @@ def robustness_study(
     for name in fingers or list(table):
         if progress is not None:
             progress(name)
-        truth = assumed.replace(**table[name])
-        flaws = FLAWS + (["gain_spread"] if name == "gain spread" else [])
-        rec = simulate(truth, scene, flaws=flaws, rng=seed + 7)
+        change = dict(table[name])
+        forward = change.pop(FORWARD, "twin")
+        flaws = change.pop(FLAWS_KEY, FLAWS + (["gain_spread"] if name == "gain spread" else []))
+        truth = assumed.replace(**change)
+        rec = simulate(truth, scene, flaws=flaws, rng=seed + 7, forward=forward)
         step = rec.truth["frame_step"]
         last = np.flatnonzero((step > 0) & np.r_[step[1:] != step[:-1], True])
         s = step[last]
@@ -150,7 +167,7 @@ def robustness_study(
         )
         frames = rec.frames[last].astype(float)
         baseline = baseline_from(rec.frames, 5)
-        corrected, calibration, fit = _calibrate(assumed, truth, flaws, seed + 11)
+        corrected, calibration, fit = _calibrate(assumed, truth, flaws, seed + 11, forward)
         for calibrated in (False, True):
             spec = corrected if calibrated else assumed
             if calibrated:
@@ -200,6 +217,6 @@ def markdown_table(rows: list[Row], spec: SensorSpec) -> str:
                 f"| {finger} | {estimator} | {raw.along_mm:.2f} -> {fixed.along_mm:.2f} "
                 f"| {raw.around_deg:.1f} -> {fixed.around_deg:.1f} "
                 f"| {raw.force_pct:.1f} -> {fixed.force_pct:.1f} "
-                f"| {fixed.fitted_depth_mm:.2f}, {fixed.fitted_nu:.2f} |"
+                + f"| {fixed.fitted_depth_mm:.2f}, {fixed.fitted_nu:.2f} |"
             )
     return "\n".join(lines)

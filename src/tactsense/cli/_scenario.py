@@ -395,7 +395,9 @@ MAX_FRAMES = 100_000_000
 """Most frames one ``simulate`` or ``emulate`` run makes (about 13 GB of 8x8 counts)."""
 
 
-def run_scenario(spec: SensorSpec, scene, *, flaws: str, seed: int | None, path=None):
+def run_scenario(
+    spec: SensorSpec, scene, *, flaws: str, seed: int | None, path=None, forward: str = "twin"
+):
     """Simulate ``scene`` with a progress bar on the terminal.
 
     Without ``path``, the :class:`Recording` (in memory); with it, the recording is
@@ -421,5 +423,7 @@ def run_scenario(spec: SensorSpec, scene, *, flaws: str, seed: int | None, path=
             bar.update(task, completed=done, total=total)
 
         if path is not None:
-            return simulate_to_file(spec, scene, path, flaws=flaws, rng=seed, progress=update)
-        return simulate(spec, scene, flaws=flaws, rng=seed, progress=update)
+            return simulate_to_file(
+                spec, scene, path, flaws=flaws, rng=seed, progress=update, forward=forward
+            )
+        return simulate(spec, scene, flaws=flaws, rng=seed, progress=update, forward=forward)

@@ -74,6 +74,16 @@ def simulate(
     angle_deg: AngleOption = None,
     flaws: FlawsOption = "all",
     seed: SeedOption = 0,
+    forward: Annotated[
+        str,
+        typer.Option(
+            "--forward",
+            help="The finger's elastic model: 'twin' (the paper's: plane stress along the "
+            "finger, ring spreading around) or 'finger3d' (the 3-D skin's finite-element "
+            "response, tabulated; probes only; the tip row from the twin; docs/model.md). "
+            "Fingers only.",
+        ),
+    ] = "twin",
     plot: Annotated[
         Path | None,
         typer.Option(help="Also draw the swept tactels' responses to this PNG (sweeps only)."),
@@ -95,6 +105,9 @@ def simulate(
             fail(f"--plot {plot} and --out {out} are the same file; choose two names")
         if plot is not None:
             check_plot_format(plot)
+        from tactsense.physics.finger3d_table import check_forward
+
+        check_forward(forward, spec)
         scenario = resolve_scenario(spec, scenario)
         if plot is not None and scenario not in (
             ScenarioKind.sweep_axial,
@@ -124,10 +137,12 @@ def simulate(
         )
         # frames go to the file as they are made: memory stays flat however long
         with atomic_output(out) as temporary:
-            written = run_scenario(spec, scene, flaws=flaws, seed=seed, path=temporary)
+            written = run_scenario(spec, scene, flaws=flaws, seed=seed, path=temporary,
+                                   forward=forward)  # fmt: skip
         console.print(
             f"wrote {out}: {written} frames of {spec.shape[0]}x{spec.shape[1]} "
-            f"counts at {spec.electronics.scan_rate_hz:g} Hz ({spec.name})"
+            f"counts at {spec.electronics.scan_rate_hz:g} Hz ({spec.name}"
+            + (", the 3-D skin's response)" if forward == "finger3d" else ")")
         )
         if plot is not None:  # a sweep: a few hundred frames, read back whole
             with atomic_output(plot) as temporary:

@@ -260,9 +260,10 @@ class LiveContacts:
 
         if calibration is not None:
             if not isinstance(calibration, ArrayCalibration):
+                what = "a point set" if sensor.kind == "points" else f"a {sensor.kind}"
                 raise TactsenseInputError(
-                    f"a finger's calibration does not apply to {sensor.name!r}, a "
-                    f"{sensor.kind}: calibrate it with 'tactsense calibrate' on its own recording"
+                    f"a finger's calibration does not apply to {sensor.name!r}, {what}: "
+                    "calibrate it with 'tactsense calibrate' on its own recording"
                 )
             calibration.check_sensor(sensor)
         self.calibration = calibration
