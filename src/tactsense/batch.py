@@ -201,7 +201,9 @@ class iter_contacts:
                     "untouched frames at the start for the baseline"
                 )
             else:
-                start = np.median(reader.frames(0, baseline_frames).astype(float), axis=0)
+                # NaN-tolerant: one unreadable value in the baseline frames does not
+                # make its taxel dead for the whole recording
+                start = np.nanmedian(reader.frames(0, baseline_frames).astype(float), axis=0)
             self.baseline = DriftBaseline(
                 start, sensor, frame_period_s=sensor.scan_period_s,
                 threshold=default_threshold(sensor) if threshold is None else threshold,

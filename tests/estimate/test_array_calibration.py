@@ -61,6 +61,8 @@ def bench(tmp_path_factory):
     loads = _loads(pad)
     ts.write_recording(folder / "loads.h5", loads)
     _log(loads, folder / "loads.csv")
+    _log(rec, folder / "one_load.csv")  # the raster's own log: 50 g every time
+    ts.write_recording(folder / "press.h5", ts.simulate(pad, fs.press(pad), rng=2))
     return folder, pad, rec, loads
 
 
@@ -162,6 +164,8 @@ def finger_files(tmp_path_factory):
 BAD = [
     ("calibrate PAD --steps PAD --out OUT", "--steps is for fingers"),
     ("calibrate PAD --loads PAD --out OUT", "--loads goes with --force-log"),
+    ("calibrate BENCH/press.h5 --out OUT", "this is not a probe pressed on every taxel"),
+    ("calibrate PAD --force-log BENCH/one_load.csv --out OUT", "the force log holds one load"),
     ("calibrate PAD --force-log DIR/missing.csv --out OUT", "cannot read"),
     (
         "calibrate PAD --force-log DIR/nocolumns.csv --out OUT",
@@ -183,7 +187,7 @@ def test_bad_calibration_input_is_one_line(bench, finger_files, tmp_path, line, 
     (tmp_path / "nocolumns.csv").write_text("t,f\n0,1\n1,2\n")
     (tmp_path / "backwards.csv").write_text("time_s,force_n\n1,0\n0,1\n")
     out = tmp_path / "never.json"
-    args = (line.replace("PAD", str(folder / "bench.h5"))
+    args = (line.replace("PAD", str(folder / "bench.h5")).replace("BENCH", str(folder))
             .replace("FINGER", str(finger_files / "finger.h5"))
             .replace("FDIR", str(finger_files)).replace("DIR", str(tmp_path))
             .replace("OUT", str(out)).split())  # fmt: skip

@@ -104,3 +104,23 @@ def test_drift_baseline_and_the_touched_baseline_warning(two, tmp_path):
     assert re.search(r"warning: (\d+) frames read below the baseline", line), line
     clean = run("locate", "two.h5", "--out", "clean.csv", cwd=two)
     assert "warning" not in clean
+
+
+def test_a_nan_in_the_baseline_frames_does_not_kill_its_taxel(tmp_path):
+    """One unreadable value among the untouched frames: the baseline is the median of the
+    others there, not NaN (which would flag every contact DEAD_TACTEL)."""
+    import dataclasses
+
+    from tactsense import flat_scenarios as fs
+    from tactsense.batch import contacts_file
+    from tactsense.estimate import Flag
+
+    pad = ts.preset("pad16")
+    rec = ts.simulate(pad, fs.two_probes(pad), rng=0)
+    frames = rec.frames.astype(float)
+    frames[1, 3, 3] = np.nan
+    ts.write_recording(tmp_path / "nan.h5", dataclasses.replace(rec, frames=frames))
+    contacts_file(tmp_path / "nan.h5", tmp_path / "nan.parquet")
+    table = pd.read_parquet(tmp_path / "nan.parquet")
+    assert len(table) > 0
+    assert not (table["flags"] & int(Flag.DEAD_TACTEL)).any()

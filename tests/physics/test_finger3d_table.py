@@ -94,5 +94,24 @@ def test_knife_edge_is_tabulated_and_other_contacts_are_refused():
     knife = ts.simulate(spec, ts.knife_edge_sweep(spec), flaws="none", forward="finger3d")
     assert knife.frames.max() > knife.frames[0].max()  # it presses
     rod = LineContact(8.7, 0.0, 0.5, orientation_deg=45.0)  # Fig. 22's rod: not tabulated
-    with pytest.raises(TactsenseInputError, match="tabulated for the probe and section 4.1"):
+    with pytest.raises(TactsenseInputError, match=r"tabulated for the probe and section 4\.1"):
         ts.simulate(spec, Scenario((Step((rod,), 1.0, "rod"),)), forward="finger3d")
+
+
+def test_uncalibrated_locate_reads_the_3d_skin_a_tenth_as_hard():
+    """The number docs/model.md quotes: on the default sweep (every flaw on, no
+    calibration) locate's median force over the applied is about 1.5 on the twin's frames
+    and about 0.16 on the 3-D skin's: the solid, nearly incompressible rubber bonded to the
+    core strains far less at the ring depth than the paper's fitted plane-stress slice."""
+    spec = ts.fearing1990_initial()
+    ratios = {}
+    for forward in ("twin", "finger3d"):
+        rec = ts.simulate(spec, ts.probe_sweep(spec), rng=0, forward=forward)
+        est = ts.locate(rec.frames, spec, baseline=ts.baseline_from(rec.frames, 5))
+        step = rec.truth["frame_step"]
+        force = rec.truth["step_force_n"][step]
+        axial = rec.truth["step_axial_mm"][step]
+        ok = np.isfinite(force) & (force > 0) & np.isfinite(est.force_n) & (axial > 4) & (axial < 20)
+        ratios[forward] = np.median(est.force_n[ok] / force[ok])
+    assert 1.2 < ratios["twin"] < 1.9
+    assert 0.1 < ratios["finger3d"] < 0.25

@@ -34,6 +34,8 @@ BAD = [
     ("locate REC --contacts --method fit --out OUT", "method 'fit' works on pads"),
     ("locate PAD --calibration DIR/cal.json --out OUT", "is not a tactsense calibration"),
     ("locate PAD --drift-s -1 --out OUT", "--drift-s"),
+    ("locate REC --method cop --out OUT", "--method apply to the long table of contacts"),
+    ("locate REC --max-contacts 2 --out OUT", "--max-contacts apply to the long table"),
     ("locate PAD --drift-s nan --out OUT", "--drift-s"),
     ("locate PAD --drift-s inf --out OUT", "--drift-s"),
 ]

@@ -50,8 +50,9 @@ SensorOption = Annotated[
 CalibrationOption = Annotated[
     Path | None,
     typer.Option(
-        help="Calibration JSON from 'tactsense calibrate': its baseline, gains, excluded "
-        "tactels and creep compensation apply from the first frame."
+        help="Calibration JSON from 'tactsense calibrate': its baseline, gains and excluded "
+        "taxels apply from the first frame, with a finger's nonlinearity and creep "
+        "compensation, or a pad's or point set's force curve."
     ),
 ]
 BaselineFramesOption = Annotated[

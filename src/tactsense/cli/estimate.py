@@ -74,7 +74,8 @@ def locate(
         typer.Option(
             "--out",
             "-o",
-            help="File to write, one row per frame; the extension sets the format: .csv "
+            help="File to write, one row per frame (on a pad, a point set or with "
+            "--contacts: one row per contact per frame); the extension sets the format: .csv "
             "(units in the column names: _s, _mm, _deg, _n; flags as bits and by name), "
             ".parquet or .h5 (flags as bits).",
         ),
@@ -103,7 +104,9 @@ def locate(
         str,
         typer.Option(
             help="Long table: how a contact's position is found: 'interpolate' (the "
-            "paper's windowed sinc and Newton, on the grid) or 'cop' (centre of pressure)."
+            "paper's windowed sinc and Newton, on the grid), 'cop' (centre of pressure) or "
+            "'fit' (pads: maximum likelihood on the layer's response, the most accurate, "
+            "about 300 us a contact; docs/accuracy.md)."
         ),
     ] = "interpolate",
     drift_s: Annotated[
@@ -114,8 +117,9 @@ def locate(
             max=1e6,
             help="Long table: time constant [s] with which the baseline follows slow "
             "drift where taxels are untouched (held while touched, as iCub's skin does; "
-            "docs/contacts.md); 0 keeps the first frames' baseline. Not used with "
-            "--calibration.",
+            "docs/contacts.md); 0 keeps the first frames' baseline. With a pad's "
+            "--calibration it starts from the calibration's baseline; not used with a "
+            "finger's.",
         ),
     ] = 2.0,
     chunk_frames: Annotated[
@@ -163,6 +167,14 @@ def locate(
             from tactsense.estimate.array_calibration import load_calibration
 
             calibrated = load_calibration(calibration, sensor)
+        if not contacts and sensor.kind == "finger":
+            changed = (("--method", method != "interpolate"), ("--max-contacts", max_contacts != 8))
+            given = [name for name, value in changed if value]
+            if given:
+                raise TactsenseInputError(
+                    f"{' and '.join(given)} apply to the long table of contacts: add "
+                    "--contacts (a finger's one-row-per-frame table has one contact)"
+                )
         if contacts or sensor.kind != "finger":
             _locate_contacts(
                 recording, out, force, quiet, baseline_frames=baseline_frames,

@@ -69,7 +69,8 @@ StreamSensorOption = Annotated[
     str | None,
     typer.Option(
         "--sensor",
-        help="The finger on the line ('initial', 'improved' or a TOML file). Default: ask "
+        help="The sensor on the line: a preset ('initial', 'improved', 'pad16', ...; "
+        "for text, byte or float formats the rows x cols) or a TOML file. Default: ask "
         "the device (IDENTIFY) for its sensor description.",
     ),
 ]
@@ -121,6 +122,12 @@ def _open_reader(source: str, sensor: str | None, timeout: float | None, *, star
     from tactsense.stream.sources import open_source
 
     spec = None if sensor is None else load_sensor(sensor)
+    if source.lower().endswith((".h5", ".hdf5")) and Path(source).is_file():
+        fail(
+            f"{source} is a recording; this command reads a device. For a recording use "
+            "'tactsense locate' (or 'view' to play it back), or play it as a device with "
+            f"'tactsense emulate --recording {source} --port 0'"
+        )
     if source.startswith(LSL_PREFIX):
         from tactsense.interop.lsl import LslReader
 
@@ -132,7 +139,15 @@ def _open_reader(source: str, sensor: str | None, timeout: float | None, *, star
 
 
 def _stream_and_locator(
-    source, sensor, timeout, calibration, baseline_frames, threshold, *, keep_deflection=False
+    source,
+    sensor,
+    timeout,
+    calibration,
+    baseline_frames,
+    threshold,
+    *,
+    keep_deflection=False,
+    contact_options: dict | None = None,
 ):
     """The device, opened but not started, and a compiled locator for it: the finger's
     :class:`LiveLocator`, or :class:`LiveContacts` (every contact, tracked) for a pad or a
@@ -153,6 +168,7 @@ def _stream_and_locator(
             frame_period_s=None,  # the sensor's scan period: device time, not the wire's
             keep_deflection=keep_deflection,
             calibration=calibration,
+            **(contact_options or {}),
         )
         return reader, locator
     if calibration is not None and not hasattr(calibration, "apply"):
@@ -475,6 +491,29 @@ def live(
             "outlets (<sensor>-frames, <sensor>-contacts; docs/interop.md).",
         ),
     ] = False,
+    method: Annotated[
+        str,
+        typer.Option(
+            help="Pads and point sets: how a contact's position is found, as for 'locate' "
+            "('interpolate', 'cop' or 'fit')."
+        ),
+    ] = "interpolate",
+    max_contacts: Annotated[
+        int,
+        typer.Option(
+            min=1, max=64, help="Pads and point sets: at most this many contacts a frame."
+        ),
+    ] = 8,
+    drift_s: Annotated[
+        float,
+        typer.Option(
+            "--drift-s",
+            min=0.0,
+            max=1e6,
+            help="Pads and point sets: time constant [s] with which the baseline follows "
+            "slow drift where taxels are untouched; 0 keeps it fixed (as 'locate').",
+        ),
+    ] = 2.0,
     force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
 ) -> None:
     """Estimate the contact of every frame as it arrives: position, force, skew, flags and
@@ -499,9 +538,15 @@ def live(
         check_output(out, force, inputs=[calibration, *sensor_file(sensor), *_source_file(source)])
     try:
         cal = None if calibration is None else load_calibration(calibration)
+        from tactsense.estimate.contacts import METHODS
+
+        if method not in METHODS:
+            raise TactsenseInputError(f"--method {method!r}: expected one of {', '.join(METHODS)}")
         reader, locator = _stream_and_locator(
-            source, sensor, timeout, cal, baseline_frames, threshold
-        )
+            source, sensor, timeout, cal, baseline_frames, threshold,
+            contact_options={"method": method, "max_contacts": max_contacts,
+                             "drift_s": drift_s if drift_s > 0 else None},
+        )  # fmt: skip
         outlets = None
         if lsl:
             from tactsense.interop.lsl import LslOutlets

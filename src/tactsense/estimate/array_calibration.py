@@ -203,7 +203,7 @@ def gains_from_press(
     from tactsense.estimate.contacts import default_threshold
 
     frames = _frames(frames, sensor, baseline_frames)
-    baseline = np.median(frames[:baseline_frames].astype(float), axis=0)
+    baseline = np.nanmedian(frames[:baseline_frames].astype(float), axis=0)
     signal = _signal(frames, sensor, baseline).reshape(len(frames), -1)
     threshold = default_threshold(sensor) if threshold is None else threshold
     loaded = np.mean(signal > threshold, axis=1) > 0.5
@@ -223,17 +223,23 @@ def gains_from_press(
 
 def gains_from_sweep(frames, sensor, *, baseline_frames: int = 5, min_response: float = 0.1):
     """Gains, baseline and dead taxels from a probe pressed on every taxel in turn: each
-    taxel's largest signal over the median of all taxels' largest signals."""
+    taxel's largest signal over the median of the largest signals of the taxels the
+    sweep reached (those above the contact threshold); the others are dead."""
+    from tactsense.estimate.contacts import default_threshold
+
     frames = _frames(frames, sensor, baseline_frames)
-    baseline = np.median(frames[:baseline_frames].astype(float), axis=0)
+    baseline = np.nanmedian(frames[:baseline_frames].astype(float), axis=0)
     peaks = _signal(frames, sensor, baseline).max(axis=0)
-    median = np.median(peaks)
-    if not median > 0:
+    reached = peaks > default_threshold(sensor)
+    if reached.mean() < 0.5:
         raise ArrayCalibrationError(
-            "the sweep moves no taxel: half or more read nothing above the baseline"
+            f"the sweep reached {int(reached.sum())} of {reached.size} taxels (above the "
+            "contact threshold): this is not a probe pressed on every taxel in turn "
+            "(simulate --scenario calibration, or a probe on a stage)"
         )
+    median = np.median(peaks[reached])
     gains = peaks / median
-    dead = ~(gains > min_response)
+    dead = ~(gains > min_response) | ~reached
     notes = {"method": "probe sweep", "frames": len(frames)}
     return np.where(dead, 1.0, gains), baseline, dead, notes
 
@@ -400,6 +406,13 @@ def calibrate_array(
     np.add.at(estimated, table.frame, np.nan_to_num(table.force_n))
     measured = np.interp(time_s, log_t, log_f)
     use = inside & (estimated > 0) & (measured > 0.05 * np.max(log_f))
+    loads = measured[use]
+    if len(loads) and np.percentile(loads, 90) < 1.5 * np.percentile(loads, 10):
+        raise ArrayCalibrationError(
+            f"the force log holds one load ({np.median(loads):.3g} N in the frames with a "
+            "contact): a force curve needs presses of several forces (a recording of "
+            "presses from light to heavy, given with --loads)"
+        )
     calibration.force_curve = force_curve(estimated[use], measured[use], bins=bins)
     calibration.notes["force_pairs"] = int(use.sum())
     return calibration

@@ -228,6 +228,6 @@ class DriftBaseline:
         need = self.rezero_frames - len(self._collect)
         self._collect.extend(np.asarray(frames[:need], dtype=float))
         if len(self._collect) >= self.rezero_frames:
-            self.baseline = np.ascontiguousarray(np.median(np.stack(self._collect), axis=0))
+            self.baseline = np.ascontiguousarray(np.nanmedian(np.stack(self._collect), axis=0))
             self._collect = None
         return frames

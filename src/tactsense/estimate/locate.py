@@ -121,9 +121,11 @@ def locate(
         processed with those tactels ignored, and flagged.
     """
     if getattr(sensor, "kind", None) in ("pad", "points"):
+        what = "a point set" if sensor.kind == "points" else f"a {sensor.kind}"
         raise TactsenseInputError(
-            f"contact estimation works on fingers so far; {sensor.name!r} is a {sensor.kind} "
-            "(simulate, record, view, info, export to MCAP and design sweep work on it)"
+            f"this works on fingers; {sensor.name!r} is {what}: its contacts come from "
+            "'tactsense locate' (the long table), 'live', 'view' and the export to MCAP "
+            "(tactsense.estimate.find_contacts)"
         )
     if not isinstance(sensor, SensorSpec):
         raise TactsenseInputError(f"sensor must be a SensorSpec; got {type(sensor).__name__}")

@@ -344,7 +344,7 @@ class LiveContacts:
             self._collected.append(np.asarray(counts, dtype=float))
             if len(self._collected) >= self._baseline_frames:
                 collected = np.stack(self._collected)
-                self._set_baseline(np.median(collected, axis=0))
+                self._set_baseline(np.nanmedian(collected, axis=0))
                 # the baseline's frames pass through it as they do in a recording's
                 # locate (batch.contacts_file): live and batch give the same numbers
                 self._drift.signal(collected)
