@@ -111,7 +111,9 @@ def test_uncalibrated_locate_reads_the_3d_skin_a_tenth_as_hard():
         step = rec.truth["frame_step"]
         force = rec.truth["step_force_n"][step]
         axial = rec.truth["step_axial_mm"][step]
-        ok = np.isfinite(force) & (force > 0) & np.isfinite(est.force_n) & (axial > 4) & (axial < 20)
+        ok = (
+            np.isfinite(force) & (force > 0) & np.isfinite(est.force_n) & (axial > 4) & (axial < 20)
+        )
         ratios[forward] = np.median(est.force_n[ok] / force[ok])
     assert 1.2 < ratios["twin"] < 1.9
     assert 0.1 < ratios["finger3d"] < 0.25
