@@ -9,7 +9,10 @@ _numba_unpickle returned a result with an exception set``).
 
 :func:`deferred_interrupts` swaps Python's SIGINT handler for one that only notes the
 press, for the length of the compiled calls, and raises the KeyboardInterrupt after
-them, in ordinary Python code. (Blocking the signal with ``pthread_sigmask`` is not
+them, in ordinary Python code. A real-time loop cannot pay for two swaps a frame: it
+installs the gate once (:func:`gate_ready`) and sets and clears a flag around each
+compiled call (``RealTimeLocator``); where the gate is installed,
+:func:`deferred_interrupts` uses the same flag. (Blocking the signal with ``pthread_sigmask`` is not
 enough: any other thread, e.g. a progress bar's, can receive it.) Callers keep each
 block of compiled work short, so that Ctrl-C stays prompt.
 """

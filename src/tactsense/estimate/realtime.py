@@ -52,8 +52,14 @@ class RealTimeLocator:
     """Everything :func:`~tactsense.estimate.locate` does, for one frame at a time, fast.
 
     The baseline, the excluded tactels and the constants are prepared once; each call
-    runs two compiled functions on the frame and a few float operations, about
-    15 microseconds on the project's CPU (docs/performance.md).
+    runs one compiled function on the frame and a few float operations, about
+    7 microseconds on the project's CPU (docs/performance.md).
+
+    Ctrl-C: making a locator in the main thread installs the process-wide SIGINT gate
+    of :mod:`tactsense._signals`, which hands the signal on to the handler in force
+    before it; a press during a frame's compiled call is delivered right after it (a
+    KeyboardInterrupt under Python's default handler).
+    :func:`tactsense._signals.remove_gate` puts the previous handler back.
 
     Parameters
     ----------
