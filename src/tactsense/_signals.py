@@ -103,7 +103,7 @@ class _Hold:
     """The context manager behind :func:`deferred_interrupts` (a class: a generator-based
     one costs more than the compiled call it guards in a real-time loop)."""
 
-    __slots__ = ("pressed", "previous", "outer")
+    __slots__ = ("outer", "pressed", "previous")
 
     def __init__(self) -> None:
         self.pressed = False

@@ -16,7 +16,6 @@ from tactsense.estimate.localize import MAX_ITERATIONS, MAX_STEP, TOLERANCE
 from tactsense.estimate.locate import CONTACT_THRESHOLD
 from tactsense.sensor import SensorSpec
 
-
 _NO_CONTACT = int(Flag.NO_CONTACT)
 _NOT_CONVERGED = int(Flag.NOT_CONVERGED)
 _EDGE = int(Flag.EDGE)
