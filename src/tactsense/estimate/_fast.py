@@ -411,3 +411,46 @@ def prepare_frames(frames, baseline, unusable, full_scale, nan_flag, saturated_f
         flags[f] = flag
         peak[f] = best
     return deflection, flags, peak
+
+
+@jit(nogil=True)
+def locate_one(frame, baseline, unusable, settings, out):
+    """Eq. 4, the contact test and :func:`locate_frames` for one frame (rows, cols)
+    [counts] in one compiled call with few arguments (a real-time loop pays for each
+    argument and each array returned): the same numbers as :func:`prepare_frames` then
+    :func:`locate_frames`.
+
+    ``settings`` (float64): full scale, threshold, tolerance, max step, periodic, first
+    row, max iterations, and the NaN, saturated and dead flags. ``out`` (10,) gets row,
+    col, value, iterations, converged, summed, skew, second, flags and touched (1 or 0);
+    the estimates are NaN (``second`` 0) where the frame is not touched.
+    """
+    rows, cols = frame.shape
+    frames = np.empty((1, rows, cols), frame.dtype)
+    frames[0] = frame
+    deflection, flags, peak = prepare_frames(
+        frames, baseline, unusable, settings[0], int(settings[7]), int(settings[8]),
+        int(settings[9]),
+    )  # fmt: skip
+    touched = peak[0] >= settings[1]
+    out[8] = flags[0]
+    out[9] = 1.0 if touched else 0.0
+    if not touched:
+        out[0:7] = np.nan
+        out[3] = 0.0
+        out[4] = 0.0
+        out[7] = 0.0
+        return
+    valid = np.ones(1, np.bool_)
+    row, col, value, iterations, converged, summed, skew, second = locate_frames(
+        deflection, valid, settings[4] != 0.0, int(settings[5]), settings[2],
+        int(settings[6]), settings[3],
+    )  # fmt: skip
+    out[0] = row[0]
+    out[1] = col[0]
+    out[2] = value[0]
+    out[3] = iterations[0]
+    out[4] = 1.0 if converged[0] else 0.0
+    out[5] = summed[0]
+    out[6] = skew[0]
+    out[7] = second[0]

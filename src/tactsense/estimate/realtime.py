@@ -6,14 +6,23 @@ from typing import NamedTuple
 
 import numpy as np
 
-from tactsense._signals import deferred_interrupts
+from tactsense import _signals
+from tactsense._signals import deliver, gate_ready
 from tactsense._validation import TactsenseInputError, check_frames
-from tactsense.estimate._fast import locate_frames, prepare_frames
+from tactsense.estimate._fast import locate_one
 from tactsense.estimate.deflection import Flag
 from tactsense.estimate.force import force_per_deflection
 from tactsense.estimate.localize import MAX_ITERATIONS, MAX_STEP, TOLERANCE
 from tactsense.estimate.locate import CONTACT_THRESHOLD
 from tactsense.sensor import SensorSpec
+
+_NO_CONTACT = int(Flag.NO_CONTACT)
+_NOT_CONVERGED = int(Flag.NOT_CONVERGED)
+_EDGE = int(Flag.EDGE)
+_TIP = int(Flag.TIP)
+_MULTIPLE = int(Flag.MULTIPLE)
+_SATURATED = int(Flag.SATURATED)
+_NAN = float("nan")
 
 
 class Contact(NamedTuple):
@@ -42,8 +51,14 @@ class RealTimeLocator:
     """Everything :func:`~tactsense.estimate.locate` does, for one frame at a time, fast.
 
     The baseline, the excluded tactels and the constants are prepared once; each call
-    runs two compiled functions on the frame and a few float operations, about
-    15 microseconds on the project's CPU (docs/performance.md).
+    runs one compiled function on the frame and a few float operations, about
+    7 microseconds on the project's CPU (docs/performance.md).
+
+    Ctrl-C: making a locator in the main thread installs the process-wide SIGINT gate
+    of :mod:`tactsense._signals`, which hands the signal on to the handler in force
+    before it; a press during a frame's compiled call is delivered right after it (a
+    KeyboardInterrupt under Python's default handler).
+    :func:`tactsense._signals.remove_gate` puts the previous handler back.
 
     Parameters
     ----------
@@ -90,13 +105,31 @@ class RealTimeLocator:
         self._rows_axial = [float(v) for v in sensor.row_axial_mm]
         self._angle0 = float(sensor.col_angle_deg[0])
         self._spacing_deg = float(sensor.array.spacing_angle_deg)
-        self._valid = np.ones(1, dtype=bool)
-        self._shape = (1, *sensor.shape)
-        # compile (or load from Numba's cache) both paths now, not on the first contact
-        self(np.asarray(baseline))
+        self._shape = tuple(sensor.shape)
+        self._settings = np.array(
+            [
+                self._full_scale,
+                threshold,
+                TOLERANCE,
+                MAX_STEP,
+                1.0 if self._periodic else 0.0,
+                self._first_row,
+                MAX_ITERATIONS,
+                int(Flag.NAN_INPUT),
+                int(Flag.SATURATED),
+                int(Flag.DEAD_TACTEL),
+            ],
+            dtype=np.float64,
+        )
+        self._out = np.empty(10)
+        # compile (or load from Numba's cache) both paths now, not on the first contact,
+        # for float64 and uint16 readings (the types taken as they come)
         touched = np.array(self._baseline)
         touched[self.sensor.shape[0] // 2, 0] *= 1.0 + 20 * threshold
-        self(touched)
+        for frame in (np.asarray(baseline), touched):
+            self(frame)
+            if self._full_scale < 2**16:
+                self(np.clip(np.round(frame), 0, self._full_scale).astype(np.uint16))
 
     def _axial(self, row: float) -> float:
         knots = self._rows_axial
@@ -105,57 +138,51 @@ class RealTimeLocator:
 
     def __call__(self, frame) -> Contact:
         """Estimate the contact of one frame of readings [counts], shape (rows, cols)."""
-        frame = np.asarray(frame, dtype=np.float64)
-        if frame.shape != self.sensor.shape:
+        frame = np.asarray(frame)
+        if frame.shape != self._shape:
             raise TactsenseInputError(
                 f"frame has shape {frame.shape}; expected {self.sensor.shape}"
             )
-        # one hold of Ctrl-C around both compiled passes (about 9 us per hold)
-        with deferred_interrupts():
-            deflection, flags, peak = prepare_frames(
-                frame.reshape(self._shape),
-                self._baseline,
-                self._unusable,
-                self._full_scale,
-                int(Flag.NAN_INPUT),
-                int(Flag.SATURATED),
-                int(Flag.DEAD_TACTEL),
-            )
-            touched = peak[0] >= self._threshold
-            if touched:
-                row, col, value, iterations, converged, summed, skew, second = locate_frames(
-                    deflection,
-                    self._valid,
-                    self._periodic,
-                    self._first_row,
-                    TOLERANCE,
-                    MAX_ITERATIONS,
-                    MAX_STEP,
-                )
-        flag = int(flags[0])
+        if frame.dtype != np.float64 and frame.dtype != np.uint16:
+            frame = frame.astype(np.float64)
+        out = self._out
+        # Ctrl-C held back by the process-wide gate's flag (tactsense._signals: a flag
+        # set and cleared, where swapping the handler cost about 7 us a frame)
+        if gate_ready():
+            outer = _signals._inside_compiled
+            _signals._inside_compiled = True
+            try:
+                locate_one(frame, self._baseline, self._unusable, self._settings, out)
+            finally:
+                _signals._inside_compiled = outer
+            if _signals._pressed and not outer:
+                deliver()
+        else:
+            locate_one(frame, self._baseline, self._unusable, self._settings, out)
+        r, c, value, iterations, converged, summed, skew, second, flag, touched = out.tolist()
+        flag = int(flag)
         if not touched:
-            nan = float("nan")
-            return Contact(nan, nan, nan, nan, nan, nan, nan, 0, False, flag | int(Flag.NO_CONTACT))
-        r, c = float(row[0]), float(col[0])
-        rows, cols = self.sensor.shape
-        if not converged[0]:
-            flag |= int(Flag.NOT_CONVERGED)
+            nan = _NAN
+            return Contact(nan, nan, nan, nan, nan, nan, nan, 0, False, flag | _NO_CONTACT)
+        rows, cols = self._shape
+        if not converged:
+            flag |= _NOT_CONVERGED
         if r < 0.5 or r > rows - 1.5 or (not self._periodic and (c < 0.5 or c > cols - 1.5)):
-            flag |= int(Flag.EDGE)
+            flag |= _EDGE
         if self._first_row and r < 1.0:
-            flag |= int(Flag.TIP)
-        if second[0] >= self._second:
-            flag |= int(Flag.MULTIPLE)
+            flag |= _TIP
+        if second >= self._second:
+            flag |= _MULTIPLE
         angle = (self._angle0 + self._spacing_deg * c + 180.0) % 360.0 - 180.0
         return Contact(
             r,
             c,
             self._axial(r),
             angle,
-            float(value[0]),
-            float("nan") if flag & int(Flag.SATURATED) else self._force * float(summed[0]),
-            float(skew[0]),
-            int(iterations[0]),
-            bool(converged[0]),
+            value,
+            _NAN if flag & _SATURATED else self._force * summed,
+            skew,
+            int(iterations),
+            bool(converged),
             flag,
         )
