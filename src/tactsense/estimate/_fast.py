@@ -414,6 +414,45 @@ def prepare_frames(frames, baseline, unusable, full_scale, nan_flag, saturated_f
 
 
 @jit(nogil=True)
+def locate_deflection_one(deflection, settings, out):
+    """:func:`locate_frames` for one frame of fractional deflection (rows, cols) [-] that a
+    calibration made (its gains, nonlinearity and creep applied; excluded tactels 0), in
+    one compiled call: ``settings`` and ``out`` as in :func:`locate_one` (``out[8]``, the
+    flags of the readings, is 0 here: the calibration reports its own)."""
+    rows, cols = deflection.shape
+    peak = -np.inf
+    for r in range(rows):
+        for c in range(cols):
+            v = deflection[r, c]
+            if v > peak:
+                peak = v
+    out[8] = 0.0
+    touched = peak >= settings[1]
+    out[9] = 1.0 if touched else 0.0
+    if not touched:
+        out[0:7] = np.nan
+        out[3] = 0.0
+        out[4] = 0.0
+        out[7] = 0.0
+        return
+    frames = np.empty((1, rows, cols), np.float64)
+    frames[0] = deflection
+    valid = np.ones(1, np.bool_)
+    row, col, value, iterations, converged, summed, skew, second = locate_frames(
+        frames, valid, settings[4] != 0.0, int(settings[5]), settings[2],
+        int(settings[6]), settings[3],
+    )  # fmt: skip
+    out[0] = row[0]
+    out[1] = col[0]
+    out[2] = value[0]
+    out[3] = iterations[0]
+    out[4] = 1.0 if converged[0] else 0.0
+    out[5] = summed[0]
+    out[6] = skew[0]
+    out[7] = second[0]
+
+
+@jit(nogil=True)
 def locate_one(frame, baseline, unusable, settings, out):
     """Eq. 4, the contact test and :func:`locate_frames` for one frame (rows, cols)
     [counts] in one compiled call with few arguments (a real-time loop pays for each

@@ -59,9 +59,9 @@ class ArrayCalibration:
 
     @property
     def sensor(self):
-        from tactsense.sensor import SensorSpec
+        from tactsense.estimate.calibrate import sensor_of
 
-        return SensorSpec.from_toml_string(self.sensor_toml)
+        return sensor_of(self.sensor_toml)
 
     def check_sensor(self, sensor) -> None:
         """Raise unless this calibration was made for ``sensor``."""

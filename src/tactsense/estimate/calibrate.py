@@ -16,6 +16,7 @@ present, else detected from the frames.
 
 from __future__ import annotations
 
+import functools
 import json
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -418,6 +419,13 @@ def jitter_statistics(readings, counts_per_gram):
 # ---- the calibration object ---------------------------------------------------------
 
 
+@functools.lru_cache(maxsize=16)
+def sensor_of(sensor_toml: str):
+    """The sensor a calibration's TOML describes, parsed once (a live stream checks it
+    every frame)."""
+    return SensorSpec.from_toml_string(sensor_toml)
+
+
 @dataclass
 class Calibration:
     """A finger's calibration: gains, baseline, masks and the fitted models.
@@ -440,7 +448,7 @@ class Calibration:
 
     def check_sensor(self, sensor: SensorSpec) -> None:
         """Raise unless this calibration was made for ``sensor``."""
-        mine = SensorSpec.from_toml_string(self.sensor_toml)
+        mine = sensor_of(self.sensor_toml)
         if mine != sensor:
             raise CalibrationError(
                 f"this calibration belongs to sensor {mine.name!r}, not {sensor.name!r} "

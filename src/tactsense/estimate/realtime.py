@@ -9,7 +9,7 @@ import numpy as np
 from tactsense import _signals
 from tactsense._signals import deliver, gate_ready
 from tactsense._validation import TactsenseInputError, check_frames
-from tactsense.estimate._fast import locate_one
+from tactsense.estimate._fast import locate_deflection_one, locate_one
 from tactsense.estimate.deflection import Flag
 from tactsense.estimate.force import force_per_deflection
 from tactsense.estimate.localize import MAX_ITERATIONS, MAX_STEP, TOLERANCE
@@ -159,6 +159,33 @@ class RealTimeLocator:
                 deliver()
         else:
             locate_one(frame, self._baseline, self._unusable, self._settings, out)
+        return self._contact(out)
+
+    def from_deflection(self, deflection) -> Contact:
+        """Estimate the contact of one frame of fractional deflection [-], shape (rows,
+        cols), that a calibration made (:meth:`Calibration.apply
+        <tactsense.estimate.calibrate.Calibration.apply>`: gains, nonlinearity and creep
+        applied, excluded tactels 0): the compiled path of ``live --calibration``."""
+        deflection = np.ascontiguousarray(deflection, dtype=np.float64)
+        if deflection.shape != self._shape:
+            raise TactsenseInputError(
+                f"deflection has shape {deflection.shape}; expected {self.sensor.shape}"
+            )
+        out = self._out
+        if gate_ready():
+            outer = _signals._inside_compiled
+            _signals._inside_compiled = True
+            try:
+                locate_deflection_one(deflection, self._settings, out)
+            finally:
+                _signals._inside_compiled = outer
+            if _signals._pressed and not outer:
+                deliver()
+        else:
+            locate_deflection_one(deflection, self._settings, out)
+        return self._contact(out)
+
+    def _contact(self, out) -> Contact:
         r, c, value, iterations, converged, summed, skew, second, flag, touched = out.tolist()
         flag = int(flag)
         if not touched:

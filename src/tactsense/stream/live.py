@@ -95,6 +95,11 @@ class LiveLocator:
             locate(np.full((1, *sensor.shape), 0.05), sensor, counts=False)
         if calibration is not None:
             calibration.check_sensor(sensor)
+            # the compiled per-frame path, on the calibrated deflection
+            self._calibrated_locator = RealTimeLocator(
+                sensor, calibration.baseline, threshold=threshold
+            )
+            self._calibrated_locator.from_deflection(np.zeros(sensor.shape))
             if calibration.viscoelastic is not None:
                 self._period = frame_period_s or sensor.scan_period_s
                 self._creep = CreepCompensator(calibration.viscoelastic, self._period, sensor.shape)
@@ -173,12 +178,10 @@ class LiveLocator:
             deflection = self._creep(deflection[0])[None]
         if self._keep:
             self.last_deflection = deflection[0]
-        est = locate(deflection, self.sensor, counts=False, threshold=self.threshold)
-        flags = int(est.flags[0]) | int(np.bitwise_or.reduce(np.ravel(apply_flags)))
+        c = self._calibrated_locator.from_deflection(deflection[0])
+        flags = int(c.flags) | int(np.bitwise_or.reduce(np.ravel(apply_flags)))
         return (
-            float(est.row[0]), float(est.col[0]), float(est.axial_mm[0]),
-            float(est.angle_deg[0]), float(est.force_n[0]), float(est.skew[0]),
-            float(est.peak_deflection[0]), flags,
+            c.row, c.col, c.axial_mm, c.angle_deg, c.force_n, c.skew, c.peak_deflection, flags,
         )  # fmt: skip
 
 
