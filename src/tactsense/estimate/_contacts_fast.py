@@ -15,6 +15,7 @@ import math
 import numpy as np
 
 from tactsense._jit import jit
+from tactsense.estimate._fast import taxel_signal
 
 HALF_WINDOW = 3
 """Taxels on each side of the peak that the interpolation uses [taxel]."""
@@ -43,21 +44,11 @@ def prepare_signal(
         flag = dead_flag if any_unusable else 0
         for r in range(rows):
             for c in range(cols):
-                v = float(frames[f, r, c])
-                d = 0.0
-                if not math.isfinite(v):
-                    flag |= nan_flag
-                elif unusable[r, c]:
-                    pass
-                elif v <= 0.0:
-                    flag |= dead_flag
-                else:
-                    if v >= full_scale:
-                        flag |= sat_flag
-                    if resistive:
-                        d = (v - baseline[r, c]) * per_count
-                    else:
-                        d = (v - baseline[r, c]) / v
+                d, bits = taxel_signal(
+                    float(frames[f, r, c]), baseline[r, c], unusable[r, c], full_scale,
+                    resistive, per_count, nan_flag, sat_flag, dead_flag,
+                )  # fmt: skip
+                flag |= bits
                 signal[f, r, c] = d
         flags[f] = flag
     return signal, flags

@@ -364,6 +364,27 @@ def locate_into(
         skew[f] = best_odd / best_even if best_even > 0 else np.nan
 
 
+@jit(inline="always")
+def taxel_signal(
+    v, base, unusable, full_scale, resistive, per_count, nan_flag, sat_flag, dead_flag
+):
+    """The signal of one reading ``v`` [counts] against its baseline ``base`` and the flag
+    bits it sets: eq. 4, ``(v - base) / v``, for a capacitive taxel; the strain,
+    ``(v - base) * per_count``, for a resistive one; 0 where the reading is unusable
+    (NaN: ``nan_flag``; excluded; zero or below: ``dead_flag``). One definition for the
+    finger's kernel, the contacts' and the drift-following baseline's."""
+    if not math.isfinite(v):
+        return 0.0, nan_flag
+    if unusable:
+        return 0.0, 0
+    if v <= 0.0:
+        return 0.0, dead_flag
+    flag = sat_flag if v >= full_scale else 0
+    if resistive:
+        return (v - base) * per_count, flag
+    return (v - base) / v, flag
+
+
 @jit(nogil=True)
 def prepare_frames(frames, baseline, unusable, full_scale, nan_flag, saturated_flag, dead_flag):
     """Eq. 4 deflection, per-frame flags and the largest tactel, in one pass.
@@ -393,24 +414,36 @@ def prepare_frames(frames, baseline, unusable, full_scale, nan_flag, saturated_f
         best = -np.inf
         for r in range(rows):
             for c in range(cols):
-                v = float(frames[f, r, c])
-                d = 0.0
-                if not math.isfinite(v):
-                    flag |= nan_flag
-                elif unusable[r, c]:
-                    pass
-                elif v <= 0.0:
-                    flag |= dead_flag
-                else:
-                    if v >= full_scale:
-                        flag |= saturated_flag
-                    d = (v - baseline[r, c]) / v
+                d, bits = taxel_signal(
+                    float(frames[f, r, c]), baseline[r, c], unusable[r, c], full_scale,
+                    False, 1.0, nan_flag, saturated_flag, dead_flag,
+                )  # fmt: skip
+                flag |= bits
                 deflection[f, r, c] = d
                 if d > best:
                     best = d
         flags[f] = flag
         peak[f] = best
     return deflection, flags, peak
+
+
+@jit(inline="always")
+def _locate_into_out(deflection, settings, out):
+    """:func:`locate_frames` on one frame (1, rows, cols), its results into ``out[0:8]``
+    (the layout of :func:`locate_one`)."""
+    valid = np.ones(1, np.bool_)
+    row, col, value, iterations, converged, summed, skew, second = locate_frames(
+        deflection, valid, settings[4] != 0.0, int(settings[5]), settings[2],
+        int(settings[6]), settings[3],
+    )  # fmt: skip
+    out[0] = row[0]
+    out[1] = col[0]
+    out[2] = value[0]
+    out[3] = iterations[0]
+    out[4] = 1.0 if converged[0] else 0.0
+    out[5] = summed[0]
+    out[6] = skew[0]
+    out[7] = second[0]
 
 
 @jit(nogil=True)
@@ -437,19 +470,7 @@ def locate_deflection_one(deflection, settings, out):
         return
     frames = np.empty((1, rows, cols), np.float64)
     frames[0] = deflection
-    valid = np.ones(1, np.bool_)
-    row, col, value, iterations, converged, summed, skew, second = locate_frames(
-        frames, valid, settings[4] != 0.0, int(settings[5]), settings[2],
-        int(settings[6]), settings[3],
-    )  # fmt: skip
-    out[0] = row[0]
-    out[1] = col[0]
-    out[2] = value[0]
-    out[3] = iterations[0]
-    out[4] = 1.0 if converged[0] else 0.0
-    out[5] = summed[0]
-    out[6] = skew[0]
-    out[7] = second[0]
+    _locate_into_out(frames, settings, out)
 
 
 @jit(nogil=True)
@@ -480,16 +501,4 @@ def locate_one(frame, baseline, unusable, settings, out):
         out[4] = 0.0
         out[7] = 0.0
         return
-    valid = np.ones(1, np.bool_)
-    row, col, value, iterations, converged, summed, skew, second = locate_frames(
-        deflection, valid, settings[4] != 0.0, int(settings[5]), settings[2],
-        int(settings[6]), settings[3],
-    )  # fmt: skip
-    out[0] = row[0]
-    out[1] = col[0]
-    out[2] = value[0]
-    out[3] = iterations[0]
-    out[4] = 1.0 if converged[0] else 0.0
-    out[5] = summed[0]
-    out[6] = skew[0]
-    out[7] = second[0]
+    _locate_into_out(deflection, settings, out)

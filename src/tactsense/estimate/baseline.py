@@ -37,6 +37,7 @@ import numpy as np
 from tactsense._jit import jit
 from tactsense._signals import deferred_interrupts
 from tactsense._validation import TactsenseInputError, check_frames
+from tactsense.estimate._fast import taxel_signal
 from tactsense.estimate.deflection import Flag
 
 TIME_CONSTANT_S = 2.0
@@ -69,23 +70,13 @@ def _follow(
                 held[r, c] = False
         for r in range(rows):
             for c in range(cols):
-                v = float(frames[f, r, c])
-                d = 0.0
-                if not math.isfinite(v):
-                    flag |= nan_flag
-                elif unusable[r, c]:
-                    pass
-                elif v <= 0.0:
-                    flag |= dead_flag
-                else:
-                    if v >= full_scale:
-                        flag |= sat_flag
-                    if resistive:
-                        d = (v - baseline[r, c]) * per_count
-                    else:
-                        d = (v - baseline[r, c]) / v
-                    if d < -threshold:
-                        flag |= below_flag
+                d, bits = taxel_signal(
+                    float(frames[f, r, c]), baseline[r, c], unusable[r, c], full_scale,
+                    resistive, per_count, nan_flag, sat_flag, dead_flag,
+                )  # fmt: skip
+                flag |= bits
+                if d < -threshold:
+                    flag |= below_flag
                 signal[f, r, c] = d
                 if d > threshold:
                     if grid:
