@@ -245,8 +245,18 @@ def calibrate(
         Path | None,
         typer.Option(
             help="Recording of a knife edge stepped past one tactel (section 4.1): "
-            "fit and store depth and Poisson's ratio. Needs the recording's scenario "
-            "for the edge positions."
+            "fit and store depth and Poisson's ratio. The edge positions come from the "
+            "recording's scenario (a simulation) or from --knife-log."
+        ),
+    ] = None,
+    knife_log: Annotated[
+        Path | None,
+        typer.Option(
+            "--knife-log",
+            help="The lab's stage log of the --knife recording: a CSV with time_s [s, the "
+            "recording's clock], position_mm [mm, the edge along the finger] and force_n "
+            "[N]; each press is the frames where the force is on, its position the "
+            "logged one at its last frame.",
         ),
     ] = None,
     row: Annotated[
@@ -304,13 +314,13 @@ def calibrate(
     from tactsense.estimate import calibrate as cal
 
     try:
-        check_output(out, force, inputs=[sweep, steps, knife, force_log, loads])
+        check_output(out, force, inputs=[sweep, steps, knife, force_log, loads, knife_log])
         from tactsense.io.recording import RecordingReader
 
         with RecordingReader(sweep) as reader:
             kind = reader.sensor.kind
         if kind != "finger":
-            for name, value in (("--steps", steps), ("--knife", knife)):
+            for name, value in (("--steps", steps), ("--knife", knife), ("--knife-log", knife_log)):
                 if value is not None:
                     raise TactsenseInputError(f"{name} is for fingers; {sweep} holds a {kind}")
             if loads is not None and force_log is None:
@@ -347,6 +357,8 @@ def calibrate(
             calibration.viscoelastic = _fit_steps(
                 read_recording(steps), sensor, row, col, baseline_frames
             )
+        if knife_log is not None and knife is None:
+            raise TactsenseInputError("--knife-log goes with --knife (the recording it logs)")
         if knife is not None:
             calibration.model_fit, compensated = _fit_knife(
                 read_recording(knife),
@@ -355,6 +367,7 @@ def calibrate(
                 col,
                 baseline_frames,
                 creep=calibration.viscoelastic,
+                log=knife_log,
             )
             calibration.notes["knife_fit_creep_compensated"] = compensated
         with atomic_output(out) as temporary:
@@ -468,7 +481,7 @@ def _fit_steps(rec, sensor, row, col, baseline_frames):
     return model
 
 
-def _fit_knife(rec, sensor, row, col, baseline_frames, *, creep=None):
+def _fit_knife(rec, sensor, row, col, baseline_frames, *, creep=None, log=None):
     """The plane-stress fit to the knife-edge recording; with a creep model (from
     --steps), the fit to the readings compensated for creep is kept when it is sound and
     its residual smaller: a knife held 0.5 s and lifted 0.5 s leaves the rubber's memory
@@ -478,14 +491,21 @@ def _fit_knife(rec, sensor, row, col, baseline_frames, *, creep=None):
 
     if rec.sensor != sensor:
         raise TactsenseInputError("the knife recording comes from another sensor than the sweep")
-    if "step_axial_mm" not in rec.truth:
+    if log is None and "step_axial_mm" not in rec.truth:
         raise TactsenseInputError(
             "the knife-edge fit needs the edge position of every step: this recording has no "
-            "scenario truth"
+            "scenario truth; give the stage's log with --knife-log"
         )
     signal = _deflection_of(rec, row, col, baseline_frames)
-    last, steps = rec.last_loaded_frames(row, col)
-    positions = np.asarray(rec.truth["step_axial_mm"])[steps]
+    if log is not None:
+        from tactsense.estimate.array_calibration import presses_from_log, read_stage_log
+
+        # the tactel reads at its own moment of each scan: the log at those times
+        sampled = np.asarray(rec.time_s) + float(np.asarray(rec.sample_offset_s)[row, col])
+        last, positions, _ = presses_from_log(sampled, read_stage_log(log))
+    else:
+        last, steps = rec.last_loaded_frames(row, col)
+        positions = np.asarray(rec.truth["step_axial_mm"])[steps]
     # distinct to 0.1 mm: the positions carry the probe's placement jitter
     distinct = np.unique(np.round(positions[np.isfinite(positions)], 1)).size
     if distinct < 6:

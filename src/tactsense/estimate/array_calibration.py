@@ -289,6 +289,57 @@ def read_force_log(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
     return t, f
 
 
+def read_stage_log(path: str | Path) -> dict[str, np.ndarray]:
+    """A lab's stage or force/torque log: a CSV with ``time_s`` [s], ``position_mm``
+    [mm] and ``force_n`` [N] (other columns ignored), rows in time order."""
+    path = Path(path)
+    try:
+        with open(path, newline="", encoding="utf-8") as stream:
+            reader = csv.DictReader(stream)
+            needed = {"time_s", "position_mm", "force_n"}
+            missing = needed - set(reader.fieldnames or [])
+            if missing:
+                raise ArrayCalibrationError(
+                    f"{path}: needs the columns time_s, position_mm and force_n; missing "
+                    f"{', '.join(sorted(missing))} (has {', '.join(reader.fieldnames or [])})"
+                )
+            rows = [(row["time_s"], row["position_mm"], row["force_n"]) for row in reader]
+    except OSError as error:
+        raise ArrayCalibrationError(f"cannot read {path}: {error.strerror}") from None
+    except UnicodeDecodeError:
+        raise ArrayCalibrationError(f"{path} is not a text CSV file") from None
+    try:
+        columns = np.array(rows, dtype=float).reshape(-1, 3).T
+    except ValueError as error:
+        raise ArrayCalibrationError(f"{path}: a value is not a number ({error})") from None
+    t, position, force = columns
+    if len(t) < 2 or not np.all(np.isfinite(columns)):
+        raise ArrayCalibrationError(f"{path}: needs at least 2 rows of finite numbers")
+    if np.any(np.diff(t) <= 0):
+        raise ArrayCalibrationError(f"{path}: time_s must increase from row to row")
+    return {"time_s": t, "position_mm": position, "force_n": force}
+
+
+def presses_from_log(time_s, log: dict, *, loaded_fraction: float = 0.1):
+    """The presses a stage log describes, seen in a recording's frames: the last frame of
+    every run of frames during which the logged force exceeds ``loaded_fraction`` of its
+    largest, and the logged position and force at that frame's time.
+
+    Returns
+    -------
+    last : ndarray of int
+        Frame indices, one per press.
+    position_mm, force_n : ndarray
+    """
+    time_s = np.asarray(time_s, dtype=float)
+    inside = (time_s >= log["time_s"][0]) & (time_s <= log["time_s"][-1])
+    force = np.interp(time_s, log["time_s"], log["force_n"])
+    loaded = inside & (force > loaded_fraction * np.max(log["force_n"]))
+    ends = np.flatnonzero(loaded & ~np.r_[loaded[1:], False])
+    position = np.interp(time_s[ends], log["time_s"], log["position_mm"])
+    return ends, position, force[ends]
+
+
 def force_curve(estimated, measured, *, bins: int = 8, min_force_n: float = 0.0):
     """Piecewise-linear knots from (estimated, measured) force pairs [N]: the medians of
     both in ``bins`` bins of equal count over the estimated force, made increasing.
