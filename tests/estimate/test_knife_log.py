@@ -50,8 +50,8 @@ def test_the_stage_log_gives_the_fit_the_truth_gives(files):
     fits = {}
     for name, extra in (("truth", []), ("log", ["--knife-log", str(files / "stage.csv")])):
         out = files / f"{name}.json"
-        result = runner.invoke(app, ["calibrate", str(files / "sweep.h5"), "--knife",
-                                     str(files / "knife.h5"), *extra, "--out", str(out)])  # fmt: skip
+        line = ["calibrate", str(files / "sweep.h5"), "--knife", str(files / "knife.h5")]
+        result = runner.invoke(app, [*line, *extra, "--out", str(out)])
         assert result.exit_code == 0, result.output
         fits[name] = json.loads(out.read_text())["model_fit"]
     # the same presses at the same positions; the frames differ where a press ends (the
