@@ -399,8 +399,10 @@ def test_pad_contacts_with_ids_trails_and_rezero(page, tmp_path):  # noqa: F811
             # that tells a right answer from a wrong taxel
             truth = a if np.hypot(*(np.array([contact["x_mm"], contact["y_mm"]]) - a)) < 5 else b
             assert np.hypot(contact["x_mm"] - truth[0], contact["y_mm"] - truth[1]) < 1.25
-        # both ids followed since they appeared: trails of the last 24 positions
-        assert sorted(state["trails"]) == [[0, 24], [1, 24]]
+        # both ids followed since they appeared: trails of their recent positions (at
+        # most 24; fewer when the page, on a loaded machine, was sent fewer frames)
+        assert [t[0] for t in sorted(state["trails"])] == [0, 1]
+        assert all(8 <= n <= 24 for _, n in state["trails"]), state["trails"]
         _contacts_panel(page, 2)
         rows = page.locator("#contact-rows tr").all_inner_texts()
         assert any(r.startswith("#0") for r in rows) and any(r.startswith("#1") for r in rows)
