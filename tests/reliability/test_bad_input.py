@@ -42,6 +42,7 @@ BAD_OPTIONS = [
     ("design bound --force-g 0", "--force-g"),
     ("design bound --diameter -1", "--diameter"),
     ("simulate --seed -1 --out OUT", "--seed"),
+    ("simulate --out OUT", "a recording is an HDF5 file; use the extension .h5"),
     ("simulate --lift-s -1 --out OUT", "--lift-s"),
     ("simulate --dwell-s 0 --out OUT", "--dwell-s"),
     ("simulate --force-g nan --out OUT", "--force-g"),

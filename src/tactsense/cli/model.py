@@ -136,6 +136,11 @@ def simulate(
             speed_mm_s=speed_mm_s,
             angle_deg=angle_deg,
         )
+        if out.suffix.lower() not in (".h5", ".hdf5"):
+            fail(
+                f"--out {out}: a recording is an HDF5 file; use the extension .h5 (or "
+                ".hdf5). Other formats come from 'tactsense export' or 'locate'"
+            )
         # frames go to the file as they are made: memory stays flat however long
         with atomic_output(out) as temporary:
             written = run_scenario(spec, scene, flaws=flaws, seed=seed, path=temporary,
