@@ -506,6 +506,18 @@ def hungarian(cost, far):
     return match
 
 
+@jit(inline="always")
+def _move_track(i, to, t_pos, t_vel, t_force, t_dforce, t_last, t_id):
+    """Track ``i``'s state into slot ``to`` (compacting the living tracks)."""
+    if to != i:
+        t_pos[to] = t_pos[i]
+        t_vel[to] = t_vel[i]
+        t_force[to] = t_force[i]
+        t_dforce[to] = t_dforce[i]
+        t_last[to] = t_last[i]
+        t_id[to] = t_id[i]
+
+
 @jit(nogil=True)
 def track_into(
     frame, pos, force, start, end, t_pos, t_vel, t_force, t_dforce, t_last, t_id, counters,
@@ -542,13 +554,7 @@ def track_into(
                 ev_other[e] = -1
                 counters[2] += 1
             else:
-                if alive != i:
-                    t_pos[alive] = t_pos[i]
-                    t_vel[alive] = t_vel[i]
-                    t_force[alive] = t_force[i]
-                    t_dforce[alive] = t_dforce[i]
-                    t_last[alive] = t_last[i]
-                    t_id[alive] = t_id[i]
+                _move_track(i, alive, t_pos, t_vel, t_force, t_dforce, t_last, t_id)
                 alive += 1
         counters[0] = alive
         if lo == n:
@@ -626,13 +632,7 @@ def track_into(
         alive = 0
         for i in range(n_t):
             if keep[i]:
-                if alive != i:
-                    t_pos[alive] = t_pos[i]
-                    t_vel[alive] = t_vel[i]
-                    t_force[alive] = t_force[i]
-                    t_dforce[alive] = t_dforce[i]
-                    t_last[alive] = t_last[i]
-                    t_id[alive] = t_id[i]
+                _move_track(i, alive, t_pos, t_vel, t_force, t_dforce, t_last, t_id)
                 alive += 1
         for j in range(n_c):
             if owner[j] >= 0:

@@ -428,9 +428,18 @@ def prepare_frames(frames, baseline, unusable, full_scale, nan_flag, saturated_f
 
 
 @jit(inline="always")
-def _locate_into_out(deflection, settings, out):
-    """:func:`locate_frames` on one frame (1, rows, cols), its results into ``out[0:8]``
-    (the layout of :func:`locate_one`)."""
+def _locate_into_out(deflection, peak, settings, out):
+    """:func:`locate_frames` on one frame (1, rows, cols) whose largest value is ``peak``,
+    its results into ``out[0:8]`` and whether it is touched into ``out[9]`` (the layout
+    of :func:`locate_one`); NaN estimates where it is not touched."""
+    touched = peak >= settings[1]
+    out[9] = 1.0 if touched else 0.0
+    if not touched:
+        out[0:7] = np.nan
+        out[3] = 0.0
+        out[4] = 0.0
+        out[7] = 0.0
+        return
     valid = np.ones(1, np.bool_)
     row, col, value, iterations, converged, summed, skew, second = locate_frames(
         deflection, valid, settings[4] != 0.0, int(settings[5]), settings[2],
@@ -460,17 +469,9 @@ def locate_deflection_one(deflection, settings, out):
             if v > peak:
                 peak = v
     out[8] = 0.0
-    touched = peak >= settings[1]
-    out[9] = 1.0 if touched else 0.0
-    if not touched:
-        out[0:7] = np.nan
-        out[3] = 0.0
-        out[4] = 0.0
-        out[7] = 0.0
-        return
     frames = np.empty((1, rows, cols), np.float64)
     frames[0] = deflection
-    _locate_into_out(frames, settings, out)
+    _locate_into_out(frames, peak, settings, out)
 
 
 @jit(nogil=True)
@@ -492,13 +493,5 @@ def locate_one(frame, baseline, unusable, settings, out):
         frames, baseline, unusable, settings[0], int(settings[7]), int(settings[8]),
         int(settings[9]),
     )  # fmt: skip
-    touched = peak[0] >= settings[1]
     out[8] = flags[0]
-    out[9] = 1.0 if touched else 0.0
-    if not touched:
-        out[0:7] = np.nan
-        out[3] = 0.0
-        out[4] = 0.0
-        out[7] = 0.0
-        return
-    _locate_into_out(deflection, settings, out)
+    _locate_into_out(deflection, peak[0], settings, out)

@@ -157,17 +157,9 @@ class ArrayCalibration:
                 raise ArrayCalibrationError(
                     f"{source}: {name} has the wrong shape, expected {tuple(sensor.shape)}"
                 )
-        used = ~calibration.dead
-        for name, values in (
-            ("gains", calibration.gains),
-            ("baseline_counts", calibration.baseline),
-        ):
-            bad = used & ~(np.isfinite(values) & (values > 0))
-            if bad.any():
-                raise ArrayCalibrationError(
-                    f"{source}: {name} of {int(bad.sum())} taxel(s) in use is not a positive "
-                    "finite number; expected > 0 (mark such taxels dead, or calibrate again)"
-                )
+        from tactsense.estimate.calibrate import check_in_use
+
+        check_in_use(source, ~calibration.dead, calibration, ArrayCalibrationError, "taxel")
         if calibration.force_curve is not None:
             x, y = (np.asarray(v) for v in calibration.force_curve)
             if len(x) < 2 or len(x) != len(y) or np.any(np.diff(x) <= 0) or np.any(np.diff(y) < 0):

@@ -170,6 +170,9 @@ class DriftBaseline:
         self.below_frames = 0
         """Frames so far with a taxel below its baseline by more than the threshold."""
         self.frames_seen = 0
+        self.last_signal: np.ndarray | None = None
+        """The signal of the frames last given to :meth:`signal` (a caller that scales
+        it in place, as a calibration's gains do, leaves it scaled)."""
         self._collect: list[np.ndarray] | None = None
         t = getattr(sensor, "transduction", None)
         self._resistive = t is not None and t.kind == "resistive"
@@ -212,6 +215,7 @@ class DriftBaseline:
             )  # fmt: skip
         self.below_frames += int(np.count_nonzero(flags & int(Flag.BELOW_BASELINE)))
         self.frames_seen += len(frames)
+        self.last_signal = signal
         return signal, flags
 
     def _take_rezero(self, frames: np.ndarray) -> np.ndarray:

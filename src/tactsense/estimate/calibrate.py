@@ -419,6 +419,21 @@ def jitter_statistics(readings, counts_per_gram):
 # ---- the calibration object ---------------------------------------------------------
 
 
+def check_in_use(source, used, calibration, error, word: str) -> None:
+    """Raise ``error`` unless the gains and the baseline of every ``used`` cell of a
+    calibration read from ``source`` are positive finite numbers (a finger's and an
+    array's calibration alike; ``word``: tactel or taxel)."""
+    for name, values in (("gains", calibration.gains), ("baseline_counts", calibration.baseline)):
+        bad = used & ~(np.isfinite(values) & (values > 0))
+        if bad.any():
+            where = ", ".join(f"({r}, {c})" for r, c in np.argwhere(bad)[:8])
+            raise error(
+                f"{source}: {name} of {int(bad.sum())} {word}(s) in use is not a positive "
+                f"finite number, e.g. at {where}; expected > 0 (mark such {word}s dead, "
+                "or calibrate again)"
+            )
+
+
 @functools.lru_cache(maxsize=16)
 def sensor_of(sensor_toml: str):
     """The sensor a calibration's TOML describes, parsed once (a live stream checks it
@@ -530,17 +545,7 @@ class Calibration:
         for name in ("gains", "baseline", "dead", "weak", "noisy"):
             if getattr(calibration, name).shape != shape:
                 raise CalibrationError(f"{path}: {name} has the wrong shape, expected {shape}")
-        used = ~calibration.excluded
-        checked = (("gains", calibration.gains), ("baseline_counts", calibration.baseline))
-        for name, values in checked:
-            bad = used & ~(np.isfinite(values) & (values > 0))
-            if bad.any():
-                where = ", ".join(f"({r}, {c})" for r, c in np.argwhere(bad)[:8])
-                raise CalibrationError(
-                    f"{path}: {name} of {int(bad.sum())} tactel(s) in use is not a positive "
-                    f"finite number, e.g. at {where}; expected > 0 (mark such tactels dead, "
-                    "or calibrate again)"
-                )
+        check_in_use(path, ~calibration.excluded, calibration, CalibrationError, "tactel")
         if sensor is not None:
             calibration.check_sensor(sensor)
         return calibration

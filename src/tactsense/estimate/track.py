@@ -92,6 +92,23 @@ def assign(cost: np.ndarray, limit: float) -> list[tuple[int, int]]:
     return [(i, int(j)) for i, j in enumerate(match) if j >= 0]
 
 
+def _columns(table: ContactTable):
+    """What both trackers read and write: positions (contiguous) [mm], forces (NaN as 0)
+    [N], and the id, velocity and slip columns to fill."""
+    n = len(table)
+    pos = np.ascontiguousarray(np.column_stack([table.x_mm, table.y_mm, table.z_mm]), float)
+    force = np.nan_to_num(np.asarray(table.force_n, dtype=float))
+    return pos, force, np.full(n, -1, np.int64), np.zeros((n, 3)), np.zeros(n, bool)
+
+
+def _tracked(table: ContactTable, ids, vel, slip) -> ContactTable:
+    """A copy of ``table`` with the tracker's columns set."""
+    return dataclasses.replace(
+        table, id=ids, vx_mm_s=vel[:, 0], vy_mm_s=vel[:, 1], vz_mm_s=vel[:, 2], slip=slip,
+        extra=dict(table.extra),
+    )  # fmt: skip
+
+
 class ReferenceTracker:
     """The tracker's rules in plain Python with :func:`scipy.optimize.linear_sum_assignment`
     each frame: the readable reference of :class:`ContactTracker` (the tests hold the two
@@ -175,12 +192,7 @@ class ReferenceTracker:
             The table with ``id``, velocity and ``slip`` set (a copy), and the events.
         """
         start, end, frames = self._check(table, first_frame)
-        n = len(frames)
-        ids = np.full(n, -1, np.int64)
-        vel = np.zeros((n, 3))
-        slip = np.zeros(n, bool)
-        pos = np.column_stack([table.x_mm, table.y_mm, table.z_mm]).astype(float)
-        force = np.nan_to_num(np.asarray(table.force_n, dtype=float))
+        pos, force, ids, vel, slip = _columns(table)
         events: list[TrackEvent] = []
         bounds = np.searchsorted(frames, np.arange(start, end + 1))
         # frames without contacts only age the tracks: jump over runs of them
@@ -191,11 +203,7 @@ class ReferenceTracker:
                         events)  # fmt: skip
         self._age_until(end, events)
         self.next_frame = end
-        out = dataclasses.replace(
-            table, id=ids, vx_mm_s=vel[:, 0], vy_mm_s=vel[:, 1], vz_mm_s=vel[:, 2], slip=slip,
-            extra=dict(table.extra),
-        )  # fmt: skip
-        return out, events
+        return _tracked(table, ids, vel, slip), events
 
     def _check(self, table, first_frame):
         """The first and end frame a table covers, and its frame column, checked."""
@@ -353,11 +361,7 @@ class ContactTracker(ReferenceTracker):
 
         start, end, frames = self._check(table, first_frame)
         n = len(frames)
-        pos = np.ascontiguousarray(np.column_stack([table.x_mm, table.y_mm, table.z_mm]), float)
-        force = np.nan_to_num(np.asarray(table.force_n, dtype=float))
-        ids = np.full(n, -1, np.int64)
-        vel = np.zeros((n, 3))
-        slip = np.zeros(n, bool)
+        pos, force, ids, vel, slip = _columns(table)
         most = int(np.bincount(frames - start).max(initial=0)) if n else 0
         need = self._alive + (self.max_missing + 2) * most + 8
         if need > len(self._t_id):
@@ -381,11 +385,7 @@ class ContactTracker(ReferenceTracker):
             TrackEvent(int(f), _KINDS[kind], int(i), () if other < 0 else (int(other),))
             for f, kind, i, other in zip(*(e[:k] for e in ev), strict=True)
         ]
-        out = dataclasses.replace(
-            table, id=ids, vx_mm_s=vel[:, 0], vy_mm_s=vel[:, 1], vz_mm_s=vel[:, 2], slip=slip,
-            extra=dict(table.extra),
-        )  # fmt: skip
-        return out, events
+        return _tracked(table, ids, vel, slip), events
 
 
 def track(table: ContactTable, frame_period_s: float, **options):

@@ -353,20 +353,13 @@ class LiveContacts:
                 self._drift.signal(collected)
                 self._collected = []
             return None
-        before = self._drift.baseline.copy() if self._keep else None
         table = find_contacts(counts[None], self.sensor, baseline=self._drift,
                               calibration=self.calibration, **self._options)  # fmt: skip
         table.frame[:] = self._serial
         tracked, _ = self._tracker.update(table, first_frame=self._serial)
         self._serial += 1
-        if self._keep:
-            from tactsense.estimate.contacts import signal_from_counts
-
-            signal = signal_from_counts(counts[None], before, self.sensor)[0][0]
-            if self.calibration is not None:
-                c = self.calibration
-                signal = np.where(c.dead, 0.0, signal / np.where(c.dead, 1.0, c.gains))
-            self.last_deflection = signal
+        if self._keep:  # the signal the estimate used (the calibration's gains applied)
+            self.last_deflection = self._drift.last_signal[-1].copy()
         columns = tracked.columns()
         contacts = [
             {name: _plain(columns[name][k]) for name in CONTACT_FIELDS if name in columns}
