@@ -73,6 +73,10 @@ BAD_OPTIONS = [
     ("record loop:// --timeout 0 --out OUT", "--timeout"),
     ("live loop:// --threshold 2", "--threshold"),
     ("live loop:// --baseline-frames 0", "--baseline-frames"),
+    ("live loop:// --method bogus", "--method 'bogus': expected one of"),
+    ("live loop:// --max-contacts 0", "--max-contacts"),
+    ("live loop:// --drift-s -1", "--drift-s"),
+    ("live loop:// --drift-s nan", "--drift-s"),
     ("reproduce --sensor bogus --out OUT", "bogus"),
     ("design sweep --depth 0:3:4 --out OUT", "--depth"),
     ("design sweep --spacing x --out OUT", "--spacing"),
@@ -171,6 +175,8 @@ BAD_FILES = [
     ("view loop:// --calibration DIR/zero_gain.json", "not a positive finite number"),
     ("export REC --calibration DIR/zero_gain.json --out DIR/x.mcap", "at (4, 3)"),
     ("sensor import DIR/empty.toml", "not XML"),
+    ("live REC", "is a recording; this command reads a device"),
+    ("record REC --out OUT", "is a recording; this command reads a device"),
 ]
 
 
