@@ -692,7 +692,8 @@ def simulate(
         Called after each chunk of frames.
     forward : {"twin", "finger3d"}
         The finger's elastic model: the paper's 2-D twin, or the 3-D skin's tabulated
-        finite-element response (:mod:`tactsense.physics.finger3d_table`; probes only),
+        finite-element response with its tip (:mod:`tactsense.physics.finger3d_table`;
+        probes and section 4.1's knife edge),
         recorded in the scenario's ``forward_model``.
 
     Returns

@@ -80,8 +80,8 @@ def simulate(
             "--forward",
             help="The finger's elastic model: 'twin' (the paper's: plane stress along the "
             "finger, ring spreading around) or 'finger3d' (the 3-D skin's finite-element "
-            "response, tabulated, with the twin's rings; probes and the knife edge only; "
-            "the tip row from the twin; docs/model.md). "
+            "response with its hemispherical tip, tabulated, with the twin's rings; probes "
+            "and the knife edge only; docs/model.md). "
             "Fingers only.",
         ),
     ] = "twin",

@@ -15,9 +15,12 @@ offset from each probe, bilinearly interpolated, times the probe's force (the sk
 linear). The skin is three-dimensional and nearly incompressible (nu 0.49), not the
 plane-stress slice of fitted depth and Poisson's ratio the estimators assume, so frames
 made this way are structurally different from those the estimators assume; only the
-rings are the twin's. What the table does not cover is taken
-from the 2-D twin and said so: the tip row and probes on the hemispherical tip (the
-3-D model is the cylinder only), and tangential components of a probe's force.
+rings are the twin's. The tip row, and the cylinder's rows under probes on the
+hemispherical tip, come from the whole finger's 3-D model with its tip
+(:mod:`tactsense.physics.finger3d_tip`, tabulated by ``scripts/finger3d_tip.py``). What
+the tables do not cover is taken from the 2-D twin and said so: the knife edge's share
+of the tip row and a knife on the hemisphere, and the tangential part of a tilted probe's
+force.
 
 Probes (:class:`~tactsense.physics.contact.Probe`) and section 4.1's knife edge (a
 :class:`~tactsense.physics.contact.LineContact` 10 mm long across the finger, 0.2 mm
@@ -27,6 +30,7 @@ contacts are an error with this forward model.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 from pathlib import Path
 
@@ -36,6 +40,7 @@ from tactsense._validation import TactsenseInputError
 from tactsense.physics.contact import LineContact, Probe
 
 TABLE = Path(__file__).with_name("data") / "finger3d_probe.npz"
+TIP_TABLE = TABLE.with_name("finger3d_tip.npz")
 
 FORWARDS = ("twin", "finger3d")
 """The forward models of a finger: the paper's 2-D twin, or the 3-D skin's table."""
@@ -55,24 +60,56 @@ STEP_DEG = 0.25
 """Angle step of the ring convolution [deg] (the table's finest)."""
 
 
-@functools.lru_cache(maxsize=8)
-def ring_table(flexural_length_mm: float, ring_radius_mm: float, load: str = "probe"):
-    """The table spread around by the ring: (axial_mm, angle_deg, strain_per_n) on a
-    uniform angle grid of :data:`STEP_DEG` from 0 to 180 deg."""
+def _ring_spread(angle, values, flexural_length_mm, ring_radius_mm):
+    """Angle profiles ``values`` (..., len(angle)) of the strain at the ring, spread around
+    by the ring (section 4's beam Green's function, a circular convolution): returns the
+    uniform angles 0-180 deg of :data:`STEP_DEG` and the spread profiles."""
     from tactsense.physics.array_response import ring_kernel
 
-    axial, angle, strain, _ = table(load)
     full = np.arange(-180.0, 180.0, STEP_DEG)
-    values = np.stack([np.interp(np.abs(full), angle, row) for row in strain])
+    flat = values.reshape(-1, values.shape[-1])
+    profiles = np.stack([np.interp(np.abs(full), angle, row) for row in flat])
     s = np.radians(full) * ring_radius_mm * 1e-3  # arc length at the ring [m]
     weights = (
         ring_kernel(s, flexural_length_mm * 1e-3) * np.radians(STEP_DEG) * ring_radius_mm * 1e-3
     )
     weights = np.fft.ifftshift(weights)  # centred on index 0 for a circular convolution
-    spread = np.fft.irfft(np.fft.rfft(values, axis=1) * np.fft.rfft(weights), n=len(full), axis=1)
-    # (the kernel is centred on index 0: the result keeps the angles' order)
+    spread = np.fft.irfft(
+        np.fft.rfft(profiles, axis=1) * np.fft.rfft(weights), n=len(full), axis=1
+    )  # (the kernel is centred on index 0: the result keeps the angles' order)
     half = full >= 0.0
-    return axial, full[half], spread[:, half]
+    return full[half], spread[:, half].reshape(*values.shape[:-1], -1)
+
+
+@functools.lru_cache(maxsize=8)
+def ring_table(flexural_length_mm: float, ring_radius_mm: float, load: str = "probe"):
+    """The table spread around by the ring: (axial_mm, angle_deg, strain_per_n) on a
+    uniform angle grid of :data:`STEP_DEG` from 0 to 180 deg."""
+    axial, angle, strain, _ = table(load)
+    spread_angle, spread = _ring_spread(angle, strain, flexural_length_mm, ring_radius_mm)
+    return axial, spread_angle, spread
+
+
+def _bilinear(xs, ys, values, x, y):
+    """Bilinear interpolation of ``values`` (len(xs), len(ys)) at (x, y), clipped to the
+    grid (the caller zeroes what lies beyond it)."""
+    x = np.clip(x, xs[0], xs[-1])
+    y = np.clip(y, ys[0], ys[-1])
+    i = np.clip(np.searchsorted(xs, x, side="right") - 1, 0, len(xs) - 2)
+    j = np.clip(np.searchsorted(ys, y, side="right") - 1, 0, len(ys) - 2)
+    tx = (x - xs[i]) / (xs[i + 1] - xs[i])
+    ty = (y - ys[j]) / (ys[j + 1] - ys[j])
+    return (
+        (1 - tx) * (1 - ty) * values[i, j]
+        + tx * (1 - ty) * values[i + 1, j]
+        + (1 - tx) * ty * values[i, j + 1]
+        + tx * ty * values[i + 1, j + 1]
+    )
+
+
+def _angle_offset(d_angle_deg):
+    """|angle| wrapped to [0, 180] deg."""
+    return np.abs((np.asarray(d_angle_deg, dtype=float) + 180.0) % 360.0 - 180.0)
 
 
 def strain_per_newton(
@@ -86,27 +123,48 @@ def strain_per_newton(
     else:
         axial, angle, strain = ring_table(*rings, load)
     x = np.abs(np.asarray(d_axial_mm, dtype=float))
-    a = np.abs((np.asarray(d_angle_deg, dtype=float) + 180.0) % 360.0 - 180.0)
-    inside = x <= axial[-1]
-    x = np.clip(x, axial[0], axial[-1])
-    i = np.clip(np.searchsorted(axial, x, side="right") - 1, 0, len(axial) - 2)
-    j = np.clip(np.searchsorted(angle, a, side="right") - 1, 0, len(angle) - 2)
-    tx = (x - axial[i]) / (axial[i + 1] - axial[i])
-    ta = (a - angle[j]) / (angle[j + 1] - angle[j])
-    value = (
-        (1 - tx) * (1 - ta) * strain[i, j]
-        + tx * (1 - ta) * strain[i + 1, j]
-        + (1 - tx) * ta * strain[i, j + 1]
-        + tx * ta * strain[i + 1, j + 1]
+    value = _bilinear(axial, angle, strain, x, _angle_offset(d_angle_deg))
+    return np.where(x <= axial[-1], value, 0.0)
+
+
+@functools.lru_cache(maxsize=1)
+def tip_table() -> dict:
+    """The tip's tables (``scripts/finger3d_tip.py``): every array of the file."""
+    with np.load(TIP_TABLE) as data:
+        return {k: data[k] if data[k].ndim else data[k].item() for k in data.files}
+
+
+def tip_row_strain_per_newton(s_mm, d_angle_deg, *, plate: str = "tip"):
+    """Mean normal strain of the tip row's tactel per newton of the probe [1/N], the
+    probe at surface coordinate ``s_mm`` (apex -19.95 mm to 12 mm; 0 beyond) and
+    ``d_angle_deg`` from the tactel; ``plate="tip_rim"``: the outer quarter of the
+    face only (the plate-size sensitivity)."""
+    t = tip_table()
+    s = np.asarray(s_mm, dtype=float)
+    values = t[f"{plate}_strain_per_n"]
+    value = _bilinear(t["s_mm"], t["angle_deg"], values, s, _angle_offset(d_angle_deg))
+    return np.where(s <= t["s_mm"][-1], value, 0.0)
+
+
+@functools.lru_cache(maxsize=8)
+def _cylinder_from_tip(flexural_length_mm: float, ring_radius_mm: float):
+    t = tip_table()
+    angle, spread = _ring_spread(
+        t["angle_deg"], t["cylinder_strain_per_n"].astype(float), flexural_length_mm, ring_radius_mm
     )
-    return np.where(inside, value, 0.0)
+    return t["row_mm"], t["s_tip_mm"], angle, spread
 
 
 def deflection_batch_3d(spec, states) -> np.ndarray:
     """Fractional deflection of every tactel for each state of probes, (S, rows, cols).
 
-    Tactels of the tip row and probes on the tip (axial < 0) take the 2-D twin's
-    response (the 3-D model has no hemisphere).
+    Probes on the cylinder reach the cylinder's rows through the cylinder's table; the
+    tip row, and the cylinder's rows under probes on the hemisphere, through the tip's
+    (:func:`tip_row_strain_per_newton`; the cylinder's rows spread around by the rings as
+    on the cylinder). The knife edge is tabulated on the cylinder only: its share of the
+    tip row, and a knife on the hemisphere, take the 2-D twin's response; so does the
+    tangential part of a tilted probe's force (the twin's response to the tilted probe
+    less its response to the probe's normal part).
     """
     from tactsense.physics.array_response import deflection_batch
 
@@ -114,33 +172,78 @@ def deflection_batch_3d(spec, states) -> np.ndarray:
     rows_mm = np.asarray(spec.row_axial_mm, dtype=float)
     cols_deg = np.asarray(spec.col_angle_deg, dtype=float)
     cylinder = rows_mm >= 0.0
-    twin_states = []
+    rings = (spec.ring_flexural_length_mm, spec.ring_radius_mm)
+    twin_states, knife_states, tilted_states = [], [], []
     for k, state in enumerate(states):
-        twin_part = []
+        twin_part, knives, tilted = [], [], []
         for contact in state:
             load = _tabulated(contact)
-            if contact.axial_mm < 0.0:  # on the hemisphere: not in the 3-D model
-                twin_part.append(contact)
-                continue
             normal = contact.force_n * np.cos(np.radians(contact.alpha_deg))
-            d = -normal * strain_per_newton(
-                rows_mm[cylinder, None] - contact.axial_mm, cols_deg[None, :] - contact.angle_deg,
-                rings=(spec.ring_flexural_length_mm, spec.ring_radius_mm), load=load,
-            )  # fmt: skip
-            out[k, cylinder] += d
+            d_angle = cols_deg[None, :] - contact.angle_deg
+            if load == "knife":
+                if contact.axial_mm < 0.0:  # a knife on the hemisphere: not tabulated
+                    twin_part.append(contact)
+                    continue
+                out[k, cylinder] -= normal * strain_per_newton(
+                    rows_mm[cylinder, None] - contact.axial_mm, d_angle, rings=rings, load=load
+                )
+                knives.append(contact)  # its share of the tip row: the twin's, below
+                continue
+            if contact.alpha_deg != 0.0:  # the tangential share: the twin's, below
+                tilted.append(contact)
+            out[k, ~cylinder] -= normal * tip_row_strain_per_newton(contact.axial_mm, d_angle)
+            if contact.axial_mm >= 0.0:
+                out[k, cylinder] -= normal * strain_per_newton(
+                    rows_mm[cylinder, None] - contact.axial_mm, d_angle, rings=rings
+                )
+            else:
+                near = cylinder & (rows_mm <= tip_table()["row_mm"][-1])
+                for r in np.nonzero(near)[0]:
+                    out[k, r] -= normal * _cylinder_row_from_tip(
+                        rows_mm[r], contact.axial_mm, d_angle[0], rings
+                    )
         twin_states.append(tuple(twin_part))
-    # the 2-D twin where the table does not reach: the tip row, probes on the tip
-    tip_rows = ~cylinder
-    if tip_rows.any() or any(twin_states):
-        whole = [tuple(s) for s in states]
-        twin = deflection_batch(spec, whole)
-        out[:, tip_rows] = twin[:, tip_rows]
-        on_tip = [k for k, s in enumerate(twin_states) if s]
-        if on_tip:
-            tip_only = deflection_batch(spec, [twin_states[k] for k in on_tip])
-            for n, k in enumerate(on_tip):
-                out[k, cylinder] += tip_only[n, cylinder]
+        knife_states.append(tuple(knives))
+        tilted_states.append(tuple(tilted))
+    on_tip = [k for k, s in enumerate(twin_states) if s]
+    if on_tip:
+        tip_only = deflection_batch(spec, [twin_states[k] for k in on_tip])
+        for n, k in enumerate(on_tip):
+            out[k] += tip_only[n]
+    with_knife = [k for k, s in enumerate(knife_states) if s]
+    if with_knife and (~cylinder).any():
+        knife_twin = deflection_batch(spec, [knife_states[k] for k in with_knife])
+        for n, k in enumerate(with_knife):
+            out[k, ~cylinder] += knife_twin[n, ~cylinder]
+    with_tilt = [k for k, s in enumerate(tilted_states) if s]
+    if with_tilt:  # the twin's response to the tilted probe less its normal part
+        whole = deflection_batch(spec, [tilted_states[k] for k in with_tilt])
+        normal_only = [
+            tuple(
+                dataclasses.replace(
+                    p, force_n=p.force_n * np.cos(np.radians(p.alpha_deg)), alpha_deg=0.0
+                )
+                for p in tilted_states[k]
+            )
+            for k in with_tilt
+        ]
+        tangential = whole - deflection_batch(spec, normal_only)
+        for n, k in enumerate(with_tilt):
+            out[k] += tangential[n]
     return out
+
+
+def _cylinder_row_from_tip(row_mm, s_mm, d_angle_deg, rings):
+    """One cylinder row's strain (cols,) under a probe on the hemisphere, interpolated
+    linearly between the table's rows."""
+    rows, s_grid, angle, spread = _cylinder_from_tip(*rings)
+    k = int(np.clip(np.searchsorted(rows, row_mm, side="right") - 1, 0, len(rows) - 2))
+    w = float(np.clip((row_mm - rows[k]) / (rows[k + 1] - rows[k]), 0.0, 1.0))
+    a = _angle_offset(d_angle_deg)
+    s = np.full_like(a, s_mm)
+    return (1 - w) * _bilinear(s_grid, angle, spread[k], s, a) + w * _bilinear(
+        s_grid, angle, spread[k + 1], s, a
+    )
 
 
 def _tabulated(contact) -> str:

@@ -103,7 +103,7 @@ class TipMeshSpec:
 TIP_LEVELS = (
     TipMeshSpec(3, 1.4e-3, 6, 20.0),
     TipMeshSpec(4, 1.0e-3, 8, 15.0),
-    TipMeshSpec(5, 0.7e-3, 11, 10.0),
+    TipMeshSpec(5, 0.8e-3, 10, 12.0),
 )
 """Mesh study levels (``docs/model.md``)."""
 

@@ -1,0 +1,133 @@
+"""Tabulate the 3-D finger's tip for ``simulate --forward finger3d``, and its mesh study.
+
+Run: ``PYTHONPATH=src python scripts/finger3d_tip.py [--level 1] [--study]``. Solves the
+finite-element half finger with its hemispherical tip (``tactsense.physics.finger3d_tip``:
+rubber of nu 0.49 on the rigid core, which ends in a flat face 2.7 mm beyond the junction
+so that 10 mm of rubber cover it at the apex, section 3.6) once per tactel functional, and
+by reciprocity writes each tactel's strain per newton of the 50-g Hertz probe centred
+anywhere on the skin to ``src/tactsense/physics/data/finger3d_tip.npz``:
+
+* ``tip``: the tip row's tactel, the mean normal strain 0.65 mm above the core's end face
+  (where a cylinder ring's plate lies above the core) over the sector of the face under
+  one strip: radius a/2 to a (the disc's outer half; the strips, 5.1 mm wide, cannot all
+  reach the centre), the strip's width at the rim around. Against the probe's surface
+  coordinate ``s`` (apex to 12 mm along the cylinder) and its angle from the tactel.
+* ``tip_rim``: the same over the outer quarter only (a/4 wide), to show how much the
+  assumed plate matters.
+* ``cylinder``: the radial strain at the ring depth of a cylinder tactel at axial
+  position ``row_mm`` (0-12 mm), for probes on the hemisphere (``s < 0``), which the
+  cylinder's table does not cover.
+
+``--study`` also solves every level of ``TIP_LEVELS`` (level 2 takes about 2.5 minutes
+and 5 GB) and stores each level's peaks: the mesh study quoted in docs/model.md. The
+tables are always those of ``--level``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+import numpy as np
+
+from tactsense.physics import finger3d_tip as tip
+
+OUT = Path(__file__).resolve().parents[1] / "src" / "tactsense" / "physics" / "data"
+S_MM = np.round(np.r_[np.arange(tip.APEX_S_M * 1e3, 12.0, 0.25), 12.0], 4)
+S_TIP_MM = S_MM[S_MM <= 0.5]
+ANGLE_DEG = np.round(np.r_[np.arange(0.0, 40.0, 1.0), np.arange(40.0, 180.01, 4.0)], 3)
+ROW_MM = np.round(np.arange(0.0, 12.01, 0.5), 3)
+FORCE_N = 0.05 * 9.80665
+STRIP_WIDTH_M = 5.1e-3
+
+
+def tip_functional(solution, inner_fraction, n=8):
+    """Mean normal strain over the sector of the end face (radius inner_fraction a to
+    a, half the strip's angle: the half model), 0.65 mm above the face."""
+    a = tip.CORE_M
+    rho = inner_fraction * a + (np.arange(n) + 0.5) * (1 - inner_fraction) * a / n
+    half = STRIP_WIDTH_M / (2 * a)
+    theta = (np.arange(n) + 0.5) * half / n
+    r, th = np.meshgrid(rho, theta, indexing="ij")
+    x = -(tip.CORE_END_M + tip.PLATE_ABOVE_CORE_M)
+    points = np.stack([np.full(r.size, x), (r * np.sin(th)).ravel(), (r * np.cos(th)).ravel()])
+    normals = np.tile([[-1.0], [0.0], [0.0]], (1, r.size))
+    return solution.normal_strain_functional(points, normals, r.ravel() / r.sum())
+
+
+def row_functional(solution, row_m):
+    """Radial strain at the ring depth over the load's meridian at axial ``row_m``."""
+    rho = tip.CORE_M + tip.PLATE_ABOVE_CORE_M
+    return solution.normal_strain_functional([[row_m], [0.0], [rho]], [[0.0], [0.0], [1.0]])
+
+
+def solve_level(level, with_tables):
+    start = time.perf_counter()
+    solution = tip.assemble(tip.TIP_LEVELS[level])
+    s, angle = np.meshgrid(S_MM, ANGLE_DEG, indexing="ij")
+    out = {"dofs": solution.n_dofs}
+    for name, inner in (("tip", 0.5), ("tip_rim", 0.75)):
+        v = solution.solve(tip_functional(solution, inner))
+        out[name] = solution.influence(v, s, angle) if with_tables else None
+        meridian = solution.influence(v, S_MM, 0 * S_MM)
+        k = int(np.argmin(meridian))
+        out[f"{name}_peak"] = (S_MM[k], meridian[k])
+    if with_tables:
+        s_tip, angle_tip = np.meshgrid(S_TIP_MM, ANGLE_DEG, indexing="ij")
+        rows = [solution.solve(row_functional(solution, x * 1e-3)) for x in ROW_MM]
+        out["cylinder"] = np.stack([solution.influence(v, s_tip, angle_tip) for v in rows])
+    row1 = solution.solve(row_functional(solution, 1.1e-3))
+    out["row1_at_junction"] = solution.influence(row1, 0.0, 0.0).item()
+    out["row1_peak"] = solution.influence(row1, 1.1, 0.0).item()
+    out["seconds"] = time.perf_counter() - start
+    peak_s, peak = out["tip_peak"]
+    print(f"level {level}: {out['dofs']} dof, {out['seconds']:.0f} s; tip peak "
+          f"{peak:.4g} per N at s = {peak_s:.2f} mm", flush=True)  # fmt: skip
+    return out
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--level", type=int, default=1, help="mesh level of TIP_LEVELS")
+    parser.add_argument("--study", action="store_true", help="also solve every other level")
+    args = parser.parse_args(argv)
+    levels = list(range(len(tip.TIP_LEVELS))) if args.study else [args.level]
+    study = [solve_level(k, k == args.level) for k in levels]
+    main_level = study[levels.index(args.level)]
+    OUT.mkdir(parents=True, exist_ok=True)
+    path = OUT / "finger3d_tip.npz"
+    np.savez_compressed(
+        path,
+        s_mm=S_MM,
+        s_tip_mm=S_TIP_MM,
+        angle_deg=ANGLE_DEG,
+        row_mm=ROW_MM,
+        tip_strain_per_n=main_level["tip"].astype(np.float32),
+        tip_rim_strain_per_n=main_level["tip_rim"].astype(np.float32),
+        cylinder_strain_per_n=main_level["cylinder"].astype(np.float32),
+        study_levels=np.array(levels),
+        study_dofs=np.array([x["dofs"] for x in study]),
+        study_seconds=np.array([x["seconds"] for x in study]),
+        study_tip_peak=np.array([x["tip_peak"][1] for x in study]),
+        study_tip_peak_s_mm=np.array([x["tip_peak"][0] for x in study]),
+        study_tip_rim_peak=np.array([x["tip_rim_peak"][1] for x in study]),
+        study_row1_peak=np.array([x["row1_peak"] for x in study]),
+        study_row1_at_junction=np.array([x["row1_at_junction"] for x in study]),
+        mesh_level=args.level,
+        poisson_ratio=0.49,
+        youngs_modulus_pa=tip.YOUNGS_PA,
+        core_end_mm=tip.CORE_END_M * 1e3,
+        plate_above_core_mm=tip.PLATE_ABOVE_CORE_M * 1e3,
+        strip_width_mm=STRIP_WIDTH_M * 1e3,
+        description=(
+            "normal strain per newton of a 1.6-mm-radius Hertz sphere centred at surface "
+            "coordinate s and angle from the tactel, on the 3-D finite-element finger with "
+            "its tip (tactsense.physics.finger3d_tip); scripts/finger3d_tip.py"
+        ),
+    )
+    print(f"wrote {path}")
+
+
+if __name__ == "__main__":
+    main()
