@@ -76,3 +76,113 @@ def test_far_cut_does_not_matter(coarse_profiles):
     far = _probe_profile(longer, XS)
     near = coarse_profiles[0]
     assert np.max(np.abs(far - near)) < 0.01 * abs(near[0])
+
+
+def test_layered_stiffness_of_one_material_is_the_plain_stiffness():
+    """The per-point material assembly, given the rubber on both sides of the layer,
+    is the single-material stiffness (to rounding)."""
+    from dataclasses import replace
+
+    from skfem import Basis, ElementHex2
+    from skfem.models.elasticity import lame_parameters
+
+    shell = f.build_mesh(replace(SMALL, dielectric_m=0.5e-3))
+    basis = Basis(shell.mesh, ElementHex2(), intorder=4)
+    lam_mu = lame_parameters(f.YOUNGS_PA, 0.49)
+    plain = f._stiffness(basis, *lam_mu)
+    layered = f._stiffness_layered(basis, lam_mu, lam_mu, f.CORE_M + 0.25e-3)
+    assert abs(plain - layered).max() <= 1e-9 * abs(plain).max()
+
+
+def two_layer_lame(r, pressure, inner, outer, c):
+    """u_r and eps_rr of two bonded thick cylinders on a rigid core under uniform external
+    pressure, plane strain: u = A_k r + B_k / r in each layer, u(a) = 0, u and sigma_rr
+    continuous at the interface c, sigma_rr(b) = -p; sigma_rr = 2 (lam + mu) A - 2 mu B/r^2.
+    ``inner``/``outer``: (lam, mu) of the layer on the core and of the skin."""
+    a, b = f.CORE_M, f.OUTER_M
+    (l1, m1), (l2, m2) = inner, outer
+    matrix = np.array(
+        [
+            [a, 1 / a, 0, 0],
+            [c, 1 / c, -c, -1 / c],
+            [2 * (l1 + m1), -2 * m1 / c**2, -2 * (l2 + m2), 2 * m2 / c**2],
+            [0, 0, 2 * (l2 + m2), -2 * m2 / b**2],
+        ]
+    )
+    a1, b1, a2, b2 = np.linalg.solve(matrix, [0, 0, 0, -pressure])
+    r = np.asarray(r, float)
+    inside = r < c
+    u = np.where(inside, a1 * r + b1 / r, a2 * r + b2 / r)
+    eps = np.where(inside, a1 - b1 / r**2, a2 - b2 / r**2)
+    return u, eps
+
+
+def test_dielectric_layer_matches_two_bonded_cylinders():
+    """A soft layer (7e4 Pa, nu 0.3, 0.5 mm) under the skin, uniform pressure, far cut
+    sliding (plane strain): the layer's mean strain (its top's displacement over its
+    thickness) and the skin's radial strain match the two-layer closed form
+    (``two_layer_lame``, independent of the FEM): the layer's strain within 0.3 % (measured
+    0.05 %), the skin's, a derivative and small beside the layer's, within 1.5 % (measured
+    0.9 %), on the coarsest mesh."""
+    from skfem.models.elasticity import lame_parameters
+
+    layer = f.Dielectric(0.5e-3, 7.0e4, 0.3)
+    pressure = 1.0e3
+    area = 4 * np.pi * f.OUTER_M * SMALL.length_m
+    sol = f.solve_load(
+        lambda x, s: 1.0 + 0 * x, pressure * area, spec=SMALL, far_end="sliding", dielectric=layer
+    )
+    inner = lame_parameters(layer.youngs_pa, layer.poisson_ratio)
+    outer = lame_parameters(f.YOUNGS_PA, 0.49)
+    c = f.CORE_M + layer.thickness_m
+    u_c, _ = two_layer_lame(c, pressure, inner, outer, c)
+    got = sol.dielectric_strain(np.array([0.0, 5e-3]), np.array([0.0, 2.0]))
+    np.testing.assert_allclose(got, u_c / layer.thickness_m, rtol=3e-3)
+    depth = np.array([1.0e-3, 2.0e-3])
+    _, eps = two_layer_lame(f.OUTER_M - depth, pressure, inner, outer, c)
+    np.testing.assert_allclose(
+        sol.radial_strain([0.0, 8e-3], [0.5, 1.5], depth=depth), eps, rtol=1.5e-2
+    )
+    with pytest.raises(ValueError, match="no dielectric"):
+        f.solve_load(lambda x, s: 1.0 + 0 * x, 1.0, spec=SMALL).dielectric_strain(0.0, 0.0)
+
+
+def _dielectric_script():
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[2] / "scripts" / "finger3d_dielectric.py"
+    loader = importlib.util.spec_from_file_location("finger3d_dielectric", path)
+    module = importlib.util.module_from_spec(loader)
+    loader.loader.exec_module(module)
+    return module
+
+
+def test_model_md_dielectric_block_is_the_recorded_study():
+    """docs/model.md's dielectric table is generated from the study's recorded results
+    (docs/data/finger3d_dielectric.json, written by the script's --solve)."""
+    import json
+
+    script = _dielectric_script()
+    data = json.loads(script.DATA.read_text())
+    assert len(data["cases"]) == len(script.CASES)
+    assert script.block(data) in script.DOC.read_text()
+
+
+@pytest.mark.slow
+def test_dielectric_study_is_reproduced():
+    """One case of the recorded study, solved again: the fitted depth and nu agree to the
+    printed digits."""
+    import json
+
+    script = _dielectric_script()
+    data = json.loads(script.DATA.read_text())
+    case = next(c for c in data["cases"] if c["modulus_pa"] == 7.0e4 and c["poisson_ratio"] == 0.3)
+    assert case["thickness_mm"] == 0.5
+    layer = f.Dielectric(0.5e-3, 7.0e4, 0.3)
+    sol = f.solve_load(f.knife_edge(), 0.5, spec=f.LEVELS[data["level"]], dielectric=layer)
+    along = sol.dielectric_strain(script.XS, 0 * script.XS)
+    full = np.concatenate([along[:0:-1], along])
+    depth, nu, _ = script.fit_2d(np.array(data["x_mm"]) * 1e-3, full)
+    assert abs(depth * 1e3 - case["fit_depth_mm"]) < 0.005
+    assert abs(nu - case["fit_nu"]) < 0.005

@@ -59,6 +59,9 @@ class MeshSpec:
         Half-size of the fine zone along the surface [m].
     length_m : float
         Distance from the load to the clamped cut [m].
+    dielectric_m : float
+        Thickness of a layer on the core meshed apart (one element through it), so that
+        a dielectric of its own material can fill it (:class:`Dielectric`) [m]; 0: none.
     """
 
     n_r: int = 2
@@ -66,6 +69,21 @@ class MeshSpec:
     n_coarse: int = 6
     fine_m: float = 6e-3
     length_m: float = 25e-3
+    dielectric_m: float = 0.0
+
+
+@dataclass(frozen=True)
+class Dielectric:
+    """The soft dielectric layer between the core's strips and the rings (section 2.3).
+
+    The paper: "a compliant dielectric of about 0.5 mm thickness, which is a molded
+    open-cell rubber layer"; section 4.1 postulates that it, "softer than the skin above
+    it", widens the measured response. Its modulus and Poisson's ratio are not given.
+    """
+
+    thickness_m: float = 0.5e-3
+    youngs_pa: float = 7.0e4
+    poisson_ratio: float = 0.3
 
 
 LEVELS = (MeshSpec(3, 6, 6, 4e-3), MeshSpec(4, 9, 7, 4e-3), MeshSpec(5, 12, 8, 4e-3))
@@ -117,7 +135,11 @@ def build_mesh(spec: MeshSpec = LEVELS[0]) -> ShellMesh:
     so the curved faces are quadratic, not faceted. Boundary facets are found on the
     box, where they are planes.
     """
-    r = np.linspace(CORE_M, OUTER_M, spec.n_r + 1)
+    if spec.dielectric_m > 0:
+        top = CORE_M + spec.dielectric_m
+        r = np.concatenate([[CORE_M], np.linspace(top, OUTER_M, spec.n_r + 1)])
+    else:
+        r = np.linspace(CORE_M, OUTER_M, spec.n_r + 1)
     theta = _graded(spec.fine_m / OUTER_M, np.pi, spec.n_fine, spec.n_coarse)
     x = _graded(spec.fine_m, spec.length_m, spec.n_fine, spec.n_coarse)
     box = MeshHex.init_tensor(x, theta, r)
@@ -194,6 +216,7 @@ class Solution:
     basis: Basis
     u: np.ndarray
     shell: ShellMesh
+    has_dielectric: bool = False
 
     def _probes(self, x, theta, r):
         """Interpolation matrix at points given by (x, theta, r), cells from the box."""
@@ -207,6 +230,23 @@ class Solution:
         rows = np.tile(np.arange(pts.shape[1]), nb)
         cols = self.basis.element_dofs[:, cells].flatten()
         return sparse.coo_matrix((phis, (rows, cols)), shape=(pts.shape[1], self.basis.N)).tocsr()
+
+    def radial_displacement(self, x, theta, r):
+        """u_r [m] at axial ``x`` [m], angle ``theta`` [rad] and radius ``r`` [m]."""
+        x, theta, r = np.broadcast_arrays(*(np.asarray(q, float) for q in (x, theta, r)))
+        probe = self._probes(x.ravel(), theta.ravel(), r.ravel())
+        sin, cos = np.sin(theta.ravel()), np.cos(theta.ravel())
+        return ((probe @ self.u[1]) * sin + (probe @ self.u[2]) * cos).reshape(x.shape)
+
+    def dielectric_strain(self, x, theta):
+        """Mean radial strain of the dielectric layer [-] (compression negative): its
+        top's radial displacement over its thickness (the bottom is bonded to the core),
+        the capacitor's fractional deflection ``dd / d_o`` with a minus sign."""
+        thickness = self.shell.nodes[2][1] - CORE_M
+        if self.shell.nodes[2][1] >= OUTER_M or not self.has_dielectric:
+            raise ValueError("this solution has no dielectric layer")
+        top = CORE_M + thickness
+        return self.radial_displacement(x, theta, np.full(np.shape(x), top)) / thickness
 
     def radial_strain(self, x, theta, depth=RING_DEPTH_M, step=1e-6):
         """eps_rr at axial position ``x`` [m], angle ``theta`` [rad], ``depth`` [m].
@@ -246,6 +286,34 @@ def _stiffness(basis, lam, mu):
     return sparse.bmat(blocks, format="csr")
 
 
+def _stiffness_layered(basis, rubber, dielectric, top_m):
+    """Elasticity stiffness with the material chosen per quadrature point by its radius:
+    ``dielectric`` (lam, mu) below ``top_m`` (an element boundary), ``rubber`` above."""
+
+    def lam_mu(w):
+        inside = np.hypot(w.x[1], w.x[2]) < top_m
+        return (
+            np.where(inside, dielectric[0], rubber[0]),
+            np.where(inside, dielectric[1], rubber[1]),
+        )
+
+    g_lam, g_mu = {}, {}
+    for i in range(3):
+        for j in range(3):
+            g_lam[i, j] = asm(
+                BilinearForm(lambda u, v, w, i=i, j=j: lam_mu(w)[0] * v.grad[i] * u.grad[j]), basis
+            )
+            g_mu[i, j] = asm(
+                BilinearForm(lambda u, v, w, i=i, j=j: lam_mu(w)[1] * v.grad[i] * u.grad[j]), basis
+            )
+    trace = g_mu[0, 0] + g_mu[1, 1] + g_mu[2, 2]
+    blocks = [
+        [g_lam[c, d] + g_mu[d, c] + (trace if c == d else 0 * trace) for d in range(3)]
+        for c in range(3)
+    ]
+    return sparse.bmat(blocks, format="csr")
+
+
 def _fixed_dofs(basis, shell: ShellMesh, far_end):
     n = basis.N
     core = basis.get_dofs(facets=shell.core).all()
@@ -270,6 +338,7 @@ def solve_load(
     spec: MeshSpec = LEVELS[0],
     poisson_ratio=0.49,
     far_end="clamped",
+    dielectric: Dielectric | None = None,
 ):
     """Solve the quarter shell under a surface pressure shape scaled to ``force_n`` [N].
 
@@ -288,16 +357,28 @@ def solve_load(
     far_end : {"clamped", "sliding"}
         The cut at ``x = length``: clamped, or free to slide in its plane
         (``u_x = 0``: with a uniform pressure, plane strain, Lame's problem).
+    dielectric : Dielectric, optional
+        A soft layer of its own material on the core, under the rubber (meshed as one
+        element through its thickness); :meth:`Solution.dielectric_strain` then reads
+        its mean radial strain, the capacitor's ``dd / d_o``.
 
     Returns
     -------
     Solution
     """
     check_choice(far_end, "far_end", ("clamped", "sliding"))
+    if dielectric is not None:
+        spec = replace(spec, dielectric_m=dielectric.thickness_m)
     shell = build_mesh(spec)
     basis = Basis(shell.mesh, ElementHex2(), intorder=4)
     lam, mu = lame_parameters(YOUNGS_PA, poisson_ratio)
-    stiffness = _stiffness(basis, lam, mu)
+    if dielectric is None:
+        stiffness = _stiffness(basis, lam, mu)
+    else:
+        soft = lame_parameters(dielectric.youngs_pa, dielectric.poisson_ratio)
+        # quadrature points lie inside elements: below the interface only in the layer
+        top = CORE_M + dielectric.thickness_m
+        stiffness = _stiffness_layered(basis, (lam, mu), soft, top)
     top = FacetBasis(shell.mesh, ElementHex2(), facets=shell.outer, intorder=6)
 
     def shape(w):
@@ -312,7 +393,7 @@ def solve_load(
     u = np.zeros(3 * basis.N)
     free = np.setdiff1d(np.arange(3 * basis.N), fixed)
     u[free] = spsolve(stiffness[free][:, free].tocsc(), f[free])
-    return Solution(basis, u.reshape(3, -1), shell)
+    return Solution(basis, u.reshape(3, -1), shell, dielectric is not None)
 
 
 def lame_radial_strain(r, pressure_pa, poisson_ratio, youngs_modulus=YOUNGS_PA):
