@@ -517,10 +517,10 @@ class _ElasticWindow:
             states = list(self.applied[lo:stop])
             if self.spec.kind != "finger":  # a pad or a point set: the layer model
                 elastic = deflection_batch_flat(self.spec, states)
-            elif self.forward == "finger3d":  # the 3-D skin's tabulated response
+            elif self.forward != "twin":  # the 3-D skin's tabulated response
                 from tactsense.physics.finger3d_table import deflection_batch_3d
 
-                elastic = deflection_batch_3d(self.spec, states)
+                elastic = deflection_batch_3d(self.spec, states, self.forward)
             elif self.compiled:
                 elastic = deflection_batch(self.spec, states)
             else:  # an empty state keeps a window of probes alone on the path of the whole
@@ -571,7 +571,7 @@ def _prepare(spec, scenario, flaws, rng, gains, forward="twin") -> _Run:
         else [step.contacts for step in scenario.steps]
     )
     boundaries = np.cumsum([0.0] + [s.duration_s for s in scenario.steps])
-    if forward == "finger3d":  # every contact must be tabulated: say so before the work
+    if forward != "twin":  # every contact must be tabulated: say so before the work
         from tactsense.physics.finger3d_table import _tabulated
 
         for state in applied:
@@ -690,10 +690,10 @@ def simulate(
         those are drawn from ``spec.flaws.gain_seed``, the same in every run).
     progress : callable(done, total), optional
         Called after each chunk of frames.
-    forward : {"twin", "finger3d"}
+    forward : {"twin", "finger3d", "finger3d-foam"}
         The finger's elastic model: the paper's 2-D twin, or the 3-D skin's tabulated
         finite-element response with its tip (:mod:`tactsense.physics.finger3d_table`;
-        probes and section 4.1's knife edge),
+        probes and section 4.1's knife edge), alone or on the foam dielectric,
         recorded in the scenario's ``forward_model``.
 
     Returns

@@ -74,6 +74,7 @@ def test_simulate_uses_it_and_records_it(tmp_path):
     [
         ("--forward bogus", "forward 'bogus': expected one of twin, finger3d"),
         ("--forward finger3d --sensor pad4", "'pad4' is a pad"),
+        ("--forward finger3d-foam --sensor pad4", "finger3d-foam is the paper's finger in 3-D"),
     ],
 )
 def test_bad_forward_is_one_line(tmp_path, line, message):
@@ -213,3 +214,40 @@ def test_a_tilted_probe_adds_the_twins_tangential_share():
     twin = deflection_batch(spec, [(tilted,), (normal,)])
     assert np.abs(twin[0] - twin[1]).max() > 1e-3 * np.abs(twin[1]).max()  # tilt matters
     np.testing.assert_allclose(three[0] - three[1], twin[0] - twin[1], rtol=1e-9, atol=1e-15)
+
+
+def test_the_foam_table_is_the_finite_element_solution_at_its_nodes():
+    """finger3d-foam: an independent solve of the skin on the foam dielectric the table
+    records (its modulus, nu and thickness), read as the capacitor reads it (the layer's
+    mean strain), equal at the table's nodes to rounding."""
+    from tactsense.physics import finger3d
+
+    _, _, strain, meta = table("probe", "finger3d-foam")
+    layer = finger3d.Dielectric(
+        meta["dielectric_thickness_mm"] * 1e-3,
+        meta["dielectric_modulus_pa"],
+        meta["dielectric_poisson_ratio"],
+    )
+    force = 0.05 * 9.80665
+    pressure, _ = finger3d.hertz_probe(force)
+    solution = finger3d.solve_load(
+        pressure, force, spec=finger3d.LEVELS[int(meta["mesh_level"])], dielectric=layer
+    )
+    x = np.array([0.0, 2.0, 3.75, 7.5, 15.0])
+    a = np.array([0.0, 0.0, 10.0, 44.0, 90.0])
+    fem = solution.dielectric_strain(x * 1e-3, np.radians(a)) / force
+    got = strain_per_newton(x, a, forward="finger3d-foam")
+    np.testing.assert_allclose(got, fem, rtol=0, atol=1e-9 * np.abs(strain).max())
+
+
+def test_foam_forward_model_is_used_and_recorded():
+    """simulate(forward="finger3d-foam") records its model; on the cylinder its frames
+    differ from the solid skin's (the foam reads more), the tip row is the same table."""
+    spec = ts.fearing1990_initial()
+    probe = Probe(8.7, 45.0, 0.4)
+    solid = deflection_batch_3d(spec, [(probe,)])[0]
+    foam = deflection_batch_3d(spec, [(probe,)], "finger3d-foam")[0]
+    assert foam[1:].max() > 1.5 * solid[1:].max()
+    np.testing.assert_array_equal(foam[0], solid[0])
+    rec = ts.simulate(spec, ts.probe_sweep(spec), rng=0, flaws="none", forward="finger3d-foam")
+    assert rec.scenario["forward_model"] == "finger3d-foam"

@@ -63,6 +63,9 @@ def perturbations(spec: SensorSpec) -> dict[str, dict]:
         # not the 2-D model with other numbers: the 3-D skin's finite-element response
         "3-D skin": {FORWARD: "finger3d"},
         "3-D skin, every flaw": {FORWARD: "finger3d", FLAWS_KEY: ALL_FLAWS},
+        # the same skin on section 2.3's foam dielectric (docs/model.md, section 3c)
+        "3-D skin on foam": {FORWARD: "finger3d-foam"},
+        "3-D skin on foam, every flaw": {FORWARD: "finger3d-foam", FLAWS_KEY: ALL_FLAWS},
     }
 
 

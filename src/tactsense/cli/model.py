@@ -79,9 +79,10 @@ def simulate(
         typer.Option(
             "--forward",
             help="The finger's elastic model: 'twin' (the paper's: plane stress along the "
-            "finger, ring spreading around) or 'finger3d' (the 3-D skin's finite-element "
+            "finger, ring spreading around), 'finger3d' (the 3-D skin's finite-element "
             "response with its hemispherical tip, tabulated, with the twin's rings; probes "
-            "and the knife edge only; docs/model.md). "
+            "and the knife edge only) or 'finger3d-foam' (the same skin on the paper's foam "
+            "dielectric, what the capacitor reads; docs/model.md, sections 3b-3d). "
             "Fingers only.",
         ),
     ] = "twin",
@@ -145,10 +146,13 @@ def simulate(
         with atomic_output(out) as temporary:
             written = run_scenario(spec, scene, flaws=flaws, seed=seed, path=temporary,
                                    forward=forward)  # fmt: skip
+        model = {
+            "finger3d": ", the 3-D skin's response",
+            "finger3d-foam": ", the 3-D skin on the foam dielectric",
+        }.get(forward, "")
         console.print(
             f"wrote {out}: {written} frames of {spec.shape[0]}x{spec.shape[1]} "
-            f"counts at {spec.electronics.scan_rate_hz:g} Hz ({spec.name}"
-            + (", the 3-D skin's response)" if forward == "finger3d" else ")")
+            f"counts at {spec.electronics.scan_rate_hz:g} Hz ({spec.name}{model})"
         )
         if plot is not None:  # a sweep: a few hundred frames, read back whole
             with atomic_output(plot) as temporary:

@@ -42,16 +42,19 @@ from tactsense.physics.contact import LineContact, Probe
 TABLE = Path(__file__).with_name("data") / "finger3d_probe.npz"
 TIP_TABLE = TABLE.with_name("finger3d_tip.npz")
 
-FORWARDS = ("twin", "finger3d")
-"""The forward models of a finger: the paper's 2-D twin, or the 3-D skin's table."""
+FORWARDS = ("twin", "finger3d", "finger3d-foam")
+"""The forward models of a finger: the paper's 2-D twin, the 3-D skin's table, or the 3-D
+skin on section 2.3's foam dielectric (what the capacitor reads: the layer's strain)."""
+TABLES = {"finger3d": TABLE, "finger3d-foam": TABLE.with_name("finger3d_probe_foam.npz")}
 
 
-@functools.lru_cache(maxsize=2)
-def table(load: str = "probe"):
+@functools.lru_cache(maxsize=4)
+def table(load: str = "probe", forward: str = "finger3d"):
     """(axial_mm, angle_deg, strain_per_n, metadata) of the tabulated 3-D response to the
-    probe, or to the knife edge (``load="knife"``)."""
+    probe, or to the knife edge (``load="knife"``), of the solid skin (``forward=
+    "finger3d"``) or of the skin on the foam dielectric (``"finger3d-foam"``)."""
     key = {"probe": "strain_per_n", "knife": "knife_strain_per_n"}[load]
-    with np.load(TABLE) as data:
+    with np.load(TABLES[forward]) as data:
         meta = {k: data[k].item() for k in data.files if data[k].ndim == 0}
         return data["axial_mm"], data["angle_deg"], data[key], meta
 
@@ -82,10 +85,12 @@ def _ring_spread(angle, values, flexural_length_mm, ring_radius_mm):
 
 
 @functools.lru_cache(maxsize=8)
-def ring_table(flexural_length_mm: float, ring_radius_mm: float, load: str = "probe"):
+def ring_table(
+    flexural_length_mm: float, ring_radius_mm: float, load: str = "probe", forward="finger3d"
+):
     """The table spread around by the ring: (axial_mm, angle_deg, strain_per_n) on a
     uniform angle grid of :data:`STEP_DEG` from 0 to 180 deg."""
-    axial, angle, strain, _ = table(load)
+    axial, angle, strain, _ = table(load, forward)
     spread_angle, spread = _ring_spread(angle, strain, flexural_length_mm, ring_radius_mm)
     return axial, spread_angle, spread
 
@@ -113,15 +118,20 @@ def _angle_offset(d_angle_deg):
 
 
 def strain_per_newton(
-    d_axial_mm, d_angle_deg, *, rings: tuple[float, float] | None = None, load: str = "probe"
+    d_axial_mm,
+    d_angle_deg,
+    *,
+    rings: tuple[float, float] | None = None,
+    load: str = "probe",
+    forward: str = "finger3d",
 ):
     """Radial strain at the ring depth per newton [1/N] at offsets from the load
     (symmetric: absolute values are used; 0 beyond the table's 24 mm); with ``rings``
     (flexural length, ring radius [mm]) as the ring passes it around (:func:`ring_table`)."""
     if rings is None:
-        axial, angle, strain, _ = table(load)
+        axial, angle, strain, _ = table(load, forward)
     else:
-        axial, angle, strain = ring_table(*rings, load)
+        axial, angle, strain = ring_table(*rings, load, forward)
     x = np.abs(np.asarray(d_axial_mm, dtype=float))
     value = _bilinear(axial, angle, strain, x, _angle_offset(d_angle_deg))
     return np.where(x <= axial[-1], value, 0.0)
@@ -155,7 +165,7 @@ def _cylinder_from_tip(flexural_length_mm: float, ring_radius_mm: float):
     return t["row_mm"], t["s_tip_mm"], angle, spread
 
 
-def deflection_batch_3d(spec, states) -> np.ndarray:
+def deflection_batch_3d(spec, states, forward: str = "finger3d") -> np.ndarray:
     """Fractional deflection of every tactel for each state of probes, (S, rows, cols).
 
     Probes on the cylinder reach the cylinder's rows through the cylinder's table; the
@@ -164,9 +174,15 @@ def deflection_batch_3d(spec, states) -> np.ndarray:
     on the cylinder). The knife edge is tabulated on the cylinder only: its share of the
     tip row, and a knife on the hemisphere, take the 2-D twin's response; so does the
     tangential part of a tilted probe's force (the twin's response to the tilted probe
-    less its response to the probe's normal part).
+    less its response to the probe's normal part). ``forward="finger3d-foam"``: the
+    cylinder's table of the skin on the foam dielectric; the tip's tables have no
+    dielectric (the tip row and probes on the tip are those of the solid skin).
     """
     from tactsense.physics.array_response import deflection_batch
+
+    check_forward(forward, spec)
+    if forward == "twin":
+        raise TactsenseInputError("deflection_batch_3d is the 3-D model: forward 'twin' is not")
 
     out = np.zeros((len(states), *spec.shape))
     rows_mm = np.asarray(spec.row_axial_mm, dtype=float)
@@ -185,7 +201,11 @@ def deflection_batch_3d(spec, states) -> np.ndarray:
                     twin_part.append(contact)
                     continue
                 out[k, cylinder] -= normal * strain_per_newton(
-                    rows_mm[cylinder, None] - contact.axial_mm, d_angle, rings=rings, load=load
+                    rows_mm[cylinder, None] - contact.axial_mm,
+                    d_angle,
+                    rings=rings,
+                    load=load,
+                    forward=forward,
                 )
                 knives.append(contact)  # its share of the tip row: the twin's, below
                 continue
@@ -193,8 +213,9 @@ def deflection_batch_3d(spec, states) -> np.ndarray:
                 tilted.append(contact)
             out[k, ~cylinder] -= normal * tip_row_strain_per_newton(contact.axial_mm, d_angle)
             if contact.axial_mm >= 0.0:
+                offset = rows_mm[cylinder, None] - contact.axial_mm
                 out[k, cylinder] -= normal * strain_per_newton(
-                    rows_mm[cylinder, None] - contact.axial_mm, d_angle, rings=rings
+                    offset, d_angle, rings=rings, forward=forward
                 )
             else:
                 near = cylinder & (rows_mm <= tip_table()["row_mm"][-1])
@@ -271,9 +292,9 @@ def check_forward(forward: str, spec) -> str:
     """The forward model's name, checked against the sensor's kind."""
     if forward not in FORWARDS:
         raise TactsenseInputError(f"forward {forward!r}: expected one of {', '.join(FORWARDS)}")
-    if forward == "finger3d" and getattr(spec, "kind", "finger") != "finger":
+    if forward != "twin" and getattr(spec, "kind", "finger") != "finger":
         raise TactsenseInputError(
-            f"--forward finger3d is the paper's finger in 3-D; {spec.name!r} is a {spec.kind} "
+            f"--forward {forward} is the paper's finger in 3-D; {spec.name!r} is a {spec.kind} "
             "(its layer model is already three-dimensional)"
         )
     return forward
