@@ -54,6 +54,8 @@ BAD_OPTIONS = [
     ("simulate --scenario calibration --row 2 --out OUT", "--row does not apply"),
     ("simulate --scenario sweep-around --col 2 --out OUT", "--col does not apply"),
     ("simulate --repeats 5 --out OUT", "which uses --col, --force-g"),
+    ("simulate --forward bogus --out OUT", "expected one of twin, finger3d, finger3d-foam"),
+    ("simulate --forward finger3d-foam --sensor pad4 --out OUT", "'pad4' is a pad"),
     ("emulate --scenario calibration --lift-s 1", "--lift-s does not apply"),
     ("locate REC --threshold -1 --out OUT", "--threshold"),
     ("locate REC --threshold nan --out OUT", "--threshold"),
