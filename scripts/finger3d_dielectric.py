@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import re
 import sys
 import time
 from pathlib import Path
@@ -25,6 +24,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "scripts"))
+from docblock import replace_block  # noqa: E402
 from finger3d_figure import fit_2d, shape_2d  # noqa: E402  (the section 3a fit)
 
 from tactsense.physics import finger3d  # noqa: E402
@@ -186,11 +186,7 @@ def main(argv=None) -> None:
     print(text)
     figure(data)
     if args.write:
-        doc = DOC.read_text()
-        pattern = re.escape(BEGIN) + r".*?" + re.escape(END)
-        if not re.search(pattern, doc, flags=re.S):
-            raise SystemExit(f"{DOC}: no generated dielectric block to replace")
-        DOC.write_text(re.sub(pattern, lambda _: text, doc, flags=re.S))
+        replace_block(DOC, BEGIN, END, text)
 
 
 if __name__ == "__main__":

@@ -11,7 +11,7 @@ replaces that block in docs/model.md. Reads tables only: no finite-element solve
 from __future__ import annotations
 
 import argparse
-import re
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -25,6 +25,9 @@ from tactsense.physics.finger3d_table import (
     tip_row_strain_per_newton,
     tip_table,
 )
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from docblock import replace_block
 
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "model.md"
@@ -290,11 +293,7 @@ def main(argv=None) -> None:
     print(text)
     figure(n)
     if args.write:
-        doc = DOC.read_text()
-        pattern = re.escape(BEGIN) + r".*?" + re.escape(END)
-        if not re.search(pattern, doc, flags=re.S):
-            raise SystemExit(f"{DOC}: no generated block to replace")
-        DOC.write_text(re.sub(pattern, lambda _: text, doc, flags=re.S))
+        replace_block(DOC, BEGIN, END, text)
 
 
 if __name__ == "__main__":
