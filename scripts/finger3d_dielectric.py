@@ -145,23 +145,35 @@ def figure(data) -> None:
     import matplotlib.pyplot as plt
 
     x = np.array(data["x_mm"])
-    fig, ax = plt.subplots(figsize=(7, 4.2))
-    ax.plot(x, shape_2d(x * 1e-3, 3.8e-3, 0.4), "b-", lw=2.5, alpha=0.5,
+    fig, ax = plt.subplots(figsize=(10, 4.4))
+    # compression positive, each curve over its own peak
+    ax.plot(x, -shape_2d(x * 1e-3, 3.8e-3, 0.4), color="C0", lw=5, alpha=0.35,
             label="the paper's fit: plane stress, 3.8 mm, nu 0.4")  # fmt: skip
-    styles = iter(["k-", "0.5", "0.7", "C3--", "C1-", "C2-.", "C4:", "C5--", "C6:"])
+    moduli = [c["modulus_pa"] for c in data["cases"]]
+    soft = sorted({m for m in moduli if m is not None and m < 2e5})
+    colours = dict(zip(soft, plt.cm.viridis(np.linspace(0.0, 0.85, len(soft))), strict=True))
     for c in data["cases"]:
-        label = (
-            "3-D, no dielectric (ring depth)"
-            if c["modulus_pa"] is None
-            else f"3-D, dielectric {c['modulus_pa']:.3g} Pa, nu {c['poisson_ratio']:g}, "
-            f"{c['thickness_mm']:g} mm"
-        )
-        ax.plot(x, c["knife_profile"], next(styles), lw=1.2, label=label)
+        if c["modulus_pa"] is None:
+            style, label = (
+                {"color": "k", "lw": 1.8},
+                "3-D, no dielectric (strain at the ring depth)",
+            )
+        else:
+            label = (
+                f"3-D, dielectric {c['modulus_pa']:.3g} Pa, nu {c['poisson_ratio']:g}, "
+                f"{c['thickness_mm']:g} mm"
+            )
+            if c["modulus_pa"] >= 2e5:  # the skin's own rubber
+                style = {"color": "0.55", "lw": 1.2, "ls": "-" if c["thickness_mm"] < 0.6 else "--"}
+            else:
+                ls = {0.3: "-", 0.0: "--", 0.45: ":"}[c["poisson_ratio"]]
+                style = {"color": colours[c["modulus_pa"]], "lw": 1.4, "ls": ls}
+        ax.plot(x, -np.array(c["knife_profile"]), label=label, **style)
     ax.axhline(0.0, color="0.85", lw=0.8)
     ax.set_xlabel("knife-edge offset along the finger [mm]")
-    ax.set_ylabel("radial strain at the capacitor / |peak|")
+    ax.set_ylabel("capacitor compression / peak")
     ax.set_title("Section 4.1's knife edge: what the capacitor reads", fontsize=10)
-    ax.legend(fontsize=7, loc="lower right")
+    ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))
     fig.tight_layout()
     FIGURE.parent.mkdir(parents=True, exist_ok=True)
     tmp = FIGURE.with_suffix(".tmp.png")

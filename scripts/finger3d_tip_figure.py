@@ -76,7 +76,7 @@ def fit_twin(spec, s_mm, target):
 def numbers():
     t = tip_table()
     spec = ts.fearing1990_initial()
-    s = np.linspace(APEX_MM, 8.0, 112)
+    s = t["s_mm"][t["s_mm"] <= 8.0]  # the table's own nodes: no interpolation
     three = -tip_row_strain_per_newton(s, 0.0)  # deflection per newton, compression +
     rim = -tip_row_strain_per_newton(s, 0.0, plate="tip_rim")
     twin = twin_meridian(spec, s)
@@ -130,9 +130,9 @@ def _frames(spec, model, axial_mm, angle_deg):
 
 
 def weak_bands(spec, model, angle_deg, step=0.25, fraction=0.1):
-    """Runs of probe positions (apex to 4 mm, every ``step``) where no tactel reads more
+    """Runs of probe positions (from the apex to 4 mm, every ``step``) where no tactel reads more
     than ``fraction`` of the largest reading under the same probe on row 1: [(from, to)]."""
-    axial = np.arange(-19.75, 4.0 + 1e-9, step)
+    axial = np.arange(APEX_MM + 1e-9, 4.0 + 1e-9, step)
     largest = _frames(spec, model, axial, angle_deg).reshape(len(axial), -1).max(axis=1)
     on_row1 = _frames(spec, model, [spec.row_axial_mm[1]], angle_deg).max()
     weak = axial[largest < fraction * on_row1]
@@ -181,7 +181,8 @@ def block(n) -> str:
     lines = [
         BEGIN,
         "",
-        "| tip row, probe moving over the meridian | peak at (s, latitude) | peak per newton |",
+        "| tip row, probe moving over the meridian | peak at (s, latitude) "
+        "| peak deflection per newton [1/N] |",
         "|---|---|---|",
         f"| 3-D, plate the face's outer half (tabulated) | {p3:.2f} mm, {latitude(p3):.0f} deg "
         f"| {v3:.4f} |",
@@ -206,11 +207,12 @@ def block(n) -> str:
         "",
         f"At the junction the first cylinder row (1.1 mm) reads {cyl:.4f} per newton from the "
         f"cylinder's table and {from_tip:.4f} from the tip's (probe at 0.01 mm either side): "
-        f"the tip's coarser mesh reads {100 * (from_tip / cyl - 1):+.0f} %.",
+        f"the tip's coarser mesh reads {100 * (1 - from_tip / cyl):.0f} % lower (its row 1 "
+        "peak rises with refinement in the mesh study below).",
         "",
         "A probe on the hemisphere's shoulder is hard to see. Probe positions (every 0.25 mm "
-        "from the apex, -19.75 mm, to 4 mm) where no tactel reads more than 10 % of what "
-        "the same probe reads on row 1:",
+        f"from the apex, {APEX_MM:.2f} mm, to 4 mm) where no tactel reads more than 10 % of "
+        "what the same probe reads on row 1:",
         "",
         "| angle from the strip | twin | 3-D |",
         "|---|---|---|",
@@ -222,7 +224,7 @@ def block(n) -> str:
         "`locate` (noiseless, threshold 1e-4) on probes every 0.25 mm from the tip row to "
         "row 1, the gap rule of `docs/estimation.md`:",
         "",
-        "| angle from the strip | frames | worst error [mm] | mean error [mm] | not located |",
+        "| angle from the strip | model | worst error [mm] | mean error [mm] | not located |",
         "|---|---|---|---|---|",
         *(
             f"| {a:g} deg | {m} | {g[0]:.1f} | {g[1]:.1f} | {g[2]} of {g[3]} |"
@@ -232,14 +234,15 @@ def block(n) -> str:
         "",
         f"Mesh study (`scripts/finger3d_tip.py --study`; the table is level {int(n['level'])}):",
         "",
-        "| level | dof | solve [s] | tip peak per N | at s [mm] | row 1 peak per N |",
+        "| level | dof | solve [s] | tip peak deflection [1/N] | at s [mm] "
+        "| row 1 peak deflection [1/N] |",
         "|---|---|---|---|---|---|",
     ]
     for k in range(len(st["levels"])):
         lines.append(
             f"| {st['levels'][k]} | {st['dofs'][k]:,} | {st['seconds'][k]:.0f} "
-            f"| {st['tip_peak'][k]:.4f} | {st['tip_peak_s_mm'][k]:.2f} "
-            f"| {st['row1_peak'][k]:.4f} |"
+            f"| {-st['tip_peak'][k]:.4f} | {st['tip_peak_s_mm'][k]:.2f} "
+            f"| {-st['row1_peak'][k]:.4f} |"
         )
     lines += ["", END]
     return "\n".join(lines)
@@ -261,6 +264,8 @@ def figure(n) -> None:
     left.axvline(0.0, color="0.6", lw=0.8)
     left.axvline(APEX_MM, color="0.6", lw=0.8)
     left.axvline(-RADIUS_MM * np.radians(RIM_DEG), color="0.8", lw=0.8, ls=":")
+    left.text(-RADIUS_MM * np.radians(RIM_DEG) + 0.3, left.get_ylim()[0] * 0.9, "core's rim",
+              fontsize=8)  # fmt: skip
     left.axhline(0.0, color="0.8", lw=0.8)
     left.text(APEX_MM + 0.3, left.get_ylim()[1] * 0.9, "apex", fontsize=8)
     left.text(0.3, left.get_ylim()[1] * 0.9, "junction", fontsize=8)

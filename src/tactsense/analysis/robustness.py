@@ -48,6 +48,7 @@ def perturbations(spec: SensorSpec) -> dict[str, dict]:
     e, r = spec.elastic, spec.rings
     return {
         "as assumed": {},
+        "as assumed, every flaw": {FLAWS_KEY: ALL_FLAWS},
         "depth +15 %": {"elastic__effective_depth_mm": 1.15 * e.effective_depth_mm},
         "depth -15 %": {"elastic__effective_depth_mm": 0.85 * e.effective_depth_mm},
         "nu -15 %": {"elastic__effective_poisson_ratio": 0.85 * e.effective_poisson_ratio},

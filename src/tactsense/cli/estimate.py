@@ -528,7 +528,9 @@ def _fit_knife(rec, sensor, row, col, baseline_frames, *, creep=None, log=None):
         raise TactsenseInputError(
             f"the knife-edge fit to tactel ({row}, {col}) cannot be trusted (depth "
             f"{fit.depth_mm:.2f} mm, nu {fit.poisson_ratio:.3f}): {'; '.join(problems)}. "
-            "Is the edge stepped past that tactel? Check --row and --col."
+            "Is the edge stepped past that tactel? Check --row and --col. (A finger the "
+            "plane-stress model does not describe, such as --forward finger3d's solid skin, "
+            "gives such fits too: docs/model.md, section 3d.)"
         )
     return fit, compensated
 

@@ -294,7 +294,8 @@ def check_forward(forward: str, spec) -> str:
         raise TactsenseInputError(f"forward {forward!r}: expected one of {', '.join(FORWARDS)}")
     if forward != "twin" and getattr(spec, "kind", "finger") != "finger":
         raise TactsenseInputError(
-            f"--forward {forward} is the paper's finger in 3-D; {spec.name!r} is a {spec.kind} "
+            f"--forward {forward} is the paper's finger in 3-D; {spec.name!r} is "
+            f"{ {'pad': 'a pad', 'points': 'a point set'}.get(spec.kind, spec.kind) } "
             "(its layer model is already three-dimensional)"
         )
     return forward
