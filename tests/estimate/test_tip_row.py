@@ -112,3 +112,28 @@ def test_docs_quote_the_measured_bound():
     quoted = re.search(r"worst error in the gap is ([0-9.]+) mm", text)
     assert quoted, "docs/estimation.md must quote the tip-gap bound"
     assert float(quoted.group(1)) == pytest.approx(worst, abs=0.05)
+
+
+def test_a_contact_whose_deflections_sum_below_zero_has_no_force():
+    """A frame with a tactel above the threshold whose deflections sum to zero or less
+    (tension around the contact: the 3-D skin near the tip's rim) is flagged
+    NEGATIVE_FORCE with a NaN force, in locate and in the real-time locator alike; the
+    position is still estimated."""
+    from tactsense.estimate import Flag
+    from tactsense.estimate.realtime import RealTimeLocator
+
+    spec = ts.fearing1990_initial()
+    frame = np.full(spec.shape, -0.004)
+    frame[3, 2] = 0.02  # one tactel above the 0.005 threshold, the rest in tension
+    assert frame[1:].sum() < 0
+    est = ts.locate(frame, spec, counts=False)
+    assert int(est.flags) & int(Flag.NEGATIVE_FORCE)
+    assert np.isnan(est.force_n) and np.isfinite(est.axial_mm)
+    plain = frame.copy()
+    plain[plain < 0] = 0.0
+    ok = ts.locate(plain, spec, counts=False)
+    assert not int(ok.flags) & int(Flag.NEGATIVE_FORCE) and ok.force_n > 0
+    baseline = np.full(spec.shape, 1000.0)
+    live = RealTimeLocator(spec, baseline)
+    got = live.from_deflection(frame)
+    assert got.flags & int(Flag.NEGATIVE_FORCE) and np.isnan(got.force_n)

@@ -35,6 +35,11 @@ class Flag(IntFlag):
     """A taxel read below its baseline by more than the contact threshold: the baseline
     was taken under load, or has drifted
     (:class:`~tactsense.estimate.baseline.DriftBaseline`)."""
+    NEGATIVE_FORCE = 512
+    """A tactel is above the contact threshold but the deflections sum to zero or less:
+    the skin reads more tension than compression around the contact (e.g. the 3-D skin
+    near the tip's rim, ``docs/model.md`` section 3b), so the sum is no measure of the
+    load; the force is NaN."""
 
     @classmethod
     def describe(cls, value: int) -> str:

@@ -220,6 +220,10 @@ def locate(
     # a clipped reading understates its tactel's deflection, so the sum is only a lower
     # bound: no number rather than a wrong one (the position is kept, flagged)
     force[(flags & int(Flag.SATURATED)) != 0] = np.nan
+    # more tension than compression around a contact: no force rather than a negative one
+    negative = touched & (summed <= 0.0)
+    flags[negative] |= int(Flag.NEGATIVE_FORCE)
+    force[negative] = np.nan
     flags[touched & ~converged] |= int(Flag.NOT_CONVERGED)
     with np.errstate(invalid="ignore"):
         edge = (row < 0.5) | (row > rows - 1.5)

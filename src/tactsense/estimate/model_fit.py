@@ -21,6 +21,10 @@ from tactsense.physics.array_response import probe_response
 from tactsense.physics.transduction import deflection_to_counts
 from tactsense.sensor import SensorSpec
 
+START_FORCE_N = 0.5
+"""The fit's starting force where the interpolation gives none (a saturated frame, or
+one whose deflections sum to zero or less) [N]: about a 50-g probe."""
+
 
 @dataclass
 class ModelEstimates:
@@ -88,7 +92,9 @@ def fit_frames(
     for k in range(n):
         if not np.isfinite(start.axial_mm[k]):
             continue
-        theta0 = np.array([start.axial_mm[k], start.angle_deg[k], max(start.force_n[k], 1e-3)])
+        force0 = start.force_n[k]  # NaN when saturated or when the sum is not positive
+        force0 = force0 if np.isfinite(force0) and force0 > 1e-3 else START_FORCE_N
+        theta0 = np.array([start.axial_mm[k], start.angle_deg[k], force0])
         frame = frames[k]
         usable = np.isfinite(frame) & (frame > 0)
         fit = least_squares(

@@ -22,6 +22,7 @@ _EDGE = int(Flag.EDGE)
 _TIP = int(Flag.TIP)
 _MULTIPLE = int(Flag.MULTIPLE)
 _SATURATED = int(Flag.SATURATED)
+_NEGATIVE_FORCE = int(Flag.NEGATIVE_FORCE)
 _NAN = float("nan")
 
 
@@ -200,6 +201,8 @@ class RealTimeLocator:
             flag |= _TIP
         if second >= self._second:
             flag |= _MULTIPLE
+        if summed <= 0.0:  # more tension than compression: no force (as locate)
+            flag |= _NEGATIVE_FORCE
         angle = (self._angle0 + self._spacing_deg * c + 180.0) % 360.0 - 180.0
         return Contact(
             r,
@@ -207,7 +210,7 @@ class RealTimeLocator:
             self._axial(r),
             angle,
             value,
-            _NAN if flag & _SATURATED else self._force * summed,
+            _NAN if flag & (_SATURATED | _NEGATIVE_FORCE) else self._force * summed,
             skew,
             int(iterations),
             bool(converged),
