@@ -151,7 +151,7 @@ def figure(data) -> None:
             label="the paper's fit: plane stress, 3.8 mm, nu 0.4")  # fmt: skip
     moduli = [c["modulus_pa"] for c in data["cases"]]
     soft = sorted({m for m in moduli if m is not None and m < 2e5})
-    colours = dict(zip(soft, plt.cm.viridis(np.linspace(0.0, 0.85, len(soft))), strict=True))
+    colours = dict(zip(soft, ["C3", "C2", "C1", "C4"], strict=False))
     for c in data["cases"]:
         if c["modulus_pa"] is None:
             style, label = (
@@ -172,7 +172,8 @@ def figure(data) -> None:
     ax.axhline(0.0, color="0.85", lw=0.8)
     ax.set_xlabel("knife-edge offset along the finger [mm]")
     ax.set_ylabel("capacitor compression / peak")
-    ax.set_title("Section 4.1's knife edge: what the capacitor reads", fontsize=10)
+    ax.set_title("A knife edge across the finger (0.5 N, 8 mm of arc): what the capacitor "
+                 "reads", fontsize=10)  # fmt: skip
     ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))
     fig.tight_layout()
     FIGURE.parent.mkdir(parents=True, exist_ok=True)

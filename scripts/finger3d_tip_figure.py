@@ -260,11 +260,12 @@ def figure(n) -> None:
     left.plot(s, n["rim"], "k:", lw=1.5, label="3-D, plate: outer quarter")
     left.plot(s, n["twin"], "C0--", label="twin (6 mm deep, at 45 deg)")
     position, depth, _, _ = n["fit"]
-    left.plot(s, n["fitted"], "C1-.", label=f"twin fitted ({depth:.1f} mm at {position:.1f} mm)")
+    left.plot(s, n["fitted"], "C1-.",
+              label=f"twin fitted (depth {depth:.1f} mm, at s = {position:.1f} mm)")  # fmt: skip
     left.axvline(0.0, color="0.6", lw=0.8)
     left.axvline(APEX_MM, color="0.6", lw=0.8)
     left.axvline(-RADIUS_MM * np.radians(RIM_DEG), color="0.8", lw=0.8, ls=":")
-    left.text(-RADIUS_MM * np.radians(RIM_DEG) + 0.3, left.get_ylim()[0] * 0.9, "core's rim",
+    left.text(-RADIUS_MM * np.radians(RIM_DEG) + 0.3, left.get_ylim()[1] * 0.9, "core's rim",
               fontsize=8)  # fmt: skip
     left.axhline(0.0, color="0.8", lw=0.8)
     left.text(APEX_MM + 0.3, left.get_ylim()[1] * 0.9, "apex", fontsize=8)

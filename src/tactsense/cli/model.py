@@ -82,7 +82,8 @@ def simulate(
             help="The finger's elastic model. 'twin': the paper's (plane stress along the "
             "finger, ring spreading around), what the estimators assume. 'finger3d': the "
             "solid 3-D skin with its hemispherical tip (finite elements, tabulated, with the "
-            "twin's rings), which reads far less than the twin. 'finger3d-foam': the same "
+            "twin's rings), which reads far less than the twin: to test estimators on a skin "
+            "structurally unlike the one they assume. 'finger3d-foam': the same "
             "skin on the paper's foam dielectric, which reads more and is the closest to the "
             "paper's finger. The two 3-D models take probes and the knife edge only, on "
             "fingers only (docs/model.md, sections 3b-3d; docs/accuracy.md).",

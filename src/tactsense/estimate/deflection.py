@@ -37,9 +37,9 @@ class Flag(IntFlag):
     (:class:`~tactsense.estimate.baseline.DriftBaseline`)."""
     NEGATIVE_FORCE = 512
     """A tactel is above the contact threshold but the deflections sum to zero or less:
-    the skin reads more tension than compression around the contact (e.g. the 3-D skin
-    near the tip's rim, ``docs/model.md`` section 3b), so the sum is no measure of the
-    load; the force is NaN."""
+    the skin reads as much tension as compression around the contact (as the solid 3-D
+    skin can, whose tensile side lobes cancel its compression, ``docs/model.md``
+    sections 3a-3b), so the sum is no measure of the load; the force is NaN."""
 
     @classmethod
     def describe(cls, value: int) -> str:
