@@ -1,4 +1,4 @@
-"""Replace a generated block (from its first marker to its last) in a document."""
+"""Helpers of the scripts that write docs: a generated block replaced, a figure saved."""
 
 from __future__ import annotations
 
@@ -15,4 +15,12 @@ def replace_block(path: Path, begin: str, end: str, text: str) -> None:
         raise SystemExit(f"{path}: no block {begin!r} ... {end!r} to replace")
     tmp = path.with_suffix(path.suffix + ".tmp")
     tmp.write_text(re.sub(pattern, lambda _: text, doc, flags=re.S))
+    tmp.replace(path)
+
+
+def save_figure(fig, path: Path, dpi: int = 110) -> None:
+    """Save a matplotlib figure to ``path`` under a temporary name, then move it."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_suffix(".tmp" + path.suffix)
+    fig.savefig(tmp, dpi=dpi)
     tmp.replace(path)

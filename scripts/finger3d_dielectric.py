@@ -24,7 +24,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "scripts"))
-from docblock import replace_block  # noqa: E402
+from docblock import replace_block, save_figure  # noqa: E402
 from finger3d_figure import fit_2d, shape_2d  # noqa: E402  (the section 3a fit)
 
 from tactsense.physics import finger3d  # noqa: E402
@@ -176,10 +176,7 @@ def figure(data) -> None:
                  "reads", fontsize=10)  # fmt: skip
     ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))
     fig.tight_layout()
-    FIGURE.parent.mkdir(parents=True, exist_ok=True)
-    tmp = FIGURE.with_suffix(".tmp.png")
-    fig.savefig(tmp, dpi=110)
-    tmp.replace(FIGURE)
+    save_figure(fig, FIGURE)
 
 
 def main(argv=None) -> None:

@@ -27,7 +27,7 @@ from tactsense.physics.finger3d_table import (
 )
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from docblock import replace_block
+from docblock import replace_block, save_figure
 
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "model.md"
@@ -284,10 +284,7 @@ def figure(n) -> None:
                     fontsize=10)  # fmt: skip
     right.legend(fontsize=8)
     fig.tight_layout()
-    FIGURE.parent.mkdir(parents=True, exist_ok=True)
-    tmp = FIGURE.with_suffix(".tmp.png")
-    fig.savefig(tmp, dpi=110)
-    tmp.replace(FIGURE)
+    save_figure(fig, FIGURE)
 
 
 def main(argv=None) -> None:
