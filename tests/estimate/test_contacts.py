@@ -221,3 +221,24 @@ def test_bad_shapes_and_inputs(pad16, initial):
 def test_empty_table():
     table = ContactTable.empty(4)
     assert len(table) == 0 and list(table.per_frame_counts()) == [0, 0, 0, 0]
+
+
+def test_finger_contacts_sharing_a_total_below_zero_have_no_force(initial):
+    """Two contacts on the finger whose frame sums to zero or less (tension around them,
+    as the solid 3-D skin gives): no shared force, NaN and NEGATIVE_FORCE on each, as one
+    contact alone gets from locate; positions still given."""
+    from tactsense.estimate import Flag
+
+    frame = np.full(initial.shape, -0.01)
+    frame[2, 1] = 0.03
+    frame[5, 5] = 0.03
+    assert frame[1:].sum() < 0
+    table = find_contacts(frame[None], initial, counts=False, threshold=0.005)
+    assert len(table) == 2
+    assert np.all(np.isnan(table.force_n))
+    assert np.all(table.flags & int(Flag.NEGATIVE_FORCE))
+    assert np.all(np.isfinite(table.row))
+    positive = np.where(frame > 0, frame, 0.0)
+    ok = find_contacts(positive[None], initial, counts=False, threshold=0.005)
+    assert len(ok) == 2 and np.all(ok.force_n > 0)
+    assert not np.any(ok.flags & int(Flag.NEGATIVE_FORCE))

@@ -534,6 +534,10 @@ def _finger_positions(signal, labels, seg, sensor, threshold, method):
         share[many] = seg["total"][many] / by_frame[frame[many]]
     force = np.where(many, force_per_deflection(sensor) * frame_total[frame] * share, est.force_n)
     force = np.where(np.isnan(est.force_n) & ~many, np.nan, force)
+    # several contacts sharing a total of zero or less: no force (as one contact has none)
+    withheld = many & (frame_total[frame] <= 0.0)
+    force = np.where(withheld, np.nan, force)
+    flags = np.where(withheld, flags | int(Flag.NEGATIVE_FORCE), flags)
     row, col = est.row, est.col
     axial, angle = est.axial_mm, est.angle_deg
     if method == "cop":
