@@ -34,6 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from tactsense._validation import TactsenseInputError, check_frames
+from tactsense.estimate.calibrate import save_json
 
 FORMAT = "tactsense-array-calibration"
 
@@ -124,11 +125,7 @@ class ArrayCalibration:
         }
 
     def save(self, path: str | Path, *, overwrite: bool = False) -> Path:
-        path = Path(path)
-        if path.exists() and not overwrite:
-            raise FileExistsError(f"{path} exists; pass --force to replace it")
-        path.write_text(json.dumps(self.to_dict(), indent=1), encoding="utf-8")
-        return path
+        return save_json(self.to_dict(), path, overwrite=overwrite)
 
     @classmethod
     def from_dict(cls, data: dict, source: str = "calibration") -> ArrayCalibration:

@@ -441,6 +441,18 @@ def sensor_of(sensor_toml: str):
     return SensorSpec.from_toml_string(sensor_toml)
 
 
+def save_json(data: dict, path: str | Path, *, overwrite: bool = False) -> Path:
+    """Write a calibration's dictionary as JSON to ``path`` (refused if it exists unless
+    ``overwrite``), under a temporary name moved into place when complete."""
+    path = Path(path)
+    if path.exists() and not overwrite:
+        raise FileExistsError(f"{path} exists; pass --force to replace it")
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(json.dumps(data, indent=1), encoding="utf-8")
+    tmp.replace(path)
+    return path
+
+
 @dataclass
 class Calibration:
     """A finger's calibration: gains, baseline, masks and the fitted models.
@@ -497,11 +509,7 @@ class Calibration:
         }
 
     def save(self, path: str | Path, *, overwrite: bool = False) -> Path:
-        path = Path(path)
-        if path.exists() and not overwrite:
-            raise FileExistsError(f"{path} exists; pass --force to replace it")
-        path.write_text(json.dumps(self.to_dict(), indent=1), encoding="utf-8")
-        return path
+        return save_json(self.to_dict(), path, overwrite=overwrite)
 
     @classmethod
     def load(cls, path: str | Path, sensor: SensorSpec | None = None) -> Calibration:
