@@ -18,6 +18,7 @@ three-dimensional layer model (``tactsense.physics.pad_response``), played back.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import shutil
 import tempfile
 import time
@@ -34,13 +35,10 @@ IMAGES = Path(__file__).resolve().parents[1] / "docs" / "images"
 OUT = IMAGES / "view.png"
 
 
-def main() -> None:
-    spec = ts.fearing1990_initial()
-    rec = ts.simulate(spec, ts.probe_sweep(spec, along="around", dwell_s=0.3), rng=11)
-    emulator = Emulator.from_recording(rec, speed=2.0, faults=FaultRates(drop=0.02), rng=1)
-    _, port = emulator.start_tcp()
-    reader = StreamReader(f"socket://127.0.0.1:{port}", start=False)
-    server = ViewServer(LiveFeed(reader, LiveLocator(reader.sensor, keep_deflection=True)))
+@contextlib.contextmanager
+def browser_page(server):
+    """Start ``server``, open its page in Chromium (1180 x 860), yield the page; stop the
+    server whatever happens."""
     server.start()
     try:
         with sync_playwright() as playwright:
@@ -49,6 +47,27 @@ def main() -> None:
             )
             page = browser.new_page(viewport={"width": 1180, "height": 860})
             page.goto(server.url)
+            yield page
+            browser.close()
+    finally:
+        server.stop()
+
+
+def shoot(page, out: Path) -> None:
+    """Let the page settle for a second, then save it to ``out``."""
+    time.sleep(1.0)
+    page.screenshot(path=str(out))
+
+
+def main() -> None:
+    spec = ts.fearing1990_initial()
+    rec = ts.simulate(spec, ts.probe_sweep(spec, along="around", dwell_s=0.3), rng=11)
+    emulator = Emulator.from_recording(rec, speed=2.0, faults=FaultRates(drop=0.02), rng=1)
+    _, port = emulator.start_tcp()
+    reader = StreamReader(f"socket://127.0.0.1:{port}", start=False)
+    server = ViewServer(LiveFeed(reader, LiveLocator(reader.sensor, keep_deflection=True)))
+    try:
+        with browser_page(server) as page:
             page.wait_for_function("() => window.tactsenseView.touching === true")
             time.sleep(12.0)
             page.mouse.click(*page.evaluate(
@@ -56,11 +75,8 @@ def main() -> None:
                 " const [x, y] = window.tactsenseView.cellCentre(4, 2);"
                 " return [r.left + x, r.top + y]; }"
             ))  # fmt: skip
-            time.sleep(1.0)
-            page.screenshot(path=str(OUT))
-            browser.close()
+            shoot(page, OUT)
     finally:
-        server.stop()
         emulator.stop()
     print(f"wrote {OUT}")
 
@@ -111,34 +127,21 @@ def flat_main(name: str) -> None:
     with tempfile.TemporaryDirectory() as folder:
         path = flat_recording(name, Path(folder) / f"{name}.h5")
         feed = RecordingFeed(path, lambda spec, file: view_locator(spec), speed=1.0)
-        server = ViewServer(feed)
-        server.start()
-        try:
-            with sync_playwright() as playwright:
-                browser = playwright.chromium.launch(
-                    executable_path=shutil.which("chromium") or "/usr/bin/chromium"
-                )
-                page = browser.new_page(viewport={"width": 1180, "height": 860})
-                page.goto(server.url)
-                page.wait_for_function(
-                    f"() => window.tactsenseView.drawnIndex >= {feed.n_frames - 1}",
-                    timeout=30000,
-                )
-                # follow the most deflected taxel in the trace (click it, as a person would)
-                page.mouse.click(*page.evaluate(
-                    "() => { const s = window.tactsenseView, d = s.latest.deflection;"
-                    " let best = [0, 0];"
-                    " d.forEach((row, r) => row.forEach((v, c) => {"
-                    "   if (v > d[best[0]][best[1]]) best = [r, c]; }));"
-                    " const rect = document.getElementById('map').getBoundingClientRect();"
-                    " const [x, y] = s.cellCentre(best[0], best[1]);"
-                    " return [rect.left + x, rect.top + y]; }"
-                ))  # fmt: skip
-                time.sleep(1.0)
-                page.screenshot(path=str(out))
-                browser.close()
-        finally:
-            server.stop()
+        with browser_page(ViewServer(feed)) as page:
+            page.wait_for_function(
+                f"() => window.tactsenseView.drawnIndex >= {feed.n_frames - 1}", timeout=30000
+            )
+            # follow the most deflected taxel in the trace (click it, as a person would)
+            page.mouse.click(*page.evaluate(
+                "() => { const s = window.tactsenseView, d = s.latest.deflection;"
+                " let best = [0, 0];"
+                " d.forEach((row, r) => row.forEach((v, c) => {"
+                "   if (v > d[best[0]][best[1]]) best = [r, c]; }));"
+                " const rect = document.getElementById('map').getBoundingClientRect();"
+                " const [x, y] = s.cellCentre(best[0], best[1]);"
+                " return [rect.left + x, rect.top + y]; }"
+            ))  # fmt: skip
+            shoot(page, out)
     print(f"wrote {out}")
 
 
@@ -157,24 +160,11 @@ def contacts_main() -> None:
     with tempfile.TemporaryDirectory() as folder:
         path = ts.write_recording(Path(folder) / "contacts.h5", rec)
         feed = RecordingFeed(path, lambda s, file: view_locator(s), speed=0.5)
-        server = ViewServer(feed)
-        server.start()
-        try:
-            with sync_playwright() as playwright:
-                browser = playwright.chromium.launch(
-                    executable_path=shutil.which("chromium") or "/usr/bin/chromium"
-                )
-                page = browser.new_page(viewport={"width": 1180, "height": 860})
-                page.goto(server.url)
-                page.wait_for_function(
-                    f"() => window.tactsenseView.drawnIndex >= {feed.n_frames - 1}",
-                    timeout=60000,
-                )
-                time.sleep(1.0)
-                page.screenshot(path=str(out))
-                browser.close()
-        finally:
-            server.stop()
+        with browser_page(ViewServer(feed)) as page:
+            page.wait_for_function(
+                f"() => window.tactsenseView.drawnIndex >= {feed.n_frames - 1}", timeout=60000
+            )
+            shoot(page, out)
     print(f"wrote {out}")
 
 
