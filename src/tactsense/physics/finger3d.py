@@ -266,6 +266,31 @@ class Solution:
         return ((radial[0] - radial[1]) / (2 * step)).reshape(x.shape)
 
 
+def _gradient_blocks(basis, weight=None):
+    """The nine scalar blocks ``G_ij = int w d_i(phi_a) d_j(phi_b)`` (``w``: a function of
+    the quadrature points' coordinates, or 1), six assembled: ``G_ji = G_ij^T``."""
+    g = {}
+    for i in range(3):
+        for j in range(i, 3):
+            if weight is None:
+                form = BilinearForm(lambda u, v, w, i=i, j=j: v.grad[i] * u.grad[j])
+            else:
+                form = BilinearForm(lambda u, v, w, i=i, j=j: weight(w.x) * v.grad[i] * u.grad[j])
+            g[i, j] = asm(form, basis)
+            g[j, i] = g[i, j].T
+    return g
+
+
+def _elasticity(g_lam, g_mu):
+    """Block (c, d) of the stiffness: ``G^lam_cd + G^mu_dc + delta_cd sum_i G^mu_ii``."""
+    trace = g_mu[0, 0] + g_mu[1, 1] + g_mu[2, 2]
+    blocks = [
+        [g_lam[c, d] + g_mu[d, c] + (trace if c == d else 0 * trace) for d in range(3)]
+        for c in range(3)
+    ]
+    return sparse.bmat(blocks, format="csr")
+
+
 def _stiffness(basis, lam, mu):
     """Elasticity stiffness, component-major dofs [u_x; u_y; u_z].
 
@@ -273,45 +298,18 @@ def _stiffness(basis, lam, mu):
     (much faster than the vector element's form): block (c, d) is
     ``lam G_cd + mu delta_cd sum_i G_ii + mu G_dc``.
     """
-    g = {}
-    for i in range(3):
-        for j in range(i, 3):
-            g[i, j] = asm(BilinearForm(lambda u, v, w, i=i, j=j: v.grad[i] * u.grad[j]), basis)
-            g[j, i] = g[i, j].T
-    trace = g[0, 0] + g[1, 1] + g[2, 2]
-    blocks = [
-        [lam * g[c, d] + mu * g[d, c] + (mu * trace if c == d else 0 * trace) for d in range(3)]
-        for c in range(3)
-    ]
-    return sparse.bmat(blocks, format="csr")
+    g = _gradient_blocks(basis)
+    return _elasticity({k: lam * v for k, v in g.items()}, {k: mu * v for k, v in g.items()})
 
 
 def _stiffness_layered(basis, rubber, dielectric, top_m):
     """Elasticity stiffness with the material chosen per quadrature point by its radius:
     ``dielectric`` (lam, mu) below ``top_m`` (an element boundary), ``rubber`` above."""
 
-    def lam_mu(w):
-        inside = np.hypot(w.x[1], w.x[2]) < top_m
-        return (
-            np.where(inside, dielectric[0], rubber[0]),
-            np.where(inside, dielectric[1], rubber[1]),
-        )
+    def material(k):
+        return lambda x: np.where(np.hypot(x[1], x[2]) < top_m, dielectric[k], rubber[k])
 
-    g_lam, g_mu = {}, {}
-    for i in range(3):
-        for j in range(3):
-            g_lam[i, j] = asm(
-                BilinearForm(lambda u, v, w, i=i, j=j: lam_mu(w)[0] * v.grad[i] * u.grad[j]), basis
-            )
-            g_mu[i, j] = asm(
-                BilinearForm(lambda u, v, w, i=i, j=j: lam_mu(w)[1] * v.grad[i] * u.grad[j]), basis
-            )
-    trace = g_mu[0, 0] + g_mu[1, 1] + g_mu[2, 2]
-    blocks = [
-        [g_lam[c, d] + g_mu[d, c] + (trace if c == d else 0 * trace) for d in range(3)]
-        for c in range(3)
-    ]
-    return sparse.bmat(blocks, format="csr")
+    return _elasticity(_gradient_blocks(basis, material(0)), _gradient_blocks(basis, material(1)))
 
 
 def _fixed_dofs(basis, shell: ShellMesh, far_end):
