@@ -38,6 +38,7 @@ Forward model only: estimation code must never import this module.
 
 from __future__ import annotations
 
+import functools
 import itertools
 from dataclasses import dataclass
 
@@ -297,11 +298,16 @@ class TipSolution:
         u[self.free] = self.lu.solve(np.asarray(rhs, float)[self.free])
         return u.reshape(3, -1)
 
+    @functools.cached_property
+    def skin(self) -> FacetBasis:
+        """Quadrature on the outer skin's facets (built once: loads and influences)."""
+        return FacetBasis(self.tip.mesh, ElementTetP2(), facets=self.tip.outer, intorder=6)
+
     def pressure_load(self, pressure, force_n) -> np.ndarray:
         """Load vector of a pressure shape ``p(x)`` (x: (3, ...) points [m], compressive
         positive) on the outer surface, scaled so that the whole finger carries
         ``force_n`` [N] (the half model carries half)."""
-        top = FacetBasis(self.tip.mesh, ElementTetP2(), facets=self.tip.outer, intorder=6)
+        top = self.skin
         scale = 0.5 * force_n / asm(LinearForm(lambda v, w: pressure(w.x) * v), top).sum()
         return np.concatenate(
             [
@@ -388,7 +394,7 @@ class TipSolution:
 
         from tactsense.physics.finger3d import hertz_probe
 
-        top = FacetBasis(self.tip.mesh, ElementTetP2(), facets=self.tip.outer, intorder=6)
+        top = self.skin
         x = np.asarray(top.global_coordinates()).reshape(3, -1)
         w = top.dx.ravel()
         n = np.asarray(top.normals).reshape(3, -1)
