@@ -356,29 +356,30 @@ class TipSolution:
                 return ref
         raise RuntimeError("the inverse of the curved map did not converge")
 
-    def normal_strain_functional(self, points, normals, weights=None, step=1e-6):
-        """The functional ``g`` (length 3 N) of the weighted mean normal strain
-        ``n . (du/dn)`` at ``points`` (3, P) with unit ``normals`` (3, P) [m].
+    def _normal_strain_matrix(self, points, normals, step=1e-6) -> sparse.csr_matrix:
+        """The (P, 3 N) matrix that maps the displacement (component-major) to the normal
+        strain ``n . (du/dn)`` at ``points`` (3, P) with unit ``normals`` (3, P) [m].
 
         Central difference of the displacement over ``2 step`` along the normal; inside
         an element this is the derivative of the quadratic interpolant."""
         points, normals = np.asarray(points, float), np.asarray(normals, float)
-        weights = np.full(points.shape[1], 1.0 / points.shape[1]) if weights is None else weights
-        g = np.zeros((3, self.basis.N))
-        for sign in (1.0, -1.0):
-            probe = self._probe_matrix(points + sign * step * normals)
-            for c in range(3):
-                g[c] += sign * (probe.T @ (weights * normals[c])) / (2 * step)
-        return g.ravel()
+        difference = self._probe_matrix(points + step * normals) - self._probe_matrix(
+            points - step * normals
+        )
+        return sparse.hstack(
+            [sparse.diags(normals[c] / (2 * step)) @ difference for c in range(3)], format="csr"
+        )
+
+    def normal_strain_functional(self, points, normals, weights=None, step=1e-6):
+        """The functional ``g`` (length 3 N) of the weighted mean normal strain at
+        ``points`` (3, P) with unit ``normals`` (3, P) [m] (equal weights by default)."""
+        n_points = np.shape(points)[1]
+        weights = np.full(n_points, 1.0 / n_points) if weights is None else weights
+        return self._normal_strain_matrix(points, normals, step).T @ np.asarray(weights, float)
 
     def normal_strain(self, u, points, normals, step=1e-6) -> np.ndarray:
         """Normal strain ``n . (du/dn)`` [-] of displacement ``u`` (3, N) at ``points``."""
-        points, normals = np.asarray(points, float), np.asarray(normals, float)
-        out = 0.0
-        for sign in (1.0, -1.0):
-            probe = self._probe_matrix(points + sign * step * normals)
-            out = out + sign * sum(normals[c] * (probe @ u[c]) for c in range(3)) / (2 * step)
-        return out
+        return self._normal_strain_matrix(points, normals, step) @ np.ravel(u)
 
     def influence(self, v, s_mm, theta_deg, *, probe_radius_m=1.6e-3, force_n=0.05 * 9.80665):
         """A tactel's reading per newton of the Hertz probe at surface points (reciprocity).
