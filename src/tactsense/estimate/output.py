@@ -31,6 +31,58 @@ def output_format(path: str | Path) -> str:
     return FORMATS[suffix]
 
 
+def estimates_schema(format: str) -> pa.Schema:
+    """The columns of a file of :class:`Estimates` and their types, from the definition
+    (never from the data of a piece: a piece with no contact must not change a type).
+
+    ``frame`` int64, ``time_s`` float64, the fields of :class:`Estimates` (float64;
+    ``iterations`` and ``flags`` int64, ``converged`` bool) and, in CSV, ``flag_names``
+    (string).
+    """
+    types = {"iterations": pa.int64(), "flags": pa.int64(), "converged": pa.bool_()}
+    schema = [("frame", pa.int64()), ("time_s", pa.float64())]
+    schema += [(name, types.get(name, pa.float64())) for name in _NAMES]
+    if format == "csv":
+        schema.append(("flag_names", pa.string()))
+    return pa.schema(schema)
+
+
+_CONTACT_TYPES = {
+    "frame": pa.int64(),
+    "contact": pa.int64(),
+    "id": pa.int64(),
+    "taxels": pa.int64(),
+    "flags": pa.int64(),
+    "slip": pa.bool_(),
+    "event": pa.string(),
+    "flag_names": pa.string(),
+}
+"""Types of the long table's columns that are not float64 (every other column, such as
+``x_mm``, ``force_n`` or a finger's ``axial_mm``, is float64)."""
+
+
+def contacts_schema(names) -> pa.Schema:
+    """The long table's columns ``names`` with their types from the definition
+    (:data:`_CONTACT_TYPES`, float64 otherwise)."""
+    return pa.schema([(name, _CONTACT_TYPES.get(name, pa.float64())) for name in names])
+
+
+def _conform(columns: dict, schema: pa.Schema) -> pa.Table:
+    """``columns`` (name -> array) as a table of exactly ``schema``: the types of the
+    file, whatever a piece holds (an empty or all-quiet piece infers no type)."""
+    if list(columns) != schema.names:
+        raise ValueError(f"a piece has the columns {list(columns)}; the file has {schema.names}")
+    arrays = [pa.array(columns[f.name], type=f.type) for f in schema]
+    return pa.Table.from_arrays(arrays, schema=schema)
+
+
+def _h5_dtype(type_: pa.DataType):
+    """The HDF5 (numpy) type of an Arrow column type."""
+    if pa.types.is_string(type_):
+        return h5py.string_dtype()
+    return np.dtype(type_.to_pandas_dtype())
+
+
 def _flag_names(flags: np.ndarray) -> np.ndarray:
     values, inverse = np.unique(flags, return_inverse=True)
     names = np.array([Flag.describe(int(v)) for v in values], dtype=object)
@@ -57,6 +109,7 @@ class EstimatesWriter:
         self.rows = 0
         self._writer = None
         self._h5 = None
+        self._schema: pa.Schema | None = None
 
     def __enter__(self) -> EstimatesWriter:
         return self
@@ -81,53 +134,59 @@ class EstimatesWriter:
             columns[name] = value
         if self.format == "csv":  # a text file also says the flags by name, as `live` does
             columns["flag_names"] = _flag_names(columns["flags"])
-        return pa.table(columns)
+        if self._schema is None:
+            self._schema = estimates_schema(self.format)
+        return _conform(columns, self._schema)
 
     def write(self, start: int, time_s, estimates: Estimates) -> None:
         """Append the estimates of frames ``start ...`` with their times [s]."""
         table = self._table(start, time_s, estimates)
+        units = {"time_s": "s", **Estimates.UNITS, "flags": "Flag bits"}
+        self._append(table, units, "tactsense-estimates")
+
+    def _append(self, table: pa.Table, units: dict, kind: str) -> None:
+        """Append a piece already of the file's schema (:func:`_conform`)."""
         if self.format == "csv":
             if self._writer is None:
                 self._writer = pa_csv.CSVWriter(str(self.path), table.schema)
             self._writer.write_table(table)
         elif self.format == "parquet":
             if self._writer is None:
-                units = {"time_s": "s", **Estimates.UNITS, "flags": "Flag bits"}
                 schema = table.schema.with_metadata({"units": str(units)})
                 self._writer = pq.ParquetWriter(str(self.path), schema)
             self._writer.write_table(table.replace_schema_metadata(self._writer.schema.metadata))
         else:
-            self._write_h5(table)
+            self._write_h5(table, units, kind)
         self.rows += table.num_rows
 
-    def _write_h5(self, table: pa.Table) -> None:
+    def _write_h5(self, table: pa.Table, units: dict, kind: str) -> None:
         if self._h5 is None:
             self._h5 = h5py.File(self.path, "w")
-            self._h5.attrs["format"] = "tactsense-estimates"
-            units = {"time_s": "s", **Estimates.UNITS, "flags": "Flag bits"}
+            self._h5.attrs["format"] = kind
             # chunks sized to the data: the first piece (a short file is one small chunk),
             # at least 1024 rows so that a long file written in small pieces is not
             # split into tiny chunks, at most 65,536 rows
             rows = min(65_536, max(1_024, table.num_rows))
-            for name in table.column_names:
-                column = table.column(name).to_numpy()
-                data = self._h5.create_dataset(
-                    name,
-                    shape=(0,),
-                    maxshape=(None,),
-                    dtype=column.dtype,
-                    chunks=(rows,),
-                    compression="gzip",
-                    compression_opts=4,
-                    shuffle=True,
-                    fletcher32=True,
-                )
-                data.attrs["units"] = units.get(name, "1")
+            for field_ in table.schema:
+                if pa.types.is_string(field_.type):  # variable length: no filters
+                    data = self._h5.create_dataset(
+                        field_.name, shape=(0,), maxshape=(None,), chunks=(rows,),
+                        dtype=_h5_dtype(field_.type),
+                    )  # fmt: skip
+                else:
+                    data = self._h5.create_dataset(
+                        field_.name, shape=(0,), maxshape=(None,), chunks=(rows,),
+                        compression="gzip", compression_opts=4, shuffle=True,
+                        fletcher32=True, dtype=_h5_dtype(field_.type),
+                    )  # fmt: skip
+                data.attrs["units"] = units.get(field_.name, "1")
         n = table.num_rows
         for name in table.column_names:
             data = self._h5[name]
             data.resize((self.rows + n,))
-            data[self.rows :] = table.column(name).to_numpy()
+            column = table.column(name)
+            values = column.to_pylist() if pa.types.is_string(column.type) else column.to_numpy()
+            data[self.rows :] = values
 
     def close(self) -> None:
         if self._writer is not None:
@@ -179,7 +238,9 @@ class ContactsWriter(EstimatesWriter):
         columns["event"] = np.full(n, "", dtype=object)
         if self.format == "csv":
             columns["flag_names"] = _flag_names(columns["flags"])
-        return pa.table(columns)
+        if self._schema is None:  # the first piece names the columns, the definition types them
+            self._schema = contacts_schema(columns)
+        return _conform(columns, self._schema)
 
     def write_contacts(self, time_s, table, events=()) -> None:
         """Append a table of contacts, ``time_s`` per row [s], and its track events."""
@@ -200,45 +261,7 @@ class ContactsWriter(EstimatesWriter):
             )
         self.events.extend(events)
         units = {"time_s": "s", **_contact_units(), "flags": "Flag bits"}
-        if self.format == "csv":
-            if self._writer is None:
-                self._writer = pa_csv.CSVWriter(str(self.path), arrow.schema)
-            self._writer.write_table(arrow)
-        elif self.format == "parquet":
-            if self._writer is None:
-                schema = arrow.schema.with_metadata({"units": str(units)})
-                self._writer = pq.ParquetWriter(str(self.path), schema)
-            self._writer.write_table(arrow.replace_schema_metadata(self._writer.schema.metadata))
-        else:
-            self._write_h5(arrow, units)
-        self.rows += arrow.num_rows
-
-    def _write_h5(self, table: pa.Table, units=None) -> None:
-        if self._h5 is None:
-            self._h5 = h5py.File(self.path, "w")
-            self._h5.attrs["format"] = "tactsense-contacts"
-            rows = min(65_536, max(1_024, table.num_rows))
-            for name in table.column_names:
-                column = table.column(name)
-                if pa.types.is_string(column.type):  # variable length: no filters
-                    data = self._h5.create_dataset(
-                        name, shape=(0,), maxshape=(None,), chunks=(rows,),
-                        dtype=h5py.string_dtype(),
-                    )  # fmt: skip
-                else:
-                    data = self._h5.create_dataset(
-                        name, shape=(0,), maxshape=(None,), chunks=(rows,), compression="gzip",
-                        compression_opts=4, shuffle=True, fletcher32=True,
-                        dtype=column.to_numpy().dtype,
-                    )  # fmt: skip
-                data.attrs["units"] = (units or {}).get(name, "1")
-        n = table.num_rows
-        for name in table.column_names:
-            data = self._h5[name]
-            data.resize((self.rows + n,))
-            column = table.column(name)
-            values = column.to_pylist() if pa.types.is_string(column.type) else column.to_numpy()
-            data[self.rows :] = values
+        self._append(arrow, units, "tactsense-contacts")
 
     def close(self) -> None:
         events = _events_table(self.events)
