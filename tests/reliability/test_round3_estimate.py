@@ -128,3 +128,48 @@ def test_contacts_writer_types_come_from_the_definition(tmp_path, fmt):
     if fmt == "h5":
         with h5py.File(path) as f:
             assert f["contact"].dtype == np.int64 and f["slip"].dtype == bool
+
+
+# ---- item 5: BELOW_BASELINE means a fault, calibrated forces are never negative ------
+
+
+@pytest.fixture(scope="module")
+def capacitive(tmp_path_factory):
+    """A capacitive pad and a point set pressed after untouched frames."""
+    folder = tmp_path_factory.mktemp("capacitive")
+    for name in ("pad4", "dome12"):
+        cli("simulate", "--sensor", name, "--scenario", "press", "--out", folder / f"{name}.h5")
+    return folder
+
+
+@pytest.mark.parametrize("name", ["pad4", "dome12"])
+def test_tension_beside_a_contact_is_not_below_baseline(capacitive, name):
+    """Issue 31 item 5: the neighbours of a press on a capacitive array read tension
+    (below the baseline: 52 of 53 rows of pad4, 25 of 33 of dome12 were flagged, with
+    the warning that the baseline was touched). The baseline was taken untouched: no row
+    may carry BELOW_BASELINE and there is no warning. A baseline taken under the press
+    (``--baseline-frames 50``) still warns."""
+    out = capacitive / f"{name}.parquet"
+    line = cli("locate", capacitive / f"{name}.h5", "--out", out, "-q", "--force")
+    flags = pq.read_table(out)["flags"].to_numpy()
+    assert len(flags) > 20
+    assert not (flags & int(ts.Flag.BELOW_BASELINE)).any()
+    assert "below the baseline" not in line
+    late = capacitive / f"{name}-late.parquet"
+    line = cli("locate", capacitive / f"{name}.h5", "--baseline-frames", 50, "--out", late,
+               "-q", "--force")  # fmt: skip
+    assert "below the baseline" in line
+
+
+@pytest.mark.parametrize(("name", "quoted"), [("pad4", 0.84), ("dome12", 0.18)])
+def test_tension_depth_quoted_in_contacts_md(capacitive, name, quoted):
+    """The numbers docs/contacts.md quotes for the rule (not a fault case): the deepest
+    tension beside a press over the press's peak, on the `press` scenario; below 1, as
+    the rule of BELOW_BASELINE assumes."""
+    rec = ts.read_recording(capacitive / f"{name}.h5")
+    frames = rec.frames.astype(float).reshape(len(rec.frames), -1)
+    base = np.median(frames[:5], axis=0)
+    signal = (frames - base) / frames  # eq. 4
+    touched = signal.max(axis=1) > 0.005
+    ratio = -signal[touched].min(axis=1) / signal[touched].max(axis=1)
+    assert round(float(ratio.max()), 2) == quoted

@@ -19,10 +19,12 @@ recording is read in one piece or in many):
 * a held taxel's baseline moves by the mean step of the untouched ones: drift common to
   the array (temperature, supply) goes on under a press, so a long press does not leave
   its taxels a drift behind when it lifts;
-* a taxel reading *below* its baseline by more than the threshold says the baseline was
-  taken under load (or the load was still on when the baseline was made): such frames
-  are counted in :attr:`DriftBaseline.below_frames` and flagged ``BELOW_BASELINE``; the
-  baseline follows them down like any untouched taxel.
+* a taxel reading *below* its baseline by more than the threshold, where no tension
+  beside a contact can explain it (:func:`below_baseline`: a capacitive taxel beside a
+  contact reads tension, up to the contact's peak), says the baseline was taken under
+  load (or the load was still on when the baseline was made): such frames are counted
+  in :attr:`DriftBaseline.below_frames` and flagged ``BELOW_BASELINE``; the baseline
+  follows them down like any untouched taxel.
 
 :meth:`DriftBaseline.rezero` replaces the baseline by the next frames' median on demand
 (a key or a command in ``live`` and ``view``).
@@ -49,6 +51,38 @@ catches up, and the taxel stays held (``tests/estimate/test_baseline.py``)."""
 
 
 @jit(nogil=True)
+def below_baseline(lowest: float, highest: float, threshold: float, resistive: bool) -> bool:
+    """Whether a frame reads below its baseline by more than the noise and tension explain
+    (the rule of the flag ``BELOW_BASELINE``).
+
+    The signal is taken with compression positive (eq. 4; the strain on a resistive
+    taxel). A taxel below the baseline by more than the contact ``threshold`` (10 counts,
+    some 20 times the read noise of 0.3 counts and quantization, so no noise explains it)
+    is a fault of the baseline unless it can be tension beside a contact: on a capacitive
+    taxel, whose plates part under tension, in a frame that holds a contact (a taxel
+    above the threshold) when it is no deeper below the baseline than that contact's
+    largest compression (an elastic layer's tension lobes are shallower than the
+    compression that makes them). A resistive taxel does not respond to tension: any
+    reading below the threshold is a fault.
+
+    Parameters
+    ----------
+    lowest, highest : float
+        The frame's most negative and most positive signal over usable taxels [-]
+        (both 0 when none is beyond the baseline).
+    threshold : float
+        The contact threshold [-].
+    resistive : bool
+        The taxels are resistive (no response to tension).
+    """
+    if lowest >= -threshold:
+        return False
+    if resistive:
+        return True
+    return not (highest > threshold and -lowest <= highest)
+
+
+@jit(nogil=True)
 def _follow(
     frames, baseline, unusable, full_scale, resistive, per_count, threshold, alpha, guard,
     grid, nan_flag, sat_flag, dead_flag, below_flag,
@@ -68,6 +102,8 @@ def _follow(
         for r in range(rows):
             for c in range(cols):
                 held[r, c] = False
+        lowest = 0.0
+        highest = 0.0
         for r in range(rows):
             for c in range(cols):
                 d, bits = taxel_signal(
@@ -75,8 +111,8 @@ def _follow(
                     resistive, per_count, nan_flag, sat_flag, dead_flag,
                 )  # fmt: skip
                 flag |= bits
-                if d < -threshold:
-                    flag |= below_flag
+                lowest = min(lowest, d)
+                highest = max(highest, d)
                 signal[f, r, c] = d
                 if d > threshold:
                     if grid:
@@ -85,6 +121,8 @@ def _follow(
                                 held[rr, cc] = True
                     else:
                         held[r, c] = True
+        if below_baseline(lowest, highest, threshold, resistive):
+            flag |= below_flag
         flags[f] = flag
         moved = 0.0
         n_moved = 0
@@ -168,7 +206,7 @@ class DriftBaseline:
         """Share of the difference to the reading taken each frame [-]."""
         self.rezero_frames = int(rezero_frames)
         self.below_frames = 0
-        """Frames so far with a taxel below its baseline by more than the threshold."""
+        """Frames so far flagged ``BELOW_BASELINE`` (:func:`below_baseline`)."""
         self.frames_seen = 0
         self.last_signal: np.ndarray | None = None
         """The signal of the frames last given to :meth:`signal` (a caller that scales

@@ -32,9 +32,11 @@ class Flag(IntFlag):
     MULTIPLE = 128
     """A second, separate contact was seen; the fields describe the largest one."""
     BELOW_BASELINE = 256
-    """A taxel read below its baseline by more than the contact threshold: the baseline
-    was taken under load, or has drifted
-    (:class:`~tactsense.estimate.baseline.DriftBaseline`)."""
+    """A taxel read below its baseline by more than the contact threshold where no
+    tension beside a contact explains it (a resistive taxel, a frame without contact, or
+    deeper than the frame's largest compression:
+    :func:`~tactsense.estimate.baseline.below_baseline`): the baseline was taken under
+    load, or has drifted (:class:`~tactsense.estimate.baseline.DriftBaseline`)."""
     NEGATIVE_FORCE = 512
     """A tactel is above the contact threshold but the deflections sum to zero or less:
     the skin reads as much tension as compression around the contact (as the solid 3-D
