@@ -173,3 +173,90 @@ def test_tension_depth_quoted_in_contacts_md(capacitive, name, quoted):
     touched = signal.max(axis=1) > 0.005
     ratio = -signal[touched].min(axis=1) / signal[touched].max(axis=1)
     assert round(float(ratio.max()), 2) == quoted
+
+
+def test_a_calibrated_force_is_never_negative():
+    """Issue 31 item 5: the force curve extended below its first knot went negative (26
+    of 100 rows of a calibrated pad). Knots (0.1, 0.05) and (0.2, 0.5) extend to -0.175 N
+    at 0.05 N estimated; the force is clamped at zero, NaN stays NaN."""
+    from tactsense.estimate.array_calibration import ArrayCalibration
+
+    pad = ts.preset("pad4")
+    ones = np.ones(pad.shape)
+    cal = ArrayCalibration(
+        pad.to_toml_string(), ones * 2000, ones, ones < 0, ([0.1, 0.2], [0.05, 0.5])
+    )
+    out = cal.force([0.05, 0.1, 0.15, -0.2, np.nan])
+    np.testing.assert_allclose(out[:4], [0.0, 0.05, 0.275, 0.0])
+    assert np.isnan(out[4])
+
+
+@pytest.fixture(scope="module")
+def bench(tmp_path_factory):
+    """The bench of tests/estimate/test_array_calibration.py: a 50-g probe on every taxel
+    of pad4, 24 presses of 0.1-1 N and the load cell's log of them, and logs gone wrong."""
+    import csv
+
+    from tactsense import flat_scenarios as fs
+    from tests.estimate.test_array_calibration import _loads, _log
+
+    folder = tmp_path_factory.mktemp("bench")
+    pad = ts.preset("pad4")
+    ts.write_recording(folder / "bench.h5", ts.simulate(pad, fs.raster(pad), rng=1))
+    loads = _loads(pad)
+    ts.write_recording(folder / "loads.h5", loads)
+    _log(loads, folder / "loads.csv")
+    with open(folder / "loads.csv", newline="") as stream:
+        rows = list(csv.reader(stream))
+    # the same log negated (compression negative), in grams, and of another session
+    # (the 24 presses' forces in another order on the same clock)
+    steps = np.array_split(np.arange(len(rows) - 1), 24)
+    order = np.random.default_rng(0).permutation(24)
+    other = [rows[1 + i][1] for k in order for i in steps[k]]
+    variants = {
+        "negated": lambda k, f: -f,
+        "grams": lambda k, f: f * 1000 / 9.80665,
+        "other": lambda k, f: float(other[k]),
+    }
+    for name, change in variants.items():
+        with open(folder / f"{name}.csv", "w", newline="") as stream:
+            writer = csv.writer(stream)
+            writer.writerow(rows[0])
+            for k, row in enumerate(rows[1:]):
+                writer.writerow([row[0], f"{change(k, float(row[1])):.6f}", row[2]])
+    return folder
+
+
+@pytest.mark.parametrize(
+    ("log", "expected"),
+    [
+        ("negated", "positive in compression"),
+        ("grams", "must be in newtons"),
+        ("other", "does not rise with the recording's force"),
+    ],
+)
+def test_a_force_log_gone_wrong_is_refused(bench, log, expected):
+    """Issue 31 item 5: --force-log took a negated log (every press mapped to 0.0022 N)
+    or a log in grams (100x) with exit 0. Each is refused: exit 2, one line, no file."""
+    out = bench / f"cal_{log}.json"
+    done = runner.invoke(app, ["calibrate", str(bench / "bench.h5"), "--loads",
+                               str(bench / "loads.h5"), "--force-log", str(bench / f"{log}.csv"),
+                               "--out", str(out)])  # fmt: skip
+    assert done.exit_code == 2, done.output
+    assert expected in " ".join(done.output.split())
+    assert "Traceback" not in done.output
+    assert not out.exists()
+
+
+def test_the_force_log_checks_are_reported(bench):
+    """The right log passes, and the calibration says what was checked; the scale
+    quoted in LOG_SCALE_LIMIT's docstring."""
+    import json
+
+    out = bench / "cal.json"
+    line = cli("calibrate", bench / "bench.h5", "--loads", bench / "loads.h5", "--force-log",
+               bench / "loads.csv", "--out", out)  # fmt: skip
+    assert "force log checked" in line
+    notes = json.loads(out.read_text())["notes"]
+    assert round(notes["force_log_scale"], 2) == 2.15
+    assert notes["force_log_rank_correlation"] > 0.5

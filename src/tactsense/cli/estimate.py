@@ -452,6 +452,12 @@ def _calibrate_array(recording, out, *, press, force_log, loads, baseline_frames
             f"{len(x)} knots from {calibration.notes['force_pairs']} frames, "
             f"{x[0]:.3g}-{x[-1]:.3g} N estimated -> {y[0]:.3g}-{y[-1]:.3g} N measured",
         )
+        notes = calibration.notes
+        table.add_row(
+            "force log checked",
+            f"positive; {notes['force_log_scale']:.3g} x the model's force; rank "
+            f"correlation {notes['force_log_rank_correlation']:.2f}",
+        )
     Console(stderr=True).print(table)
 
 

@@ -90,7 +90,8 @@ class ArrayCalibration:
         return signal, flags
 
     def force(self, estimated) -> np.ndarray:
-        """Forces through the curve [N] (unchanged without one; linear beyond its ends)."""
+        """Forces through the curve [N] (unchanged without one; linear beyond its ends,
+        never below zero: a load pressing on the array has no negative force)."""
         estimated = np.asarray(estimated, dtype=float)
         if self.force_curve is None:
             return estimated
@@ -103,6 +104,7 @@ class ArrayCalibration:
             slope_hi = (y[-1] - y[-2]) / (x[-1] - x[-2])
             out = np.where(low, y[0] + slope_lo * (estimated - x[0]), out)
             out = np.where(high, y[-1] + slope_hi * (estimated - x[-1]), out)
+        out = np.maximum(out, 0.0)  # NaN stays NaN
         return np.where(np.isfinite(estimated), out, np.nan)
 
     # ---- JSON --------------------------------------------------------------------------
@@ -445,6 +447,7 @@ def calibrate_array(
     estimated = np.zeros(len(load_frames))
     np.add.at(estimated, table.frame, np.nan_to_num(table.force_n))
     measured = np.interp(time_s, log_t, log_f)
+    check_force_log(estimated[inside & (estimated > 0)], measured[inside & (estimated > 0)])
     use = inside & (estimated > 0) & (measured > 0.05 * np.max(log_f))
     loads = measured[use]
     if len(loads) and np.percentile(loads, 90) < 1.5 * np.percentile(loads, 10):
@@ -453,9 +456,73 @@ def calibrate_array(
             "contact): a force curve needs presses of several forces (a recording of "
             "presses from light to heavy, given with --loads)"
         )
+    scale, rank = _log_agreement(estimated[use], measured[use])
     calibration.force_curve = force_curve(estimated[use], measured[use], bins=bins)
     calibration.notes["force_pairs"] = int(use.sum())
+    calibration.notes["force_log_scale"] = scale
+    calibration.notes["force_log_rank_correlation"] = rank
     return calibration
+
+
+LOG_SCALE_LIMIT = 10.0
+"""A force log whose forces are more than this factor above or below the forces the
+recording's layer model gives (median over the frames with a contact) is refused: the
+model of a correctly described sensor is well within it (``pad4``'s twin under 24
+presses of 0.1-1 N: 2.15, ``tests/reliability/test_round3_estimate.py``); a log in grams
+reads 102 times as much as one in newtons, in millinewtons 1000 times. (A log in
+kilograms-force, 0.1 times, can pass unseen.)"""
+
+LOG_RANK_LIMIT = 0.5
+"""Smallest rank (Spearman) correlation between the estimated and the logged force over
+the frames with a contact: below it the log does not follow the recording (another
+session, another clock)."""
+
+
+def check_force_log(estimated, measured) -> None:
+    """Refuse a force log whose sign says it is not a compressive load in newtons.
+
+    ``estimated`` [N] and ``measured`` [N] are the frames with a contact within the log.
+    More of them negative than positive: the load cell reads compression negative (or
+    the column is another quantity)."""
+    measured = np.asarray(measured, dtype=float)
+    negative = int(np.count_nonzero(measured < 0))
+    if len(measured) and negative > np.count_nonzero(measured > 0):
+        raise ArrayCalibrationError(
+            f"the force log is negative in {negative} of the {len(measured)} frames with a "
+            f"contact (median {np.median(measured):.3g} N): force_n must be the load pressing "
+            "on the array, positive in compression (negate the column of a load cell that "
+            "reads compression negative)"
+        )
+
+
+def _log_agreement(estimated, measured) -> tuple[float, float]:
+    """The log's scale against the recording (median of measured over estimated [-]) and
+    the rank correlation of the two [-]; refuse a log in the wrong unit or one that does
+    not follow the recording (:data:`LOG_SCALE_LIMIT`, :data:`LOG_RANK_LIMIT`)."""
+    from scipy.stats import spearmanr
+
+    estimated = np.asarray(estimated, dtype=float)
+    measured = np.asarray(measured, dtype=float)
+    if len(estimated) < 3:
+        return float("nan"), float("nan")  # force_curve says there are too few pairs
+    scale = float(np.median(measured / estimated))
+    if not (1 / LOG_SCALE_LIMIT <= scale <= LOG_SCALE_LIMIT):
+        raise ArrayCalibrationError(
+            f"the force log reads {scale:.3g} times the force the recording shows (median "
+            f"over {len(measured)} frames with a contact; a sensor described correctly is "
+            f"within {LOG_SCALE_LIMIT:g} times): force_n must be in newtons (a log in grams "
+            "reads 102 times as much, in millinewtons 1000 times); if it is, check the "
+            "sensor's description (layer, transduction)"
+        )
+    rank = float(spearmanr(estimated, measured).statistic)
+    if not rank >= LOG_RANK_LIMIT:
+        raise ArrayCalibrationError(
+            f"the force log does not rise with the recording's force (rank correlation "
+            f"{rank:.2f} over {len(measured)} frames with a contact, at least "
+            f"{LOG_RANK_LIMIT:g} expected): is it the log of the --loads recording, on its "
+            "clock (time_s in seconds from the recording's start)?"
+        )
+    return scale, rank
 
 
 def load_calibration(path: str | Path, sensor=None):
