@@ -260,3 +260,65 @@ def test_the_force_log_checks_are_reported(bench):
     notes = json.loads(out.read_text())["notes"]
     assert round(notes["force_log_scale"], 2) == 2.15
     assert notes["force_log_rank_correlation"] > 0.5
+
+
+# ---- item 13 (estimation): messages that say where and what ------------------------
+
+
+@pytest.mark.parametrize("reader", ["read_force_log", "read_stage_log"])
+def test_a_blank_cell_in_a_log_names_its_line(tmp_path, reader):
+    """Issue 31 item 13: a blank cell in a knife (stage) log or a force log said
+    "could not convert string to float: ''", no line. Now: the line and the column."""
+    from tactsense.estimate import array_calibration
+
+    path = tmp_path / "log.csv"
+    path.write_text("time_s,position_mm,force_n\n0.0,1.0,0.0\n0.1,1.0,0.5\n0.2,1.0,\n0.3,1.0,0.0\n")
+    with pytest.raises(array_calibration.ArrayCalibrationError) as error:
+        getattr(array_calibration, reader)(path)
+    assert str(error.value) == f"{path}, line 4: force_n is blank; expected a number"
+
+
+def test_a_damaged_array_calibration_names_the_missing_key(bench):
+    """Issue 31 item 13: "badcal.json is damaged: 'sensor_toml'". Now the key is named
+    as missing, and what the file should be is said; exit 2, no traceback."""
+    import json
+
+    good = bench / "cal.json"
+    if not good.exists():
+        cli("calibrate", bench / "bench.h5", "--out", good)
+    data = json.loads(good.read_text())
+    del data["sensor_toml"]
+    bad = bench / "badcal.json"
+    bad.write_text(json.dumps(data))
+    done = runner.invoke(app, ["locate", str(bench / "loads.h5"), "--calibration", str(bad),
+                               "--out", str(bench / "x.csv")])  # fmt: skip
+    said = " ".join(done.output.split())
+    assert done.exit_code == 2, said
+    assert "the key 'sensor_toml' is missing" in said
+    assert "array calibration is the JSON file 'tactsense calibrate' writes" in said
+
+
+def test_a_damaged_finger_calibration_names_the_missing_key(tmp_path):
+    import json
+
+    from tactsense.estimate.calibrate import FORMAT, Calibration, CalibrationError
+
+    path = tmp_path / "badcal.json"
+    path.write_text(json.dumps({"format": FORMAT, "version": 1}))
+    with pytest.raises(CalibrationError, match="the key 'threshold_g_per_count' is missing"):
+        Calibration.load(path)
+
+
+def test_a_repeated_taxel_position_is_said_in_plain_numbers(tmp_path):
+    """Issue 31 item 13: the duplicate-taxel error printed np.float64(0.0)."""
+    import dataclasses
+
+    dome = ts.preset("dome12")
+    positions = list(dome.taxels.positions_mm)
+    positions[5] = positions[0]
+    taxels = dataclasses.replace(dome.taxels, positions_mm=tuple(positions))
+    with pytest.raises(ts.SensorSpecError) as error:
+        dataclasses.replace(dome, taxels=taxels)
+    said = str(error.value)
+    assert "positions_mm[5] = [0.0, 0.0, 7.5] repeats another taxel's position (taxel 0's)" in said
+    assert "np.float64" not in said

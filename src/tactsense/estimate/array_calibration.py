@@ -150,7 +150,10 @@ class ArrayCalibration:
             )
             sensor = calibration.sensor
         except (KeyError, TypeError, ValueError) as error:
-            raise ArrayCalibrationError(f"{source} is damaged: {error}") from None
+            from tactsense.estimate.calibrate import damaged
+
+            keys = ("format", "sensor_toml", "baseline_counts", "gains", "dead", "force_curve")
+            raise ArrayCalibrationError(damaged(source, error, "array calibration", keys)) from None
         for name in ("baseline", "gains", "dead"):
             if getattr(calibration, name).shape != tuple(sensor.shape):
                 raise ArrayCalibrationError(
@@ -259,18 +262,12 @@ def read_force_log(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
                     f"{path}: needs the columns time_s and force_n; missing "
                     f"{', '.join(sorted(missing))} (has {', '.join(reader.fieldnames or [])})"
                 )
-            rows = [(row["time_s"], row["force_n"]) for row in reader]
+            columns = _numbers(path, reader, ("time_s", "force_n"))
     except OSError as error:
         raise ArrayCalibrationError(f"cannot read {path}: {error.strerror}") from None
     except UnicodeDecodeError:
         raise ArrayCalibrationError(f"{path} is not a text CSV file") from None
-    try:
-        t, f = (np.array(v, dtype=float) for v in zip(*rows, strict=True)) if rows else ([], [])
-    except ValueError as error:
-        raise ArrayCalibrationError(
-            f"{path}: a time_s or force_n value is not a number ({error})"
-        ) from None
-    t, f = np.asarray(t, dtype=float), np.asarray(f, dtype=float)
+    t, f = columns
     if len(t) < 2:
         raise ArrayCalibrationError(f"{path}: needs at least 2 rows of time_s, force_n")
     if not (np.all(np.isfinite(t)) and np.all(np.isfinite(f))):
@@ -278,6 +275,25 @@ def read_force_log(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
     if np.any(np.diff(t) <= 0):
         raise ArrayCalibrationError(f"{path}: time_s must increase from row to row")
     return t, f
+
+
+def _numbers(path, reader: csv.DictReader, names) -> np.ndarray:
+    """The columns ``names`` of a CSV's rows as numbers, shape (len(names), rows); a
+    blank or non-numeric cell is an error naming its line (1 is the header) and column."""
+    values = []
+    for row in reader:
+        numbers = []
+        for name in names:
+            cell = row.get(name)
+            try:
+                numbers.append(float(cell))
+            except (TypeError, ValueError):
+                shown = "blank" if cell is None or not cell.strip() else repr(cell)
+                raise ArrayCalibrationError(
+                    f"{path}, line {reader.line_num}: {name} is {shown}; expected a number"
+                ) from None
+        values.append(numbers)
+    return np.array(values, dtype=float).reshape(-1, len(names)).T
 
 
 def read_stage_log(path: str | Path) -> dict[str, np.ndarray]:
@@ -294,15 +310,11 @@ def read_stage_log(path: str | Path) -> dict[str, np.ndarray]:
                     f"{path}: needs the columns time_s, position_mm and force_n; missing "
                     f"{', '.join(sorted(missing))} (has {', '.join(reader.fieldnames or [])})"
                 )
-            rows = [(row["time_s"], row["position_mm"], row["force_n"]) for row in reader]
+            columns = _numbers(path, reader, ("time_s", "position_mm", "force_n"))
     except OSError as error:
         raise ArrayCalibrationError(f"cannot read {path}: {error.strerror}") from None
     except UnicodeDecodeError:
         raise ArrayCalibrationError(f"{path} is not a text CSV file") from None
-    try:
-        columns = np.array(rows, dtype=float).reshape(-1, 3).T
-    except ValueError as error:
-        raise ArrayCalibrationError(f"{path}: a value is not a number ({error})") from None
     t, position, force = columns
     if len(t) < 2 or not np.all(np.isfinite(columns)):
         raise ArrayCalibrationError(f"{path}: needs at least 2 rows of finite numbers")

@@ -435,6 +435,31 @@ def check_in_use(source, used, calibration, error, word: str) -> None:
 
 
 @functools.lru_cache(maxsize=16)
+def damaged(source, error: Exception, kind: str, keys) -> str:
+    """The one-line message for a calibration file whose content cannot be read: which
+    key is missing (or which value is wrong) and what the file should be.
+
+    Parameters
+    ----------
+    source : str or Path
+        The file.
+    error : KeyError, TypeError or ValueError
+        What reading it raised.
+    kind : str
+        What the file should be (``"finger's calibration"``...).
+    keys : sequence of str
+        The keys such a file holds.
+    """
+    if isinstance(error, KeyError):
+        what = f"the key {error.args[0]!r} is missing"
+    else:
+        what = f"a value is not what it should be ({error})"
+    return (
+        f"{source} is damaged: {what}; a tactsense {kind} is the JSON file 'tactsense "
+        f"calibrate' writes, with the keys {', '.join(keys)}: make it anew"
+    )
+
+
 def sensor_of(sensor_toml: str):
     """The sensor a calibration's TOML describes, parsed once (a live stream checks it
     every frame)."""
@@ -548,7 +573,11 @@ class Calibration:
                 notes=data.get("notes", {}),
             )
         except (KeyError, TypeError, ValueError) as error:
-            raise CalibrationError(f"{path} is damaged: {error}") from None
+            keys = (
+                "format", "sensor_toml", "gains", "baseline_counts", "dead", "weak", "noisy",
+                "threshold_g_per_count", "nonlinearity", "viscoelastic", "model_fit",
+            )  # fmt: skip
+            raise CalibrationError(damaged(path, error, "finger's calibration", keys)) from None
         shape = SensorSpec.from_toml_string(calibration.sensor_toml).shape
         for name in ("gains", "baseline", "dead", "weak", "noisy"):
             if getattr(calibration, name).shape != shape:

@@ -179,10 +179,11 @@ def _validate(spec: PointsSpec) -> list[str]:
         order = np.lexsort(points.T[::-1])
         same = np.all(np.diff(points[order], axis=0) == 0, axis=1)
         if same.any():
-            k = int(order[int(np.argmax(same)) + 1])
+            first = int(np.argmax(same))
+            k, other = sorted((int(order[first + 1]), int(order[first])))
             problems.append(
-                f"[taxels] positions_mm[{k}] = {list(points[k])} repeats another taxel's "
-                "position; every taxel needs its own point"
+                f"[taxels] positions_mm[{other}] = {points[other].tolist()} repeats another "
+                f"taxel's position (taxel {k}'s); every taxel needs its own point"
             )
     check_layer(spec.layer, problems)
     check_transduction(spec.transduction, problems)
