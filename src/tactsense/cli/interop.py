@@ -48,8 +48,9 @@ def export(
         ExportFormat | None,
         typer.Option(
             "--format",
-            help="mcap: tactile_msgs/TactileState and TactileContact messages (ROS 2 CDR) for "
-            "ROS 2 and Foxglove; rerun: heat map, contact and force for the Rerun viewer; "
+            help="mcap: tactile_msgs/TactileState, TactileContact and TactileContacts "
+            "messages (ROS 2 CDR) for ROS 2 and Foxglove; rerun: heat map, contact and force "
+            "for the Rerun viewer; "
             "lerobot: a LeRobot v3 dataset folder. "
             "Default: from the extension of OUT.",
         ),
@@ -144,7 +145,8 @@ def export(
     if counts.get("kind", "finger") != "finger":  # every contact of every frame
         console.print(
             f"wrote {out}: {counts['frames']} frames, {counts['contacts']} contacts (one "
-            f"TactileContact per contact per frame; {export_format.value}{clock})"
+            f"TactileContact per contact per frame, named <sensor>/<id>; "
+            f"{export_format.value}{clock})"
         )
         return
     console.print(
