@@ -3,6 +3,7 @@ tools. Each case failed before its fix."""
 
 from collections import defaultdict
 
+import numpy as np
 import pandas as pd
 import pytest
 from typer.testing import CliRunner
@@ -72,3 +73,116 @@ def test_mcap_contacts_of_one_frame_have_distinct_names(tmp_path, recordings, ki
     # one list per frame, holding that frame's contacts
     assert len(lists) == frames
     assert {t: names for t, names in lists if names} == dict(by_stamp)
+
+
+# --- item 3: every kind of sensor exports to every format -------------------------------
+
+
+def _lerobot_stat_shape(feature: dict) -> tuple[int, ...]:
+    """The shape of LeRobot's statistics (min, max, mean, std, quantiles) of a feature, as
+    ``lerobot.datasets.compute_stats.compute_episode_stats`` (0.4.4) makes them: a scalar
+    ``(1,)``, a vector its length, and a ``[rows, cols]`` array ``(cols,)`` (its
+    ``RunningQuantileStats`` takes every axis but the last as samples)."""
+    shape = tuple(feature["shape"])
+    return shape[-1:]
+
+
+def _contacts_table(tmp_path, rec):
+    out = tmp_path / "contacts.csv"
+    assert runner.invoke(app, ["locate", str(rec), "--out", str(out)]).exit_code == 0
+    return pd.read_csv(out)
+
+
+@pytest.mark.parametrize("kind", ["pad16", "dome12"])
+def test_lerobot_export_of_a_pad_and_a_point_set(tmp_path, recordings, kind):
+    """The v3 layout (pyarrow and JSON, against the definitions in lerobot's utils.py and
+    compute_stats.py), every contact of locate's long table in ``observation.state``
+    slot by slot, and the frames and times back through ``tactsense import``."""
+    import json
+
+    import pyarrow.parquet as pq
+
+    rec = recordings[kind]
+    recording = ts.read_recording(rec)
+    n, (rows, cols) = len(recording.frames), recording.sensor.shape
+    out = tmp_path / "ds"
+    result = runner.invoke(app, ["export", str(rec), "--format", "lerobot", "--out", str(out),
+                                 "--episode-split", "20"])  # fmt: skip
+    assert result.exit_code == 0, result.output
+    info = json.loads((out / "meta/info.json").read_text())
+    assert info["codebase_version"] == "v3.0" and info["total_frames"] == n
+    assert info["features"]["observation.tactile"]["shape"] == [rows, cols]
+    table = pq.read_table(out / "data/chunk-000/file-000.parquet").to_pydict()
+    assert set(table) == set(info["features"])
+    tactile = np.asarray(table["observation.tactile"])
+    np.testing.assert_array_equal(tactile, recording.frames.astype(np.float32))
+    # statistics: LeRobot's shapes, in the dataset and in every episode
+    stats = json.loads((out / "meta/stats.json").read_text())
+    episodes = pq.read_table(out / "meta/episodes/chunk-000/file-000.parquet").to_pylist()
+    assert len(episodes) == -(-n // 20)
+    for key, feature in info["features"].items():
+        for name in ("min", "max", "mean", "std", "q01", "q50", "q99"):
+            assert np.shape(stats[key][name]) == _lerobot_stat_shape(feature), (key, name)
+            for e in episodes:
+                assert np.shape(e[f"stats/{key}/{name}"]) == _lerobot_stat_shape(feature)
+        assert stats[key]["count"] == [n]
+    np.testing.assert_allclose(
+        stats["observation.tactile"]["mean"], recording.frames.reshape(-1, cols).mean(0)
+    )
+    # the contacts: locate's long table, slot by slot (slot = rank in the frame)
+    names = info["features"]["observation.state"]["names"]
+    state = np.asarray(table["observation.state"])
+    contacts = _contacts_table(tmp_path, rec)
+    assert len(contacts) > n / 2
+    np.testing.assert_array_equal(
+        state[:, names.index("contacts.count")], np.bincount(contacts["frame"], minlength=n)
+    )
+    for field in ("id", "x_mm", "y_mm", "z_mm", "force_n"):
+        got = state[contacts["frame"], [names.index(f"contact{k}.{field}") for k in
+                                        contacts["contact"]]]  # fmt: skip
+        np.testing.assert_allclose(got, contacts[field], rtol=1e-6, atol=1e-6)
+    # and back
+    back = tmp_path / "back.h5"
+    assert runner.invoke(app, ["import", str(out), "--out", str(back)]).exit_code == 0
+    again = ts.read_recording(back)
+    np.testing.assert_array_equal(again.frames, recording.frames)
+    np.testing.assert_array_equal(again.time_s, recording.time_s)
+
+
+@pytest.mark.parametrize("kind", ["pad16", "dome12"])
+def test_rerun_export_of_a_pad_and_a_point_set(tmp_path, recordings, kind):
+    """Read with Rerun's own reader: every frame's signal, every contact of locate's long
+    table at its position [mm], labelled with its tracked id."""
+    from rerun.chunk import RrdReader
+
+    rec = recordings[kind]
+    recording = ts.read_recording(rec)
+    root = recording.sensor.kind
+    out = tmp_path / "x.rrd"
+    result = runner.invoke(app, ["export", str(rec), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    tensors, points = 0, {}
+    for chunk in RrdReader(str(out)).stream().to_chunks():
+        batch = chunk.to_record_batch()
+        if "time" not in batch.schema.names:
+            continue
+        times = [round(t.total_seconds() * 1e9) for t in batch.column("time").to_pylist()]
+        path = str(chunk.entity_path)
+        if path == f"/{root}/signal_values":
+            tensors += len(times)
+        elif path == f"/{root}/contacts" and "Points3D:positions" in batch.schema.names:
+            positions = batch.column("Points3D:positions").to_pylist()
+            labels = batch.column("Points3D:labels").to_pylist()
+            for t, xyz, label in zip(times, positions, labels, strict=True):
+                if xyz:
+                    points[t] = sorted(zip(label, map(tuple, xyz), strict=True))
+    assert tensors == len(recording.frames)
+    contacts = _contacts_table(tmp_path, rec)
+    expected = defaultdict(list)
+    for row in contacts.itertuples():
+        expected[round(row.time_s * 1e9)].append((str(row.id), (row.x_mm, row.y_mm, row.z_mm)))
+    assert set(points) == set(expected)
+    for t, got in points.items():
+        want = sorted(expected[t])
+        assert [label for label, _ in got] == [label for label, _ in want]
+        np.testing.assert_allclose([p for _, p in got], [p for _, p in want], atol=1e-4)

@@ -143,10 +143,14 @@ def export(
         fail(str(error))
     clock = f", {counts['clock']} clock" if "clock" in counts else ""
     if counts.get("kind", "finger") != "finger":  # every contact of every frame
+        what = (
+            "one TactileContact per contact per frame, named <sensor>/<id>; "
+            if export_format is ExportFormat.mcap
+            else "tracked, labelled with their ids; "
+        )
         console.print(
-            f"wrote {out}: {counts['frames']} frames, {counts['contacts']} contacts (one "
-            f"TactileContact per contact per frame, named <sensor>/<id>; "
-            f"{export_format.value}{clock})"
+            f"wrote {out}: {counts['frames']} frames, {counts['contacts']} contacts "
+            f"({what}{export_format.value}{clock})"
         )
         return
     console.print(
@@ -172,7 +176,12 @@ def _export_lerobot(recording, out, calibration, baseline_frames, threshold, epi
         recording, out, calibration=cal, baseline_frames=baseline_frames,
         threshold=threshold, episode_split=episode_split,
     )  # fmt: skip
+    contacts = (
+        f"{counts['contacts']} with a contact"
+        if counts.get("kind", "finger") == "finger"
+        else f"{counts['contacts']} contacts"
+    )
     console.print(
         f"wrote {out}: {counts['frames']} frames in {counts['episodes']} episodes at "
-        f"{counts['fps']} fps, {counts['contacts']} with a contact (lerobot)"
+        f"{counts['fps']} fps, {contacts} (lerobot)"
     )
