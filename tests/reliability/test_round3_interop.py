@@ -2,6 +2,7 @@
 tools. Each case failed before its fix."""
 
 from collections import defaultdict
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -88,7 +89,7 @@ def _lerobot_stat_shape(feature: dict) -> tuple[int, ...]:
 
 
 def _contacts_table(tmp_path, rec):
-    out = tmp_path / "contacts.csv"
+    out = tmp_path / f"{Path(rec).stem}.contacts.csv"
     assert runner.invoke(app, ["locate", str(rec), "--out", str(out)]).exit_code == 0
     return pd.read_csv(out)
 
@@ -186,3 +187,29 @@ def test_rerun_export_of_a_pad_and_a_point_set(tmp_path, recordings, kind):
         want = sorted(expected[t])
         assert [label for label, _ in got] == [label for label, _ in want]
         np.testing.assert_allclose([p for _, p in got], [p for _, p in want], atol=1e-4)
+
+
+def test_batch_on_pads_and_point_sets(tmp_path, recordings):
+    """`batch` of a folder of pad and point-set recordings (all failed: 'this works on
+    fingers'): each output is the long table `locate` writes, events beside a CSV, and
+    the summary counts its contacts."""
+    import shutil
+
+    folder = tmp_path / "lab"
+    folder.mkdir()
+    for name in ("pad16", "dome12"):
+        shutil.copy(recordings[name], folder / f"{name}.h5")
+    out = tmp_path / "out"
+    result = runner.invoke(app, ["batch", str(folder / "*.h5"), "--out", str(out),
+                                 "--format", "csv", "--workers", "1", "--quiet"])  # fmt: skip
+    assert result.exit_code == 0, result.output
+    summary = pd.read_csv(out / "summary.csv")
+    assert list(summary["status"]) == ["done", "done"], summary["reason"].tolist()
+    for name, row in zip(("dome12", "pad16"), summary.itertuples(), strict=True):
+        alone = _contacts_table(tmp_path, folder / f"{name}.h5")
+        batch = pd.read_csv(out / f"{name}.csv")
+        pd.testing.assert_frame_equal(batch, alone)
+        assert (out / f"{name}.events.csv").is_file()
+        assert row.contacts == len(alone) > 0
+        assert row.force_mean_n == pytest.approx(alone["force_n"].mean(), rel=1e-9)
+    assert sorted(p.name for p in out.iterdir() if p.name.startswith(".")) == []
