@@ -213,3 +213,73 @@ def test_batch_on_pads_and_point_sets(tmp_path, recordings):
         assert row.contacts == len(alone) > 0
         assert row.force_mean_n == pytest.approx(alone["force_n"].mean(), rel=1e-9)
     assert sorted(p.name for p in out.iterdir() if p.name.startswith(".")) == []
+
+
+def test_csv_export_imports_back_whole(tmp_path, recordings):
+    """`export X.csv` (refused before: 'say --format mcap or rerun') writes what `import`
+    reads: counts, times, host times and a lost reading (NaN) come back equal."""
+    import dataclasses
+
+    recording = ts.read_recording(recordings["pad16"])
+    frames = recording.frames.astype(np.float64)
+    frames[3, 2, 5] = np.nan  # a lost reading
+    host = 1.7e9 + recording.time_s + 0.25
+    streamed = dataclasses.replace(recording, frames=frames, host_time_s=host)
+    cases = {"counts": recording, "stream": streamed}
+    for name, rec in cases.items():
+        path, out, back = (tmp_path / f"{name}.{ext}" for ext in ("h5", "csv", "back.h5"))
+        ts.write_recording(path, rec)
+        result = runner.invoke(app, ["export", str(path), "--out", str(out)])
+        assert result.exit_code == 0, result.output
+        result = runner.invoke(app, ["import", str(out), "--sensor", "pad16", "--out", str(back)])
+        assert result.exit_code == 0, result.output
+        again = ts.read_recording(back)
+        np.testing.assert_array_equal(again.frames, rec.frames)
+        np.testing.assert_array_equal(again.time_s, rec.time_s)
+        if rec.host_time_s is None:
+            assert again.host_time_s is None
+        else:
+            np.testing.assert_array_equal(again.host_time_s, rec.host_time_s)
+
+
+# --- item 10: CSV import: times that go backwards or repeat; Excel's byte-order mark ----
+
+
+def _csv(path, times, bom=False):
+    header = "time," + ",".join(f"v{k}" for k in range(64))
+    rows = [f"{t}," + ",".join(["2000"] * 64) for t in times]
+    path.write_bytes(
+        (b"\xef\xbb\xbf" if bom else b"") + ("\n".join([header, *rows]) + "\n").encode()
+    )
+    return path
+
+
+@pytest.mark.parametrize(
+    ("times", "message"),
+    [
+        ((0.0, 0.1, 0.05, 0.2), "line 4: the time 0.05 s goes backwards from 0.1 s on line 3"),
+        ((0.0, 0.1, 0.1, 0.2), "line 4: the time 0.1 s repeats 0.1 s on line 3"),
+    ],
+)
+def test_csv_import_refuses_times_out_of_order(tmp_path, times, message):
+    """Refused, with the line (a flag would leave a recording whose rate and velocities
+    are wrong; the file is the user's to sort or fix): exit 2, nothing written."""
+    path = _csv(tmp_path / "x.csv", times)
+    out = tmp_path / "x.h5"
+    result = runner.invoke(app, ["import", str(path), "--sensor", "initial", "--out", str(out)])
+    assert result.exit_code == 2
+    said = " ".join(result.output.split())
+    assert message in said and "must increase" in said and "Traceback" not in said
+    assert not out.exists()
+
+
+def test_csv_import_accepts_excels_byte_order_mark(tmp_path):
+    """Excel's "CSV UTF-8" starts with a byte-order mark; it was read as part of the
+    first column's name ("no time column 'time' in the header (\\ufefftime, ...)")."""
+    path = _csv(tmp_path / "excel.csv", (0.0, 0.1, 0.2), bom=True)
+    out = tmp_path / "x.h5"
+    result = runner.invoke(app, ["import", str(path), "--sensor", "initial", "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    back = ts.read_recording(out)
+    np.testing.assert_array_equal(back.time_s, [0.0, 0.1, 0.2])
+    assert (back.frames == 2000).all()

@@ -30,9 +30,10 @@ class ExportFormat(StrEnum):
     mcap = "mcap"
     rerun = "rerun"
     lerobot = "lerobot"
+    csv = "csv"
 
 
-SUFFIXES = {ExportFormat.mcap: ".mcap", ExportFormat.rerun: ".rrd"}
+SUFFIXES = {ExportFormat.mcap: ".mcap", ExportFormat.rerun: ".rrd", ExportFormat.csv: ".csv"}
 
 
 @app.command()
@@ -41,7 +42,10 @@ def export(
     out: Annotated[
         Path,
         typer.Option(
-            "--out", "-o", help="New file: .mcap for --format mcap, .rrd for --format rerun."
+            "--out",
+            "-o",
+            help="New file: .mcap for --format mcap, .rrd for --format rerun, .csv for "
+            "--format csv; a new folder for --format lerobot.",
         ),
     ],
     export_format: Annotated[
@@ -51,7 +55,8 @@ def export(
             help="mcap: tactile_msgs/TactileState, TactileContact and TactileContacts "
             "messages (ROS 2 CDR) for ROS 2 and Foxglove; rerun: heat map, contact and force "
             "for the Rerun viewer; "
-            "lerobot: a LeRobot v3 dataset folder. "
+            "lerobot: a LeRobot v3 dataset folder; csv: the frames, one a row, as "
+            "'tactsense import' reads them. "
             "Default: from the extension of OUT.",
         ),
     ] = None,
@@ -98,14 +103,21 @@ def export(
         export_format = by_suffix.get(out.suffix.lower())
         if export_format is None:
             fail(
-                f"{out}: say --format mcap or rerun (or lerobot, for a dataset folder), or use "
-                "the extension .mcap or .rrd"
+                f"{out}: say --format mcap or rerun (or csv for the frames, lerobot for a "
+                "dataset folder), or use the extension .mcap, .rrd or .csv"
             )
     if export_format is ExportFormat.lerobot:
         _export_lerobot(recording, out, calibration, baseline_frames, threshold, episode_split)
         return
     if episode_split is not None:
         fail("--episode-split applies to --format lerobot only")
+    if export_format is ExportFormat.csv:
+        if calibration is not None or threshold is not None:
+            fail("--calibration and --threshold apply to contacts; a CSV export holds the frames")
+        if frame_id != "finger" or start_time is not None:
+            fail("--frame-id and --start-time apply to --format mcap only")
+        _export_csv(recording, out, force, quiet)
+        return
     if export_format is not ExportFormat.mcap and (frame_id != "finger" or start_time is not None):
         fail("--frame-id and --start-time apply to --format mcap only")
     if not frame_id.strip() or any(c.isspace() for c in frame_id):
@@ -156,6 +168,28 @@ def export(
     console.print(
         f"wrote {out}: {counts['frames']} frames, {counts['contacts']} with a contact "
         f"({export_format.value}{clock})"
+    )
+
+
+def _export_csv(recording, out, force, quiet) -> None:
+    """``export --format csv``: the frames, one a row (tactsense.interop.csvfile)."""
+    from tactsense.interop.csvfile import export_csv
+
+    check_output(out, force, inputs=[recording])
+    try:
+        with progress_bar("exporting", unit="frames", quiet=quiet) as bar:
+            task = bar.add_task("frames", total=None)
+            with atomic_output(out) as temporary:
+                counts = export_csv(
+                    recording, temporary,
+                    progress=lambda done, total: bar.update(task, completed=done, total=total),
+                )  # fmt: skip
+    except (TactsenseInputError, FileExistsError) as error:
+        fail(str(error))
+    host = ", with host times" if counts["host_time"] else ""
+    console.print(
+        f"wrote {out}: {counts['frames']} frames{host} (csv; 'tactsense import {out.name} "
+        "--sensor S' reads it back)"
     )
 
 
