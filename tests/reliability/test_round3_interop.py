@@ -283,3 +283,45 @@ def test_csv_import_accepts_excels_byte_order_mark(tmp_path):
     back = ts.read_recording(out)
     np.testing.assert_array_equal(back.time_s, [0.0, 0.1, 0.2])
     assert (back.frames == 2000).all()
+
+
+# --- item 13: an MCAP file that is empty, has no messages, or is cut short -------------
+
+
+def _mcap_without_messages(path):
+    from mcap_ros2.writer import Writer
+
+    from tactsense.interop.ros import TACTILE_STATE, TACTILE_STATE_MSGDEF
+
+    with open(path, "wb") as stream:
+        writer = Writer(stream)
+        writer.register_msgdef(TACTILE_STATE, TACTILE_STATE_MSGDEF)  # a schema, no channel
+        writer.finish()
+
+
+@pytest.mark.parametrize(
+    ("content", "message"),
+    [
+        (b"", "empty.mcap is empty (0 bytes); expected an MCAP file"),
+        (None, "the file holds no messages (no topic at all)"),
+        (b"\x89MCAP0\r\n", "empty.mcap is truncated (8 bytes)"),
+        (b"\x89MC", "empty.mcap is truncated (3 bytes)"),  # a traceback before
+        (b"hello, world", "is not an MCAP file: it does not start with MCAP's magic bytes"),
+    ],
+)
+def test_import_says_what_is_wrong_with_an_mcap_file(tmp_path, content, message):
+    """It said 'not a readable MCAP file ()' for an empty file, wrapped 'no topics' in
+    'not a readable MCAP file (...)', and 'cannot read it (Invalid argument)' for a
+    file cut after MCAP's magic: exit 2, one line naming what is wrong."""
+    path = tmp_path / "empty.mcap"
+    if content is None:
+        _mcap_without_messages(path)
+    else:
+        path.write_bytes(content)
+    out = tmp_path / "x.h5"
+    result = runner.invoke(app, ["import", str(path), "--out", str(out)])
+    said = " ".join(result.output.split())
+    assert result.exit_code == 2, said
+    assert message in said and "not a readable MCAP file" not in said
+    assert "()" not in said and "Traceback" not in said
+    assert not out.exists()

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import errno
 import math
 from pathlib import Path
 
@@ -156,14 +157,45 @@ def _choose_topic(topics: dict[str, str], topic: str | None, source: Path) -> st
                 f"{', '.join(states) or 'none'}"
             )
         return topic
+    if not topics:
+        raise ImportError_(
+            f"{source}: the file holds no messages (no topic at all); expected "
+            "tactile_msgs/msg/TactileState frames"
+        )
     if not states:
-        found = ", ".join(f"{t} ({k})" for t, k in sorted(topics.items())) or "no topics"
+        found = ", ".join(f"{t} ({k})" for t, k in sorted(topics.items()))
         raise ImportError_(f"{source}: no tactile_msgs/msg/TactileState topic; it has {found}")
     if len(states) > 1:
         raise ImportError_(
             f"{source}: several TactileState topics ({', '.join(states)}); pass --topic"
         )
     return states[0]
+
+
+MCAP_MAGIC = b"\x89MCAP0\r\n"
+"""The eight bytes an MCAP file starts (and ends) with (MCAP specification, "Magic")."""
+
+
+def _check_mcap_start(stream, source: Path) -> None:
+    """An empty file or one that is no MCAP file, said as such (the reader's own errors
+    for them are an empty message or a bare seek error)."""
+    start = stream.read(len(MCAP_MAGIC))
+    stream.seek(0)
+    if not start:
+        raise ImportError_(
+            f"{source} is empty (0 bytes); expected an MCAP file of "
+            "tactile_msgs/msg/TactileState messages"
+        )
+    if start == MCAP_MAGIC[: len(start)] and len(start) < len(MCAP_MAGIC):
+        raise ImportError_(
+            f"{source} is truncated ({len(start)} bytes): the start of MCAP's magic bytes "
+            "and nothing more"
+        )
+    if start != MCAP_MAGIC:
+        raise ImportError_(
+            f"{source} is not an MCAP file: it does not start with MCAP's magic bytes "
+            f"(\\x89MCAP0\\r\\n); it starts with {start!r}"
+        )
 
 
 def read_mcap(source: Path, *, sensor=None, topic: str | None = None):
@@ -178,6 +210,7 @@ def read_mcap(source: Path, *, sensor=None, topic: str | None = None):
     spec = None
     try:
         with open(source, "rb") as stream:
+            _check_mcap_start(stream, source)
             reader = make_reader(stream, decoder_factories=[DecoderFactory()])
             summary = reader.get_summary()
             if summary is None:
@@ -196,9 +229,17 @@ def read_mcap(source: Path, *, sensor=None, topic: str | None = None):
                     spec = _ros_sensor(sensor, [s.name for s in ros.sensors], source)
                 frames.append(_pick_values(ros.sensors, spec, str(source)))
                 stamps.append(ros.header.stamp.sec + ros.header.stamp.nanosec * 1e-9)
+    except ImportError_:
+        raise
     except (McapError, ValueError, KeyError, EOFError) as error:
-        raise ImportError_(f"{source} is not a readable MCAP file ({error})") from None
+        why = str(error) or type(error).__name__
+        raise ImportError_(f"{source} is not a readable MCAP file ({why})") from None
     except OSError as error:
+        if error.errno == errno.EINVAL:  # a seek before the start: too short for its index
+            raise ImportError_(
+                f"{source} is truncated ({source.stat().st_size} bytes): an MCAP file's "
+                "start without its records and summary (a recorder killed at once?)"
+            ) from None
         raise ImportError_(f"{source}: cannot read it ({error.strerror or error})") from None
     if spec is None:
         raise ImportError_(f"{source}: topic {chosen} holds no messages")
