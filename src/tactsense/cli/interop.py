@@ -195,7 +195,6 @@ def _export_csv(recording, out, force, quiet) -> None:
 
 def _export_lerobot(recording, out, calibration, baseline_frames, threshold, episode_split):
     """``export --format lerobot``: a new dataset folder (tactsense.interop.lerobot)."""
-    from tactsense.estimate import Calibration
     from tactsense.interop.lerobot import export_lerobot
 
     if out.exists():
@@ -205,7 +204,10 @@ def _export_lerobot(recording, out, calibration, baseline_frames, threshold, epi
         )
     check_output(out, False, what="dataset folder", inputs=[recording, calibration])
     remove_stale_partials(out.parent)  # left by a run killed outright
-    cal = None if calibration is None else Calibration.load(calibration)
+    try:  # a finger's calibration or a pad's (an array calibration)
+        cal = None if calibration is None else load_calibration(calibration)
+    except TactsenseInputError as error:
+        fail(str(error))
     counts = export_lerobot(
         recording, out, calibration=cal, baseline_frames=baseline_frames,
         threshold=threshold, episode_split=episode_split,
