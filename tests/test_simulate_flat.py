@@ -91,7 +91,7 @@ def test_a_pad_exports_its_frames_and_contacts_to_mcap(tmp_path):
         for _, channel, _, message in reader.iter_decoded_messages():
             if channel.topic == "/tactile_states":
                 values.append(np.asarray(message.sensors[0].values))
-            else:
+            elif channel.topic == "/tactile_contacts":
                 contacts.append(message)
     assert len(values) == len(recording.frames)
     np.testing.assert_array_equal(np.stack(values), recording.frames.reshape(len(values), -1))

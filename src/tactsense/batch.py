@@ -263,14 +263,16 @@ def contacts_file(
         ``ids`` (distinct tracked contacts), ``most`` (largest number in one frame),
         ``births``, ``deaths``, ``merges``, ``splits``, ``below_baseline`` (frames with a
         taxel below its baseline by more than the threshold: the first frames were
-        probably touched).
+        probably touched), ``saturated`` (contacts flagged SATURATED), ``force_mean_n``
+        and ``force_max_n`` over the contacts of known force [N].
     """
     from tactsense.estimate.contacts import find_contacts
     from tactsense.estimate.output import ContactsWriter
 
     output_format(out)
     counts = {"births": 0, "deaths": 0, "merges": 0, "splits": 0}
-    frames_with = most = 0
+    frames_with = most = saturated = 0
+    force_sum, force_count, force_max = 0.0, 0, float("nan")
     with RecordingReader(recording) as reader:
         sensor = reader.sensor
         total = reader.n_frames
@@ -287,6 +289,12 @@ def contacts_file(
                 per_frame = np.bincount(tracked.frame - start, minlength=n)
                 frames_with += int(np.count_nonzero(per_frame))
                 most = max(most, int(per_frame.max(initial=0)))
+                saturated += int(np.count_nonzero(tracked.flags & int(Flag.SATURATED)))
+                finite = tracked.force_n[np.isfinite(tracked.force_n)]
+                if finite.size:
+                    force_sum += float(finite.sum())
+                    force_count += finite.size
+                    force_max = float(np.fmax(force_max, finite.max()))
                 for e in events:
                     counts[e.kind + "s"] += 1
                 if progress is not None:
@@ -307,4 +315,7 @@ def contacts_file(
         "most": most,
         **counts,
         "below_baseline": 0 if baseline is None else baseline.below_frames,
+        "saturated": saturated,
+        "force_mean_n": force_sum / force_count if force_count else float("nan"),
+        "force_max_n": force_max,
     }

@@ -76,33 +76,63 @@ def process_recording(
     recording: str,
     output: str,
     calibration: str | None = None,
-    threshold: float = 0.005,
+    threshold: float | None = None,
 ) -> dict:
-    """One task: locate every frame of ``recording`` into ``output``; its summary."""
-    from tactsense.batch import locate_file
+    """One task: locate every frame of ``recording`` into ``output``; its summary.
+
+    A finger: one row per frame (:func:`~tactsense.batch.locate_file`; ``threshold``
+    default 0.005). A pad or a point set: every contact, tracked, as ``tactsense
+    locate`` writes them (:func:`~tactsense.batch.contacts_file`, the baseline following
+    drift with a 2-s time constant, ``threshold`` default the sensor's; a CSV's events in
+    ``<name>.events.csv`` beside it); ``contacts`` then counts contacts, not frames.
+    """
+    from tactsense.batch import contacts_file, locate_file
+    from tactsense.estimate.locate import CONTACT_THRESHOLD
+    from tactsense.estimate.output import events_sidecar
 
     start = time.perf_counter()
     output = Path(output)
     temporary = output.with_name(f".{output.stem}.{os.getpid()}.partial{output.suffix}")
+    sidecar = events_sidecar(output) if output.suffix == ".csv" else None
+    events = None if sidecar is None else temporary.with_name(temporary.name + ".events.csv")
     try:
         cal = _calibration(recording, calibration)
-        summary = locate_file(recording, temporary, calibration=cal, threshold=threshold)
+        if _kind_of(recording) == "finger":
+            threshold = CONTACT_THRESHOLD if threshold is None else threshold
+            summary = locate_file(recording, temporary, calibration=cal, threshold=threshold)
+        else:
+            found = contacts_file(recording, temporary, calibration=cal, threshold=threshold,
+                                  drift_s=2.0, events_path=events)  # fmt: skip
+            summary = {key: found[key] for key in ("frames", "saturated", "force_mean_n",
+                                                   "force_max_n")}  # fmt: skip
+            summary["contacts"] = found["rows"]
+        if events is not None and events.exists():
+            os.replace(events, sidecar)
         os.replace(temporary, output)
     finally:
         temporary.unlink(missing_ok=True)
+        if events is not None:
+            events.unlink(missing_ok=True)
     summary.update(_losses(recording), seconds=time.perf_counter() - start)
     return summary
+
+
+def _kind_of(recording: str) -> str:
+    from tactsense.io.recording import RecordingReader
+
+    with RecordingReader(recording) as reader:
+        return reader.sensor.kind
 
 
 def _calibration(recording: str, calibration: str | None):
     """The calibration file checked against the recording's sensor (None without one)."""
     if calibration is None:
         return None
-    from tactsense.estimate import Calibration
+    from tactsense.estimate.array_calibration import load_calibration
     from tactsense.io.recording import RecordingReader
 
     with RecordingReader(recording) as reader:
-        return Calibration.load(calibration, reader.sensor)
+        return load_calibration(calibration, reader.sensor)  # a finger's or an array's
 
 
 def range_end_state(recording: str, calibration: str, lo: int, hi: int):
@@ -131,7 +161,7 @@ def process_range(
     part: str,
     lo: int,
     hi: int,
-    threshold: float = 0.005,
+    threshold: float | None = None,
     calibration: str | None = None,
     before: list | None = None,
 ) -> dict:
@@ -152,7 +182,7 @@ def process_range(
     tally = Tally()
     with RecordingReader(recording) as reader, EstimatesWriter(part) as writer:
         sensor = reader.sensor
-        options: dict = {"threshold": threshold}
+        options: dict = {"threshold": 0.005 if threshold is None else threshold}
         if cal is None:
             options["baseline"] = np.median(reader.frames(0, 5).astype(float), axis=0)
         else:
@@ -228,11 +258,13 @@ def _has_creep(recording: Path, calibration: str) -> bool:
 
 
 def _frames_of(recording: Path) -> int | None:
+    """A finger's frames, for splitting; None for a pad or a point set, whose contacts
+    are tracked through the whole recording in one task."""
     from tactsense.io.recording import RecordingReader
 
     try:
         with RecordingReader(recording) as reader:
-            return reader.n_frames
+            return reader.n_frames if reader.sensor.kind == "finger" else None
     except TactsenseInputError:
         return None  # the task itself will fail and say why
 
@@ -243,7 +275,7 @@ def run_batch(
     *,
     fmt: str = "parquet",
     calibration: Path | None = None,
-    threshold: float = 0.005,
+    threshold: float | None = None,
     client=None,
     split_frames: int | None = None,
     progress: Callable[[int, int], None] | None = None,

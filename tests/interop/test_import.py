@@ -257,9 +257,13 @@ def test_lerobot_export_has_the_v3_layout_and_imports_back(tmp_path, rec_path, s
     np.testing.assert_allclose(
         state[present, names.index("contact.force_n")], est.force_n[touching], rtol=1e-6
     )
-    # the dataset's statistics are the frames' (independent: numpy over the raw frames)
+    # the dataset's statistics are the frames' (independent: numpy over the raw frames),
+    # of LeRobot's shape for a [rows, cols] feature: per column, over frames and rows
     stats = json.loads((out / "meta/stats.json").read_text())
-    np.testing.assert_allclose(stats["observation.tactile"]["mean"], sweep.frames.mean(0))
+    cols = sweep.sensor.shape[1]
+    np.testing.assert_allclose(
+        stats["observation.tactile"]["mean"], sweep.frames.reshape(-1, cols).mean(0)
+    )
     assert stats["frame_index"]["count"] == [n]
 
     back = _import(out, tmp_path / "back.h5")

@@ -37,7 +37,10 @@ def _messages(path):
     with open(path, "rb") as stream:
         reader = make_reader(stream, decoder_factories=[DecoderFactory()])
         for m in map(lambda args: _Message(*args), reader.iter_decoded_messages()):
-            (states if m.channel.topic == "/tactile_states" else contacts).append(m)
+            if m.channel.topic == "/tactile_states":
+                states.append(m)
+            elif m.channel.topic == "/tactile_contacts":
+                contacts.append(m)
     return states, contacts
 
 
@@ -167,6 +170,14 @@ geometry_msgs/Vector3 normal
 # this wrench should be represented in reference frame, not in contact point frame
 geometry_msgs/Wrench wrench
 """
+UPSTREAM_TACTILE_CONTACTS = (
+    "# Message to publish tactile contact information extracted from raw tactile data.\n"
+    """# This msg provides a list of contact points and corresponding
+# contact wrenches, both represented w.r.t the link reference frame.
+
+tactile_msgs/TactileContact[] contacts
+"""
+)
 UPSTREAM_TACTILE_STATE = """# specify the timestamp (frame not used)
 Header header
 
@@ -190,7 +201,9 @@ def test_rosbags_decodes_the_export_from_the_upstream_message_text(tmp_path, swe
     store = get_typestore(Stores.ROS2_HUMBLE)
     store.register(get_types_from_msg(UPSTREAM_TACTILE_CONTACT, "tactile_msgs/msg/TactileContact"))
     store.register(get_types_from_msg(UPSTREAM_TACTILE_STATE, "tactile_msgs/msg/TactileState"))
-    counts = {"/tactile_states": 0, "/tactile_contacts": 0}
+    lists = "tactile_msgs/msg/TactileContacts"
+    store.register(get_types_from_msg(UPSTREAM_TACTILE_CONTACTS, lists))
+    counts = {"/tactile_states": 0, "/tactile_contacts": 0, "/contact_states": 0}
     with open(out, "rb") as stream:
         for schema, channel, message in make_reader(stream).iter_messages():
             decoded = store.deserialize_cdr(message.data, schema.name)
@@ -201,3 +214,4 @@ def test_rosbags_decodes_the_export_from_the_upstream_message_text(tmp_path, swe
                 t = decoded.wrench.torque
                 np.testing.assert_allclose([t.x, t.y, t.z], expected, rtol=1e-12, atol=1e-18)
     assert counts["/tactile_states"] > 100 and counts["/tactile_contacts"] > 100
+    assert counts["/contact_states"] == counts["/tactile_states"]

@@ -99,7 +99,7 @@ BAD_OPTIONS = [
     ("view loop:// --speed 2", "--speed applies to recordings"),
     ("view no_such_recording.h5", "no recording at no_such_recording.h5"),
     ("view REC --host 203.0.113.9", "cannot listen on 203.0.113.9"),
-    ("export REC --out OUT", "say --format mcap or rerun"),
+    ("export REC --out OUT.txt", "say --format mcap or rerun"),
     ("export REC --format xml --out OUT", "--format"),
     ("export REC --threshold 0 --out OUT", "--threshold"),
     ("export REC --baseline-frames 0 --out OUT", "--baseline-frames"),

@@ -28,7 +28,6 @@ def folder(tmp_path_factory):
 CASES = [
     ("calibrate pad.h5 --out OUT.json", "this is not a probe pressed on every taxel"),
     ("reproduce --sensor pad16 --out OUT", "works on finger sensors; 'pad16' is a pad"),
-    ("export pad.h5 --out OUT.rrd", "this works on fingers; 'pad4' is a pad"),
     ("design bound --sensor dome12", "works on finger sensors; 'dome12' is a points"),
     ("design sweep --sensor dome12 --out OUT.nc", "fingers and pads; 'dome12' is a points"),
     ("sensor import pad.h5 --extends bogus", "--extends 'bogus' is not a preset"),

@@ -16,7 +16,6 @@ from tactsense.cli._common import (
     BaselineFramesOption,
     CalibrationOption,
     ContactThresholdOption,
-    ThresholdOption,
     atomic_output,
     check_output,
     console,
@@ -574,9 +573,9 @@ def batch(
     ] = OutputFormat.parquet,
     calibration: Annotated[
         Path | None,
-        typer.Option(help="Calibration JSON applied to every recording (same finger)."),
+        typer.Option(help="Calibration JSON applied to every recording (same sensor)."),
     ] = None,
-    threshold: ThresholdOption = 0.005,
+    threshold: ContactThresholdOption = None,
     workers: Annotated[
         int,
         typer.Option(
@@ -603,6 +602,10 @@ def batch(
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,
 ) -> None:
     """Locate every frame of many recordings on a Dask cluster, one task per recording.
+
+    A finger's output has one row per frame; a pad's or a point set's every contact,
+    tracked, as 'locate' writes them (its 'contacts' column in summary.csv then counts
+    contacts, not frames; such a recording is never split).
 
     Resumable: a recording whose output is complete and newer is skipped (its row in
     summary.csv keeps the numbers of the run that wrote it). summary.csv has one column

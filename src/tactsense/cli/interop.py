@@ -30,9 +30,10 @@ class ExportFormat(StrEnum):
     mcap = "mcap"
     rerun = "rerun"
     lerobot = "lerobot"
+    csv = "csv"
 
 
-SUFFIXES = {ExportFormat.mcap: ".mcap", ExportFormat.rerun: ".rrd"}
+SUFFIXES = {ExportFormat.mcap: ".mcap", ExportFormat.rerun: ".rrd", ExportFormat.csv: ".csv"}
 
 
 @app.command()
@@ -41,16 +42,21 @@ def export(
     out: Annotated[
         Path,
         typer.Option(
-            "--out", "-o", help="New file: .mcap for --format mcap, .rrd for --format rerun."
+            "--out",
+            "-o",
+            help="New file: .mcap for --format mcap, .rrd for --format rerun, .csv for "
+            "--format csv; a new folder for --format lerobot.",
         ),
     ],
     export_format: Annotated[
         ExportFormat | None,
         typer.Option(
             "--format",
-            help="mcap: tactile_msgs/TactileState and TactileContact messages (ROS 2 CDR) for "
-            "ROS 2 and Foxglove; rerun: heat map, contact and force for the Rerun viewer; "
-            "lerobot: a LeRobot v3 dataset folder. "
+            help="mcap: tactile_msgs/TactileState, TactileContact and TactileContacts "
+            "messages (ROS 2 CDR) for ROS 2 and Foxglove; rerun: heat map, contact and force "
+            "for the Rerun viewer; "
+            "lerobot: a LeRobot v3 dataset folder; csv: the frames, one a row, as "
+            "'tactsense import' reads them. "
             "Default: from the extension of OUT.",
         ),
     ] = None,
@@ -97,14 +103,21 @@ def export(
         export_format = by_suffix.get(out.suffix.lower())
         if export_format is None:
             fail(
-                f"{out}: say --format mcap or rerun (or lerobot, for a dataset folder), or use "
-                "the extension .mcap or .rrd"
+                f"{out}: say --format mcap or rerun (or csv for the frames, lerobot for a "
+                "dataset folder), or use the extension .mcap, .rrd or .csv"
             )
     if export_format is ExportFormat.lerobot:
         _export_lerobot(recording, out, calibration, baseline_frames, threshold, episode_split)
         return
     if episode_split is not None:
         fail("--episode-split applies to --format lerobot only")
+    if export_format is ExportFormat.csv:
+        if calibration is not None or threshold is not None:
+            fail("--calibration and --threshold apply to contacts; a CSV export holds the frames")
+        if frame_id != "finger" or start_time is not None:
+            fail("--frame-id and --start-time apply to --format mcap only")
+        _export_csv(recording, out, force, quiet)
+        return
     if export_format is not ExportFormat.mcap and (frame_id != "finger" or start_time is not None):
         fail("--frame-id and --start-time apply to --format mcap only")
     if not frame_id.strip() or any(c.isspace() for c in frame_id):
@@ -142,9 +155,14 @@ def export(
         fail(str(error))
     clock = f", {counts['clock']} clock" if "clock" in counts else ""
     if counts.get("kind", "finger") != "finger":  # every contact of every frame
+        what = (
+            "one TactileContact per contact per frame, named <sensor>/<id>; "
+            if export_format is ExportFormat.mcap
+            else "tracked, labelled with their ids; "
+        )
         console.print(
-            f"wrote {out}: {counts['frames']} frames, {counts['contacts']} contacts (one "
-            f"TactileContact per contact per frame; {export_format.value}{clock})"
+            f"wrote {out}: {counts['frames']} frames, {counts['contacts']} contacts "
+            f"({what}{export_format.value}{clock})"
         )
         return
     console.print(
@@ -153,9 +171,30 @@ def export(
     )
 
 
+def _export_csv(recording, out, force, quiet) -> None:
+    """``export --format csv``: the frames, one a row (tactsense.interop.csvfile)."""
+    from tactsense.interop.csvfile import export_csv
+
+    check_output(out, force, inputs=[recording])
+    try:
+        with progress_bar("exporting", unit="frames", quiet=quiet) as bar:
+            task = bar.add_task("frames", total=None)
+            with atomic_output(out) as temporary:
+                counts = export_csv(
+                    recording, temporary,
+                    progress=lambda done, total: bar.update(task, completed=done, total=total),
+                )  # fmt: skip
+    except (TactsenseInputError, FileExistsError) as error:
+        fail(str(error))
+    host = ", with host times" if counts["host_time"] else ""
+    console.print(
+        f"wrote {out}: {counts['frames']} frames{host} (csv; 'tactsense import {out.name} "
+        "--sensor S' reads it back)"
+    )
+
+
 def _export_lerobot(recording, out, calibration, baseline_frames, threshold, episode_split):
     """``export --format lerobot``: a new dataset folder (tactsense.interop.lerobot)."""
-    from tactsense.estimate import Calibration
     from tactsense.interop.lerobot import export_lerobot
 
     if out.exists():
@@ -165,12 +204,20 @@ def _export_lerobot(recording, out, calibration, baseline_frames, threshold, epi
         )
     check_output(out, False, what="dataset folder", inputs=[recording, calibration])
     remove_stale_partials(out.parent)  # left by a run killed outright
-    cal = None if calibration is None else Calibration.load(calibration)
+    try:  # a finger's calibration or a pad's (an array calibration)
+        cal = None if calibration is None else load_calibration(calibration)
+    except TactsenseInputError as error:
+        fail(str(error))
     counts = export_lerobot(
         recording, out, calibration=cal, baseline_frames=baseline_frames,
         threshold=threshold, episode_split=episode_split,
     )  # fmt: skip
+    contacts = (
+        f"{counts['contacts']} with a contact"
+        if counts.get("kind", "finger") == "finger"
+        else f"{counts['contacts']} contacts"
+    )
     console.print(
         f"wrote {out}: {counts['frames']} frames in {counts['episodes']} episodes at "
-        f"{counts['fps']} fps, {counts['contacts']} with a contact (lerobot)"
+        f"{counts['fps']} fps, {contacts} (lerobot)"
     )

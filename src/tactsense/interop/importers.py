@@ -27,6 +27,8 @@ stamps are the frame times as they are. Frames are counts as given: whole number
 from __future__ import annotations
 
 import csv
+import dataclasses
+import errno
 import math
 from pathlib import Path
 
@@ -155,14 +157,45 @@ def _choose_topic(topics: dict[str, str], topic: str | None, source: Path) -> st
                 f"{', '.join(states) or 'none'}"
             )
         return topic
+    if not topics:
+        raise ImportError_(
+            f"{source}: the file holds no messages (no topic at all); expected "
+            "tactile_msgs/msg/TactileState frames"
+        )
     if not states:
-        found = ", ".join(f"{t} ({k})" for t, k in sorted(topics.items())) or "no topics"
+        found = ", ".join(f"{t} ({k})" for t, k in sorted(topics.items()))
         raise ImportError_(f"{source}: no tactile_msgs/msg/TactileState topic; it has {found}")
     if len(states) > 1:
         raise ImportError_(
             f"{source}: several TactileState topics ({', '.join(states)}); pass --topic"
         )
     return states[0]
+
+
+MCAP_MAGIC = b"\x89MCAP0\r\n"
+"""The eight bytes an MCAP file starts (and ends) with (MCAP specification, "Magic")."""
+
+
+def _check_mcap_start(stream, source: Path) -> None:
+    """An empty file or one that is no MCAP file, said as such (the reader's own errors
+    for them are an empty message or a bare seek error)."""
+    start = stream.read(len(MCAP_MAGIC))
+    stream.seek(0)
+    if not start:
+        raise ImportError_(
+            f"{source} is empty (0 bytes); expected an MCAP file of "
+            "tactile_msgs/msg/TactileState messages"
+        )
+    if start == MCAP_MAGIC[: len(start)] and len(start) < len(MCAP_MAGIC):
+        raise ImportError_(
+            f"{source} is truncated ({len(start)} bytes): the start of MCAP's magic bytes "
+            "and nothing more"
+        )
+    if start != MCAP_MAGIC:
+        raise ImportError_(
+            f"{source} is not an MCAP file: it does not start with MCAP's magic bytes "
+            f"(\\x89MCAP0\\r\\n); it starts with {start!r}"
+        )
 
 
 def read_mcap(source: Path, *, sensor=None, topic: str | None = None):
@@ -177,6 +210,7 @@ def read_mcap(source: Path, *, sensor=None, topic: str | None = None):
     spec = None
     try:
         with open(source, "rb") as stream:
+            _check_mcap_start(stream, source)
             reader = make_reader(stream, decoder_factories=[DecoderFactory()])
             summary = reader.get_summary()
             if summary is None:
@@ -195,9 +229,17 @@ def read_mcap(source: Path, *, sensor=None, topic: str | None = None):
                     spec = _ros_sensor(sensor, [s.name for s in ros.sensors], source)
                 frames.append(_pick_values(ros.sensors, spec, str(source)))
                 stamps.append(ros.header.stamp.sec + ros.header.stamp.nanosec * 1e-9)
+    except ImportError_:
+        raise
     except (McapError, ValueError, KeyError, EOFError) as error:
-        raise ImportError_(f"{source} is not a readable MCAP file ({error})") from None
+        why = str(error) or type(error).__name__
+        raise ImportError_(f"{source} is not a readable MCAP file ({why})") from None
     except OSError as error:
+        if error.errno == errno.EINVAL:  # a seek before the start: too short for its index
+            raise ImportError_(
+                f"{source} is truncated ({source.stat().st_size} bytes): an MCAP file's "
+                "start without its records and summary (a recorder killed at once?)"
+            ) from None
         raise ImportError_(f"{source}: cannot read it ({error.strerror or error})") from None
     if spec is None:
         raise ImportError_(f"{source}: topic {chosen} holds no messages")
@@ -336,12 +378,24 @@ def read_xdf(source: Path, *, sensor=None, stream: str | None = None):
 
 
 def read_csv(source: Path, *, sensor=None, time_column: str = "time"):
-    """One frame per row: a time column [s] and rows x cols values in row-major order."""
+    """One frame per row: a time column [s] and rows x cols values in row-major order.
+
+    An optional ``host_time`` column (Unix time [s], as ``tactsense export X.csv`` writes
+    for a recorded stream) becomes the recording's host times. A value ``nan`` is a lost
+    reading (a float recording keeps it as NaN); a time must be a finite number, and the
+    times must increase from row to row: a time that goes backwards or repeats is
+    refused with its line (frames out of order or a clock that stepped back would give
+    the estimators wrong rates and the tracker wrong velocities; sort the file or fix
+    its times). A byte-order mark (Excel's "CSV UTF-8") is skipped.
+    """
+    from tactsense.interop.csvfile import HOST_TIME_COLUMN
+
     spec = _sensor(sensor, source, "a CSV file")
     rows, cols = spec.shape
-    frames, stamps = [], []
+    frames, stamps, hosts = [], [], []
     try:
-        with open(source, newline="", encoding="utf-8") as stream:
+        # utf-8-sig: the byte-order mark Excel writes before the header is not a name
+        with open(source, newline="", encoding="utf-8-sig") as stream:
             reader = csv.reader(stream)
             header = next(reader, None)
             if header is None:
@@ -354,11 +408,14 @@ def read_csv(source: Path, *, sensor=None, time_column: str = "time"):
                     "pass --time-column"
                 )
             t = header.index(time_column)
-            if len(header) - 1 != rows * cols:
+            h = header.index(HOST_TIME_COLUMN) if HOST_TIME_COLUMN in header else None
+            times = 1 if h is None else 2
+            if len(header) - times != rows * cols:
                 raise ImportError_(
-                    f"{source}: {len(header) - 1} value columns; sensor {spec.name!r} has "
+                    f"{source}: {len(header) - times} value columns; sensor {spec.name!r} has "
                     f"{rows} x {cols} = {rows * cols} taxels"
                 )
+            previous = None
             for line, row in enumerate(reader, start=2):
                 if not row:
                     continue
@@ -370,17 +427,37 @@ def read_csv(source: Path, *, sensor=None, time_column: str = "time"):
                     numbers = [float(x) for x in row]
                 except ValueError as error:
                     raise ImportError_(f"{source} line {line}: {error}") from None
-                if not all(math.isfinite(x) for x in numbers):
-                    raise ImportError_(f"{source} line {line}: a value is not a finite number")
-                stamps.append(numbers.pop(t))
-                frames.append(numbers)
+                if not all(math.isfinite(x) or math.isnan(x) for x in numbers):
+                    raise ImportError_(f"{source} line {line}: a value is infinite")
+                stamp = numbers[t]
+                host = None if h is None else numbers[h]
+                for name, value in ((time_column, stamp), (HOST_TIME_COLUMN, host)):
+                    if value is not None and not math.isfinite(value):
+                        raise ImportError_(
+                            f"{source} line {line}: the {name} {value} is not a finite number"
+                        )
+                if previous is not None and stamp <= previous[1]:
+                    how = "repeats" if stamp == previous[1] else "goes backwards from"
+                    raise ImportError_(
+                        f"{source} line {line}: the time {stamp!r} s {how} "
+                        f"{previous[1]!r} s on line {previous[0]}; the times must increase "
+                        "(sort the rows by time, or fix the clock)"
+                    )
+                previous = (line, stamp)
+                stamps.append(stamp)
+                if h is not None:
+                    hosts.append(host)
+                frames.append([x for k, x in enumerate(numbers) if k != t and k != h])
     except UnicodeDecodeError:
         raise ImportError_(f"{source} is not a text (UTF-8) CSV file") from None
     except csv.Error as error:
         raise ImportError_(f"{source}: not a CSV file ({error})") from None
-    return build_recording(
+    recording = build_recording(
         spec, frames, stamps, source=str(source), description=f"imported from {source}"
     )
+    if hosts:  # the host's arrival times, as the recording that was exported had them
+        recording = dataclasses.replace(recording, host_time_s=np.asarray(hosts, float))
+    return recording
 
 
 # ---- dispatch -------------------------------------------------------------------------

@@ -15,10 +15,15 @@ Features of a row:
 
 * ``observation.tactile``: the frame [counts], float32, shape ``[rows, cols]``, names
   ``["row", "col"]`` (row-major, as a tactsense frame);
-* ``observation.state``: the contact estimate, float32, names ``contact.present``
-  (1 or 0), ``contact.axial_mm``, ``contact.angle_deg``, ``contact.force_n``,
-  ``contact.row``, ``contact.col`` (0 without a contact; units in the names, tactels for
-  row and col);
+* ``observation.state``: the contact estimate, float32. A finger's one contact: names
+  ``contact.present`` (1 or 0), ``contact.axial_mm``, ``contact.angle_deg``,
+  ``contact.force_n``, ``contact.row``, ``contact.col`` (0 without a contact; units in
+  the names, tactels for row and col). A pad's or a point set's contacts, as ``locate``
+  finds and tracks them (at most ``MAX_CONTACTS`` a frame, largest force first):
+  ``contacts.count``, then per slot k ``contact{k}.present``, ``.id`` (the tracked id),
+  ``.x_mm``, ``.y_mm``, ``.z_mm`` (the sensor's frame), ``.force_n`` and ``.flags``
+  (:class:`~tactsense.estimate.Flag` bits; a contact whose force is unknown, a
+  saturated one, has force 0 and its flag); 0 in an empty slot;
 * ``frame_time``: the frame's recorded time [s] (float64; the device clock);
 * LeRobot's ``timestamp`` (float32, ``frame_index / fps``: the time in the episode LeRobot
   assumes), ``frame_index``, ``episode_index``, ``index``, ``task_index``.
@@ -60,6 +65,17 @@ STATE_NAMES = (
     "contact.col",
 )
 DEFAULT_TASK = "tactile recording"
+MAX_CONTACTS = 8
+"""Contact slots in a pad's or point set's ``observation.state``: ``locate`` finds at most
+this many contacts a frame (``find_contacts``' ``max_contacts``), so none is dropped."""
+SLOT_NAMES = ("present", "id", "x_mm", "y_mm", "z_mm", "force_n", "flags")
+
+
+def contact_state_names(slots: int = MAX_CONTACTS) -> tuple[str, ...]:
+    """The ``observation.state`` names of a pad or a point set: ``contacts.count`` and
+    ``contact{k}.<field>`` for each slot."""
+    slot_names = (f"contact{k}.{field}" for k in range(slots) for field in SLOT_NAMES)
+    return ("contacts.count", *slot_names)
 
 
 class LeRobotError(TactsenseInputError):
@@ -73,7 +89,7 @@ def _pyarrow():
     return pa, pq
 
 
-def features_of(shape: tuple[int, int]) -> dict:
+def features_of(shape: tuple[int, int], state_names=STATE_NAMES) -> dict:
     """The ``features`` of ``meta/info.json`` for a sensor of this frame shape."""
     rows, cols = shape
     return {
@@ -84,8 +100,8 @@ def features_of(shape: tuple[int, int]) -> dict:
         },
         "observation.state": {
             "dtype": "float32",
-            "shape": [len(STATE_NAMES)],
-            "names": list(STATE_NAMES),
+            "shape": [len(state_names)],
+            "names": list(state_names),
         },
         "frame_time": {"dtype": "float64", "shape": [1], "names": None},
         "timestamp": {"dtype": "float32", "shape": [1], "names": None},
@@ -115,16 +131,26 @@ def _hf_features(features: dict) -> dict:
 
 
 def _stats(values: np.ndarray, scalar: bool) -> dict:
-    """LeRobot's statistics of one feature over axis 0 (``compute_stats.get_feature_stats``)."""
+    """LeRobot's statistics of one feature (``compute_stats.compute_episode_stats``).
+
+    Over axis 0, and, as LeRobot's ``RunningQuantileStats`` takes every axis but the last
+    as samples, over the rows too for a feature of shape ``[rows, cols]``: its statistics
+    have shape ``(cols,)`` (LeRobot 0.4.4 gives ``(16,)`` for a ``[16, 16]`` feature), so
+    that LeRobot's ``aggregate_stats`` can merge them with its own. ``count`` is the
+    number of frames. Quantiles exact (``numpy.quantile``; LeRobot's are from a
+    histogram).
+    """
     values = np.asarray(values, dtype=np.float64)
+    frames = len(values)
     if values.ndim == 1:
         values = values[:, None]
+    values = values.reshape(-1, values.shape[-1])
     stats = {
         "min": values.min(axis=0),
         "max": values.max(axis=0),
         "mean": values.mean(axis=0),
         "std": values.std(axis=0),
-        "count": np.array([len(values)]),
+        "count": np.array([frames]),
     }
     for q in QUANTILES:
         stats[f"q{round(q * 100):02d}"] = np.quantile(values, q, axis=0)
@@ -154,6 +180,26 @@ def _state(est, n: int) -> np.ndarray:
     return state
 
 
+def _contacts_state(table, start: int, n: int, slots: int = MAX_CONTACTS) -> np.ndarray:
+    """``observation.state`` rows of ``n`` frames from a tracked contact table whose
+    ``frame`` column counts from ``start`` (rows sorted by frame, then by rank)."""
+    width = len(SLOT_NAMES)
+    state = np.zeros((n, 1 + slots * width), dtype=np.float32)
+    frame = np.asarray(table.frame, dtype=np.int64) - start
+    rank = np.asarray(table.contact, dtype=np.int64)
+    if len(frame) and (rank.max() >= slots):
+        raise LeRobotError(f"a frame has more than {slots} contacts; the state has {slots} slots")
+    state[:, 0] = np.bincount(frame, minlength=n)
+    force = np.asarray(table.force_n, dtype=float)
+    fields = (
+        np.ones(len(frame)), table.id, table.x_mm, table.y_mm, table.z_mm,
+        np.where(np.isfinite(force), force, 0.0), table.flags,
+    )  # fmt: skip
+    for j, values in enumerate(fields):
+        state[frame, 1 + rank * width + j] = np.nan_to_num(np.asarray(values, dtype=float))
+    return state
+
+
 def write_dataset(
     folder: Path,
     *,
@@ -161,6 +207,7 @@ def write_dataset(
     frames: np.ndarray,
     frame_time: np.ndarray,
     state: np.ndarray,
+    state_names=STATE_NAMES,
     episode_split: int | None = None,
     task: str = DEFAULT_TASK,
     fps: int | None = None,
@@ -185,7 +232,12 @@ def write_dataset(
         frame_index[s:stop] = np.arange(stop - s)
     timestamp = (frame_index / fps).astype(np.float32)
     tactile = np.asarray(frames, dtype=np.float32)
-    features = features_of((rows, cols))
+    features = features_of((rows, cols), state_names)
+    state = np.asarray(state, dtype=np.float32)
+    if state.shape != (n, len(state_names)):
+        raise LeRobotError(
+            f"state has shape {state.shape}; expected ({n}, {len(state_names)}) for its names"
+        )
     columns = {
         "observation.tactile": tactile,
         "observation.state": np.asarray(state, dtype=np.float32),
@@ -206,7 +258,7 @@ def write_dataset(
             inner.cast(pa.list_(pa.float32())),
         ),
         "observation.state": pa.FixedSizeListArray.from_arrays(
-            pa.array(columns["observation.state"].reshape(-1)), len(STATE_NAMES)
+            pa.array(columns["observation.state"].reshape(-1)), len(state_names)
         ),
     }
     for key in ("frame_time", "timestamp", "frame_index", "episode_index", "index", "task_index"):
@@ -303,11 +355,16 @@ def export_lerobot(
     episode_split: int | None = None,
     task: str = DEFAULT_TASK,
     progress=None,
+    drift_s: float | None = 2.0,
 ) -> dict:
     """Write a recording and its contact estimates as a LeRobot v3 dataset folder ``out``.
 
-    The dataset is written into a temporary folder beside ``out`` and moved into place
-    when complete. Returns ``frames``, ``contacts``, ``episodes`` and ``fps``.
+    A finger's contact as ``locate`` estimates it; a pad's or a point set's contacts as
+    ``locate`` finds and tracks them (its long table; the baseline following drift with
+    ``drift_s`` [s], as there). The dataset is written into a temporary folder beside
+    ``out`` and moved into place when complete. Returns ``frames``, ``contacts`` (a
+    finger: frames with a contact; a pad or a point set: contacts over all frames),
+    ``episodes``, ``fps`` and the sensor's ``kind``.
     """
     from tactsense.batch import iter_locate
     from tactsense.estimate.locate import CONTACT_THRESHOLD
@@ -322,18 +379,32 @@ def export_lerobot(
     with RecordingReader(recording) as reader:
         sensor = reader.sensor
         losses = reader.losses
-        pieces = iter_locate(
-            reader,
-            baseline_frames=baseline_frames,
-            calibration=calibration,
-            threshold=CONTACT_THRESHOLD if threshold is None else threshold,
-        )
-        for start, time_s, est in pieces:
-            frames.append(reader.frames(start, start + len(time_s)))
+        if sensor.kind == "finger":
+            state_names = STATE_NAMES
+            pieces = (
+                (start, len(time_s), time_s, _state(est, len(time_s)))
+                for start, time_s, est in iter_locate(
+                    reader, baseline_frames=baseline_frames, calibration=calibration,
+                    threshold=CONTACT_THRESHOLD if threshold is None else threshold,
+                )
+            )  # fmt: skip
+        else:  # every contact, tracked, as locate's long table has them
+            from tactsense.batch import iter_contacts
+
+            state_names = contact_state_names()
+            pieces = (
+                (start, n, time_s, _contacts_state(table, start, n))
+                for start, n, time_s, table, _ in iter_contacts(
+                    reader, baseline_frames=baseline_frames, calibration=calibration,
+                    threshold=threshold, max_contacts=MAX_CONTACTS, drift_s=drift_s,
+                )
+            )  # fmt: skip
+        for start, n, time_s, state in pieces:
+            frames.append(reader.frames(start, start + n))
             times.append(time_s)
-            states.append(_state(est, len(time_s)))
+            states.append(state)
             if progress is not None:
-                progress(start + len(time_s), reader.n_frames)
+                progress(start + n, reader.n_frames)
     if not frames:
         raise LeRobotError(f"{recording} has no frames")
     state = np.concatenate(states)
@@ -347,6 +418,7 @@ def export_lerobot(
             frames=np.concatenate(frames),
             frame_time=np.concatenate(times),
             state=state,
+            state_names=state_names,
             episode_split=episode_split,
             task=task,
             extra={"source": str(recording), "losses": losses},
@@ -355,7 +427,8 @@ def export_lerobot(
     except BaseException:
         shutil.rmtree(temporary, ignore_errors=True)
         raise
-    return {**counts, "contacts": int(state[:, 0].sum())}
+    # a finger: frames with a contact; a pad or a point set: contacts over all frames
+    return {**counts, "contacts": int(state[:, 0].sum()), "kind": sensor.kind}
 
 
 def import_lerobot(folder: str | Path, *, sensor=None):

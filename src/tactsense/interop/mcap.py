@@ -22,6 +22,8 @@ from tactsense._validation import TactsenseInputError
 from tactsense.interop.ros import (
     TACTILE_CONTACT,
     TACTILE_CONTACT_MSGDEF,
+    TACTILE_CONTACTS,
+    TACTILE_CONTACTS_MSGDEF,
     TACTILE_STATE,
     TACTILE_STATE_MSGDEF,
     contact_geometry,
@@ -32,6 +34,8 @@ from tactsense.sensor import SensorSpec
 
 STATES_TOPIC = "/tactile_states"
 CONTACTS_TOPIC = "/tactile_contacts"
+CONTACT_LISTS_TOPIC = "/contact_states"
+"""One ``TactileContacts`` per frame (upstream's merger publishes them on ``contact_states``)."""
 
 
 def _writer_class():
@@ -70,6 +74,67 @@ class _Template:
         return b"".join((self.head, _STAMP.pack(sec, nanosec), self.middle, values.tobytes()))
 
 
+class _ContactBytes:
+    """The CDR bytes of ``TactileContact`` messages and ``TactileContacts`` lists of them,
+    from the bytes the library's encoder makes for each contact name.
+
+    A contact's bytes are its stamp, a middle (frame_id, name, padding) and its twelve
+    float64 numbers. Alone, its body starts at offset 0; first in a list, at offset 4
+    (after the list's length), later in a list at a multiple of 8 (the end of the
+    previous contact's last float64): so two middles per name, taken from the encoder's
+    bytes of the contact alone and of the list of it alone. Checked at construction
+    against the encoder on lists of 0 to 3 contacts with names of every length mod 8.
+    """
+
+    _CACHE = 4096  # names kept (a long recording has a new tracked id now and then)
+
+    def __init__(self, encode_contact, encode_list, make):
+        self._encode_contact, self._encode_list, self._make = encode_contact, encode_list, make
+        self._middles: dict[str, tuple[bytes, bytes]] = {}
+        self.head = bytes(encode_list({"contacts": []}))[:4]
+        probe = np.arange(12, dtype="<f8") - 0.5
+        same = True
+        for k in range(9):  # lists of 0 to 3 contacts, names of every length mod 8
+            lengths = (k, 8 - k, 3 * k % 8 + 1)[: min(k, 3)]
+            items = [("n" * (n + 1), 1 + j, 2 * j, probe + j) for j, n in enumerate(lengths)]
+            for names in (items, items[::-1]):
+                expected = bytes(encode_list({"contacts": [make(*item) for item in names]}))
+                alone = [bytes(encode_contact(make(*item))) for item in names]
+                same &= self.contacts(names) == expected
+                same &= alone == [self.contact(*item) for item in names]
+        if not same:
+            raise AssertionError("the CDR layout is not the one assumed")  # pragma: no cover
+        self._middles.clear()
+
+    def _middle(self, name: str) -> tuple[bytes, bytes]:
+        middles = self._middles.get(name)
+        if middles is None:
+            numbers = np.zeros(12)
+            alone = bytes(self._encode_contact(self._make(name, 0, 0, numbers)))
+            listed = bytes(self._encode_list({"contacts": [self._make(name, 0, 0, numbers)]}))
+            middles = (alone[12:-96], listed[16:-96])
+            if len(self._middles) >= self._CACHE:
+                self._middles.clear()
+            self._middles[name] = middles
+        return middles
+
+    def contact(self, name: str, sec: int, nanosec: int, numbers) -> bytes:
+        """One ``TactileContact``: what the encoder makes of it."""
+        numbers = np.ascontiguousarray(numbers, dtype="<f8")
+        return b"".join(
+            (self.head, _STAMP.pack(sec, nanosec), self._middle(name)[0], numbers.tobytes())
+        )
+
+    def contacts(self, items) -> bytes:
+        """One ``TactileContacts`` of ``(name, sec, nanosec, numbers)`` items."""
+        parts = [self.head, _LENGTH.pack(len(items))]
+        for k, (name, sec, nanosec, numbers) in enumerate(items):
+            middle = self._middle(name)[1 if k == 0 else 0]
+            numbers = np.ascontiguousarray(numbers, dtype="<f8")
+            parts += [_STAMP.pack(sec, nanosec), middle, numbers.tobytes()]
+        return b"".join(parts)
+
+
 class McapTactileWriter:
     """Write frames and contacts of one finger to an MCAP file, as they come.
 
@@ -104,6 +169,7 @@ class McapTactileWriter:
         self._writer = Writer(stream, chunk_size=chunk_size)
         self._state = self._writer.register_msgdef(TACTILE_STATE, TACTILE_STATE_MSGDEF)
         self._contact = self._writer.register_msgdef(TACTILE_CONTACT, TACTILE_CONTACT_MSGDEF)
+        self._lists = self._writer.register_msgdef(TACTILE_CONTACTS, TACTILE_CONTACTS_MSGDEF)
         self._fast = fast
         self._raw = self._writer._writer  # the mcap Writer under the ROS 2 one
         self._channels: dict[str, int] = {}
@@ -121,26 +187,26 @@ class McapTactileWriter:
                     "sensors": [{"name": sensor.name, "values": values.tolist()}],
                 }
 
-            def contact(sec, nanosec, values):
-                names = ("position", "normal")
-                message = {
-                    "header": {"stamp": {"sec": sec, "nanosec": nanosec}, **header},
-                    "name": sensor.name,
-                }
-                for k, name in enumerate(names):
-                    message[name] = dict(
-                        zip("xyz", map(float, values[3 * k : 3 * k + 3]), strict=True)
-                    )
-                message["wrench"] = {
-                    "force": dict(zip("xyz", map(float, values[6:9]), strict=True)),
-                    "torque": dict(zip("xyz", map(float, values[9:12]), strict=True)),
-                }
-                return message
+            def contact(name, sec, nanosec, values):
+                def xyz(k):
+                    return dict(zip("xyz", map(float, values[3 * k : 3 * k + 3]), strict=True))
 
+                return {
+                    "header": {"stamp": {"sec": sec, "nanosec": nanosec}, **header},
+                    "name": name,
+                    "position": xyz(0),
+                    "normal": xyz(1),
+                    "wrench": {"force": xyz(2), "torque": xyz(3)},
+                }
+
+            encode_lists = serialize_dynamic(TACTILE_CONTACTS, TACTILE_CONTACTS_MSGDEF)[
+                TACTILE_CONTACTS
+            ]
             self._state_bytes = _Template(encode_state, state, cells, np.float32)
-            self._contact_bytes = _Template(encode_contact, contact, 12, np.float64)
+            self._contact_bytes = _ContactBytes(encode_contact, encode_lists, contact)
         self.frames = 0
         self.contacts = 0
+        self.lists = 0
 
     def _channel(self, topic: str, schema) -> int:
         """The channel of a topic, registered at its first message as the ROS 2 writer
@@ -190,51 +256,87 @@ class McapTactileWriter:
         self.frames += len(time_s)
 
     def contacts_of(self, time_s, axial_mm, angle_deg, force_n, has_contact) -> None:
-        """A finger's contacts of many frames at once (vectorised geometry)."""
+        """A finger's contacts of many frames at once (vectorised geometry): one
+        ``TactileContact`` per frame with a contact, and one ``TactileContacts`` per frame
+        (of that contact, or empty)."""
         chosen = np.flatnonzero(has_contact)
-        if len(chosen) == 0:
-            return
         points, normals = contact_geometry(
             self.sensor, np.asarray(axial_mm)[chosen], np.asarray(angle_deg)[chosen]
         )
-        self.contacts_at(
-            np.asarray(time_s, dtype=float)[chosen], points, normals,
-            np.asarray(force_n, dtype=float)[chosen],
-        )  # fmt: skip
+        self.contacts_at(time_s, chosen, points, normals, np.asarray(force_n, dtype=float)[chosen])
 
-    def contacts_at(self, time_s, points_m, normals, force_n) -> None:
-        """One ``TactileContact`` per row: its time [s], point [m] and outward unit
-        normal in the sensor's frame, and the normal force [N] (pressing inward)."""
+    def contacts_at(self, time_s, frame, points_m, normals, force_n, names=None) -> None:
+        """The contacts of consecutive frames.
+
+        One ``TactileContact`` per row (``/tactile_contacts``) and one ``TactileContacts``
+        per frame (``/contact_states``; empty for a frame without a contact), stamped
+        with the frame's time.
+
+        Parameters
+        ----------
+        time_s : (n,) array
+            The frames' times [s].
+        frame : (k,) int array
+            Each contact's frame, an index into ``time_s``, non-decreasing.
+        points_m : (k, 3) array
+            Points [m] in the sensor's frame.
+        normals : (k, 3) array
+            Outward unit normals there.
+        force_n : (k,) array
+            Normal forces [N] (pressing inward).
+        names : sequence of k str, optional
+            The contacts' unique names (within a frame); default the sensor's name (a
+            finger's one contact).
+        """
+        time_s = np.asarray(time_s, dtype=float)
+        frame = np.asarray(frame, dtype=np.int64)
         if len(time_s) == 0:
             return
         points = np.asarray(points_m, dtype=float).reshape(-1, 3)
         normals = np.asarray(normals, dtype=float).reshape(-1, 3)
         force_n = np.asarray(force_n, dtype=float)
-        if self._fast:
-            channel = self._channel(CONTACTS_TOPIC, self._contact)
-            force = -force_n[:, None] * normals
-            numbers = np.zeros((len(time_s), 12), dtype="<f8")
-            numbers[:, 0:3], numbers[:, 3:6], numbers[:, 6:9] = points, normals, force
-            numbers[:, 9:12] = np.cross(points, force)  # about the frame's origin [N m]
-            head, middle = self._contact_bytes.head, self._contact_bytes.middle
-        for k in range(len(time_s)):
-            t = float(time_s[k])
-            ns = round(t * 1e9)
+        if names is None:
+            names = [self.sensor.name] * len(frame)
+        force = -force_n[:, None] * normals
+        numbers = np.zeros((len(frame), 12), dtype="<f8")
+        numbers[:, 0:3], numbers[:, 3:6], numbers[:, 6:9] = points, normals, force
+        numbers[:, 9:12] = np.cross(points, force)  # about the frame's origin [N m]
+        ns = np.array([round(float(t) * 1e9) for t in time_s], dtype=np.int64)
+        bounds = np.searchsorted(frame, np.arange(len(time_s) + 1))
+        for f in range(len(time_s)):
+            t = int(ns[f])
+            sec, nanosec = t // 1_000_000_000, t % 1_000_000_000
+            rows = range(bounds[f], bounds[f + 1])
             if self._fast:
-                stamp = _STAMP.pack(ns // 1_000_000_000, ns % 1_000_000_000)
+                items = [(names[i], sec, nanosec, numbers[i]) for i in rows]
+                for item in items:
+                    self._raw.add_message(
+                        channel_id=self._channel(CONTACTS_TOPIC, self._contact), log_time=t,
+                        publish_time=t, sequence=self.contacts,
+                        data=self._contact_bytes.contact(*item),
+                    )  # fmt: skip
+                    self.contacts += 1
                 self._raw.add_message(
-                    channel_id=channel, log_time=ns, publish_time=ns, sequence=self.contacts,
-                    data=b"".join((head, stamp, middle, numbers[k].tobytes())),
+                    channel_id=self._channel(CONTACT_LISTS_TOPIC, self._lists), log_time=t,
+                    publish_time=t, sequence=self.lists, data=self._contact_bytes.contacts(items),
                 )  # fmt: skip
             else:
-                message = tactile_contact(
-                    self.sensor, t, points[k], normals[k], force_n[k], self.frame_id
-                )
+                messages = [
+                    tactile_contact(self.sensor, float(time_s[f]), points[i], normals[i],
+                                    force_n[i], self.frame_id, name=names[i])
+                    for i in rows
+                ]  # fmt: skip
+                for message in messages:
+                    self._writer.write_message(
+                        CONTACTS_TOPIC, self._contact, message, log_time=t, publish_time=t,
+                        sequence=self.contacts,
+                    )  # fmt: skip
+                    self.contacts += 1
                 self._writer.write_message(
-                    CONTACTS_TOPIC, self._contact, message, log_time=ns, publish_time=ns,
-                    sequence=self.contacts,
+                    CONTACT_LISTS_TOPIC, self._lists, {"contacts": messages}, log_time=t,
+                    publish_time=t, sequence=self.lists,
                 )  # fmt: skip
-            self.contacts += 1
+            self.lists += 1
 
     def metadata(self, name: str, data: dict[str, str]) -> None:
         """An MCAP metadata record (name and string pairs) in the file."""
@@ -246,6 +348,8 @@ class McapTactileWriter:
 
 _STAMP = struct.Struct("<iI")
 """builtin_interfaces/Time in CDR: int32 sec, uint32 nanosec, little-endian."""
+_LENGTH = struct.Struct("<I")
+"""The length of a CDR sequence, uint32, little-endian."""
 
 
 def export_mcap(
@@ -347,9 +451,11 @@ def export_mcap(
                 nearest = np.argmin(
                     ((xyz[:, None, :] - positions[None, :, :]) ** 2).sum(axis=-1), axis=1
                 ) if len(xyz) else np.zeros(0, int)  # fmt: skip
+                # upstream: "unique name of the contact"; RViz keeps one per (frame_id, name)
+                names = [f"{sensor.name}/{i}" for i in table.id[keep]]
                 writer.contacts_at(
-                    when[table.frame[keep] - start], xyz * 1e-3, taxel_normals[nearest],
-                    table.force_n[keep],
+                    when, table.frame[keep] - start, xyz * 1e-3, taxel_normals[nearest],
+                    table.force_n[keep], names,
                 )  # fmt: skip
                 if progress is not None:
                     progress(start + n, reader.n_frames)

@@ -15,6 +15,22 @@ Entities, on the timeline ``time`` (the frames' times on the device clock):
 * ``finger/force_g``: a ``Scalars`` with the estimated force [g] (0 without contact),
   its series named ``force [g]``.
 
+A pad or a point set (``<kind>`` is ``pad`` or ``points``), with every contact
+``locate`` finds and tracks (its long table):
+
+* ``pad/signal``: an RGB ``Image`` of the taxels' signal (fractional deflection for
+  capacitive taxels, strain for resistive ones), rows down (y = row) and columns across
+  (x = column), through viridis over one fixed range for the whole file;
+* ``<kind>/signal_values``: a ``Tensor`` of the signal, dims ``(row, col)`` on a pad,
+  ``(taxel,)`` on a point set (its taxels in the sensor's order), ``value_range`` that
+  range;
+* ``<kind>/signal/contacts``: a pad's contacts as ``Points2D`` in the image's pixels
+  (x = column + 0.5, y = row + 0.5), labelled with their tracked ids;
+* ``<kind>/taxels`` (static) and ``<kind>/contacts``: ``Points3D`` of the taxels and of
+  the contacts [mm] in the sensor's frame, the contacts labelled with their ids;
+* ``<kind>/force_g``: the frame's total force [g] (series ``force [g]``), and
+  ``<kind>/contact_force_g/<id>`` each contact's force while it lasts.
+
 Each export gets a recording id of its own (a UUID: two files exported from
 recordings of the same name do not merge when opened together); the file's recording
 properties (``tactsense``) hold that id, the source recording, the sensor, the
@@ -53,6 +69,7 @@ def export_rerun(
     deflection_range: tuple[float, float] | None = None,
     recording_id: str | None = None,
     progress=None,
+    drift_s: float | None = 2.0,
 ) -> dict:
     """Write a recording's heat maps, contacts and force to a Rerun file, a piece at a time.
 
@@ -61,7 +78,12 @@ def export_rerun(
     deflection_range : (low, high), optional
         Fractional deflection [-] at the two ends of the colour map, the same for every
         frame; default: from 0 (or the lowest deflection, if below 0) to the highest
-        deflection of the recording (a first pass over it, a piece at a time).
+        deflection of the recording (a first pass over it, a piece at a time). On a pad
+        or a point set, the signal (strain for resistive taxels).
+    drift_s : float, optional
+        A pad or a point set: the time constant [s] with which the contacts' baseline
+        follows drift, as in ``locate`` (the heat map's baseline stays the first
+        frames').
     recording_id : str, optional
         Rerun's recording id; default a new UUID.
 
@@ -82,6 +104,13 @@ def export_rerun(
     frames_written = contacts = 0
     with RecordingReader(recording) as reader:
         sensor = reader.sensor
+        if sensor.kind != "finger":
+            return _export_array(
+                rr, reader, recording, out, calibration=calibration,
+                baseline_frames=baseline_frames, threshold=threshold,
+                signal_range=deflection_range, recording_id=recording_id, progress=progress,
+                drift_s=drift_s,
+            )  # fmt: skip
         baseline = None
         if calibration is None:
             baseline = np.median(reader.frames(0, baseline_frames).astype(float), axis=0)
@@ -160,3 +189,111 @@ def export_rerun(
         "recording_id": recording_id,
         "deflection_range": (low, high),
     }
+
+
+def _range_of(chunks, signal) -> tuple[float, float]:
+    """From 0 (or the lowest value, if below 0) to the highest value of the signal."""
+    low, high = 0.0, 0.0
+    for _, counts, _ in chunks:
+        values = signal(counts)
+        if np.isfinite(values).any():
+            low = min(low, float(np.nanmin(values)))
+            high = max(high, float(np.nanmax(values)))
+    return low, high if high > low else low + 1e-3
+
+
+def _export_array(
+    rr, reader, recording, out, *, calibration, baseline_frames, threshold, signal_range,
+    recording_id, progress, drift_s,
+) -> dict:  # fmt: skip
+    """:func:`export_rerun` of a pad or a point set: every contact, tracked."""
+    from matplotlib import colormaps
+
+    from tactsense.batch import iter_contacts
+    from tactsense.estimate.array_calibration import ArrayCalibration
+    from tactsense.estimate.contacts import signal_from_counts
+    from tactsense.physics.contact import newtons_to_grams
+
+    sensor = reader.sensor
+    root = sensor.kind
+    viridis = colormaps["viridis"]
+    pieces = iter_contacts(reader, baseline_frames=baseline_frames, calibration=calibration,
+                           threshold=threshold, drift_s=drift_s)  # fmt: skip
+    if isinstance(calibration, ArrayCalibration):
+
+        def signal(counts):
+            return calibration.signal(counts, sensor)[0]
+    else:
+        if calibration is not None:  # iter_contacts has refused it already
+            raise TactsenseInputError(f"a finger's calibration does not apply to {sensor.name!r}")
+        start = np.nanmedian(reader.frames(0, baseline_frames).astype(float), axis=0)
+
+        def signal(counts):
+            return signal_from_counts(counts, start, sensor)[0]
+
+    if signal_range is None:
+        signal_range = _range_of(reader.chunks(), signal)
+    low, high = map(float, signal_range)
+    if not (np.isfinite(low) and np.isfinite(high) and high > low):
+        raise TactsenseInputError(
+            f"signal range ({low}, {high}) must be two finite numbers, low < high"
+        )
+    stream = rr.RecordingStream("tactsense", recording_id=recording_id)
+    stream.save(str(out))
+    stream.send_recording_name(Path(recording).stem)
+    stream.send_property(
+        "tactsense",
+        rr.AnyValues(
+            recording_id=recording_id, source=str(recording), sensor=sensor.name,
+            kind=sensor.kind,
+            signal_units="1 (fractional deflection, or strain for resistive taxels)",
+            signal_range=[low, high], force_units="g", position_units="mm",
+            time_units="s (device clock)",
+        ),
+    )  # fmt: skip
+    stream.log(f"{root}/force_g", rr.SeriesLines(names="force [g]"), static=True)
+    stream.log(f"{root}/taxels", rr.Points3D(sensor.taxel_positions_mm(), radii=0.3), static=True)
+    frames_written = contacts = 0
+    for start_frame, n, time_s, table, _ in pieces:
+        values = signal(reader.frames(start_frame, start_frame + n))
+        scaled = np.clip((np.nan_to_num(values) - low) / (high - low), 0.0, 1.0)
+        colours = (viridis(scaled)[..., :3] * 255).round().astype(np.uint8)  # pads only
+        bounds = np.searchsorted(table.frame, np.arange(start_frame, start_frame + n + 1))
+        force_g = newtons_to_grams(np.asarray(table.force_n, dtype=float))
+        for k, t in enumerate(time_s):
+            stream.set_time("time", duration=float(t))
+            frame = np.ascontiguousarray(values[k], dtype=np.float32)
+            if sensor.kind == "pad":
+                stream.log(f"{root}/signal", rr.Image(colours[k], color_model="RGB"))
+                tensor = rr.Tensor(frame, dim_names=("row", "col"), value_range=(low, high))
+            else:  # a point set: no grid to picture; its taxels in order
+                tensor = rr.Tensor(frame.ravel(), dim_names=("taxel",), value_range=(low, high))
+            stream.log(f"{root}/signal_values", tensor)
+            rows = slice(bounds[k], bounds[k + 1])
+            ids = [str(i) for i in table.id[rows]]
+            if ids:
+                xyz = np.column_stack([table.x_mm[rows], table.y_mm[rows], table.z_mm[rows]])
+                stream.log(f"{root}/contacts", rr.Points3D(xyz, labels=ids, radii=0.5))
+                if sensor.kind == "pad":
+                    pixels = np.column_stack([table.col[rows] + 0.5, table.row[rows] + 0.5])
+                    stream.log(f"{root}/signal/contacts",
+                               rr.Points2D(pixels, labels=ids, radii=0.15))  # fmt: skip
+                for i, grams in zip(ids, force_g[rows], strict=True):
+                    if np.isfinite(grams):
+                        stream.log(f"{root}/contact_force_g/{i}", rr.Scalars([float(grams)]))
+                contacts += len(ids)
+            else:
+                stream.log(f"{root}/contacts", rr.Clear(recursive=False))
+                if sensor.kind == "pad":
+                    stream.log(f"{root}/signal/contacts", rr.Clear(recursive=False))
+            finite = force_g[rows][np.isfinite(force_g[rows])]
+            stream.log(f"{root}/force_g", rr.Scalars([float(finite.sum())]))
+            frames_written += 1
+        if progress is not None:
+            progress(start_frame + n, reader.n_frames)
+    stream.flush()
+    stream.disconnect()
+    return {
+        "frames": frames_written, "contacts": contacts, "recording_id": recording_id,
+        "deflection_range": (low, high), "kind": sensor.kind,
+    }  # fmt: skip

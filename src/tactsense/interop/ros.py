@@ -23,9 +23,14 @@ junction of tip and cylinder toward the base, angle 0 along +y, as
 the object applies (-force x normal [N]) with its torque about the frame's origin,
 ``position x force`` [N m]: upstream's message says the wrench "should be represented in
 reference frame, not in contact point frame", and its contact merger writes the torque
-so. The contact's ``name`` is the sensor's name (upstream names contacts by sensor or
-group). The header's ``frame_id`` is the link the sensor is mounted on (``--frame-id``,
-default ``finger``, the link ``sensor export --urdf`` writes) and its stamp the frame's
+so. Upstream's ``name`` is the "unique name of the contact", and RViz's tactile contact
+display keeps one contact per ``(frame_id, name)``: a finger's one contact is named as
+the sensor, and each contact of a pad or a point set ``<sensor>/<id>`` with its tracked
+id (stable while the contact lasts). Each frame's contacts also go together in one
+``tactile_msgs/msg/TactileContacts`` (an empty list for a frame without one), as
+upstream's contact merger publishes them. The header's ``frame_id`` is the link the
+sensor is mounted on (``--frame-id``, default ``finger``, the link ``sensor export
+--urdf`` writes) and its stamp the frame's
 arrival on the host's clock for a recorded stream, else the recording's time plus
 ``--start-time``.
 """
@@ -50,6 +55,7 @@ _DEPENDENCIES = {
 
 TACTILE_STATE = "tactile_msgs/msg/TactileState"
 TACTILE_CONTACT = "tactile_msgs/msg/TactileContact"
+TACTILE_CONTACTS = "tactile_msgs/msg/TactileContacts"
 
 
 def _msgdef(body: str, dependencies: list[str]) -> str:
@@ -78,6 +84,22 @@ TACTILE_CONTACT_MSGDEF = _msgdef(
     ],
 )
 """ROS 2 message definition of ``TactileContact`` with its dependencies."""
+
+_DEPENDENCIES["tactile_msgs/TactileContact"] = TACTILE_CONTACT_MSGDEF.split(f"\n{SEPARATOR}")[0]
+TACTILE_CONTACTS_MSGDEF = _msgdef(
+    "tactile_msgs/TactileContact[] contacts",
+    [
+        "tactile_msgs/TactileContact",
+        "std_msgs/Header",
+        "builtin_interfaces/Time",
+        "geometry_msgs/Point",
+        "geometry_msgs/Vector3",
+        "geometry_msgs/Wrench",
+    ],
+)
+"""ROS 2 message definition of ``TactileContacts`` (upstream's list of the contacts of
+one moment, which its contact merger publishes on ``contact_states`` and RViz's
+tactile contact display reads) with its dependencies."""
 
 
 def stamp(time_s: float) -> dict:
@@ -112,19 +134,21 @@ def tactile_contact(
     normal,
     force_n: float,
     frame_id: str = "finger",
+    name: str | None = None,
 ) -> dict:
     """One ``TactileContact``: where, the normal, and the wrench the object applies.
 
     The wrench is in the reference frame (``frame_id``), as upstream's message says
     ("represented in reference frame, not in contact point frame"): the force, and the
     torque of that force about the frame's origin, ``position x force`` [N m], as the
-    toolbox's contact merger writes it.
+    toolbox's contact merger writes it. ``name``: the contact's unique name (default the
+    sensor's, for a finger's one contact).
     """
     force = -float(force_n) * np.asarray(normal, dtype=float)
     torque = np.cross(np.asarray(point_m, dtype=float), force)
     return {
         "header": {"stamp": stamp(time_s), "frame_id": frame_id},
-        "name": sensor.name,
+        "name": sensor.name if name is None else name,
         "position": dict(zip("xyz", map(float, point_m), strict=True)),
         "normal": dict(zip("xyz", map(float, normal), strict=True)),
         "wrench": {
