@@ -311,42 +311,46 @@ static void put_decimal(ts_context *ts, uint64_t v)
     while (n) put(&ts->enc, (uint8_t)digits[--n]);
 }
 
-void ts_ident_text(ts_context *ts, const char *text, size_t len)
+/* One byte of a JSON string, escaped. */
+static void put_escaped(ts_context *ts, uint8_t c)
 {
     static const char hex[] = "0123456789abcdef";
-    while (len--) {
-        uint8_t c = (uint8_t)*text++;
-        if (c == '"' || c == '\\') {
-            put(&ts->enc, '\\');
-            put(&ts->enc, c);
-        } else if (c == '\n') {
-            put_text(ts, "\\n");
-        } else if (c == '\t') {
-            put_text(ts, "\\t");
-        } else if (c == '\r') {
-            put_text(ts, "\\r");
-        } else if (c < 0x20u) {
-            put_text(ts, "\\u00");
-            put(&ts->enc, (uint8_t)hex[c >> 4]);
-            put(&ts->enc, (uint8_t)hex[c & 15u]);
-        } else {
-            put(&ts->enc, c); /* UTF-8 passes through */
-        }
+    if (c == '"' || c == '\\') {
+        put(&ts->enc, '\\');
+        put(&ts->enc, c);
+    } else if (c == '\n') {
+        put_text(ts, "\\n");
+    } else if (c == '\t') {
+        put_text(ts, "\\t");
+    } else if (c == '\r') {
+        put_text(ts, "\\r");
+    } else if (c < 0x20u) {
+        put_text(ts, "\\u00");
+        put(&ts->enc, (uint8_t)hex[c >> 4]);
+        put(&ts->enc, (uint8_t)hex[c & 15u]);
+    } else {
+        put(&ts->enc, c); /* UTF-8 passes through */
     }
 }
 
-static size_t text_length(const char *text)
+void ts_ident_text(ts_context *ts, const char *text, size_t len)
 {
-    size_t n = 0;
-    while (text[n]) n++;
-    return n;
+    while (len--) put_escaped(ts, (uint8_t)*text++);
+}
+
+/* A NUL-terminated string, escaped, in one pass: no length is counted first, since
+   GCC turns a counting loop into a call of strlen at -O2, -O3 and -Os (the library
+   calls nothing outside itself; tests/firmware/test_freestanding.py checks it). */
+static void put_escaped_text(ts_context *ts, const char *text)
+{
+    while (*text) put_escaped(ts, (uint8_t)*text++);
 }
 
 static void put_string_field(ts_context *ts, const char *key, const char *value)
 {
     put_text(ts, key);
     put(&ts->enc, '"');
-    ts_ident_text(ts, value, text_length(value));
+    put_escaped_text(ts, value);
     put(&ts->enc, '"');
 }
 
@@ -381,7 +385,7 @@ void ts_send_ident(ts_context *ts, const char *device, const char *firmware, con
                    const char *sensor_toml)
 {
     ts_ident_begin(ts, device, firmware, serial);
-    ts_ident_text(ts, sensor_toml, text_length(sensor_toml));
+    put_escaped_text(ts, sensor_toml);
     ts_ident_end(ts);
 }
 

@@ -136,3 +136,105 @@ def design_point(
         "crb_position_mm": position,
         "crb_force_pct": force_pct,
     }
+
+
+IRRELEVANT = ("name", "description", "grid.rows", "grid.cols", "electronics.scan_rate_hz")
+"""Fields of a pad that no variable of the map depends on: every design is evaluated on
+a 7 x 7 patch of taxels (:func:`design_variant`) from one frame."""
+
+
+def _fields(spec: PadSpec) -> dict:
+    """The description as dotted keys -> values."""
+
+    def flatten(data: dict, prefix: str) -> dict:
+        out = {}
+        for key, value in data.items():
+            name = f"{prefix}{key}"
+            if isinstance(value, dict):
+                out.update(flatten(value, f"{name}."))
+            else:
+                out[name] = value
+        return out
+
+    return flatten(spec.to_dict(), "")
+
+
+def map_point(pad: PadSpec) -> tuple[float, float]:
+    """Where ``pad`` sits on a design map: (sensing depth, pitch) [mm], the larger pitch
+    if its two differ (as :func:`design_variant` takes it)."""
+    return pad.layer.sensing_depth_mm, max(pad.grid.row_pitch_mm, pad.grid.col_pitch_mm)
+
+
+def map_differences(sensor: PadSpec, other: PadSpec, poisson_ratio: float) -> dict:
+    """How ``other``, at its own sensing depth and pitch, differs from the design the map
+    of ``sensor`` evaluates there: dotted field -> (other's value, the map's value);
+    empty when the map's values at that point are ``other``'s own.
+
+    The map scales the layer's thickness with the depth and the electrodes with the
+    pitch, keeping ``sensor``'s ratios, and keeps everything else of ``sensor``
+    (transduction, the layer's modulus, electronics, noise): a pad of another
+    transduction, layer or thickness ratio is not on it.
+    """
+    depth, pitch = map_point(other)
+    try:
+        mine = _fields(design_variant(sensor, depth, pitch, poisson_ratio))
+        theirs = _fields(design_variant(other, depth, pitch, poisson_ratio))
+    except SensorSpecError:
+        return {"design": ("not a valid variant", "")}
+    differences = {}
+    for key in sorted(set(mine) | set(theirs)):
+        if key in IRRELEVANT:
+            continue
+        a, b = theirs.get(key), mine.get(key)
+        same = a == b or (
+            isinstance(a, float) and isinstance(b, float) and np.isclose(a, b, rtol=1e-9, atol=0)
+        )
+        if not same:
+            differences[key] = (a, b)
+    return differences
+
+
+def designs_on_map(
+    sensor: PadSpec, pads, poisson_ratio: float
+) -> tuple[dict[str, tuple[float, float]], dict[str, dict]]:
+    """The pads to mark on the design map of ``sensor``: name -> (sensing depth, pitch)
+    [mm] of those whose own design the map evaluates at their point (``sensor`` itself,
+    always), and name -> :func:`map_differences` of those left out (e.g. ``pad4`` on
+    ``pad16``'s map: another transduction and layer, whose bound is finite where the map's
+    is not)."""
+
+    marked = {sensor.name: map_point(sensor)}
+    left_out = {}
+    for pad in pads:
+        if pad.kind != "pad" or pad.name == sensor.name:
+            continue
+        differences = map_differences(sensor, pad, poisson_ratio)
+        if differences:
+            left_out[pad.name] = differences
+        else:
+            marked[pad.name] = map_point(pad)
+    return marked, left_out
+
+
+def _what(key: str) -> str:
+    """A field of a pad description in a few words, for the map's note."""
+    if key == "layer.thickness_mm":
+        return "layer thickness / depth"
+    if key.startswith("grid.electrode"):
+        return "electrode size / pitch"
+    section = key.split(".")[0]
+    return {"layer": "layer material", "flaws": "noise and flaws"}.get(section, section)
+
+
+def left_out_note(left_out: dict[str, dict], sensor_name: str) -> str | None:
+    """One line under the map naming the pads it does not describe, and why."""
+    if not left_out:
+        return None
+    parts = []
+    for name, differences in sorted(left_out.items()):
+        words = dict.fromkeys(_what(key) for key in differences)  # in order, once each
+        parts.append(f"{name} (other {', '.join(words)})")
+    return (
+        f"Not marked: {'; '.join(parts)}. The map keeps {sensor_name}'s transduction, layer "
+        "and ratios; map another pad with --sensor NAME."
+    )

@@ -181,13 +181,16 @@ def design_sweep(
     )
 
 
-def draw_map(dataset, *, designs: dict[str, tuple[float, float]]):
+def draw_map(dataset, *, designs: dict[str, tuple[float, float]], note: str | None = None):
     """The figure of :func:`plot_map` (matplotlib ``Figure``), not yet saved.
 
-    Each named design is a star with its name beside it; names are put alternately above
-    and below their stars (in order of spacing) and on the side of the star away from the
-    nearer edge of the plot, on a white ground, so that two designs of the same depth and
-    close spacings (the paper's two fingers) do not write over each other.
+    Each named design is a star with its name beside it, on a white ground. A name goes
+    first above or below its star (alternately, in order of spacing) on the side away
+    from the nearer edge of the plot; where that would meet another name or star or leave
+    the plot, the other side, below or above, then farther off, until one is clear: two
+    designs of the same depth and close spacings (the paper's two fingers) or close
+    depths and spacings (two pads) never write over each other. ``note``: one line under
+    the panels.
     """
     import matplotlib
 
@@ -196,15 +199,16 @@ def draw_map(dataset, *, designs: dict[str, tuple[float, float]]):
 
     view = dataset.isel(poisson_ratio=0, load_g=0)
     d, s = view["depth_mm"].values, view["spacing_mm"].values
-    fig, axes = plt.subplots(1, 3, figsize=(14, 4.2), constrained_layout=True)
+    fig, axes = plt.subplots(1, 3, figsize=(14, 4.2 if note is None else 4.5), layout="constrained")
     ordered = sorted(designs.items(), key=lambda item: (item[1][1], item[1][0]))
+    pad = "crb_position_mm" in view
     for ax, (name, title) in zip(
         axes,
         (
             ("counts_per_gram", "sensitivity [A/D units per g]"),
-            ("xi", "aliasing xi (eq. 45; in 2-D for a pad)"),
+            ("xi", "aliasing xi (eq. 45, in 2-D)" if pad else "aliasing xi (eq. 45)"),
             (
-                "crb_position_mm" if "crb_position_mm" in view else "crb_axial_mm",
+                "crb_position_mm" if pad else "crb_axial_mm",
                 "best possible position sd [mm] (CRB)",
             ),
         ),
@@ -223,36 +227,88 @@ def draw_map(dataset, *, designs: dict[str, tuple[float, float]]):
         fig.colorbar(mesh, ax=ax)
         if unbounded:
             title = f"{title}\n(blank: not observable, no overlap between taxels)"
-        low, high = ax.get_xlim()
-        for k, (label, (depth, spacing)) in enumerate(ordered):
+        for _, (depth, spacing) in ordered:
             ax.plot(spacing, depth, "r*", ms=12, mec="white", mew=0.8)
-            right_half = spacing > 0.5 * (low + high)
-            above = k % 2 == 0
-            ax.annotate(
-                label,
-                (spacing, depth),
-                color="r",
-                fontsize=9,
-                xytext=(-6 if right_half else 6, 9 if above else -9),
-                textcoords="offset points",
-                ha="right" if right_half else "left",
-                va="bottom" if above else "top",
-                bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.85},
-            )
-        pad = "crb_position_mm" in view
         ax.set_xlabel("taxel pitch [mm]" if pad else "tactel spacing along the finger [mm]")
         ax.set_ylabel("sensing depth [mm]" if pad else "effective depth [mm]")
         ax.set_title(title, fontsize=10)
     nu, load = float(view["poisson_ratio"]), float(view["load_g"])
     fig.suptitle(f"Design map (nu = {nu:g}, {load:g}-g probe)")
+    if note:
+        import textwrap
+
+        fig.supxlabel(textwrap.fill(note, 190), fontsize=9, color="0.25")
+    # settle the layout, then keep it: the names are placed where they will be drawn
+    fig.canvas.draw()
+    fig.set_layout_engine("none")
+    renderer = fig.canvas.get_renderer()
+    for ax in axes:
+        _name_designs(ax, ordered, renderer)
     return fig
 
 
-def plot_map(dataset, path, *, designs: dict[str, tuple[float, float]]) -> None:
+def _name_designs(ax, ordered, renderer) -> None:
+    """Write each design's name beside its star where it meets no other name or star and
+    stays inside the plot (see :func:`draw_map`)."""
+    low, high = ax.get_xlim()
+    inside = ax.get_window_extent(renderer)
+    stars = []
+    for _, (depth, spacing) in ordered:
+        x, y = ax.transData.transform((spacing, depth))
+        stars.append(_bbox(x - 7, y - 7, x + 7, y + 7))
+    taken = []
+    for k, (label, (depth, spacing)) in enumerate(ordered):
+        away = -1 if spacing > 0.5 * (low + high) else 1  # toward the middle of the plot
+        first = 1 if k % 2 == 0 else -1  # above, below, above...
+        tried = [
+            (side, up * distance)
+            for distance in (9, 22, 36)
+            for up in (first, -first)
+            for side in (away, -away)
+        ]
+        own = stars[k]
+        for n, (side, dy) in enumerate(tried):
+            text = ax.annotate(
+                label,
+                (spacing, depth),
+                color="r",
+                fontsize=9,
+                xytext=(6 * side, dy),
+                textcoords="offset points",
+                ha="left" if side > 0 else "right",
+                va="bottom" if dy > 0 else "top",
+                bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.85},
+            )
+            box = text.get_window_extent(renderer).padded(2)
+            clear = (
+                box.x0 >= inside.x0
+                and box.x1 <= inside.x1
+                and box.y0 >= inside.y0
+                and box.y1 <= inside.y1
+                and not any(box.overlaps(other) for other in taken)
+                and not any(box.overlaps(star) for star in stars if star is not own)
+            )
+            if clear or n == len(tried) - 1:
+                taken.append(box)
+                break
+            text.remove()
+
+
+def _bbox(x0: float, y0: float, x1: float, y1: float):
+    """A matplotlib ``Bbox`` in display coordinates [px]."""
+    from matplotlib.transforms import Bbox
+
+    return Bbox.from_extents(x0, y0, x1, y1)
+
+
+def plot_map(
+    dataset, path, *, designs: dict[str, tuple[float, float]], note: str | None = None
+) -> None:
     """Sensitivity, aliasing and the position bound over depth x spacing, with the named
-    designs (name -> (depth, spacing)) marked; first Poisson's ratio and load."""
+    designs (name -> (depth, spacing)) marked and ``note`` under them; first Poisson's
+    ratio and load."""
     import matplotlib.pyplot as plt
 
-    fig = draw_map(dataset, designs=designs)
+    fig = draw_map(dataset, designs=designs, note=note)
     fig.savefig(path, dpi=100)
     plt.close(fig)

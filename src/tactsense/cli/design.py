@@ -397,15 +397,14 @@ def design_sweep_command(
     with atomic_output(out) as temporary:
         dataset.to_netcdf(temporary, engine="scipy")
     if plot is not None:
-        if spec.kind == "pad":  # the pad presets: sensing depth and pitch
+        note = None
+        if spec.kind == "pad":  # the pad and the presets the map describes (same layer...)
+            from tactsense.analysis.pad_design import designs_on_map, left_out_note
             from tactsense.sensor import PRESETS
 
             pads = [make() for make in PRESETS.values()]
-            designs = {
-                p.name: (p.layer.sensing_depth_mm, p.grid.row_pitch_mm)
-                for p in pads
-                if p.kind == "pad"
-            }
+            designs, left_out = designs_on_map(spec, pads, ratios[0])
+            note = left_out_note(left_out, spec.name)
         else:
             designs = {
                 "initial": (3.8, 3.8),
@@ -415,7 +414,7 @@ def design_sweep_command(
                 ),
             }
         with atomic_output(plot) as temporary:
-            plot_map(dataset, temporary, designs=designs)
+            plot_map(dataset, temporary, designs=designs, note=note)
     n = len(depths) * len(spacings) * len(ratios) * len(loads)
     fits = int(np.isfinite(dataset["xi"].values).sum())
     console.print(f"wrote {out}: {n} designs ({n - fits} do not fit the {spec.kind}: NaN)")

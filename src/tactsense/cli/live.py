@@ -717,9 +717,11 @@ def view(
 
     The page shows a finger unwrapped (length across, circumference down, the tip row
     apart, the seam marked), a pad as a flat grid in millimetres, a point set as dots at
-    their positions; the interpolated surface, the contact with its trail (fingers:
-    contacts on pads and point sets are not estimated yet), force and tactel time
-    traces, and the stream's health (frame rate, losses by kind, latency). The server
+    their positions; the interpolated surface, the contacts with their trails (a finger's
+    one contact; on pads and point sets every contact, tracked, with its id), force and
+    tactel time traces, and the stream's health (frame rate, losses by kind, latency).
+    A recording played to its end says "ended"; the page's speed selector shows --speed.
+    The server
     listens on 127.0.0.1 only unless --host says otherwise; it prints the address and
     serves until Ctrl-C.
     """

@@ -254,7 +254,8 @@ PLURAL = {"finger": "fingers", "pad": "pads", "points": "point sets"}
 
 
 def estimates(sensor: SpecBase) -> bool:
-    """Whether contacts on this kind of sensor are estimated (the finger, for now)."""
+    """Whether contacts on this kind of sensor are estimated (:data:`LOCATORS`: fingers,
+    pads and point sets)."""
     return sensor.kind in LOCATORS
 
 
@@ -634,6 +635,7 @@ class RecordingFeed(Feed):
         self._wake = threading.Event()
         self._jumped = False
         self._pending_show = True  # show the frame at the position now (start, seek, step)
+        self._finished = False  # played to the last frame (status "ended")
         times = self.file.time_s(0, min(self.n_frames, 2))
         self.period_s = float(np.diff(times)[0]) if len(times) > 1 else sensor.scan_period_s
         if not self.period_s > 0:
@@ -652,6 +654,12 @@ class RecordingFeed(Feed):
             self._times = self.file.time_s(self._block_start, stop)
         offset = index - self._block_start
         return self._block[offset], float(self._times[offset])
+
+    def layout(self) -> dict:
+        message = super().layout()
+        with self._lock:  # the state now: the history's frames carry the state then
+            message["playback"] = self._playback()
+        return message
 
     def _playback(self) -> dict:
         return {
@@ -683,6 +691,8 @@ class RecordingFeed(Feed):
             self.rezero()
             return
         with self._lock:
+            if command in ("play", "step", "seek"):
+                self._finished = False
             if command == "play":
                 if self.position >= self.n_frames - 1:
                     self.position, self._jumped = 0, True
@@ -731,7 +741,8 @@ class RecordingFeed(Feed):
                         self.position += 1
                 continue
             if not playing:
-                self._status_if("paused")
+                # played to the last frame: ended, not paused (play starts it over)
+                self._status_if("ended" if self._finished else "paused")
                 self._wake.wait(0.25)
                 self._wake.clear()
                 continue
@@ -742,12 +753,17 @@ class RecordingFeed(Feed):
             self._status_if("playing")
             self._show(position, self._rate(now))
             next_due = max(next_due + self.period_s / self.speed, now - 0.5)
+            finished = None
             with self._lock:
                 if self.position == position:  # not moved by a command meanwhile
                     if position >= self.n_frames - 1:
                         self.playing = False
+                        self._finished = True
+                        finished = self._playback()
                     else:
                         self.position = position + 1
+            if finished is not None:  # every page's play button says "play" now
+                self._publish(json.dumps({"type": "playback", **finished}))
 
     def _status_if(self, status: str) -> None:
         if self.status != status:

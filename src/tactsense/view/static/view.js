@@ -588,6 +588,21 @@ function showHealth(frame) {
   $("skipped").textContent = state.skipped;
 }
 
+// The speed selector shows the speed the server plays at (--speed, or another page's
+// choice); a speed not among its options gets an option of its own, in order.
+function showSpeed(speed) {
+  if (typeof speed !== "number" || !(speed > 0)) return;
+  const select = $("speed");
+  if (document.activeElement === select) return;
+  let option = [...select.options].find((o) => Number(o.value) === speed);
+  if (!option) {
+    option = new Option(`${speed}×`, String(speed));
+    const after = [...select.options].find((o) => Number(o.value) > speed);
+    select.add(option, after || null);
+  }
+  select.value = option.value;
+}
+
 function showPlayback(p) {
   if (!p) return;
   $("playback").hidden = false;
@@ -595,6 +610,7 @@ function showPlayback(p) {
   seek.max = p.n_frames - 1;
   if (document.activeElement !== seek) seek.value = p.position;
   $("play").textContent = p.playing ? "pause" : "play";
+  showSpeed(p.speed);
   const f = state.latest;
   // frames count from 0, as the stream panel, the seek bar and the estimates' frame column
   if (f) $("position").textContent = `frame ${f.index} of 0–${p.n_frames - 1} · ${f.time_s.toFixed(2)} s`;
@@ -694,6 +710,7 @@ function onLayout(L) {
   if (!forcePlot) makePlots();
   onStatus(L.status);
   for (const f of L.history || []) onFrame(f, true);
+  if (L.playback) showPlayback(L.playback);   // now, not as the last frame in history was
   state.dirty = true;
 }
 
