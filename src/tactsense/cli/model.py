@@ -244,6 +244,39 @@ def sensor_show(
         fail(str(error))
 
 
+def _preset_row(name: str, spec) -> tuple[str, str, str, str, str]:
+    """(name, kind, size, pitch, one-line description) of a preset, for ``sensor list``."""
+    if spec.kind == "finger":
+        a = spec.array
+        size = f"{spec.shape[0]} x {spec.shape[1]} tactels"
+        pitch = f"{a.spacing_axial_mm:g} mm x {a.spacing_angle_deg:g} deg"
+    elif spec.kind == "pad":
+        g = spec.grid
+        size = f"{g.rows} x {g.cols} taxels"
+        pitch = f"{g.row_pitch_mm:g} x {g.col_pitch_mm:g} mm"
+    else:  # a point set: the median distance from each taxel to its nearest
+        positions = spec.taxel_positions_mm()
+        gaps = np.linalg.norm(positions[:, None] - positions[None], axis=-1)
+        np.fill_diagonal(gaps, np.inf)
+        size = f"{spec.n_taxels} taxels"
+        pitch = f"{np.median(gaps.min(axis=1)):.3g} mm (nearest, median)"
+    first = spec.description.split(". ")[0].rstrip(".")
+    return name, spec.kind, size, pitch, first
+
+
+@sensor_app.command("list")
+def sensor_list() -> None:
+    """List the built-in presets: name, kind, size, pitch and what each is."""
+    from tactsense.sensor import PRESETS
+
+    table = Table(title="built-in sensors (tactsense sensor show NAME prints one as TOML)")
+    for column in ("name", "kind", "size", "pitch", "description"):
+        table.add_column(column)
+    for name, make in PRESETS.items():
+        table.add_row(*_preset_row(name, make()))
+    print_table(table)
+
+
 @sensor_app.command("check")
 def sensor_check(
     path: Annotated[Path, typer.Argument(help="Sensor TOML file to validate.")],
