@@ -111,22 +111,33 @@ def two_probes(
     dwell_s: float = 0.5,
     settle_s: float = 0.2,
     angle_deg: float = 90.0,
+    x_mm: float | None = None,
+    y_mm: float | None = None,
 ) -> Scenario:
-    """Two equal spheres ``separation_mm`` apart about the middle, along ``angle_deg`` from x."""
+    """Two equal spheres ``separation_mm`` apart about ``(x_mm, y_mm)`` (default: the
+    middle), the pair along ``angle_deg`` from the x axis (90: along y, the default)."""
     check_positive(separation_mm, "separation_mm")
     cx, cy = centre_mm(spec)
+    cx, cy = (cx if x_mm is None else float(x_mm)), (cy if y_mm is None else float(y_mm))
+    if not math.isfinite(angle_deg):
+        raise TactsenseInputError(f"angle_deg must be a finite angle [deg]; got {angle_deg!r}")
+    _check_on(spec, cx, cy, "the pair's centre (x_mm, y_mm)")
     dx = 0.5 * separation_mm * math.cos(math.radians(angle_deg))
     dy = 0.5 * separation_mm * math.sin(math.radians(angle_deg))
     first = SphereProbe(cx - dx, cy - dy, force_n, radius_mm=size_mm)
     second = SphereProbe(cx + dx, cy + dy, force_n, radius_mm=size_mm)
     for probe in (first, second):
-        _check_on(spec, probe.x_mm, probe.y_mm, "probe")
+        _check_on(spec, probe.x_mm, probe.y_mm,
+                  f"a probe {separation_mm:g} mm (separation_mm) from its pair along "
+                  f"{angle_deg:g} deg (angle_deg)")  # fmt: skip
     return Scenario(
         (*_settle(settle_s), Step((first, second), dwell_s, "two probes"), Step((), 0.2, "lifted")),
         "two-probes",
-        f"two {size_mm:g}-mm spheres of {force_n:g} N each, {separation_mm:g} mm apart",
-        {"separation_mm": separation_mm, "force_n": force_n, "size_mm": size_mm},
-    )
+        f"two {size_mm:g}-mm spheres of {force_n:g} N each, {separation_mm:g} mm apart about "
+        f"({cx:g}, {cy:g}) mm along {angle_deg:g} deg from x",
+        {"separation_mm": separation_mm, "force_n": force_n, "size_mm": size_mm,
+         "x_mm": cx, "y_mm": cy, "angle_deg": angle_deg},
+    )  # fmt: skip
 
 
 def slide(

@@ -54,13 +54,15 @@ ScenarioOption = Annotated[
 XOption = Annotated[
     float | None,
     typer.Option("--x-mm", min=-1e4, max=1e4,
-                 help="Pads: where the indenter presses, along x (the rows) [mm] "
+                 help="Pads: where the indenter presses ('two-probes': the pair's centre, "
+                 "'loads': where the presses are), along x (the rows) [mm] "
                  "[default: the middle]; point sets: in the tangent plane of taxel 0."),
 ]  # fmt: skip
 YOption = Annotated[
     float | None,
     typer.Option("--y-mm", min=-1e4, max=1e4,
-                 help="Pads: where the indenter presses, along y (the columns) [mm] "
+                 help="Pads: where the indenter presses ('two-probes': the pair's centre, "
+                 "'loads': where the presses are), along y (the columns) [mm] "
                  "[default: the middle]."),
 ]  # fmt: skip
 SeparationOption = Annotated[
@@ -89,7 +91,8 @@ AngleOption = Annotated[
     float | None,
     typer.Option("--angle-deg", min=-360.0, max=360.0,
                  help="'knife-edge' on a pad: the edge's angle from the x axis [deg] "
-                 "[default: 0]."),
+                 "[default: 0]; 'two-probes': the axis the pair is separated along, from "
+                 "the x axis [deg] [default: 90, along y]."),
 ]  # fmt: skip
 RowOption = Annotated[
     int | None,
@@ -178,7 +181,15 @@ USES = {
         "repeats",
     ),
     ScenarioKind.hold: ("x_mm", "y_mm", "force_g", "indenter", "size_mm", "dwell_s", "lift_s"),
-    ScenarioKind.two_probes: ("separation_mm", "force_g", "size_mm", "dwell_s"),
+    ScenarioKind.two_probes: (
+        "x_mm",
+        "y_mm",
+        "separation_mm",
+        "angle_deg",
+        "force_g",
+        "size_mm",
+        "dwell_s",
+    ),
     ScenarioKind.slide: ("force_g", "size_mm", "speed_mm_s", "increment"),
     ScenarioKind.sweep: ("x_mm", "force_g", "size_mm", "increment", "dwell_s"),
     ScenarioKind.punch: ("force_g", "size_mm", "dwell_s"),
@@ -364,6 +375,24 @@ def build_scenario(
     )
 
 
+def _check_place(spec, x_mm: float | None, y_mm: float | None) -> None:
+    """Refuse a ``--x-mm`` or ``--y-mm`` off a pad, naming the option and the pad's range."""
+    if spec.kind != "pad":
+        return
+    g = spec.grid
+    for flag, value, pitch, n, axis in (
+        ("--x-mm", x_mm, g.row_pitch_mm, g.rows, "x"),
+        ("--y-mm", y_mm, g.col_pitch_mm, g.cols, "y"),
+    ):
+        low, high = -0.5 * pitch, (n - 0.5) * pitch
+        if value is not None and not low <= value <= high:
+            raise TactsenseInputError(
+                f"{flag} {value:g} is off the {g.rows}x{g.cols} pad {spec.name!r}: "
+                f"{axis} runs from {low:g} to {high:g} mm (taxel centres 0 to "
+                f"{(n - 1) * pitch:g} mm)"
+            )
+
+
 def _flat_scenario(spec, scenario: ScenarioKind, given: dict):
     """A pad's or a point set's scenario from the options given (None: the builder's
     default)."""
@@ -373,6 +402,7 @@ def _flat_scenario(spec, scenario: ScenarioKind, given: dict):
              "y_mm": "y_mm", "separation_mm": "separation_mm", "indenter": "indenter",
              "speed_mm_s": "speed_mm_s", "angle_deg": "angle_deg"}  # fmt: skip
     options = {names[k]: v for k, v in given.items() if k in names and v is not None}
+    _check_place(spec, given.get("x_mm"), given.get("y_mm"))
     # the help's default, 50 g, for every scenario (a knife edge included)
     options["force_n"] = grams_force(
         DEFAULTS["force_g"] if given["force_g"] is None else given["force_g"]
