@@ -6,6 +6,7 @@ import math
 from enum import StrEnum
 from typing import Annotated
 
+import numpy as np
 import typer
 
 from tactsense._validation import TactsenseInputError
@@ -27,11 +28,12 @@ class ScenarioKind(StrEnum):
     slide = "slide"
     sweep = "sweep"
     punch = "punch"
+    loads = "loads"
 
 
 FINGER_SCENARIOS = ("sweep-axial", "sweep-around", "repeated", "calibration", "knife-edge")
 FLAT_SCENARIOS = ("press", "hold", "two-probes", "slide", "sweep", "knife-edge", "punch",
-                  "calibration")  # fmt: skip
+                  "calibration", "loads")  # fmt: skip
 """The scenarios of a finger, and of a pad or a point set (``tactsense.flat_scenarios``)."""
 
 ScenarioOption = Annotated[
@@ -48,7 +50,9 @@ ScenarioOption = Annotated[
         "'slide' slides a sphere across at --speed-mm-s, 'sweep' presses a sphere every "
         "--increment mm along y (Fig. 7 on a pad), 'knife-edge' presses a knife edge "
         "across the middle, 'punch' a flat punch (a uniform press), 'calibration' a "
-        "sphere on every taxel in turn (for 'calibrate')."
+        "sphere on every taxel in turn (for 'calibrate'), 'loads' presses a sphere with "
+        "each of --forces-g in turn (for 'calibrate --force-log'; write the log with "
+        "--force-log)."
     ),
 ]
 XOption = Annotated[
@@ -56,14 +60,15 @@ XOption = Annotated[
     typer.Option("--x-mm", min=-1e4, max=1e4,
                  help="Pads: where the indenter presses ('two-probes': the pair's centre, "
                  "'loads': where the presses are), along x (the rows) [mm] "
-                 "[default: the middle]; point sets: in the tangent plane of taxel 0."),
+                 "[default: the middle; 'loads': the taxel nearest it]; point sets: in the "
+                 "tangent plane of taxel 0."),
 ]  # fmt: skip
 YOption = Annotated[
     float | None,
     typer.Option("--y-mm", min=-1e4, max=1e4,
                  help="Pads: where the indenter presses ('two-probes': the pair's centre, "
                  "'loads': where the presses are), along y (the columns) [mm] "
-                 "[default: the middle]."),
+                 "[default: the middle; 'loads': the taxel nearest it]."),
 ]  # fmt: skip
 SeparationOption = Annotated[
     float | None,
@@ -93,6 +98,13 @@ AngleOption = Annotated[
                  help="'knife-edge' on a pad: the edge's angle from the x axis [deg] "
                  "[default: 0]; 'two-probes': the axis the pair is separated along, from "
                  "the x axis [deg] [default: 90, along y]."),
+]  # fmt: skip
+ForcesGOption = Annotated[
+    str | None,
+    typer.Option("--forces-g", metavar="A,B,C|START:STOP:COUNT",
+                 help="'loads': the press forces in grams-force, a list (20,50,100) or "
+                 "COUNT evenly spaced from START to STOP (10:100:8), each 0.001-100000 g "
+                 "[default: 10:100:8]."),
 ]  # fmt: skip
 RowOption = Annotated[
     int | None,
@@ -191,6 +203,7 @@ USES = {
         "dwell_s",
     ),
     ScenarioKind.slide: ("force_g", "size_mm", "speed_mm_s", "increment"),
+    ScenarioKind.loads: ("x_mm", "y_mm", "forces_g", "size_mm", "dwell_s", "lift_s", "repeats"),
     ScenarioKind.sweep: ("x_mm", "force_g", "size_mm", "increment", "dwell_s"),
     ScenarioKind.punch: ("force_g", "size_mm", "dwell_s"),
     ScenarioKind.sweep_axial: ("col", "force_g", "increment", "dwell_s", "lift_s"),
@@ -309,6 +322,7 @@ def build_scenario(
     size_mm: float | None = None,
     speed_mm_s: float | None = None,
     angle_deg: float | None = None,
+    forces_g: str | None = None,
 ):
     """The :class:`~tactsense.simulate.Scenario` the command-line options describe.
 
@@ -322,7 +336,7 @@ def build_scenario(
             row=row, col=col, force_g=force_g, increment=increment, dwell_s=dwell_s,
             lift_s=lift_s, repeats=repeats, x_mm=x_mm, y_mm=y_mm,
             separation_mm=separation_mm, indenter=indenter, size_mm=size_mm,
-            speed_mm_s=speed_mm_s, angle_deg=angle_deg,
+            speed_mm_s=speed_mm_s, angle_deg=angle_deg, forces_g=forces_g,
         )  # fmt: skip
         check_scenario_options(scenario, given, spec.kind)
         check_timing(spec, dwell_s, lift_s)
@@ -342,6 +356,8 @@ def build_scenario(
             repeats=repeats,
         ),
     )
+    if forces_g is not None:
+        check_scenario_options(scenario, {"forces_g": forces_g})
     row, col, force_g = values["row"], values["col"], values["force_g"]
     dwell_s, lift_s, repeats = values["dwell_s"], values["lift_s"], values["repeats"]
     check_timing(spec, dwell, lift_s)
@@ -373,6 +389,29 @@ def build_scenario(
         dwell_s=dwell_s,
         lift_s=lift_s,
     )
+
+
+def parse_forces_g(text: str) -> list[float]:
+    """``--forces-g``: 'A,B,C' or 'START:STOP:COUNT' (COUNT 1-10000), each value
+    0.001-100000 g, as a list of grams [g]."""
+    expected = (
+        f"--forces-g {text!r}: expected grams-force as A,B,C or START:STOP:COUNT "
+        "(COUNT 1-10000), each from 0.001 to 100000 g"
+    )
+    try:
+        if ":" in text:
+            start, stop, count = text.split(":")
+            n = int(count)
+            if not 1 <= n <= 10_000:
+                raise ValueError
+            values = [float(v) for v in np.linspace(float(start), float(stop), n)]
+        else:
+            values = [float(v) for v in text.split(",")]
+    except ValueError:
+        raise TactsenseInputError(expected) from None
+    if not values or not all(math.isfinite(v) and 1e-3 <= v <= 1e5 for v in values):
+        raise TactsenseInputError(expected)
+    return values
 
 
 def _check_place(spec, x_mm: float | None, y_mm: float | None) -> None:
@@ -409,6 +448,10 @@ def _flat_scenario(spec, scenario: ScenarioKind, given: dict):
     )
     if given["increment"] is not None:
         options["increment_mm"] = given["increment"]
+    if scenario is ScenarioKind.loads:
+        del options["force_n"]
+        text = given.get("forces_g") or "10:100:8"
+        options["forces_n"] = [grams_force(g) for g in parse_forces_g(text)]
     if given["size_mm"] is not None:
         key = {"knife-edge": "length_mm", "punch": "radius_mm"}.get(scenario.value, "size_mm")
         options[key] = given["size_mm"]

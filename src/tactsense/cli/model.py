@@ -27,6 +27,7 @@ from tactsense.cli._scenario import (
     DwellOption,
     FlawsOption,
     ForceGOption,
+    ForcesGOption,
     IncrementOption,
     IndenterOption,
     LiftOption,
@@ -72,6 +73,7 @@ def simulate(
     size_mm: SizeOption = None,
     speed_mm_s: SpeedOption = None,
     angle_deg: AngleOption = None,
+    forces_g: ForcesGOption = None,
     flaws: FlawsOption = "all",
     seed: SeedOption = 0,
     forward: Annotated[
@@ -93,8 +95,19 @@ def simulate(
         Path | None,
         typer.Option(help="Also draw the swept tactels' responses to this PNG (sweeps only)."),
     ] = None,
+    force_log: Annotated[
+        Path | None,
+        typer.Option(
+            "--force-log",
+            help="Also write the force applied in each frame (jitter included) as a load "
+            "cell's log: a CSV of time_s [s, the recording's clock] and force_n [N], the "
+            "file 'calibrate --force-log' reads (with --scenario loads: the force curve's "
+            "data). Extension .csv.",
+        ),
+    ] = None,
     force: Annotated[
-        bool, typer.Option("--force", help="Replace OUT and PLOT if they already exist.")
+        bool,
+        typer.Option("--force", help="Replace OUT, PLOT and FORCE_LOG if they already exist."),
     ] = False,
 ) -> None:
     """Simulate a sensor (a finger, a pad or a point set) under a scenario and write an
@@ -103,11 +116,18 @@ def simulate(
 
     try:
         spec = load_sensor(sensor)
-        for target in (out, plot):
+        for target in (out, plot, force_log):
             if target is not None:
                 check_output(target, force, inputs=sensor_file(sensor))
         if plot is not None and same_file(plot, out):
             fail(f"--plot {plot} and --out {out} are the same file; choose two names")
+        if force_log is not None:
+            if same_file(force_log, out) or (plot is not None and same_file(force_log, plot)):
+                fail(f"--force-log {force_log} is the same file as --out or --plot; "
+                     "choose another name")  # fmt: skip
+            if force_log.suffix.lower() != ".csv":
+                fail(f"--force-log {force_log}: the load cell's log is a CSV file; use the "
+                     "extension .csv")  # fmt: skip
         if plot is not None:
             check_plot_format(plot)
         from tactsense.physics.finger3d_table import check_forward
@@ -139,6 +159,7 @@ def simulate(
             size_mm=size_mm,
             speed_mm_s=speed_mm_s,
             angle_deg=angle_deg,
+            forces_g=forces_g,
         )
         if out.suffix.lower() not in (".h5", ".hdf5"):
             fail(
@@ -157,12 +178,42 @@ def simulate(
             f"wrote {out}: {written} frames of {spec.shape[0]}x{spec.shape[1]} "
             f"counts at {spec.electronics.scan_rate_hz:g} Hz ({spec.name}{model})"
         )
+        if force_log is not None:
+            with atomic_output(force_log) as temporary:
+                rows = write_force_log(out, temporary)
+            console.print(f"wrote {force_log}: the applied force of {rows} frames")
         if plot is not None:  # a sweep: a few hundred frames, read back whole
             with atomic_output(plot) as temporary:
                 plot_sweep(read_recording(out), temporary)
             console.print(f"wrote {plot}")
     except (TactsenseInputError, FileExistsError) as error:
         fail(str(error))
+
+
+def write_force_log(recording: Path, path: Path, chunk: int = 65_536) -> int:
+    """Write a simulated recording's applied force per frame as a load cell's CSV log.
+
+    Columns ``time_s`` (the frame's time on the recording's clock [s]) and ``force_n``
+    (the total force of the step the frame reads, jitter included [N]), the format
+    :func:`tactsense.estimate.array_calibration.read_force_log` reads; read from the
+    file's truth in pieces (memory stays flat). Returns the number of rows.
+    """
+    import csv
+
+    import h5py
+
+    with h5py.File(recording, "r") as h5:
+        force = np.asarray(h5["truth/step_force_n"][()], dtype=float)
+        steps, times = h5["truth/frame_step"], h5["time"]
+        with open(path, "w", newline="", encoding="utf-8") as stream:
+            writer = csv.writer(stream)
+            writer.writerow(["time_s", "force_n"])
+            for start in range(0, len(times), chunk):
+                t = times[start : start + chunk]
+                f = np.nan_to_num(force[steps[start : start + chunk]])
+                writer.writerows(zip((f"{v:.9g}" for v in t), (f"{v:.9g}" for v in f),
+                                     strict=True))  # fmt: skip
+        return len(times)
 
 
 @app.command()
