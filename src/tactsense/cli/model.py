@@ -331,8 +331,20 @@ def sensor_list() -> None:
 @sensor_app.command("check")
 def sensor_check(
     path: Annotated[Path, typer.Argument(help="Sensor TOML file to validate.")],
+    probe_g: Annotated[
+        float,
+        typer.Option(
+            "--probe-g",
+            min=1e-3,
+            max=1e5,
+            help="Pads: the load of the 3.2-mm sphere probe the blind-spot check presses "
+            "everywhere on the pad [g].",
+        ),
+    ] = 50.0,
 ) -> None:
-    """Validate a sensor TOML file (finger, pad or point set) and print its derived quantities."""
+    """Validate a sensor TOML file (finger, pad or point set) and print its derived
+    quantities; on a pad, warn of blind spots: places where a --probe-g press moves no
+    taxel's reading by more than three times its noise (read noise and quantization)."""
     try:
         spec = load_sensor(path) if path.suffix.lower() == ".toml" else SensorSpec.from_toml(path)
     except TactsenseInputError as error:
@@ -340,7 +352,65 @@ def sensor_check(
     table = Table(title=f"{spec.name}: valid", show_header=False)
     for label, value in spec.summary():
         table.add_row(label, value)
+    warnings = []
+    if spec.kind == "pad":
+        label, value, warnings = _blind_spot_report(spec, probe_g)
+        table.add_row(label, value)
     print_table(table)
+    for warning in warnings:
+        console.print(f"warning: {warning}", soft_wrap=True, markup=False, highlight=False)
+
+
+def _blind_spot_report(spec, probe_g: float) -> tuple[str, str, list[str]]:
+    """A pad's blind spots for a ``probe_g`` press: (table label, value, warnings)."""
+    from tactsense.analysis.pad_bound import blind_spots, signal_map
+    from tactsense.estimate.contacts import default_threshold
+    from tactsense.physics.contact import grams_force
+
+    force = grams_force(probe_g)
+    found = blind_spots(spec, force)
+    threshold = found["threshold_counts"]
+    label = f"blind spots ({probe_g:g}-g probe)"
+    warnings = []
+    if not found["regions"]:
+        value = (
+            f"none: every place moves a taxel by at least {found['weakest_change_counts']:.3g} "
+            f"counts (threshold {threshold:.3g}, 3 x the reading noise)"
+        )
+    else:
+        regions = found["regions"]
+        biggest = regions[0]
+        value = (
+            f"{100 * found['blind_fraction']:.1f} % of the pad ({found['blind_area_mm2']:.3g} "
+            f"mm^2) in {len(regions)} regions"
+        )
+        where = "; ".join(
+            f"({r['centre_mm'][0]:.3g}, {r['centre_mm'][1]:.3g}) mm" for r in regions[:6]
+        ) + ("; and more" if len(regions) > 6 else "")
+        warnings.append(
+            f"{spec.name!r} does not see a {probe_g:g}-g press (3.2-mm sphere) on "
+            f"{100 * found['blind_fraction']:.1f} % of its area ({found['blind_area_mm2']:.3g} "
+            f"mm^2): there no taxel's reading moves by more than {threshold:.3g} counts "
+            f"(3 x its noise). {len(regions)} blind regions, the largest "
+            f"{biggest['area_mm2']:.3g} mm^2 ({biggest['extent_mm'][0]:.3g} x "
+            f"{biggest['extent_mm'][1]:.3g} mm), centred at {where}. A finer pitch closes "
+            "them ('tactsense design sweep' maps depth against pitch)"
+        )
+    # what locate needs: a rise above its contact threshold
+    _, _, _, rise = signal_map(spec, force)
+    level = default_threshold(spec)
+    if spec.transduction.kind == "resistive":
+        needed = level * spec.transduction.counts_per_strain
+    else:  # the signal is (V - V_o) / V: a rise of level V_o / (1 - level)
+        needed = level * spec.electronics.nominal_counts / (1.0 - level)
+    weak = float(np.mean(rise < needed))
+    if weak > found["blind_fraction"] + 1e-9:
+        warnings.append(
+            f"on {100 * weak:.1f} % of {spec.name!r} a {probe_g:g}-g press raises no taxel "
+            f"above locate's contact threshold ({needed:.3g} counts): it is seen but not "
+            "found as a contact"
+        )
+    return label, value, warnings
 
 
 @sensor_app.command("import")
