@@ -358,7 +358,9 @@ def sensor_check(
         table.add_row(label, value)
     print_table(table)
     for warning in warnings:
-        console.print(f"warning: {warning}", soft_wrap=True, markup=False, highlight=False)
+        console.print(
+            f"warning: {warning}", soft_wrap=True, markup=False, highlight=False, emoji=False
+        )
 
 
 def _blind_spot_report(spec, probe_g: float) -> tuple[str, str, list[str]]:
