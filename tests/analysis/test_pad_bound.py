@@ -149,3 +149,28 @@ def test_pads_only():
         pb.cramer_rao_bound(ts.preset("initial"), 1.0, 1.0, FIFTY_G)
     with pytest.raises(TactsenseInputError, match="blind spots are mapped on pads"):
         pb.blind_spots(ts.preset("dome12"), FIFTY_G)
+
+
+def test_the_numbers_in_docs_sensors_md_are_the_code_s(lab4):
+    """docs/sensors.md quotes the lab pad's blind spots, the presets' weakest places and
+    pad4's bound: each as the code prints it now."""
+    from pathlib import Path
+
+    doc = " ".join((Path(__file__).parents[2] / "docs" / "sensors.md").read_text().split())
+    found = pb.blind_spots(ts.load_sensor(lab4), FIFTY_G)
+    assert (
+        f"on {100 * found['blind_fraction']:.1f} % of its area "
+        f"({found['blind_area_mm2']:.3g} mm^2) in {len(found['regions'])} regions" in doc
+    )
+    assert f"each {found['regions'][0]['area_mm2']:.3g} mm^2" in doc
+    weakest = {
+        name: f"{pb.blind_spots(ts.preset(name), FIFTY_G)['weakest_change_counts']:.3g}"
+        for name in ("pad4", "pad16", "pad12x32")
+    }
+    assert (
+        f"by {weakest['pad4']} counts on `pad4`, {weakest['pad16']} on `pad16` and "
+        f"{weakest['pad12x32']} on `pad12x32`" in doc
+    )
+    crb = pb.cramer_rao_bound(ts.preset("pad4"), 6.0, 6.0, FIFTY_G)
+    assert f"{1e3 * crb['x_mm']:.3g} um along x and y" in doc
+    assert f"{100 * crb['force_relative']:.2g} % of the force" in doc
