@@ -16,6 +16,7 @@ def workspace(tmp_path_factory):
     folder = tmp_path_factory.mktemp("asks")
     (folder / "taken.csv").write_text("x")
     (folder / "pad16.toml").write_text('name = "pad16"\nextends = "pad16"\n')
+    (folder / "initial.toml").write_text('name = "initial"\nextends = "initial"\n')
     return folder
 
 
@@ -53,6 +54,7 @@ BAD = [
     ("design bound --sensor pad4 --x-mm nan", "'--x-mm': NaN is not a number"),
     ("sensor check DIR/pad16.toml --probe-g 0", "Invalid value for '--probe-g'"),
     ("sensor check DIR/pad16.toml --probe-g nan", "'--probe-g': NaN is not a number"),
+    ("sensor check DIR/initial.toml --probe-g 50", "--probe-g maps the blind spots of a pad"),
     ("sensor list --sensor pad4", "No such option: --sensor"),
 ]  # fmt: skip
 

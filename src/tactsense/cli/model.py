@@ -332,15 +332,15 @@ def sensor_list() -> None:
 def sensor_check(
     path: Annotated[Path, typer.Argument(help="Sensor TOML file to validate.")],
     probe_g: Annotated[
-        float,
+        float | None,
         typer.Option(
             "--probe-g",
             min=1e-3,
             max=1e5,
             help="Pads: the load of the 3.2-mm sphere probe the blind-spot check presses "
-            "everywhere on the pad [g].",
+            "everywhere on the pad [g] [default: 50].",
         ),
-    ] = 50.0,
+    ] = None,
 ) -> None:
     """Validate a sensor TOML file (finger, pad or point set) and print its derived
     quantities; on a pad, warn of blind spots: places where a --probe-g press moves no
@@ -353,8 +353,10 @@ def sensor_check(
     for label, value in spec.summary():
         table.add_row(label, value)
     warnings = []
+    if spec.kind != "pad" and probe_g is not None:
+        fail(f"--probe-g maps the blind spots of a pad; {spec.name!r} is a {spec.kind}")
     if spec.kind == "pad":
-        label, value, warnings = _blind_spot_report(spec, probe_g)
+        label, value, warnings = _blind_spot_report(spec, 50.0 if probe_g is None else probe_g)
         table.add_row(label, value)
     print_table(table)
     for warning in warnings:
