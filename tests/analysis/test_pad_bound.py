@@ -93,6 +93,15 @@ def test_signal_map_is_the_layer_model_at_every_probe_position():
             assert change[i, j] == pytest.approx(direct, rel=0.03, abs=0.05)
 
 
+@pytest.mark.parametrize("rows, cols", [(20, 20), (13, 31), (40, 7)])
+def test_a_large_pad_s_map_folded_from_a_small_one_is_the_same(rows, cols):
+    spec = ts.preset("pad16").replace(grid__rows=rows, grid__cols=cols)
+    *_, change, rise = pb.signal_map(spec, FIFTY_G)
+    *_, change_all, rise_all = pb.signal_map(spec, FIFTY_G, fold=False)
+    np.testing.assert_array_equal(change, change_all)
+    np.testing.assert_array_equal(rise, rise_all)
+
+
 def test_lab_pad_is_blind_between_taxels(lab4):
     spec = ts.load_sensor(lab4)
     found = pb.blind_spots(spec, FIFTY_G)

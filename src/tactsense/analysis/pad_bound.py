@@ -166,7 +166,12 @@ def cramer_rao_bound(
 
 
 def signal_map(
-    spec, force_n: float, *, radius_mm: float = PROBE_RADIUS_MM, step_mm: float | None = None
+    spec,
+    force_n: float,
+    *,
+    radius_mm: float = PROBE_RADIUS_MM,
+    step_mm: float | None = None,
+    fold: bool = True,
 ):
     """The largest change of any taxel's reading for a sphere at each point of the pad.
 
@@ -175,7 +180,9 @@ def signal_map(
     strain averaged over an electrode centred at each grid point) gives every taxel's
     strain for every probe position on the grid. The grid covers the pad (a half pitch
     beyond the outer taxels), ``step_mm`` apart (default: the pitch over an integer
-    near 16, at most 0.25 mm), the taxel centres on it.
+    near 16, at most 0.25 mm), the taxel centres on it. With ``fold`` (the default) a
+    large pad's map is made from a small one's (the same numbers, in a time that does
+    not grow with the number of taxels).
 
     Returns
     -------
@@ -209,6 +216,38 @@ def signal_map(
     # probe positions: the pad and a half pitch beyond its outer taxels
     px = np.arange(-(nx // 2), (g.rows - 1) * nx + nx // 2 + 1)
     py = np.arange(-(ny // 2), (g.cols - 1) * ny + ny // 2 + 1)
+    # a probe reaches the taxels within kx, ky grid steps: away from the edges the map
+    # repeats from one cell to the next, and a large pad's map is a small one's with its
+    # middle cell repeated (exactly: the kernel ends at the reach)
+    mx, my = math.ceil(kx / nx), math.ceil(ky / ny)
+    small_rows, small_cols = min(g.rows, 2 * mx + 3), min(g.cols, 2 * my + 3)
+    if fold and (small_rows, small_cols) != (g.rows, g.cols):
+        small = spec.replace(grid__rows=small_rows, grid__cols=small_cols, flaws__dead_tactels=())
+        _, _, change, rise = _signal_map_direct(small, kernel, nx, ny, kx, ky, ox.size, oy.size)
+        ix = _fold(px, nx, mx, g.rows, small_rows) + nx // 2
+        iy = _fold(py, ny, my, g.cols, small_cols) + ny // 2
+        return px * hx, py * hy, change[np.ix_(ix, iy)], rise[np.ix_(ix, iy)]
+    _, _, change, rise = _signal_map_direct(spec, kernel, nx, ny, kx, ky, ox.size, oy.size)
+    return px * hx, py * hy, change, rise
+
+
+def _fold(u: np.ndarray, n: int, m: int, count: int, small: int) -> np.ndarray:
+    """Grid index ``u`` (taxel k at ``k n``) on a row of ``count`` taxels -> the index
+    with the same map on a row of ``small`` (``2 m + 3``) taxels: the first and last
+    ``m + 1`` cells as they are, every cell between as the middle one."""
+    if count == small:
+        return u
+    left, right = (m + 1) * n, (count - 1 - (m + 1)) * n
+    return np.where(
+        u <= left, u, np.where(u >= right, u - (count - small) * n, left + (u - left) % n)
+    )
+
+
+def _signal_map_direct(spec, kernel, nx, ny, kx, ky, size_x, size_y):
+    """:func:`signal_map`'s maps, every taxel's kernel placed in turn."""
+    g = spec.grid
+    px = np.arange(-(nx // 2), (g.rows - 1) * nx + nx // 2 + 1)
+    py = np.arange(-(ny // 2), (g.cols - 1) * ny + ny // 2 + 1)
     change = np.zeros((px.size, py.size))
     rise = np.zeros((px.size, py.size))
     for r in range(g.rows):
@@ -216,12 +255,12 @@ def signal_map(
             # taxel at grid index (r nx, c ny); the probe at index p sees kernel[t - p]
             ix = r * nx - px + kx
             iy = c * ny - py + ky
-            okx, oky = (ix >= 0) & (ix < ox.size), (iy >= 0) & (iy < oy.size)
+            okx, oky = (ix >= 0) & (ix < size_x), (iy >= 0) & (iy < size_y)
             block = kernel[np.ix_(ix[okx], iy[oky])]
             sub = np.ix_(okx, oky)
             change[sub] = np.maximum(change[sub], np.abs(block))
             rise[sub] = np.maximum(rise[sub], block)
-    return px * hx, py * hy, change, rise
+    return px, py, change, rise
 
 
 def _regions(mask: np.ndarray) -> tuple[np.ndarray, int]:
