@@ -111,22 +111,33 @@ def two_probes(
     dwell_s: float = 0.5,
     settle_s: float = 0.2,
     angle_deg: float = 90.0,
+    x_mm: float | None = None,
+    y_mm: float | None = None,
 ) -> Scenario:
-    """Two equal spheres ``separation_mm`` apart about the middle, along ``angle_deg`` from x."""
+    """Two equal spheres ``separation_mm`` apart about ``(x_mm, y_mm)`` (default: the
+    middle), the pair along ``angle_deg`` from the x axis (90: along y, the default)."""
     check_positive(separation_mm, "separation_mm")
     cx, cy = centre_mm(spec)
+    cx, cy = (cx if x_mm is None else float(x_mm)), (cy if y_mm is None else float(y_mm))
+    if not math.isfinite(angle_deg):
+        raise TactsenseInputError(f"angle_deg must be a finite angle [deg]; got {angle_deg!r}")
+    _check_on(spec, cx, cy, "the pair's centre (x_mm, y_mm)")
     dx = 0.5 * separation_mm * math.cos(math.radians(angle_deg))
     dy = 0.5 * separation_mm * math.sin(math.radians(angle_deg))
     first = SphereProbe(cx - dx, cy - dy, force_n, radius_mm=size_mm)
     second = SphereProbe(cx + dx, cy + dy, force_n, radius_mm=size_mm)
     for probe in (first, second):
-        _check_on(spec, probe.x_mm, probe.y_mm, "probe")
+        _check_on(spec, probe.x_mm, probe.y_mm,
+                  f"a probe {separation_mm:g} mm (separation_mm) from its pair along "
+                  f"{angle_deg:g} deg (angle_deg)")  # fmt: skip
     return Scenario(
         (*_settle(settle_s), Step((first, second), dwell_s, "two probes"), Step((), 0.2, "lifted")),
         "two-probes",
-        f"two {size_mm:g}-mm spheres of {force_n:g} N each, {separation_mm:g} mm apart",
-        {"separation_mm": separation_mm, "force_n": force_n, "size_mm": size_mm},
-    )
+        f"two {size_mm:g}-mm spheres of {force_n:g} N each, {separation_mm:g} mm apart about "
+        f"({cx:g}, {cy:g}) mm along {angle_deg:g} deg from x",
+        {"separation_mm": separation_mm, "force_n": force_n, "size_mm": size_mm,
+         "x_mm": cx, "y_mm": cy, "angle_deg": angle_deg},
+    )  # fmt: skip
 
 
 def slide(
@@ -264,6 +275,85 @@ def raster(
     )
 
 
+def loads(
+    spec,
+    *,
+    forces_n=None,
+    x_mm: float | None = None,
+    y_mm: float | None = None,
+    places=None,
+    size_mm: float = 1.6,
+    dwell_s: float = 0.5,
+    lift_s: float = 0.5,
+    repeats: int = 1,
+    settle_s: float = 0.2,
+) -> Scenario:
+    """Presses of varied, known force: a sphere pressed with each of ``forces_n`` in turn
+    (the whole list ``repeats`` times), lifted between presses.
+
+    What a lab records with a probe on a stage over a load cell, to fit the force curve
+    of ``tactsense calibrate --force-log``: the force of every frame is in the
+    recording's truth (``step_force_n`` of ``frame_step``), and ``tactsense simulate
+    --force-log`` writes it as the load cell's CSV.
+
+    Parameters
+    ----------
+    forces_n : sequence of float, optional
+        The loads, each positive [N] (default: 8 from 10 to 100 g, light to heavy).
+    x_mm, y_mm : float, optional
+        Where the presses are [mm] (default: on the taxel nearest the middle of a pad,
+        where a light press reaches a taxel; the middle of an even pad lies between
+        taxels, where a 10-g press on ``pad4`` is missed).
+    places : sequence of (x [mm], y [mm]), optional
+        Several places instead, taken in turn press after press (not with ``x_mm``,
+        ``y_mm``).
+    """
+    if forces_n is None:
+        forces_n = [grams_force(g) for g in np.linspace(10.0, 100.0, 8)]
+    forces = np.asarray(forces_n, dtype=float).ravel()
+    if forces.size == 0 or not np.all(np.isfinite(forces) & (forces > 0)):
+        raise TactsenseInputError(
+            f"forces_n must be one or more positive forces [N]; got {list(forces)}"
+        )
+    check_positive(dwell_s, "dwell_s")
+    if repeats < 1:
+        raise TactsenseInputError(f"repeats must be at least 1; got {repeats}")
+    cx = cy = 0.0
+    if spec.kind == "pad":
+        g = spec.grid
+        cx, cy = (g.rows - 1) // 2 * g.row_pitch_mm, (g.cols - 1) // 2 * g.col_pitch_mm
+    if places is None:
+        places = [((cx if x_mm is None else x_mm), (cy if y_mm is None else y_mm))]
+    elif x_mm is not None or y_mm is not None:
+        raise TactsenseInputError("give places or x_mm/y_mm, not both")
+    places = [(float(x), float(y)) for x, y in places]
+    if not places:
+        raise TactsenseInputError("places is empty; give at least one (x, y) [mm]")
+    for x, y in places:
+        _check_on(spec, x, y, "a press")
+    extra = {"at_taxel": 0} if spec.kind == "points" else {}
+    steps = _settle(settle_s)
+    k = 0
+    for _ in range(repeats):
+        for force in forces:
+            x, y = places[k % len(places)]
+            probe = make_indenter("sphere", x, y, float(force), size_mm, **extra)
+            steps.append(Step((probe,), dwell_s, f"{force:g} N at ({x:g}, {y:g}) mm"))
+            if lift_s > 0:
+                steps.append(Step((), lift_s, "lifted"))
+            k += 1
+    where = f"({places[0][0]:g}, {places[0][1]:g}) mm" if len(places) == 1 else (
+        f"{len(places)} places in turn")  # fmt: skip
+    return Scenario(
+        tuple(steps),
+        "loads",
+        f"{size_mm:g}-mm sphere pressed with {forces.size} forces of {forces.min():g}-"
+        f"{forces.max():g} N ({repeats}x) at {where}",
+        {"forces_n": [float(f) for f in forces], "places_mm": [list(p) for p in places],
+         "size_mm": size_mm, "repeats": repeats},
+    )  # fmt: skip
+
+
 SCENARIOS = {
     "press": press,
     "hold": hold,
@@ -273,5 +363,6 @@ SCENARIOS = {
     "knife-edge": knife,
     "punch": punch,
     "calibration": raster,
+    "loads": loads,
 }
 """Scenario builders for pads and point sets, by the name ``--scenario`` takes."""

@@ -175,8 +175,9 @@ def progress_bar(label: str, *, unit: str = "", quiet: bool = False, eta: bool =
 
 def fail(message: str) -> NoReturn:
     """Print ``error: message`` and leave with exit status 2 (bad input)."""
-    # the message is text, not markup ("[array]" must survive), and one line however long
-    console.print(f"[bold red]error:[/] {escape(message)}", soft_wrap=True)
+    # the message is text, not markup ("[array]" must survive) nor emoji codes ("10:100:8"
+    # must not print as "10💯8"), and one line however long
+    console.print(f"[bold red]error:[/] {escape(message)}", soft_wrap=True, emoji=False)
     raise typer.Exit(code=2)
 
 

@@ -6,6 +6,7 @@ import math
 from enum import StrEnum
 from typing import Annotated
 
+import numpy as np
 import typer
 
 from tactsense._validation import TactsenseInputError
@@ -27,11 +28,12 @@ class ScenarioKind(StrEnum):
     slide = "slide"
     sweep = "sweep"
     punch = "punch"
+    loads = "loads"
 
 
 FINGER_SCENARIOS = ("sweep-axial", "sweep-around", "repeated", "calibration", "knife-edge")
 FLAT_SCENARIOS = ("press", "hold", "two-probes", "slide", "sweep", "knife-edge", "punch",
-                  "calibration")  # fmt: skip
+                  "calibration", "loads")  # fmt: skip
 """The scenarios of a finger, and of a pad or a point set (``tactsense.flat_scenarios``)."""
 
 ScenarioOption = Annotated[
@@ -48,20 +50,25 @@ ScenarioOption = Annotated[
         "'slide' slides a sphere across at --speed-mm-s, 'sweep' presses a sphere every "
         "--increment mm along y (Fig. 7 on a pad), 'knife-edge' presses a knife edge "
         "across the middle, 'punch' a flat punch (a uniform press), 'calibration' a "
-        "sphere on every taxel in turn (for 'calibrate')."
+        "sphere on every taxel in turn (for 'calibrate'), 'loads' presses a sphere with "
+        "each of --forces-g in turn (for 'calibrate --force-log'; write the log with "
+        "--force-log)."
     ),
 ]
 XOption = Annotated[
     float | None,
     typer.Option("--x-mm", min=-1e4, max=1e4,
-                 help="Pads: where the indenter presses, along x (the rows) [mm] "
-                 "[default: the middle]; point sets: in the tangent plane of taxel 0."),
+                 help="Pads: where the indenter presses ('two-probes': the pair's centre, "
+                 "'loads': where the presses are), along x (the rows) [mm] "
+                 "[default: the middle; 'loads': the taxel nearest it]; point sets: in the "
+                 "tangent plane of taxel 0."),
 ]  # fmt: skip
 YOption = Annotated[
     float | None,
     typer.Option("--y-mm", min=-1e4, max=1e4,
-                 help="Pads: where the indenter presses, along y (the columns) [mm] "
-                 "[default: the middle]."),
+                 help="Pads: where the indenter presses ('two-probes': the pair's centre, "
+                 "'loads': where the presses are), along y (the columns) [mm] "
+                 "[default: the middle; 'loads': the taxel nearest it]."),
 ]  # fmt: skip
 SeparationOption = Annotated[
     float | None,
@@ -89,7 +96,15 @@ AngleOption = Annotated[
     float | None,
     typer.Option("--angle-deg", min=-360.0, max=360.0,
                  help="'knife-edge' on a pad: the edge's angle from the x axis [deg] "
-                 "[default: 0]."),
+                 "[default: 0]; 'two-probes': the axis the pair is separated along, from "
+                 "the x axis [deg] [default: 90, along y]."),
+]  # fmt: skip
+ForcesGOption = Annotated[
+    str | None,
+    typer.Option("--forces-g", metavar="A,B,C|START:STOP:COUNT",
+                 help="'loads': the press forces in grams-force, a list (20,50,100) or "
+                 "COUNT evenly spaced from START to STOP (10:100:8), each 0.001-100000 g "
+                 "[default: 10:100:8]."),
 ]  # fmt: skip
 RowOption = Annotated[
     int | None,
@@ -178,8 +193,17 @@ USES = {
         "repeats",
     ),
     ScenarioKind.hold: ("x_mm", "y_mm", "force_g", "indenter", "size_mm", "dwell_s", "lift_s"),
-    ScenarioKind.two_probes: ("separation_mm", "force_g", "size_mm", "dwell_s"),
+    ScenarioKind.two_probes: (
+        "x_mm",
+        "y_mm",
+        "separation_mm",
+        "angle_deg",
+        "force_g",
+        "size_mm",
+        "dwell_s",
+    ),
     ScenarioKind.slide: ("force_g", "size_mm", "speed_mm_s", "increment"),
+    ScenarioKind.loads: ("x_mm", "y_mm", "forces_g", "size_mm", "dwell_s", "lift_s", "repeats"),
     ScenarioKind.sweep: ("x_mm", "force_g", "size_mm", "increment", "dwell_s"),
     ScenarioKind.punch: ("force_g", "size_mm", "dwell_s"),
     ScenarioKind.sweep_axial: ("col", "force_g", "increment", "dwell_s", "lift_s"),
@@ -298,6 +322,7 @@ def build_scenario(
     size_mm: float | None = None,
     speed_mm_s: float | None = None,
     angle_deg: float | None = None,
+    forces_g: str | None = None,
 ):
     """The :class:`~tactsense.simulate.Scenario` the command-line options describe.
 
@@ -311,7 +336,7 @@ def build_scenario(
             row=row, col=col, force_g=force_g, increment=increment, dwell_s=dwell_s,
             lift_s=lift_s, repeats=repeats, x_mm=x_mm, y_mm=y_mm,
             separation_mm=separation_mm, indenter=indenter, size_mm=size_mm,
-            speed_mm_s=speed_mm_s, angle_deg=angle_deg,
+            speed_mm_s=speed_mm_s, angle_deg=angle_deg, forces_g=forces_g,
         )  # fmt: skip
         check_scenario_options(scenario, given, spec.kind)
         check_timing(spec, dwell_s, lift_s)
@@ -331,6 +356,8 @@ def build_scenario(
             repeats=repeats,
         ),
     )
+    if forces_g is not None:
+        check_scenario_options(scenario, {"forces_g": forces_g})
     row, col, force_g = values["row"], values["col"], values["force_g"]
     dwell_s, lift_s, repeats = values["dwell_s"], values["lift_s"], values["repeats"]
     check_timing(spec, dwell, lift_s)
@@ -364,6 +391,47 @@ def build_scenario(
     )
 
 
+def parse_forces_g(text: str) -> list[float]:
+    """``--forces-g``: 'A,B,C' or 'START:STOP:COUNT' (COUNT 1-10000), each value
+    0.001-100000 g, as a list of grams [g]."""
+    expected = (
+        f"--forces-g {text!r}: expected grams-force as A,B,C or START:STOP:COUNT "
+        "(COUNT 1-10000), each from 0.001 to 100000 g"
+    )
+    try:
+        if ":" in text:
+            start, stop, count = text.split(":")
+            n = int(count)
+            if not 1 <= n <= 10_000:
+                raise ValueError
+            values = [float(v) for v in np.linspace(float(start), float(stop), n)]
+        else:
+            values = [float(v) for v in text.split(",")]
+    except ValueError:
+        raise TactsenseInputError(expected) from None
+    if not values or not all(math.isfinite(v) and 1e-3 <= v <= 1e5 for v in values):
+        raise TactsenseInputError(expected)
+    return values
+
+
+def _check_place(spec, x_mm: float | None, y_mm: float | None) -> None:
+    """Refuse a ``--x-mm`` or ``--y-mm`` off a pad, naming the option and the pad's range."""
+    if spec.kind != "pad":
+        return
+    g = spec.grid
+    for flag, value, pitch, n, axis in (
+        ("--x-mm", x_mm, g.row_pitch_mm, g.rows, "x"),
+        ("--y-mm", y_mm, g.col_pitch_mm, g.cols, "y"),
+    ):
+        low, high = -0.5 * pitch, (n - 0.5) * pitch
+        if value is not None and not low <= value <= high:
+            raise TactsenseInputError(
+                f"{flag} {value:g} is off the {g.rows}x{g.cols} pad {spec.name!r}: "
+                f"{axis} runs from {low:g} to {high:g} mm (taxel centres 0 to "
+                f"{(n - 1) * pitch:g} mm)"
+            )
+
+
 def _flat_scenario(spec, scenario: ScenarioKind, given: dict):
     """A pad's or a point set's scenario from the options given (None: the builder's
     default)."""
@@ -373,12 +441,17 @@ def _flat_scenario(spec, scenario: ScenarioKind, given: dict):
              "y_mm": "y_mm", "separation_mm": "separation_mm", "indenter": "indenter",
              "speed_mm_s": "speed_mm_s", "angle_deg": "angle_deg"}  # fmt: skip
     options = {names[k]: v for k, v in given.items() if k in names and v is not None}
+    _check_place(spec, given.get("x_mm"), given.get("y_mm"))
     # the help's default, 50 g, for every scenario (a knife edge included)
     options["force_n"] = grams_force(
         DEFAULTS["force_g"] if given["force_g"] is None else given["force_g"]
     )
     if given["increment"] is not None:
         options["increment_mm"] = given["increment"]
+    if scenario is ScenarioKind.loads:
+        del options["force_n"]
+        text = given.get("forces_g") or "10:100:8"
+        options["forces_n"] = [grams_force(g) for g in parse_forces_g(text)]
     if given["size_mm"] is not None:
         key = {"knife-edge": "length_mm", "punch": "radius_mm"}.get(scenario.value, "size_mm")
         options[key] = given["size_mm"]

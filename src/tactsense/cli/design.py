@@ -84,39 +84,90 @@ def design_aliasing(
 @app.command("bound")
 def design_bound(
     axial: Annotated[
-        float,
+        float | None,
         typer.Option(
             min=-1e3,
             max=1e3,
-            help="Probe position along the finger, arc length from the "
-            "junction of tip and cylinder, in mm.",
+            help="Fingers: probe position along the finger, arc length from the "
+            "junction of tip and cylinder, in mm [default: 12.5].",
         ),
-    ] = 12.5,
+    ] = None,
     angle: Annotated[
-        float, typer.Option(min=-360.0, max=360.0, help="Probe angle around the finger, in deg.")
-    ] = 0.0,
+        float | None,
+        typer.Option(
+            min=-360.0,
+            max=360.0,
+            help="Fingers: probe angle around the finger, in deg [default: 0].",
+        ),
+    ] = None,
+    x_mm: Annotated[
+        float | None,
+        typer.Option(
+            "--x-mm",
+            min=-1e4,
+            max=1e4,
+            help="Pads: where the probe presses, along x (the rows) [mm] [default: the middle].",
+        ),
+    ] = None,
+    y_mm: Annotated[
+        float | None,
+        typer.Option(
+            "--y-mm",
+            min=-1e4,
+            max=1e4,
+            help="Pads: where the probe presses, along y (the columns) [mm] [default: the middle].",
+        ),
+    ] = None,
     force_g: Annotated[
         float, typer.Option(min=1e-3, max=1e5, help="Probe load in grams-force.")
     ] = 50.0,
     diameter: Annotated[
-        float,
+        float | None,
         typer.Option(
-            min=1e-3, max=100.0, help="Contact diameter of the hemispherical probe, in mm."
+            min=1e-3,
+            max=100.0,
+            help="Fingers: contact diameter of the hemispherical probe, in mm [default: 3]; "
+            "pads: the sphere's diameter, in mm [default: 3.2, the paper's probe].",
         ),
-    ] = 3.0,
+    ] = None,
     sensor: SensorOption = "initial",
     as_json: Annotated[
         bool, typer.Option("--json", help="Print the result as JSON instead of a table.")
     ] = False,
 ) -> None:
-    """Cramer-Rao lower bound on contact position and force at the sensor's reading noise."""
+    """Cramer-Rao lower bound on contact position and force at the sensor's reading noise
+    (a finger, or a pad: a sphere at --x-mm, --y-mm)."""
+    try:
+        spec = load_sensor(sensor)
+        if spec.kind == "pad":
+            for flag, value in (("--axial", axial), ("--angle", angle)):
+                if value is not None:
+                    fail(f"{flag} is for fingers; {spec.name!r} is a pad: give --x-mm, --y-mm")
+            _pad_bound(spec, x_mm, y_mm, force_g, 3.2 if diameter is None else diameter,
+                       as_json)  # fmt: skip
+            return
+        for flag, value in (("--x-mm", x_mm), ("--y-mm", y_mm)):
+            if value is not None:
+                fail(f"{flag} is for pads; {spec.name!r} is a {spec.kind}: give --axial, --angle")
+        spec.require_kind("finger", what="design bound (on fingers and pads)")
+    except TactsenseInputError as error:
+        fail(str(error))
+    _finger_bound(
+        spec,
+        12.5 if axial is None else axial,
+        0.0 if angle is None else angle,
+        force_g,
+        3.0 if diameter is None else diameter,
+        as_json,
+    )
+
+
+def _finger_bound(spec, axial, angle, force_g, diameter, as_json) -> None:
     import json
 
     from tactsense.analysis.bound import cramer_rao_bound, noise_variance
 
     try:
-        spec = load_sensor(sensor)
-        spec.require_kind("finger", what="design bound (design sweep maps pads)")
         bound = cramer_rao_bound(
             spec, axial, angle, grams_force(force_g), contact_diameter_mm=diameter
         )
@@ -157,6 +208,50 @@ def design_bound(
     )
     table.add_row(
         "force", f"{1e3 * bound['force_n']:.2f} mN ({100 * bound['force_relative']:.2f} %)"
+    )
+    print_table(table)
+
+
+def _pad_bound(spec, x_mm, y_mm, force_g, diameter, as_json) -> None:
+    """``design bound`` on a pad: a sphere of ``diameter`` mm at (x_mm, y_mm)."""
+    import json
+
+    from tactsense.analysis.pad_bound import cramer_rao_bound, noise_variance
+    from tactsense.flat_scenarios import centre_mm
+
+    g = spec.grid
+    cx, cy = centre_mm(spec)
+    x = cx if x_mm is None else x_mm
+    y = cy if y_mm is None else y_mm
+    for flag, value, pitch, n, axis in (
+        ("--x-mm", x, g.row_pitch_mm, g.rows, "x"),
+        ("--y-mm", y, g.col_pitch_mm, g.cols, "y"),
+    ):
+        low, high = -0.5 * pitch, (n - 0.5) * pitch
+        if not low <= value <= high:
+            fail(f"{flag} {value:g} is off the {g.rows}x{g.cols} pad {spec.name!r}: {axis} "
+                 f"runs from {low:g} to {high:g} mm")  # fmt: skip
+    force = grams_force(force_g)
+    try:
+        bound = cramer_rao_bound(spec, x, y, force, radius_mm=0.5 * diameter)
+    except TactsenseInputError as error:
+        fail(str(error))
+    noise = float(np.sqrt(noise_variance(spec)))
+    if as_json:
+        inputs = {"x_mm": x, "y_mm": y, "force_n": force, "probe_diameter_mm": diameter,
+                  "sensor": spec.name, "noise_counts": noise}  # fmt: skip
+        typer.echo(json.dumps({"inputs": inputs, "bound": bound}, indent=2))
+        return
+    table = Table(
+        title=f"Cramer-Rao bound, {force_g:g} g ({diameter:g}-mm sphere) at ({x:g}, {y:g}) mm "
+        f"on {spec.name}",
+        show_header=False,
+    )
+    table.add_row("reading noise", f"{noise:.3f} counts RMS (read noise and quantization)")
+    table.add_row("along x", f"{1e3 * bound['x_mm']:.3g} um ({bound['x_pitch']:.3g} pitch)")
+    table.add_row("along y", f"{1e3 * bound['y_mm']:.3g} um ({bound['y_pitch']:.3g} pitch)")
+    table.add_row(
+        "force", f"{1e3 * bound['force_n']:.3g} mN ({100 * bound['force_relative']:.3g} %)"
     )
     print_table(table)
 

@@ -33,6 +33,7 @@ from tactsense.cli._scenario import (
     DwellOption,
     FlawsOption,
     ForceGOption,
+    ForcesGOption,
     IncrementOption,
     IndenterOption,
     LiftOption,
@@ -194,7 +195,7 @@ def _stream_and_locator(
 SCENARIO_PARAMETERS = (
     "sensor", "scenario", "row", "col", "force_g", "increment", "dwell_s", "lift_s",
     "repeats", "x_mm", "y_mm", "separation_mm", "indenter", "size_mm", "speed_mm_s",
-    "angle_deg", "flaws", "seed",
+    "angle_deg", "forces_g", "flaws", "seed",
 )  # fmt: skip
 """emulate's options that build a scenario: a --recording brings its own frames."""
 
@@ -218,6 +219,7 @@ def emulate(
     size_mm: SizeOption = None,
     speed_mm_s: SpeedOption = None,
     angle_deg: AngleOption = None,
+    forces_g: ForcesGOption = None,
     flaws: FlawsOption = "all",
     seed: SeedOption = 0,
     recording: Annotated[
@@ -312,7 +314,7 @@ def emulate(
                 spec, scenario, row=row, col=col, force_g=force_g, increment=increment,
                 dwell_s=dwell_s, lift_s=lift_s, repeats=repeats, x_mm=x_mm, y_mm=y_mm,
                 separation_mm=separation_mm, indenter=indenter, size_mm=size_mm,
-                speed_mm_s=speed_mm_s, angle_deg=angle_deg,
+                speed_mm_s=speed_mm_s, angle_deg=angle_deg, forces_g=forces_g,
             )  # fmt: skip
             source = run_scenario(spec, scene, flaws=flaws, seed=seed)
         emulator = Emulator.from_recording(

@@ -27,6 +27,7 @@ from tactsense.cli._scenario import (
     DwellOption,
     FlawsOption,
     ForceGOption,
+    ForcesGOption,
     IncrementOption,
     IndenterOption,
     LiftOption,
@@ -72,6 +73,7 @@ def simulate(
     size_mm: SizeOption = None,
     speed_mm_s: SpeedOption = None,
     angle_deg: AngleOption = None,
+    forces_g: ForcesGOption = None,
     flaws: FlawsOption = "all",
     seed: SeedOption = 0,
     forward: Annotated[
@@ -93,8 +95,19 @@ def simulate(
         Path | None,
         typer.Option(help="Also draw the swept tactels' responses to this PNG (sweeps only)."),
     ] = None,
+    force_log: Annotated[
+        Path | None,
+        typer.Option(
+            "--force-log",
+            help="Also write the force applied in each frame (jitter included) as a load "
+            "cell's log: a CSV of time_s [s, the recording's clock] and force_n [N], the "
+            "file 'calibrate --force-log' reads (with --scenario loads: the force curve's "
+            "data). Extension .csv.",
+        ),
+    ] = None,
     force: Annotated[
-        bool, typer.Option("--force", help="Replace OUT and PLOT if they already exist.")
+        bool,
+        typer.Option("--force", help="Replace OUT, PLOT and FORCE_LOG if they already exist."),
     ] = False,
 ) -> None:
     """Simulate a sensor (a finger, a pad or a point set) under a scenario and write an
@@ -103,11 +116,18 @@ def simulate(
 
     try:
         spec = load_sensor(sensor)
-        for target in (out, plot):
+        for target in (out, plot, force_log):
             if target is not None:
                 check_output(target, force, inputs=sensor_file(sensor))
         if plot is not None and same_file(plot, out):
             fail(f"--plot {plot} and --out {out} are the same file; choose two names")
+        if force_log is not None:
+            if same_file(force_log, out) or (plot is not None and same_file(force_log, plot)):
+                fail(f"--force-log {force_log} is the same file as --out or --plot; "
+                     "choose another name")  # fmt: skip
+            if force_log.suffix.lower() != ".csv":
+                fail(f"--force-log {force_log}: the load cell's log is a CSV file; use the "
+                     "extension .csv")  # fmt: skip
         if plot is not None:
             check_plot_format(plot)
         from tactsense.physics.finger3d_table import check_forward
@@ -139,6 +159,7 @@ def simulate(
             size_mm=size_mm,
             speed_mm_s=speed_mm_s,
             angle_deg=angle_deg,
+            forces_g=forces_g,
         )
         if out.suffix.lower() not in (".h5", ".hdf5"):
             fail(
@@ -157,12 +178,42 @@ def simulate(
             f"wrote {out}: {written} frames of {spec.shape[0]}x{spec.shape[1]} "
             f"counts at {spec.electronics.scan_rate_hz:g} Hz ({spec.name}{model})"
         )
+        if force_log is not None:
+            with atomic_output(force_log) as temporary:
+                rows = write_force_log(out, temporary)
+            console.print(f"wrote {force_log}: the applied force of {rows} frames")
         if plot is not None:  # a sweep: a few hundred frames, read back whole
             with atomic_output(plot) as temporary:
                 plot_sweep(read_recording(out), temporary)
             console.print(f"wrote {plot}")
     except (TactsenseInputError, FileExistsError) as error:
         fail(str(error))
+
+
+def write_force_log(recording: Path, path: Path, chunk: int = 65_536) -> int:
+    """Write a simulated recording's applied force per frame as a load cell's CSV log.
+
+    Columns ``time_s`` (the frame's time on the recording's clock [s]) and ``force_n``
+    (the total force of the step the frame reads, jitter included [N]), the format
+    :func:`tactsense.estimate.array_calibration.read_force_log` reads; read from the
+    file's truth in pieces (memory stays flat). Returns the number of rows.
+    """
+    import csv
+
+    import h5py
+
+    with h5py.File(recording, "r") as h5:
+        force = np.asarray(h5["truth/step_force_n"][()], dtype=float)
+        steps, times = h5["truth/frame_step"], h5["time"]
+        with open(path, "w", newline="", encoding="utf-8") as stream:
+            writer = csv.writer(stream)
+            writer.writerow(["time_s", "force_n"])
+            for start in range(0, len(times), chunk):
+                t = times[start : start + chunk]
+                f = np.nan_to_num(force[steps[start : start + chunk]])
+                writer.writerows(zip((f"{v:.9g}" for v in t), (f"{v:.9g}" for v in f),
+                                     strict=True))  # fmt: skip
+        return len(times)
 
 
 @app.command()
@@ -244,11 +295,56 @@ def sensor_show(
         fail(str(error))
 
 
+def _preset_row(name: str, spec) -> tuple[str, str, str, str, str]:
+    """(name, kind, size, pitch, one-line description) of a preset, for ``sensor list``."""
+    if spec.kind == "finger":
+        a = spec.array
+        size = f"{spec.shape[0]} x {spec.shape[1]} tactels"
+        pitch = f"{a.spacing_axial_mm:g} mm x {a.spacing_angle_deg:g} deg"
+    elif spec.kind == "pad":
+        g = spec.grid
+        size = f"{g.rows} x {g.cols} taxels"
+        pitch = f"{g.row_pitch_mm:g} x {g.col_pitch_mm:g} mm"
+    else:  # a point set: the median distance from each taxel to its nearest
+        positions = spec.taxel_positions_mm()
+        gaps = np.linalg.norm(positions[:, None] - positions[None], axis=-1)
+        np.fill_diagonal(gaps, np.inf)
+        size = f"{spec.n_taxels} taxels"
+        pitch = f"{np.median(gaps.min(axis=1)):.3g} mm (nearest, median)"
+    first = spec.description.split(". ")[0].rstrip(".")
+    return name, spec.kind, size, pitch, first
+
+
+@sensor_app.command("list")
+def sensor_list() -> None:
+    """List the built-in presets: name, kind, size, pitch and what each is."""
+    from tactsense.sensor import PRESETS
+
+    table = Table(title="built-in sensors (tactsense sensor show NAME prints one as TOML)")
+    for column in ("name", "kind", "size", "pitch", "description"):
+        table.add_column(column)
+    for name, make in PRESETS.items():
+        table.add_row(*_preset_row(name, make()))
+    print_table(table)
+
+
 @sensor_app.command("check")
 def sensor_check(
     path: Annotated[Path, typer.Argument(help="Sensor TOML file to validate.")],
+    probe_g: Annotated[
+        float | None,
+        typer.Option(
+            "--probe-g",
+            min=1e-3,
+            max=1e5,
+            help="Pads: the load of the 3.2-mm sphere probe the blind-spot check presses "
+            "everywhere on the pad [g] [default: 50].",
+        ),
+    ] = None,
 ) -> None:
-    """Validate a sensor TOML file (finger, pad or point set) and print its derived quantities."""
+    """Validate a sensor TOML file (finger, pad or point set) and print its derived
+    quantities; on a pad, warn of blind spots: places where a --probe-g press moves no
+    taxel's reading by more than three times its noise (read noise and quantization)."""
     try:
         spec = load_sensor(path) if path.suffix.lower() == ".toml" else SensorSpec.from_toml(path)
     except TactsenseInputError as error:
@@ -256,7 +352,69 @@ def sensor_check(
     table = Table(title=f"{spec.name}: valid", show_header=False)
     for label, value in spec.summary():
         table.add_row(label, value)
+    warnings = []
+    if spec.kind != "pad" and probe_g is not None:
+        fail(f"--probe-g maps the blind spots of a pad; {spec.name!r} is a {spec.kind}")
+    if spec.kind == "pad":
+        label, value, warnings = _blind_spot_report(spec, 50.0 if probe_g is None else probe_g)
+        table.add_row(label, value)
     print_table(table)
+    for warning in warnings:
+        console.print(
+            f"warning: {warning}", soft_wrap=True, markup=False, highlight=False, emoji=False
+        )
+
+
+def _blind_spot_report(spec, probe_g: float) -> tuple[str, str, list[str]]:
+    """A pad's blind spots for a ``probe_g`` press: (table label, value, warnings)."""
+    from tactsense.analysis.pad_bound import blind_spots, signal_map
+    from tactsense.estimate.contacts import default_threshold
+    from tactsense.physics.contact import grams_force
+
+    force = grams_force(probe_g)
+    found = blind_spots(spec, force)
+    threshold = found["threshold_counts"]
+    label = f"blind spots ({probe_g:g}-g probe)"
+    warnings = []
+    if not found["regions"]:
+        value = (
+            f"none: every place moves a taxel by at least {found['weakest_change_counts']:.3g} "
+            f"counts (threshold {threshold:.3g}, 3 x the reading noise)"
+        )
+    else:
+        regions = found["regions"]
+        biggest = regions[0]
+        value = (
+            f"{100 * found['blind_fraction']:.1f} % of the pad ({found['blind_area_mm2']:.3g} "
+            f"mm^2) in {len(regions)} regions"
+        )
+        where = "; ".join(
+            f"({r['centre_mm'][0]:.3g}, {r['centre_mm'][1]:.3g}) mm" for r in regions[:6]
+        ) + ("; and more" if len(regions) > 6 else "")
+        warnings.append(
+            f"{spec.name!r} does not see a {probe_g:g}-g press (3.2-mm sphere) on "
+            f"{100 * found['blind_fraction']:.1f} % of its area ({found['blind_area_mm2']:.3g} "
+            f"mm^2): there no taxel's reading moves by more than {threshold:.3g} counts "
+            f"(3 x its noise). {len(regions)} blind regions, the largest "
+            f"{biggest['area_mm2']:.3g} mm^2 ({biggest['extent_mm'][0]:.3g} x "
+            f"{biggest['extent_mm'][1]:.3g} mm), centred at {where}. A finer pitch closes "
+            "them ('tactsense design sweep' maps depth against pitch)"
+        )
+    # what locate needs: a rise above its contact threshold
+    _, _, _, rise = signal_map(spec, force)
+    level = default_threshold(spec)
+    if spec.transduction.kind == "resistive":
+        needed = level * spec.transduction.counts_per_strain
+    else:  # the signal is (V - V_o) / V: a rise of level V_o / (1 - level)
+        needed = level * spec.electronics.nominal_counts / (1.0 - level)
+    weak = float(np.mean(rise < needed))
+    if weak > found["blind_fraction"] + 1e-9:
+        warnings.append(
+            f"on {100 * weak:.1f} % of {spec.name!r} a {probe_g:g}-g press raises no taxel "
+            f"above locate's contact threshold ({needed:.3g} counts): it is seen but not "
+            "found as a contact"
+        )
+    return label, value, warnings
 
 
 @sensor_app.command("import")
