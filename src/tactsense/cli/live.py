@@ -322,7 +322,9 @@ def emulate(
         fail(str(error))
     try:
         if port is None:
-            master, _slave, path = emulator.open_pty()  # the slave stays open: no EIO
+            # the protocol's twin keeps the slave open (no EIO); another format's closes
+            # it, to see when a host opens the line
+            master, _slave, path = emulator.open_pty()
             typer.echo(prefix + path)
             sys.stdout.flush()
             console.print(
@@ -353,6 +355,31 @@ def emulate(
             f"{k} {getattr(log, k)}" for k in ("garbage", "bitflip", "drop", "truncate", "stall")
         )
     )
+
+
+RECORD_SUFFIXES = {".h5": RecordFormat.h5, ".hdf5": RecordFormat.h5, ".mcap": RecordFormat.mcap}
+"""What ``record`` writes, by the extension of ``--out`` (without ``--format``)."""
+OTHER_SUFFIXES = (".csv", ".jsonl", ".json", ".txt", ".rrd", ".xdf", ".db3", ".toml", ".npy")
+"""Extensions of files of other kinds: ``record`` never writes a recording under them."""
+
+
+def _check_record_suffix(out: Path, record_format: RecordFormat | None) -> None:
+    """Refuse an output whose name says another kind of file than the one written."""
+    suffix = out.suffix.lower()
+    kind = RECORD_SUFFIXES.get(suffix)
+    if record_format is None and kind is None:
+        fail(
+            f"--out {out}: record writes HDF5 (.h5, .hdf5) or MCAP (.mcap); use one of "
+            "these extensions or say --format h5 or mcap. For estimates as CSV or JSON "
+            "lines use 'tactsense live --out'"
+        )
+    if record_format is not None and (
+        suffix in OTHER_SUFFIXES or (kind is not None and kind is not record_format)
+    ):
+        fail(
+            f"--out {out}: the extension {suffix} says another kind of file than "
+            f"--format {record_format.value}; use .h5 for h5, .mcap for mcap"
+        )
 
 
 @app.command()
@@ -418,6 +445,7 @@ def record(
         except TactsenseInputError as error:
             fail(str(error))
     check_output(out, force, inputs=[*sensor_file(sensor), *_source_file(source)])
+    _check_record_suffix(out, record_format)
     try:
         reader = _open_reader(source, sensor, timeout)
     except TactsenseInputError as error:
