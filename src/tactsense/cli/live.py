@@ -156,13 +156,43 @@ def _stream_and_locator(
     The calibration was checked before the line was opened; whether it belongs to the
     device's sensor can only be checked once the device has said which.
     """
+    from tactsense.stream.sources import split_source
+
+    try:
+        wire_format = None if source.startswith(LSL_PREFIX) else split_source(source)[0]
+    except TactsenseInputError as error:
+        fail(str(error))
+    if wire_format is not None and sensor is not None:
+        # a device of another format streams once the line opens (it has no START):
+        # compile and warm the estimator first, or the first frames queue behind it
+        locator = _locator_for(
+            load_sensor(sensor), calibration, baseline_frames, threshold,
+            keep_deflection=keep_deflection, contact_options=contact_options,
+        )  # fmt: skip
+        return _open_reader(source, sensor, timeout, start=False), locator
+    reader = _open_reader(source, sensor, timeout, start=False)
+    try:
+        locator = _locator_for(
+            reader.sensor, calibration, baseline_frames, threshold,
+            keep_deflection=keep_deflection, contact_options=contact_options,
+        )  # fmt: skip
+    except BaseException:
+        reader.close()
+        raise
+    return reader, locator
+
+
+def _locator_for(
+    spec, calibration, baseline_frames, threshold, *, keep_deflection, contact_options
+):
+    """The compiled, warmed locator of a sensor: :class:`LiveLocator` for a finger,
+    :class:`LiveContacts` (every contact, tracked) for a pad or a point set."""
     from tactsense.stream import LiveLocator
     from tactsense.stream.live import LiveContacts
 
-    reader = _open_reader(source, sensor, timeout, start=False)
-    if reader.sensor.kind != "finger":
-        locator = LiveContacts(
-            reader.sensor,
+    if spec.kind != "finger":
+        return LiveContacts(
+            spec,
             baseline_frames=baseline_frames,
             threshold=threshold,
             frame_period_s=None,  # the sensor's scan period: device time, not the wire's
@@ -170,25 +200,23 @@ def _stream_and_locator(
             calibration=calibration,
             **(contact_options or {}),
         )
-        return reader, locator
     if calibration is not None and not hasattr(calibration, "apply"):
         raise TactsenseInputError(
-            f"an array's calibration does not apply to {reader.sensor.name!r}, a finger: "
+            f"an array's calibration does not apply to {spec.name!r}, a finger: "
             "calibrate it with 'tactsense calibrate' on a probe sweep of the finger"
         )
     if threshold is None:
         threshold = 0.005
     if calibration is not None:
-        calibration.check_sensor(reader.sensor)
-    locator = LiveLocator(
-        reader.sensor,
+        calibration.check_sensor(spec)
+    return LiveLocator(
+        spec,
         calibration=calibration,
         baseline_frames=baseline_frames,
         threshold=threshold,
         frame_period_s=None,  # the sensor's scan period: device time, not the wire's
         keep_deflection=keep_deflection,
     )
-    return reader, locator
 
 
 SCENARIO_PARAMETERS = (
