@@ -118,16 +118,21 @@ def _source_file(source: str) -> list[Path]:
     return [] if "://" in source or source.startswith(LSL_PREFIX) else [Path(source)]
 
 
-def _open_reader(source: str, sensor: str | None, timeout: float | None, *, start: bool = True):
-    from tactsense.stream.sources import open_source
-
-    spec = None if sensor is None else load_sensor(sensor)
+def _refuse_recording_source(source: str) -> None:
+    """A recording given where a device is expected: say what reads it."""
     if source.lower().endswith((".h5", ".hdf5")) and Path(source).is_file():
         fail(
             f"{source} is a recording; this command reads a device. For a recording use "
             "'tactsense locate' (or 'view' to play it back), or play it as a device with "
             f"'tactsense emulate --recording {source} --port 0'"
         )
+
+
+def _open_reader(source: str, sensor: str | None, timeout: float | None, *, start: bool = True):
+    from tactsense.stream.sources import open_source
+
+    _refuse_recording_source(source)
+    spec = None if sensor is None else load_sensor(sensor)
     if source.startswith(LSL_PREFIX):
         from tactsense.interop.lsl import LslReader
 
@@ -473,6 +478,7 @@ def record(
         except TactsenseInputError as error:
             fail(str(error))
     check_output(out, force, inputs=[*sensor_file(sensor), *_source_file(source)])
+    _refuse_recording_source(source)
     _check_record_suffix(out, record_format)
     try:
         reader = _open_reader(source, sensor, timeout)

@@ -135,7 +135,7 @@ class LiveLocator:
         """Run the per-frame path on a synthetic touch (:func:`warm_frames`), so that
         nothing compiles or loads at the first real frame or the first contact; then
         forget it (baseline, creep history)."""
-        saved = (self._locator, self._baseline, self._collected, self.last_deflection)
+        saved = (self._locator, self._baseline, list(self._collected), self.last_deflection)
         frames = warm_frames(self.sensor, self._baseline)
         if not self.ready:  # the baseline's frames too, as a run begins
             frames = [frames[-1]] * self._baseline_frames + frames
@@ -334,7 +334,7 @@ class LiveContacts:
         """Run the per-frame path (contacts, force, tracking) on a synthetic touch
         (:func:`warm_frames`), so that nothing compiles or loads at the first real frame
         or the first contact (``--method fit`` stalled 1.7 s there); then forget it."""
-        saved = (self._drift, self._collected, self.last_deflection)
+        saved = (self._drift, list(self._collected), self.last_deflection)
         frames = warm_frames(self.sensor, None if self._drift is None else self._drift.baseline)
         if self._drift is None:  # the baseline's frames too, as a run begins
             frames = [frames[-1]] * self._baseline_frames + frames
