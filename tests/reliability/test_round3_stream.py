@@ -361,3 +361,20 @@ def test_live_warms_the_locator_before_opening_a_format_device(monkeypatch):
         emulator.stop()
     assert code == 0, message
     assert calls == ["locator", "open"]
+
+
+def test_frames_queued_behind_a_busy_reader_keep_their_spread():
+    """Ten text frames arrive 0.1 s apart while the reader is busy for 1.3 s: their
+    stamps spread over the wait (they all had the time of the one read that took them,
+    so a stall behind them showed as 1.5 ms of latency)."""
+    line = (",".join(["7"] * 256) + "\r\n").encode()
+    port, sent = _serve_once([(line, 0.2)] + [(line, 0.1)] * 10)
+    with open_source(f"text:socket://127.0.0.1:{port}", sensor=SPEC) as stream:
+        first = next(stream.frames(max_frames=1))
+        time.sleep(1.3)  # busy: the other ten frames queue in the socket
+        queued = stream.read_batch(20, wait_s=0.5)
+    assert len(queued) == 10
+    stamps = np.array([f.arrival for f in queued])
+    assert (np.diff(stamps) > 0).all() and stamps[0] > first.arrival
+    assert stamps[-1] - stamps[0] > 0.5  # spread over the wait, not one instant
+    assert abs(stamps[-1] - sent[-1]) < 0.5

@@ -304,6 +304,7 @@ class FormatReader:
         # pyserial's socket read drops what it has read when the peer closes in the same
         # call; on a plain socket or serial device the descriptor is read directly
         self._raw = self._fileno is not None and type(self.port).__module__ in RAW_PORTS
+        self._clock.start(time.perf_counter())  # the device streams once the line opens
         if start:
             self.start()
 

@@ -106,7 +106,8 @@ class ByteClock:
     A read returning ``N`` bytes at ``t_read`` (:func:`time.perf_counter`) holds bytes
     that arrived in the window ``(t_lo, t_read]``: ``t_lo`` is the moment the reader's
     wait for the read's first byte ended, or, when the bytes were already waiting, the
-    end of the previous read. Byte ``j`` of the read (1 to ``N``) is stamped
+    end of the previous read (before the first read: the moment the line opened, or
+    START was sent). Byte ``j`` of the read (1 to ``N``) is stamped
     ``t_lo + (t_read - t_lo) * j / N``: the read's last byte at ``t_read``, the others
     spread evenly by position over the window, as a line at a steady rate delivers
     them. Stamps increase strictly: one not later than the stamp before it is raised to
@@ -127,6 +128,11 @@ class ByteClock:
         self._last_stamp = -np.inf
         self.wall_offset: float | None = None
         """``time.time() - time.perf_counter()`` at the first read [s]."""
+
+    def start(self, t: float) -> None:
+        """The line is open (or the device was asked to stream) at ``t``: bytes read
+        later arrived after it (the first read's window starts here)."""
+        self._last_read = t if self._last_read is None else max(self._last_read, t)
 
     def add(self, size: int, t_read: float, woke: float | None = None) -> None:
         """A read of ``size`` bytes that returned at ``t_read``; ``woke``: when the wait
@@ -516,6 +522,7 @@ class StreamReader:
         except (serial.SerialException, OSError) as error:
             raise StreamError(f"{self.url}: cannot send START: {error}") from None
         self._started_at = time.perf_counter()
+        self._clock.start(self._started_at)
 
     def stop(self, wait_s: float = 1.0) -> None:
         """Ask the device to stop and account for the frames it sent before END.
