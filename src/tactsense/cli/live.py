@@ -817,15 +817,28 @@ def view(
 
             feed = RecordingFeed(path, locator_for, speed=speed)
         else:
-            reader = _open_reader(source, sensor, timeout, start=False)
-            try:
-                locator = view_locator(
-                    reader.sensor,
+            from tactsense.stream.sources import split_source
+
+            def make_locator(spec):
+                return view_locator(
+                    spec,
                     calibration=cal,
                     baseline_frames=baseline_frames,
                     threshold=threshold,
                     frame_period_s=None,  # the sensor's scan period: device time, not the wire's
                 )
+
+            streams_at_once = not source.startswith(LSL_PREFIX) and sensor is not None
+            if streams_at_once and split_source(source)[0] is not None:
+                # a device of another format streams once its line opens: locator first
+                locator = make_locator(load_sensor(sensor))
+                reader = _open_reader(source, sensor, timeout, start=False)
+            else:
+                reader = _open_reader(source, sensor, timeout, start=False)
+                locator = None
+            try:
+                if locator is None:
+                    locator = make_locator(reader.sensor)
             except BaseException:
                 reader.close()
                 raise
