@@ -20,13 +20,11 @@ from dataclasses import fields
 from pathlib import Path
 
 from tactsense._validation import TactsenseInputError
+from tactsense.stream.reader import LOSS_KINDS
 
-LOSS_COLUMNS = tuple(
-    f"{kind}_frames" if kind == "lost" else kind
-    for kind in ("lost", "gaps", "bad_check", "truncated", "garbage", "timeouts", "duplicates")
-)
+LOSS_COLUMNS = tuple(f"{kind}_frames" if kind == "lost" else kind for kind in LOSS_KINDS)
 """One column per loss counter of a recording (``tactsense.stream.LOSS_KINDS``): a lost
-frame, a gap, a bad checksum, a truncation, garbage bytes and a timeout are different
+frame, a gap, a bad checksum, a truncation, a garbage run, its bytes and a timeout are different
 things and are never summed. ``lost`` is named ``lost_frames``."""
 
 SUMMARY_FIELDS = [

@@ -261,7 +261,7 @@ def test_batch_summary_gives_every_loss_counter_its_own_column(tmp_path):
 
     spec = ts.fearing1990_initial()
     counts = {"lost": 104, "gaps": 3, "bad_check": 200, "truncated": 5, "garbage": 30,
-              "timeouts": 2}  # fmt: skip
+              "garbage_bytes": 517, "timeouts": 2}  # fmt: skip
     recording = dataclasses.replace(ts.simulate(spec, ts.probe_sweep(spec), rng=0), losses=counts)
     ts.write_recording(tmp_path / "r.h5", recording)
     row = cluster.process_recording(str(tmp_path / "r.h5"), str(tmp_path / "r.parquet"))
@@ -270,6 +270,6 @@ def test_batch_summary_gives_every_loss_counter_its_own_column(tmp_path):
     written = pa_csv.read_csv(tmp_path / "summary.csv").to_pylist()[0]
     assert "losses" not in written  # no sum of different things
     assert written["lost_frames"] == 104
-    for kind in ("gaps", "bad_check", "truncated", "garbage", "timeouts"):
+    for kind in ("gaps", "bad_check", "truncated", "garbage", "garbage_bytes", "timeouts"):
         assert written[kind] == counts[kind], kind
     assert written["duplicates"] == 0

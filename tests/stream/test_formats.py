@@ -119,7 +119,7 @@ def test_text_takes_any_separator_and_counts_what_is_no_frame():
     assert len(frames) == 2
     np.testing.assert_array_equal(frames[0].ravel(), row)
     assert (stats.garbage, stats.truncated) == (3, 1)
-    assert stats.garbage_bytes == len(lines[1]) + len(lines[3]) + len(lines[4]) + 3  # + \r
+    assert stats.garbage_bytes == len(lines[1]) + len(lines[3]) + len(lines[4])  # no \r\n
 
 
 def test_text_prefix_and_header():

@@ -119,16 +119,21 @@ def _source_file(source: str) -> list[Path]:
     return [] if "://" in source or source.startswith(LSL_PREFIX) else [Path(source)]
 
 
-def _open_reader(source: str, sensor: str | None, timeout: float | None, *, start: bool = True):
-    from tactsense.stream.sources import open_source
-
-    spec = None if sensor is None else load_sensor(sensor)
+def _refuse_recording_source(source: str) -> None:
+    """A recording given where a device is expected: say what reads it."""
     if source.lower().endswith((".h5", ".hdf5")) and Path(source).is_file():
         fail(
             f"{source} is a recording; this command reads a device. For a recording use "
             "'tactsense locate' (or 'view' to play it back), or play it as a device with "
             f"'tactsense emulate --recording {source} --port 0'"
         )
+
+
+def _open_reader(source: str, sensor: str | None, timeout: float | None, *, start: bool = True):
+    from tactsense.stream.sources import open_source
+
+    _refuse_recording_source(source)
+    spec = None if sensor is None else load_sensor(sensor)
     if source.startswith(LSL_PREFIX):
         from tactsense.interop.lsl import LslReader
 
@@ -157,13 +162,43 @@ def _stream_and_locator(
     The calibration was checked before the line was opened; whether it belongs to the
     device's sensor can only be checked once the device has said which.
     """
+    from tactsense.stream.sources import split_source
+
+    try:
+        wire_format = None if source.startswith(LSL_PREFIX) else split_source(source)[0]
+    except TactsenseInputError as error:
+        fail(str(error))
+    if wire_format is not None and sensor is not None:
+        # a device of another format streams once the line opens (it has no START):
+        # compile and warm the estimator first, or the first frames queue behind it
+        locator = _locator_for(
+            load_sensor(sensor), calibration, baseline_frames, threshold,
+            keep_deflection=keep_deflection, contact_options=contact_options,
+        )  # fmt: skip
+        return _open_reader(source, sensor, timeout, start=False), locator
+    reader = _open_reader(source, sensor, timeout, start=False)
+    try:
+        locator = _locator_for(
+            reader.sensor, calibration, baseline_frames, threshold,
+            keep_deflection=keep_deflection, contact_options=contact_options,
+        )  # fmt: skip
+    except BaseException:
+        reader.close()
+        raise
+    return reader, locator
+
+
+def _locator_for(
+    spec, calibration, baseline_frames, threshold, *, keep_deflection, contact_options
+):
+    """The compiled, warmed locator of a sensor: :class:`LiveLocator` for a finger,
+    :class:`LiveContacts` (every contact, tracked) for a pad or a point set."""
     from tactsense.stream import LiveLocator
     from tactsense.stream.live import LiveContacts
 
-    reader = _open_reader(source, sensor, timeout, start=False)
-    if reader.sensor.kind != "finger":
-        locator = LiveContacts(
-            reader.sensor,
+    if spec.kind != "finger":
+        return LiveContacts(
+            spec,
             baseline_frames=baseline_frames,
             threshold=threshold,
             frame_period_s=None,  # the sensor's scan period: device time, not the wire's
@@ -171,25 +206,23 @@ def _stream_and_locator(
             calibration=calibration,
             **(contact_options or {}),
         )
-        return reader, locator
     if calibration is not None and not hasattr(calibration, "apply"):
         raise TactsenseInputError(
-            f"an array's calibration does not apply to {reader.sensor.name!r}, a finger: "
+            f"an array's calibration does not apply to {spec.name!r}, a finger: "
             "calibrate it with 'tactsense calibrate' on a probe sweep of the finger"
         )
     if threshold is None:
         threshold = 0.005
     if calibration is not None:
-        calibration.check_sensor(reader.sensor)
-    locator = LiveLocator(
-        reader.sensor,
+        calibration.check_sensor(spec)
+    return LiveLocator(
+        spec,
         calibration=calibration,
         baseline_frames=baseline_frames,
         threshold=threshold,
         frame_period_s=None,  # the sensor's scan period: device time, not the wire's
         keep_deflection=keep_deflection,
     )
-    return reader, locator
 
 
 SCENARIO_PARAMETERS = (
@@ -324,7 +357,9 @@ def emulate(
         fail(str(error))
     try:
         if port is None:
-            master, _slave, path = emulator.open_pty()  # the slave stays open: no EIO
+            # the protocol's twin keeps the slave open (no EIO); another format's closes
+            # it, to see when a host opens the line
+            master, _slave, path = emulator.open_pty()
             typer.echo(prefix + path)
             sys.stdout.flush()
             console.print(
@@ -355,6 +390,31 @@ def emulate(
             f"{k} {getattr(log, k)}" for k in ("garbage", "bitflip", "drop", "truncate", "stall")
         )
     )
+
+
+RECORD_SUFFIXES = {".h5": RecordFormat.h5, ".hdf5": RecordFormat.h5, ".mcap": RecordFormat.mcap}
+"""What ``record`` writes, by the extension of ``--out`` (without ``--format``)."""
+OTHER_SUFFIXES = (".csv", ".jsonl", ".json", ".txt", ".rrd", ".xdf", ".db3", ".toml", ".npy")
+"""Extensions of files of other kinds: ``record`` never writes a recording under them."""
+
+
+def _check_record_suffix(out: Path, record_format: RecordFormat | None) -> None:
+    """Refuse an output whose name says another kind of file than the one written."""
+    suffix = out.suffix.lower()
+    kind = RECORD_SUFFIXES.get(suffix)
+    if record_format is None and kind is None:
+        fail(
+            f"--out {out}: record writes HDF5 (.h5, .hdf5) or MCAP (.mcap); use one of "
+            "these extensions or say --format h5 or mcap. For estimates as CSV or JSON "
+            "lines use 'tactsense live --out'"
+        )
+    if record_format is not None and (
+        suffix in OTHER_SUFFIXES or (kind is not None and kind is not record_format)
+    ):
+        fail(
+            f"--out {out}: the extension {suffix} says another kind of file than "
+            f"--format {record_format.value}; use .h5 for h5, .mcap for mcap"
+        )
 
 
 @app.command()
@@ -420,6 +480,8 @@ def record(
         except TactsenseInputError as error:
             fail(str(error))
     check_output(out, force, inputs=[*sensor_file(sensor), *_source_file(source)])
+    _refuse_recording_source(source)
+    _check_record_suffix(out, record_format)
     try:
         reader = _open_reader(source, sensor, timeout)
     except TactsenseInputError as error:
@@ -759,15 +821,28 @@ def view(
 
             feed = RecordingFeed(path, locator_for, speed=speed)
         else:
-            reader = _open_reader(source, sensor, timeout, start=False)
-            try:
-                locator = view_locator(
-                    reader.sensor,
+            from tactsense.stream.sources import split_source
+
+            def make_locator(spec):
+                return view_locator(
+                    spec,
                     calibration=cal,
                     baseline_frames=baseline_frames,
                     threshold=threshold,
                     frame_period_s=None,  # the sensor's scan period: device time, not the wire's
                 )
+
+            streams_at_once = not source.startswith(LSL_PREFIX) and sensor is not None
+            if streams_at_once and split_source(source)[0] is not None:
+                # a device of another format streams once its line opens: locator first
+                locator = make_locator(load_sensor(sensor))
+                reader = _open_reader(source, sensor, timeout, start=False)
+            else:
+                reader = _open_reader(source, sensor, timeout, start=False)
+                locator = None
+            try:
+                if locator is None:
+                    locator = make_locator(reader.sensor)
             except BaseException:
                 reader.close()
                 raise

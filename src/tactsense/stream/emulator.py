@@ -86,6 +86,14 @@ class FaultLog:
         return asdict(self)
 
 
+def _host_on_pty(master: int) -> bool:
+    """Whether a host holds the slave side of a pseudo-terminal open (the master reports
+    a hang-up while nobody does)."""
+    poll = select.poll()
+    poll.register(master, select.POLLIN)
+    return not any(event & select.POLLHUP for _, event in poll.poll(0))
+
+
 class Emulator:
     """The twin playing the device.
 
@@ -136,7 +144,7 @@ class Emulator:
         self.format = wire_format
         if wire_format is not None:
             wire_format.check_shape(sensor.shape)
-            self.frames = wire_format.prepare(self.frames)
+            self.frames = wire_format.prepare(self.frames, sensor.electronics.adc_bits)
         self.speed = float(speed)
         self.faults = faults or FaultRates()
         self.repeat = repeat
@@ -374,11 +382,21 @@ class Emulator:
                     except (BrokenPipeError, ConnectionResetError):
                         pass
 
-    def open_pty(self) -> tuple[int, int, str]:
-        """A new pseudo-terminal in raw mode: (master fd, slave fd, slave path)."""
+    def open_pty(self) -> tuple[int, int | None, str]:
+        """A new pseudo-terminal in raw mode: (master fd, slave fd, slave path).
+
+        In another wire format the slave is closed at once (None): the device then sees
+        a host open the line (the master's hang-up clears) and starts to stream
+        :data:`FORMAT_BOOT_S` later, as on a TCP port. The protocol's device keeps it
+        open (it waits for START; a read of the master never fails).
+        """
         master, slave = os.openpty()
         tty.setraw(slave)
-        return master, slave, os.ttyname(slave)
+        path = os.ttyname(slave)
+        if self.format is not None:
+            os.close(slave)
+            return master, None, path
+        return master, slave, path
 
     def serve_pty(self, master: int) -> None:
         """Serve on the master side of a pseudo-terminal until :meth:`stop`."""
@@ -393,6 +411,9 @@ class Emulator:
         while not self._stop.is_set():
             if self.format is not None and self.exhausted:
                 self._stop.wait(0.1)  # a pty never closes: the device is done
+                continue
+            if self.format is not None and not _host_on_pty(master):
+                self._stop.wait(0.01)  # streams only once a host opened the line
                 continue
             self.serve_fd(lambda: os.read(master, 1 << 16), write, master)
             time.sleep(0.05)  # the host closed the line; wait for the next one
@@ -422,7 +443,8 @@ class Emulator:
                 self.serve_pty(master)
             finally:
                 os.close(master)
-                os.close(slave)
+                if slave is not None:
+                    os.close(slave)
 
         thread = threading.Thread(target=run, daemon=True)
         thread.start()

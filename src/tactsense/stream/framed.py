@@ -29,6 +29,7 @@ import serial
 from tactsense._validation import TactsenseInputError
 from tactsense.sensor import SensorSpec
 from tactsense.stream.reader import (
+    ByteClock,
     LossCounters,
     StreamError,
     StreamFrame,
@@ -92,13 +93,16 @@ class WireFormat:
         """Raise :class:`FormatError` if frames of this shape cannot be carried."""
 
     def decoder(self, shape: tuple[int, int], stats: LossCounters, url: str):
-        """A new decoder: ``feed(bytes) -> list[ndarray]`` and ``finish() -> list``."""
+        """A new decoder: ``feed(bytes) -> list[ndarray]`` and ``finish() -> list``, and
+        ``feed_ends``/``finish_ends``, which pair each frame with the number of bytes fed
+        up to and including its last byte (for its time stamp)."""
         raise NotImplementedError
 
     # ---- the emulator's side ------------------------------------------------------
 
-    def prepare(self, frames: np.ndarray) -> np.ndarray:
-        """The frames (uint16 counts) as this format carries them (default: as they are)."""
+    def prepare(self, frames: np.ndarray, adc_bits: int = 16) -> np.ndarray:
+        """The frames (uint16 counts of an ``adc_bits`` converter) as this format carries
+        them (default: as they are)."""
         return frames
 
     def preamble(self) -> bytes:
@@ -123,7 +127,12 @@ class DelimitedFramer:
     delimiter and classifies the run of bytes before it: exactly a frame, shorter
     (``truncated``) or longer (``garbage``). With a start marker a frame is confirmed
     by the next frame's marker, so it is delivered when that marker arrives (or when
-    the line closes).
+    the line closes), but its last byte is that of its own samples: the frame is
+    stamped when ``length`` bytes after its marker were complete, not when the next
+    marker came.
+
+    :meth:`feed_ends` returns each frame with the number of bytes fed up to and
+    including its last byte (the tail, with a tail; the last sample, with a marker).
     """
 
     def __init__(
@@ -135,6 +144,7 @@ class DelimitedFramer:
         self.stats = stats
         self._on_shape = on_shape  # called with a run length seen repeatedly before any frame
         self._buffer = bytearray()
+        self._base = 0  # bytes fed before buffer[0]
         self._in_step = False
         self._first = True
         self._framed = False  # a frame was delivered
@@ -142,17 +152,26 @@ class DelimitedFramer:
         self._limit = 2 * (length + len(delimiter)) + (1 << 16)
 
     def feed(self, data: bytes) -> list[bytes]:
+        return [frame for frame, _ in self.feed_ends(data)]
+
+    def _drop(self, size: int) -> None:
+        del self._buffer[:size]
+        self._base += size
+
+    def feed_ends(self, data: bytes) -> list[tuple[bytes, int]]:
+        """Frames completed by ``data``, each with the bytes fed up to its last byte."""
         buffer, delimiter, length = self._buffer, self.delimiter, self.length
         buffer.extend(data)
-        out: list[bytes] = []
+        out: list[tuple[bytes, int]] = []
         width = len(delimiter)
+        tail = 0 if self.leading else width  # a tail belongs to its frame, a marker not
         while True:
             if self._in_step:
                 if len(buffer) < length + width:
                     break
                 if buffer[length : length + width] == delimiter:
-                    out.append(bytes(buffer[:length]))
-                    del buffer[: length + width]
+                    out.append((bytes(buffer[:length]), self._base + length + tail))
+                    self._drop(length + width)
                     self._framed = True
                     continue
                 self._in_step = False
@@ -161,10 +180,11 @@ class DelimitedFramer:
                 if len(buffer) > self._limit:  # no delimiter in sight: one run of garbage
                     keep = width - 1
                     self._garbage(len(buffer) - keep)
-                    del buffer[: len(buffer) - keep]
+                    self._drop(len(buffer) - keep)
                 break
             run = bytes(buffer[:at])
-            del buffer[: at + width]
+            end = self._base + at + tail
+            self._drop(at + width)
             first, self._first = self._first, False
             self._in_step = True
             if self.leading and first:
@@ -173,19 +193,24 @@ class DelimitedFramer:
                 continue
             frame = self._classify(run, first)
             if frame is not None:
-                out.append(frame)
+                out.append((frame, end))
         return out
 
     def finish(self) -> list[bytes]:
+        return [frame for frame, _ in self.finish_ends()]
+
+    def finish_ends(self) -> list[tuple[bytes, int]]:
         """The line closed: what is left is a last frame (after a marker) or a cut one."""
         rest, self._buffer = bytes(self._buffer), bytearray()
+        end = self._base + len(rest)
+        self._base = end
         if not rest:
             return []
-        if self.leading and self._first:
+        if self._first:  # no delimiter yet: joined mid-frame, as before a first delimiter
             self._garbage(len(rest))
             return []
         if self.leading and self._in_step and len(rest) == self.length:
-            return [rest]
+            return [(rest, end)]
         if len(rest) < self.length:
             self.stats.truncated += 1
         else:
@@ -265,6 +290,7 @@ class FormatReader:
             timeout_s, first_frame_timeout_s, self.frame_period_s
         )
         self._decoder = wire_format.decoder(sensor.shape, self.stats, self.url)
+        self._clock = ByteClock()
         self._ready: deque[StreamFrame] = deque()
         self._index = -1
         self._first_arrival: float | None = None
@@ -278,46 +304,54 @@ class FormatReader:
         # pyserial's socket read drops what it has read when the peer closes in the same
         # call; on a plain socket or serial device the descriptor is read directly
         self._raw = self._fileno is not None and type(self.port).__module__ in RAW_PORTS
+        self._clock.start(time.perf_counter())  # the device streams once the line opens
         if start:
             self.start()
 
     # ---- receiving ---------------------------------------------------------------
 
-    def _receive(self, wait_s: float) -> bytes | None:
-        """Bytes that arrived within ``wait_s`` (None: the line closed)."""
+    def _receive(self, wait_s: float) -> tuple[bytes | None, float | None]:
+        """Bytes that arrived within ``wait_s`` (None: the line closed), and when the
+        wait for them ended (None: they were waiting already)."""
         if self._fileno is not None:
-            ready, _, _ = select.select([self._fileno], [], [], max(wait_s, 0.0))
+            woke = None
+            ready, _, _ = select.select([self._fileno], [], [], 0)
             if not ready:
-                return b""
+                ready, _, _ = select.select([self._fileno], [], [], max(wait_s, 0.0))
+                if not ready:
+                    return b"", None
+                woke = time.perf_counter()
             if self._raw:  # an empty read is the end of the line
                 try:
-                    return os.read(self._fileno, 1 << 16) or None
+                    return os.read(self._fileno, 1 << 16) or None, woke
                 except OSError:  # a pty whose other side closed: EIO
-                    return None
+                    return None, woke
             try:
                 data = self.port.read(1 << 16)
             except serial.SerialException:  # pyserial's word for a peer that hung up
-                return None
-            return data if data else None
+                return None, woke
+            return (data if data else None), woke
         deadline = time.perf_counter() + wait_s
+        woke = None
         while True:  # ports without a file descriptor (loop://): poll
             waiting = self.port.in_waiting
             if waiting:
-                return self.port.read(waiting)
+                return self.port.read(waiting), woke
             if time.perf_counter() >= deadline:
-                return b""
+                return b"", None
             time.sleep(0.0005)
+            woke = time.perf_counter()
 
     def _pump(self, wait_s: float) -> bool:
         if self.ended:
             return False
         try:
-            data = self._receive(wait_s)
+            data, woke = self._receive(wait_s)
         except (serial.SerialException, OSError) as error:
             raise StreamError(f"{self.url}: {error}") from None
         if data is None:  # no END in these formats: the line closing ends the stream
             self.ended = True
-            self._accept(self._decoder.finish(), time.time(), time.perf_counter())
+            self._accept(self._decoder.finish_ends())
             if self._first_arrival is None:
                 seen = self.stats.summary().removeprefix("0 frames")
                 raise StreamError(
@@ -329,15 +363,16 @@ class FormatReader:
             return True
         if not data:
             return False
-        host_time, arrival = time.time(), time.perf_counter()
-        self._accept(self._decoder.feed(data), host_time, arrival)
+        self._clock.add(len(data), time.perf_counter(), woke)
+        self._accept(self._decoder.feed_ends(data))
         return True
 
-    def _accept(self, frames: list[np.ndarray], host_time: float, arrival: float) -> None:
-        for counts in frames:
+    def _accept(self, frames: list[tuple[np.ndarray, int]]) -> None:
+        for counts, end in frames:
             if self._finished:
                 self.unused += 1
                 continue
+            arrival, host_time = self._clock.stamp(end)
             if self._first_arrival is None:
                 self._first_arrival = arrival
             self._index += 1

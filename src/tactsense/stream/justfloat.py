@@ -2,9 +2,10 @@
 4-byte tail ``00 00 80 7F`` (VOFA+ "JustFloat"; ``docs/devices.md``).
 
 Decoded with :func:`numpy.frombuffer`; framed by
-:class:`~tactsense.stream.framed.DelimitedFramer`. Values become counts as
-``rint(value * scale)``; a frame with a value that is no count (not finite, below 0 or
-above 65535 once scaled) is garbage.
+:class:`~tactsense.stream.framed.DelimitedFramer`. A frame with a value that is no count
+once scaled (``value * scale`` not finite, below 0 or above 65535, checked before any
+rounding) is garbage; the others become counts as ``floor(value * scale + 0.5)``, the
+nearest count with halves rounded up.
 """
 
 from __future__ import annotations
@@ -81,21 +82,30 @@ class JustFloatDecoder:
     def _frames(self, raws):
         if not raws:
             return []
-        values = np.frombuffer(b"".join(raws), FLOAT).reshape(len(raws), -1) * self.scale
-        counts = np.rint(values)
-        with np.errstate(invalid="ignore"):
-            good = np.isfinite(counts).all(1) & (counts >= 0).all(1) & (counts <= 65535).all(1)
+        values = np.frombuffer(b"".join(raw for raw, _ in raws), FLOAT).reshape(len(raws), -1)
+        values = values.astype(np.float64) * self.scale
+        with np.errstate(invalid="ignore"):  # the range is checked before rounding
+            good = np.isfinite(values).all(1) & (values >= 0).all(1) & (values <= 65535).all(1)
         bad = int(len(raws) - good.sum())
-        if bad:  # values that are no counts: not finite, negative or too large
+        if bad:  # values that are no counts: not finite, or outside [0, 65535]
             self.stats.garbage += bad
-            self.stats.garbage_bytes += bad * len(raws[0])
-        return list(counts[good].astype(np.uint16).reshape(-1, *self.shape))
+            self.stats.garbage_bytes += bad * len(raws[0][0])
+        counts = np.floor(values[good] + 0.5).astype(np.uint16)  # half up
+        ends = [end for (_, end), ok in zip(raws, good, strict=True) if ok]
+        return list(zip(counts.reshape(-1, *self.shape), ends, strict=True))
+
+    def feed_ends(self, data: bytes) -> list[tuple[np.ndarray, int]]:
+        """Frames completed by ``data``, each with the bytes fed up to its last byte."""
+        return self._frames(self.framer.feed_ends(data))
+
+    def finish_ends(self) -> list[tuple[np.ndarray, int]]:
+        return self._frames(self.framer.finish_ends())
 
     def feed(self, data: bytes) -> list[np.ndarray]:
-        return self._frames(self.framer.feed(data))
+        return [counts for counts, _ in self.feed_ends(data)]
 
     def finish(self) -> list[np.ndarray]:
-        return self._frames(self.framer.finish())
+        return [counts for counts, _ in self.finish_ends()]
 
     def _shape_error(self, size: int) -> None:
         rows, cols = self.shape

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 import time
 
 import numpy as np
@@ -33,6 +34,29 @@ FIELDS = (
     "latency_ms",
 )
 """Fields of every estimate :class:`LiveLocator` returns, in output order."""
+
+
+def warm_frames(sensor, baseline=None, amplitude: float = 0.3) -> list[StreamFrame]:
+    """Synthetic frames that take an estimator down every path a real touch takes: a
+    bump of ``amplitude`` (a fraction of the baseline) pressed both ways (counts up and
+    down: the sign depends on the transducer), and the baseline itself [counts, uint16].
+    """
+    rows, cols = sensor.shape
+    base = (
+        np.full(sensor.shape, float(sensor.electronics.nominal_counts))
+        if baseline is None
+        else np.asarray(baseline, dtype=float)
+    )
+    r, c = np.mgrid[0:rows, 0:cols]
+    bump = np.exp(-((r - (rows - 1) / 2) ** 2 + (c - (cols - 1) / 2) ** 2) / 2.0)
+    top = 2 ** min(int(sensor.electronics.adc_bits), 16) - 1
+    frames = []
+    for k, counts in enumerate(
+        (base * (1 + amplitude * bump), base * (1 - amplitude * bump), base, base)
+    ):
+        counts = np.clip(np.nan_to_num(np.rint(counts)), 0, top).astype(np.uint16)
+        frames.append(StreamFrame(k, k, k * sensor.scan_period_s, 0.0, time.perf_counter(), counts))
+    return frames
 
 
 def flag_names(flags: int) -> str:
@@ -105,6 +129,20 @@ class LiveLocator:
                 self._creep = CreepCompensator(calibration.viscoelastic, self._period, sensor.shape)
         elif baseline is not None:
             self._set_baseline(np.asarray(baseline, dtype=float))
+        self._warm_up()
+
+    def _warm_up(self) -> None:
+        """Run the per-frame path on a synthetic touch (:func:`warm_frames`), so that
+        nothing compiles or loads at the first real frame or the first contact; then
+        forget it (baseline, creep history)."""
+        saved = (self._locator, self._baseline, list(self._collected), self.last_deflection)
+        frames = warm_frames(self.sensor, self._baseline)
+        if not self.ready:  # the baseline's frames too, as a run begins
+            frames = [frames[-1]] * self._baseline_frames + frames
+        for frame in frames:
+            self(frame)
+        self._locator, self._baseline, self._collected, self.last_deflection = saved
+        self.reset()
 
     def _set_baseline(self, baseline: np.ndarray) -> None:
         self._baseline = baseline
@@ -290,6 +328,22 @@ class LiveContacts:
             self._set_baseline(np.asarray(calibration.baseline, dtype=float))
         elif baseline is not None:
             self._set_baseline(np.asarray(baseline, dtype=float))
+        self._warm_up()
+
+    def _warm_up(self) -> None:
+        """Run the per-frame path (contacts, force, tracking) on a synthetic touch
+        (:func:`warm_frames`), so that nothing compiles or loads at the first real frame
+        or the first contact (``--method fit`` stalled 1.7 s there); then forget it."""
+        saved = (self._drift, list(self._collected), self.last_deflection)
+        frames = warm_frames(self.sensor, None if self._drift is None else self._drift.baseline)
+        if self._drift is None:  # the baseline's frames too, as a run begins
+            frames = [frames[-1]] * self._baseline_frames + frames
+        else:
+            self._drift = copy.deepcopy(self._drift)  # the warm frames move it: a copy
+        for frame in frames:
+            self(frame)
+        self._drift, self._collected, self.last_deflection = saved
+        self.reset()
 
     def _set_baseline(self, baseline: np.ndarray) -> None:
         from tactsense.estimate.baseline import DriftBaseline

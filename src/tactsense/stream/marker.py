@@ -59,11 +59,12 @@ class MarkerFrames(WireFormat):
 
     # ---- the emulator's side ------------------------------------------------------
 
-    def prepare(self, frames: np.ndarray) -> np.ndarray:
-        """8 bits: the top 8 bits of the counts (an 8-bit converter), 16: as they are."""
+    def prepare(self, frames: np.ndarray, adc_bits: int = 16) -> np.ndarray:
+        """8 bits: the top 8 of the converter's ``adc_bits`` bits (an 8-bit converter on
+        the same range), whatever the frames hold; 16: as they are."""
         if self.width == 16:
             return frames
-        shift = max(int(frames.max()).bit_length() - 8, 0)
+        shift = max(min(int(adc_bits), 16) - 8, 0)
         return (frames >> shift).astype(np.uint16)
 
     def encode(self, counts: np.ndarray) -> bytes:
@@ -86,14 +87,21 @@ class MarkerDecoder:
     def _frames(self, raws):
         if not raws:
             return []
-        joined = np.frombuffer(b"".join(raws), self.dtype).astype(np.uint16)
-        return list(joined.reshape(-1, *self.shape))
+        joined = np.frombuffer(b"".join(raw for raw, _ in raws), self.dtype).astype(np.uint16)
+        return list(zip(joined.reshape(-1, *self.shape), (end for _, end in raws), strict=True))
+
+    def feed_ends(self, data: bytes) -> list[tuple[np.ndarray, int]]:
+        """Frames completed by ``data``, each with the bytes fed up to its last byte."""
+        return self._frames(self.framer.feed_ends(data))
+
+    def finish_ends(self) -> list[tuple[np.ndarray, int]]:
+        return self._frames(self.framer.finish_ends())
 
     def feed(self, data: bytes) -> list[np.ndarray]:
-        return self._frames(self.framer.feed(data))
+        return [counts for counts, _ in self.feed_ends(data)]
 
     def finish(self) -> list[np.ndarray]:
-        return self._frames(self.framer.finish())
+        return [counts for counts, _ in self.finish_ends()]
 
     def _shape_error(self, size: int) -> None:
         rows, cols = self.shape

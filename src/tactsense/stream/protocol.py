@@ -211,19 +211,33 @@ class PacketSplitter:
     def __init__(self, max_packet: int = 1 << 20):
         self._tail = b""
         self._max = max_packet
+        self._received = 0
         self.overflow_bytes = 0
         """Bytes dropped because no delimiter came within ``max_packet`` bytes."""
 
     def feed(self, data: bytes) -> list[bytes]:
         """Packets completed by ``data`` (empty ones, from repeated delimiters, skipped)."""
+        return [packet for packet, _ in self.feed_ends(data)]
+
+    def feed_ends(self, data: bytes) -> list[tuple[bytes, int]]:
+        """Packets completed by ``data``, each with the number of bytes fed up to and
+        including its delimiter (its last byte on the wire; for time stamps)."""
         if not data:
             return []
-        parts = (self._tail + data).split(DELIMITER)
-        self._tail = parts.pop()
+        buffer = self._tail + data
+        base = self._received - len(self._tail)  # offset of buffer[0] in the stream
+        self._received += len(data)
+        out = []
+        start = 0
+        while (at := buffer.find(DELIMITER, start)) >= 0:
+            if at > start:
+                out.append((buffer[start:at], base + at + 1))
+            start = at + 1
+        self._tail = buffer[start:]
         if len(self._tail) > self._max:
             self.overflow_bytes += len(self._tail)
             self._tail = b""
-        return [part for part in parts if part]
+        return out
 
     @property
     def pending(self) -> int:

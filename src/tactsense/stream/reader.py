@@ -37,7 +37,16 @@ from tactsense.stream.protocol import (
     encoded_frame_size,
 )
 
-LOSS_KINDS = ("lost", "gaps", "bad_check", "truncated", "garbage", "timeouts", "duplicates")
+LOSS_KINDS = (
+    "lost",
+    "gaps",
+    "bad_check",
+    "truncated",
+    "garbage",
+    "garbage_bytes",
+    "timeouts",
+    "duplicates",
+)
 """Counters of :class:`LossCounters` written with a recording, in this order."""
 
 
@@ -62,6 +71,7 @@ class LossCounters:
     garbage: int = 0
     """Runs of bytes between delimiters that were no packet: the reader resynchronised."""
     garbage_bytes: int = 0
+    """Bytes in those runs (delimiters and line endings not included)."""
     timeouts: int = 0
     """Intervals of ``timeout_s`` with no frame."""
     duplicates: int = 0
@@ -79,6 +89,83 @@ class LossCounters:
             if value:
                 parts.append(f"{kind.replace('_', ' ')} {value}")
         return ", ".join(parts)
+
+
+STAMP_STEP_S = 1e-6
+"""The least step between the time stamps of consecutive frames [s]: a stamp that would
+not be later than the one before is raised to it plus this step."""
+
+MAX_READS_KEPT = 4096
+"""Reads whose times :class:`ByteClock` keeps (for a frame completed by an earlier read)."""
+
+
+class ByteClock:
+    """When each byte of a line arrived, from the times of the reads that returned it;
+    a frame is stamped at its last byte (``docs/recordings.md``, "Time stamps").
+
+    A read returning ``N`` bytes at ``t_read`` (:func:`time.perf_counter`) holds bytes
+    that arrived in the window ``(t_lo, t_read]``: ``t_lo`` is the moment the reader's
+    wait for the read's first byte ended, or, when the bytes were already waiting, the
+    end of the previous read (before the first read: the moment the line opened, or
+    START was sent). Byte ``j`` of the read (1 to ``N``) is stamped
+    ``t_lo + (t_read - t_lo) * j / N``: the read's last byte at ``t_read``, the others
+    spread evenly by position over the window, as a line at a steady rate delivers
+    them. Stamps increase strictly: one not later than the stamp before it is raised to
+    that stamp plus :data:`STAMP_STEP_S`. The error of a stamp is at most the width of
+    its read's window (plus the step for each frame clamped); the window is as long as
+    the reader was away from the line (busy, or the data came in a burst).
+
+    The wall-clock stamp is the :func:`time.perf_counter` stamp plus the offset between
+    the two clocks at the first read, so it increases strictly too (a step of the
+    system clock during a run is not followed).
+    """
+
+    def __init__(self):
+        self.received = 0
+        """Bytes received so far."""
+        self._reads: deque[tuple[int, int, float, float]] = deque(maxlen=MAX_READS_KEPT)
+        self._last_read: float | None = None
+        self._last_stamp = -np.inf
+        self.wall_offset: float | None = None
+        """``time.time() - time.perf_counter()`` at the first read [s]."""
+
+    def start(self, t: float) -> None:
+        """The line is open (or the device was asked to stream) at ``t``: bytes read
+        later arrived after it (the first read's window starts here)."""
+        self._last_read = t if self._last_read is None else max(self._last_read, t)
+
+    def add(self, size: int, t_read: float, woke: float | None = None) -> None:
+        """A read of ``size`` bytes that returned at ``t_read``; ``woke``: when the wait
+        for its first byte ended (None: the bytes were waiting when the reader asked)."""
+        if self.wall_offset is None:
+            self.wall_offset = time.time() - time.perf_counter()
+        t_lo = woke if woke is not None else self._last_read
+        if t_lo is None or t_lo > t_read:
+            t_lo = t_read
+        self._last_read = t_read
+        if size <= 0:
+            return
+        self._reads.append((self.received, self.received + size, t_lo, t_read))
+        self.received += size
+
+    def byte_time(self, end: int) -> float:
+        """The arrival of the ``end``-th byte received (counting from 1) [s,
+        perf_counter], spread by position over its read's window."""
+        reads = self._reads
+        while len(reads) > 1 and reads[0][1] < end:
+            reads.popleft()  # frames are stamped in order: earlier reads are done with
+        if not reads:
+            return time.perf_counter()
+        start, stop, t_lo, t_read = reads[0]
+        j = min(max(end - start, 0), stop - start)
+        return t_lo + (t_read - t_lo) * j / (stop - start)
+
+    def stamp(self, end: int) -> tuple[float, float]:
+        """The stamps of a frame whose last byte is the ``end``-th received: (arrival
+        on :func:`time.perf_counter`, Unix time) [s], later than the frame before."""
+        t = max(self.byte_time(end), self._last_stamp + STAMP_STEP_S)
+        self._last_stamp = t
+        return t, t + (self.wall_offset or 0.0)
 
 
 @dataclass(frozen=True)
@@ -186,6 +273,7 @@ class StreamReader:
         self.ended = False
         self.frames_sent: int | None = None
         self._splitter = PacketSplitter()
+        self._clock = ByteClock()
         self._ready: deque[tuple[StreamFrame, int]] = deque()  # (frame, sequence step)
         self.unused = 0
         """Intact frames that arrived after the caller stopped taking them (not kept)."""
@@ -228,39 +316,47 @@ class StreamReader:
 
     # ---- receiving ---------------------------------------------------------------
 
-    def _receive(self, wait_s: float) -> bytes:
-        """Bytes that arrived, waiting up to ``wait_s`` for the first."""
+    def _receive(self, wait_s: float) -> tuple[bytes, float | None]:
+        """Bytes that arrived, waiting up to ``wait_s`` for the first, and when the wait
+        for them ended (None: they were waiting already)."""
         if self._fileno is not None:
-            ready, _, _ = select.select([self._fileno], [], [], max(wait_s, 0.0))
+            woke = None
+            ready, _, _ = select.select([self._fileno], [], [], 0)
             if not ready:
-                return b""
+                ready, _, _ = select.select([self._fileno], [], [], max(wait_s, 0.0))
+                if not ready:
+                    return b"", None
+                woke = time.perf_counter()
             data = self.port.read(1 << 16)
             if not data:
                 raise StreamError(f"{self.url}: the device closed the line")
-            return data
+            return data, woke
         deadline = time.perf_counter() + wait_s
+        woke = None
         while True:  # ports without a file descriptor (loop://): poll
             waiting = self.port.in_waiting
             if waiting:
-                return self.port.read(waiting)
-            if time.perf_counter() >= deadline:
-                return b""
+                return self.port.read(waiting), woke
+            now = time.perf_counter()
+            if now >= deadline:
+                return b"", None
             time.sleep(0.0005)
+            woke = time.perf_counter()
 
     def _pump(self, wait_s: float) -> bool:
         """Receive and decode what arrives within ``wait_s``; True if anything came."""
         try:
-            data = self._receive(wait_s)
+            data, woke = self._receive(wait_s)
         except (serial.SerialException, OSError) as error:
             raise StreamError(f"{self.url}: {error}") from None
         if not data:
             return False
-        host_time, arrival = time.time(), time.perf_counter()
-        for raw in self._splitter.feed(data):
-            self._handle(raw, host_time, arrival)
+        self._clock.add(len(data), time.perf_counter(), woke)
+        for raw, end in self._splitter.feed_ends(data):
+            self._handle(raw, end)
         return True
 
-    def _handle(self, raw: bytes, host_time: float, arrival: float) -> None:
+    def _handle(self, raw: bytes, end: int) -> None:
         try:
             packet = decode_packet(raw, self._frame_bytes)
         except ProtocolError as error:
@@ -269,7 +365,7 @@ class StreamReader:
                 self.stats.garbage_bytes += len(raw)
             return
         if isinstance(packet, FramePacket):
-            self._accept(packet, host_time, arrival)
+            self._accept(packet, end)
         elif isinstance(packet, EndPacket):
             self._end_sequence = packet.last_sequence
             self.frames_sent = packet.frames_sent
@@ -277,7 +373,7 @@ class StreamReader:
         elif isinstance(packet, ControlPacket) and packet.kind == Kind.IDENT:
             self.identity = packet.body
 
-    def _accept(self, packet: FramePacket, host_time: float, arrival: float) -> None:
+    def _accept(self, packet: FramePacket, end: int) -> None:
         if self.sensor is not None and packet.counts.shape != self.sensor.shape:
             rows, cols = packet.counts.shape
             raise StreamError(
@@ -308,6 +404,7 @@ class StreamReader:
         self._last_seq = packet.sequence
         self._last_time_us = packet.device_time_us
         self._index += step
+        arrival, host_time = self._clock.stamp(end)
         frame = StreamFrame(
             packet.sequence,
             self._index,
@@ -425,6 +522,7 @@ class StreamReader:
         except (serial.SerialException, OSError) as error:
             raise StreamError(f"{self.url}: cannot send START: {error}") from None
         self._started_at = time.perf_counter()
+        self._clock.start(self._started_at)
 
     def stop(self, wait_s: float = 1.0) -> None:
         """Ask the device to stop and account for the frames it sent before END.

@@ -46,6 +46,22 @@ _LINE = re.compile(r"[A-Za-z][\w+.-]*://|/|\.|COM\d|[A-Za-z]:\\", re.IGNORECASE)
 """How a line begins: a URL, a path, a Windows port."""
 
 
+_FORMAT_NAME = re.compile(r"([A-Za-z][\w-]+)(,[^:]*)?:")
+"""A word (two letters or more: not a Windows drive) and options, before a colon."""
+
+
+def _check_unknown_format(source: str) -> None:
+    """Raise for ``NAME:LINE`` whose NAME is no format (``csvline:/dev/ttyACM0``): the
+    line is a URL or a path, so the word before it can only be meant as a format."""
+    match = _FORMAT_NAME.match(source)
+    if match and _LINE.match(source, match.end()):
+        raise FormatError(
+            f"{source}: unknown wire format {match.group(1)!r}; the formats are "
+            f"{', '.join(FORMATS)} (e.g. text:/dev/ttyACM0), or a plain pyserial URL or "
+            "device path for the tactsense protocol"
+        )
+
+
 def split_source(source: str) -> tuple[WireFormat | None, str]:
     """The format a source names (None: the tactsense protocol) and the line's URL.
 
@@ -53,7 +69,10 @@ def split_source(source: str) -> tuple[WireFormat | None, str]:
     may hold a colon: ``text,prefix=F::/dev/ttyACM0`` is the prefix ``F:``.
     """
     name = source.partition(",")[0].partition(":")[0].strip().lower()
-    if name not in FORMATS or source[len(name) : len(name) + 3] == "://":
+    if source[len(name) : len(name) + 3] == "://":
+        return None, source
+    if name not in FORMATS:
+        _check_unknown_format(source)
         return None, source
     at = source.find(":")
     while at >= 0:

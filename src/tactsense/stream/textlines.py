@@ -108,23 +108,34 @@ class TextDecoder(Packetizer):
         self.prefix = prefix
         self.skip = header
         self.limit = max(MAX_LINE_BYTES, 24 * self.size)
-        self._out: list[np.ndarray] = []
-        self._pending: list[tuple[list[bytes], int]] = []
+        self._out: list[tuple[np.ndarray, int]] = []
+        self._pending: list[tuple[list[bytes], int, int]] = []  # (tokens, size, end)
+        self._base = 0  # bytes fed before the line being split
+        self._closing = False
         self._framed = False
         self._wrong = (-1, 0)
 
     def feed(self, data: bytes) -> list[np.ndarray]:
+        return [counts for counts, _ in self.feed_ends(data)]
+
+    def finish(self) -> list[np.ndarray]:
+        return [counts for counts, _ in self.finish_ends()]
+
+    def feed_ends(self, data: bytes) -> list[tuple[np.ndarray, int]]:
+        """Frames completed by ``data``, each with the bytes fed up to its newline."""
         self.data_received(data)
         self._parse()
         if len(self.buffer) > self.limit:  # no newline in sight
             self._garbage(len(self.buffer))
+            self._base += len(self.buffer)
             self.buffer.clear()
         out, self._out = self._out, []
         return out
 
-    def finish(self) -> list[np.ndarray]:
+    def finish_ends(self) -> list[tuple[np.ndarray, int]]:
         """The line closed: a last line without its newline is taken as it is."""
         if self.buffer.strip():
+            self._closing = True
             self.handle_packet(bytes(self.buffer))
         self.buffer.clear()
         self._parse()
@@ -136,32 +147,39 @@ class TextDecoder(Packetizer):
         self.stats.garbage_bytes += size
 
     def handle_packet(self, packet) -> None:
+        # the line's last byte: its newline (none on the last line of a closed line)
+        end = self._base + len(packet) + (not self._closing)
+        self._base = end
         line = bytes(packet).rstrip(b"\r")
         if self.skip:
             self.skip -= 1
             return
         if not line.strip():
             return
+        size = len(line)  # the line ending (\r\n or \n) is no garbage, as no delimiter is
         if self.prefix:
             if not line.startswith(self.prefix):
-                self._garbage(len(packet))
+                self._garbage(size)
                 return
             line = line[len(self.prefix) :]
+        if b"_" in line:  # Python's float() takes 1_000; a device prints no such number
+            self._garbage(size)
+            return
         tokens = line.translate(_TO_SPACE).split()
         if len(tokens) == self.size:
             self._framed = True  # the right length: parsed with the others of this read
-            self._pending.append((tokens, len(packet)))
+            self._pending.append((tokens, size, end))
             return
         try:
             np.array(tokens, dtype=np.float64)
         except ValueError:
-            self._garbage(len(packet))
+            self._garbage(size)
             return
         self._wrong_length(len(tokens))
         if len(tokens) < self.size:
             self.stats.truncated += 1
         else:
-            self._garbage(len(packet))
+            self._garbage(size)
 
     def _parse(self) -> None:
         """The lines of the right length, all at once (one float conversion); a line
@@ -170,11 +188,11 @@ class TextDecoder(Packetizer):
         if not pending:
             return
         try:
-            values = np.array([t for tokens, _ in pending for t in tokens], dtype=np.float64)
+            values = np.array([t for tokens, _, _ in pending for t in tokens], dtype=np.float64)
             values = values.reshape(len(pending), self.size)
         except ValueError:  # a word among them: line by line
             rows = []
-            for tokens, _size in pending:
+            for tokens, _, _ in pending:
                 try:
                     rows.append(np.array(tokens, dtype=np.float64))
                 except ValueError:
@@ -183,10 +201,12 @@ class TextDecoder(Packetizer):
         counts = np.rint(values)
         with np.errstate(invalid="ignore"):
             good = (counts == values).all(1) & (counts >= 0).all(1) & (counts <= 65535).all(1)
-        for (_, size), ok in zip(pending, good, strict=True):
+        for (_, size, _), ok in zip(pending, good, strict=True):
             if not ok:
                 self._garbage(size)
-        self._out.extend(counts[good].astype(np.uint16).reshape(-1, *self.shape))
+        ends = [end for (_, _, end), ok in zip(pending, good, strict=True) if ok]
+        frames = counts[good].astype(np.uint16).reshape(-1, *self.shape)
+        self._out.extend(zip(frames, ends, strict=True))
 
     def _wrong_length(self, n: int) -> None:
         if self._framed:
