@@ -224,6 +224,7 @@ def read_mcap(source: Path, *, sensor=None, topic: str | None = None):
                 if ch.schema_id in summary.schemas
             }
             chosen = _choose_topic(topics, topic, source)
+            losses = _mcap_losses(reader, source)
             for _, _, _, ros in reader.iter_decoded_messages(topics=[chosen]):
                 if spec is None:
                     spec = _ros_sensor(sensor, [s.name for s in ros.sensors], source)
@@ -244,8 +245,29 @@ def read_mcap(source: Path, *, sensor=None, topic: str | None = None):
     if spec is None:
         raise ImportError_(f"{source}: topic {chosen} holds no messages")
     return build_recording(
-        spec, frames, stamps, source=str(source), description=f"imported from {source} ({chosen})"
-    )
+        spec, frames, stamps, source=str(source), description=f"imported from {source} ({chosen})",
+        losses=losses,
+    )  # fmt: skip
+
+
+def _mcap_losses(reader, source: Path) -> dict[str, int]:
+    """The loss counters tactsense's MCAP writers keep (metadata ``tactsense.losses``), or
+    none; a counter that is not a whole number is refused rather than dropped."""
+    from tactsense.interop.mcap import LOSSES_METADATA
+
+    losses = {}
+    for record in reader.iter_metadata():
+        if record.name != LOSSES_METADATA:
+            continue
+        for kind, value in record.metadata.items():
+            try:
+                losses[kind] = int(value)
+            except ValueError:
+                raise ImportError_(
+                    f"{source}: the loss counter {kind!r} in its {LOSSES_METADATA} record is "
+                    f"{value!r}; expected a whole number"
+                ) from None
+    return losses
 
 
 def read_rosbag2(source: Path, *, sensor=None, topic: str | None = None):

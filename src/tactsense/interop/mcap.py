@@ -342,9 +342,19 @@ class McapTactileWriter:
         """An MCAP metadata record (name and string pairs) in the file."""
         self._raw.add_metadata(name, data)
 
+    def losses(self, counts: dict) -> None:
+        """The loss counters (``tactsense.stream.LOSS_KINDS``, each its own count) as the
+        metadata record ``tactsense.losses``, which ``tactsense import`` reads back."""
+        from tactsense.stream.reader import LOSS_KINDS
+
+        self.metadata(LOSSES_METADATA, {k: str(int(counts.get(k, 0))) for k in LOSS_KINDS})
+
     def finish(self) -> None:
         self._writer.finish()
 
+
+LOSSES_METADATA = "tactsense.losses"
+"""Name of the MCAP metadata record that holds a recording's loss counters."""
 
 _STAMP = struct.Struct("<iI")
 """builtin_interfaces/Time in CDR: int32 sec, uint32 nanosec, little-endian."""
@@ -431,6 +441,8 @@ def export_mcap(
                 "source": str(Path(recording).name),
             },
         )
+        if reader.losses:
+            writer.losses(reader.losses)
         if reader.sensor.kind != "finger":  # every contact, tracked: one message each
             from tactsense.batch import iter_contacts
 
@@ -528,6 +540,7 @@ def record_mcap(
                 if hasattr(reader, "stop"):
                     reader.stop(wait_s=0.5)  # END settles the last frames' losses
             finally:
+                writer.losses(reader.stats.as_dict())
                 writer.finish()
                 if progress is not None:
                     elapsed = max(time.perf_counter() - start, 1e-9)
