@@ -256,7 +256,7 @@ def test_view_feeds_a_format_source():
         reader = open_source(f"justfloat:socket://127.0.0.1:{port}", sensor=SPEC, start=False)
         feed = LiveFeed(reader, view_locator(SPEC, baseline_frames=5))
         feed.start(messages.append)
-        feed._thread.join(20)
+        feed._thread.join(90)  # a cold Numba cache compiles the locator first
     finally:
         emulator.stop()
     assert feed.frames_in == 60 and feed.status == "ended", feed.health()
