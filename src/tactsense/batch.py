@@ -181,6 +181,7 @@ class iter_contacts:
         from tactsense.estimate.array_calibration import ArrayCalibration
         from tactsense.estimate.baseline import DriftBaseline
         from tactsense.estimate.contacts import default_threshold
+        from tactsense.estimate.creep import recording_creep
         from tactsense.estimate.track import ContactTracker
 
         sensor = reader.sensor
@@ -204,10 +205,12 @@ class iter_contacts:
                 # NaN-tolerant: one unreadable value in the baseline frames does not
                 # make its taxel dead for the whole recording
                 start = np.nanmedian(reader.frames(0, baseline_frames).astype(float), axis=0)
+            creep, stiffening = recording_creep(sensor, reader.attrs)
             self.baseline = DriftBaseline(
                 start, sensor, frame_period_s=sensor.scan_period_s,
                 threshold=default_threshold(sensor) if threshold is None else threshold,
                 time_constant_s=math.inf if drift_s is None else drift_s,
+                creep=creep, stiffening=stiffening,
             )  # fmt: skip
         self.tracker = ContactTracker(sensor.scan_period_s, **(tracker_options or {}))
         self._options = dict(calibration=calibration, threshold=threshold,
