@@ -84,10 +84,32 @@ def recording_creep(sensor, attrs) -> tuple[Viscoelastic | None, float]:
             scenario = {}
         if isinstance(scenario, dict) and scenario.get("steps"):
             on = {f for f in str(attrs.get("flaws", "")).split(",") if f}
-    creep = described_creep(sensor) if on is None or "viscoelastic" in on else None
-    if creep is None or (on is not None and "nonlinearity" not in on):
+    if on is None:
+        return described_compensation(sensor)
+    creep = described_creep(sensor) if "viscoelastic" in on else None
+    if creep is None or "nonlinearity" not in on:
         return creep, 0.0
     return creep, float(sensor.flaws.nonlinear_saturation)
+
+
+def described_compensation(sensor) -> tuple[Viscoelastic | None, float]:
+    """The creep to take out of a pad's or point set's measured frames (a live stream,
+    a recording that is no simulation) and the stiffening scale after it: the sensor's
+    description's (:func:`described_creep`, ``nonlinear_saturation``); ``(None, 0)`` on
+    a finger, whose creep compensation is its calibration's.
+
+    Returns
+    -------
+    creep : Viscoelastic or None
+    stiffening : float
+        [-]; 0 for none.
+    """
+    if getattr(sensor, "kind", None) == "finger":
+        return None, 0.0
+    creep = described_creep(sensor)
+    if creep is None:
+        return None, 0.0
+    return creep, max(float(sensor.flaws.nonlinear_saturation), 0.0)
 
 
 def _memory_response(u, dt, model: Viscoelastic):
