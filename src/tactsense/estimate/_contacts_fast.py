@@ -757,3 +757,149 @@ def fit_into(signal, labels, frame_of, root, peak_row, peak_col, kernel, half, r
         row[k] = pr - 1 + (best_a + da) * step
         col[k] = pc - 1 + (best_b + db) * step
         force[k] = amp
+
+
+@jit(inline="always")
+def _kernel_at(kernel, step, half, qr, qc, r, c):
+    """The tabulated response [-/N] of taxel (r, c) to 1 N at (qr, qc) [taxel]
+    (bilinear between the table's sub-taxel positions), 0 outside its window."""
+    n_sub = kernel.shape[0] - 1
+    r0 = math.floor(qr)
+    c0 = math.floor(qc)
+    i = r - r0 + half
+    j = c - c0 + half
+    if i < 0 or i > 2 * half or j < 0 or j > 2 * half:
+        return 0.0
+    a = (qr - r0) / step
+    b = (qc - c0) / step
+    ia = min(int(a), n_sub - 1)
+    ib = min(int(b), n_sub - 1)
+    ta = a - ia
+    tb = b - ib
+    return (
+        (1 - ta) * (1 - tb) * kernel[ia, ib, i, j]
+        + ta * (1 - tb) * kernel[ia + 1, ib, i, j]
+        + (1 - ta) * tb * kernel[ia, ib + 1, i, j]
+        + ta * tb * kernel[ia + 1, ib + 1, i, j]
+    )
+
+
+@jit(inline="always")
+def _pair_gain(signal, label_frames, f, own, ru, cv, reach, u, v, er, ec, h, kernel, step,
+               half, floor):  # fmt: skip
+    """Residual reduction [-^2] and summed amplitude [N] of two loads at ``(u, v) +- h e``
+    with non-negative least-squares amplitudes (reduction -1 where one would be
+    negative or the two are not independent)."""
+    rows = signal.shape[1]
+    cols = signal.shape[2]
+    s11 = 0.0
+    s22 = 0.0
+    s12 = 0.0
+    y1 = 0.0
+    y2 = 0.0
+    for r in range(max(0, ru - reach), min(rows, ru + reach + 1)):
+        for c in range(max(0, cv - reach), min(cols, cv + reach + 1)):
+            lab = label_frames[f, r, c]
+            s = signal[f, r, c]
+            if (lab >= 0 and lab != own) or not s > floor:
+                continue
+            g1 = _kernel_at(kernel, step, half, u - h * er, v - h * ec, r, c)
+            g2 = _kernel_at(kernel, step, half, u + h * er, v + h * ec, r, c)
+            s11 += g1 * g1
+            s22 += g2 * g2
+            s12 += g1 * g2
+            y1 += g1 * s
+            y2 += g2 * s
+    det = s11 * s22 - s12 * s12
+    if not det > 1e-9 * s11 * s22:
+        return -1.0, 0.0
+    a1 = (s22 * y1 - s12 * y2) / det
+    a2 = (s11 * y2 - s12 * y1) / det
+    if a1 < 0.0 or a2 < 0.0:
+        return -1.0, 0.0
+    return a1 * y1 + a2 * y2, a1 + a2
+
+
+@jit(nogil=True)
+def merged_force(
+    signal, label_frames, frame_of, root, row, col, mrr, mcc, mrc, kernel, step, half,
+    halves, noise_var, gain, floor, force,
+):  # fmt: skip
+    """Force of each contact as the sum of two loads where two explain its signal
+    clearly better than one: a contact that the segmentation holds as one may cover two
+    loads too close to part (below the resolution limit), and one load's least-squares
+    amplitude then carries only part of their force.
+
+    ``kernel`` is :func:`~tactsense.estimate.contacts.pad_force_kernel`'s signed table
+    (responses that add up). For each contact, over the taxels within ``half + 1`` of
+    its position whose signal exceeds ``floor`` (other contacts' taxels left out): two
+    loads at ``(row, col) +- h e``, ``e`` the major axis
+    of its second moments ``mrr, mcc, mrc`` [taxel^2] and ``h`` each of ``halves``
+    [taxel], with non-negative least-squares amplitudes. The pair with the least
+    residual replaces ``force[k]`` by the sum of its amplitudes when it lowers the
+    residual of the one load at ``(row, col)`` by more than ``gain`` times
+    ``noise_var`` (the variance of one taxel's signal [-^2]). Contacts whose force is
+    NaN are left so.
+    """
+    rows = signal.shape[1]
+    cols = signal.shape[2]
+    reach = half + 1
+    for k in range(frame_of.shape[0]):
+        f = frame_of[k]
+        u = row[k]
+        v = col[k]
+        if not (math.isfinite(u) and math.isfinite(v) and math.isfinite(force[k])):
+            continue
+        angle = 0.5 * math.atan2(2.0 * mrc[k], mrr[k] - mcc[k])
+        er = math.cos(angle)
+        ec = math.sin(angle)
+        ru = math.floor(u + 0.5)
+        cv = math.floor(v + 0.5)
+        # one load at (u, v)
+        num = 0.0
+        den = 0.0
+        total = 0.0
+        for r in range(max(0, ru - reach), min(rows, ru + reach + 1)):
+            for c in range(max(0, cv - reach), min(cols, cv + reach + 1)):
+                lab = label_frames[f, r, c]
+                if (lab >= 0 and lab != root[k]) or not signal[f, r, c] > floor:
+                    continue
+                g = _kernel_at(kernel, step, half, u, v, r, c)
+                num += g * signal[f, r, c]
+                den += g * g
+                total += signal[f, r, c] * signal[f, r, c]
+        if not den > 0.0:
+            continue
+        one = num * num / den  # the residual's reduction by one load
+        if not total - one > gain * noise_var:
+            continue  # one load explains the signal to the noise: nothing to gain
+        best = one
+        best_force = -1.0
+        best_h = -1.0
+        for m in range(halves.shape[0]):
+            gained, amp = _pair_gain(
+                signal, label_frames, f, root[k], ru, cv, reach, u, v, er, ec, halves[m],
+                kernel, step, half, floor,
+            )  # fmt: skip
+            if gained > best:
+                best, best_force, best_h = gained, amp, halves[m]
+        if best_h < 0.0:
+            continue
+        # the response changes fast with the loads' spacing: refine it twice, each
+        # time on 17 points across the step before
+        width = halves[1] - halves[0] if halves.shape[0] > 1 else 0.125
+        for _ in range(2):
+            centre = best_h
+            for m in range(17):
+                h = centre + (m - 8) * width / 8.0
+                if h <= 0.0:
+                    continue
+                gained, amp = _pair_gain(
+                    signal, label_frames, f, root[k], ru, cv, reach, u, v, er, ec, h,
+                    kernel, step, half, floor,
+                )  # fmt: skip
+                if gained > best:
+                    best, best_force, best_h = gained, amp, h
+            width = width / 8.0
+        if best_force >= 0.0 and best - one > gain * noise_var:
+            force[k] = best_force
