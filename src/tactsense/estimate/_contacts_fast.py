@@ -811,7 +811,7 @@ def _pair_gain(signal, label_frames, f, own, ru, cv, reach, u, v, er, ec, h, ker
             y1 += g1 * s
             y2 += g2 * s
     det = s11 * s22 - s12 * s12
-    if not det > 1e-9 * s11 * s22:
+    if not det > 0.1 * s11 * s22:  # the two responses too alike: no split to trust
         return -1.0, 0.0
     a1 = (s22 * y1 - s12 * y2) / det
     a2 = (s11 * y2 - s12 * y1) / det
@@ -820,10 +820,31 @@ def _pair_gain(signal, label_frames, f, own, ru, cv, reach, u, v, er, ec, h, ker
     return a1 * y1 + a2 * y2, a1 + a2
 
 
+@jit(inline="always")
+def _one_gain(signal, label_frames, f, own, ru, cv, reach, qr, qc, kernel, step, half, floor):
+    """Residual reduction [-^2] and least-squares amplitude [N] of one load at (qr, qc)."""
+    rows = signal.shape[1]
+    cols = signal.shape[2]
+    num = 0.0
+    den = 0.0
+    for r in range(max(0, ru - reach), min(rows, ru + reach + 1)):
+        for c in range(max(0, cv - reach), min(cols, cv + reach + 1)):
+            lab = label_frames[f, r, c]
+            s = signal[f, r, c]
+            if (lab >= 0 and lab != own) or not s > floor:
+                continue
+            g = _kernel_at(kernel, step, half, qr, qc, r, c)
+            num += g * s
+            den += g * g
+    if not den > 0.0:
+        return -1.0, 0.0
+    return num * num / den, num / den
+
+
 @jit(nogil=True)
 def merged_force(
     signal, label_frames, frame_of, root, row, col, mrr, mcc, mrc, kernel, step, half,
-    halves, noise_var, gain, floor, force,
+    halves, noise_var, gain, floor, threshold, spread, force,
 ):  # fmt: skip
     """Force of each contact as the sum of two loads where two explain its signal
     clearly better than one: a contact that the segmentation holds as one may cover two
@@ -831,19 +852,23 @@ def merged_force(
     amplitude then carries only part of their force.
 
     ``kernel`` is :func:`~tactsense.estimate.contacts.pad_force_kernel`'s signed table
-    (responses that add up). For each contact, over the taxels within ``half + 1`` of
-    its position whose signal exceeds ``floor`` (other contacts' taxels left out): two
-    loads at ``(row, col) +- h e``, ``e`` the major axis
-    of its second moments ``mrr, mcc, mrc`` [taxel^2] and ``h`` each of ``halves``
-    [taxel], with non-negative least-squares amplitudes. The pair with the least
-    residual replaces ``force[k]`` by the sum of its amplitudes when it lowers the
-    residual of the one load at ``(row, col)`` by more than ``gain`` times
-    ``noise_var`` (the variance of one taxel's signal [-^2]). Contacts whose force is
-    NaN are left so.
+    (responses that add up). Only a contact wider along its major axis ``e`` (from its
+    second moments ``mrr, mcc, mrc`` [taxel^2]) than one load at its position would be,
+    by more than ``spread`` [taxel^2], is looked at (one load's width: the second
+    moment of the table's response above ``threshold``, scaled by the contact's
+    one-load amplitude). Over the taxels within ``half + 1`` of it whose signal
+    exceeds ``floor`` (other contacts' taxels left out): one load at ``(row, col) + t
+    e`` and two loads at ``(row, col) + (t +- h) e``, with non-negative least-squares
+    amplitudes, for ``t`` in [-0.5, 0.5] taxel and ``h`` each of ``halves`` [taxel],
+    the best of each refined twice. The two loads' summed amplitudes replace
+    ``force[k]`` when they lower the residual by more than the best single load does,
+    by more than ``gain`` times ``noise_var`` (the variance of one taxel's signal
+    [-^2]). Contacts whose force is NaN are left so.
     """
     rows = signal.shape[1]
     cols = signal.shape[2]
     reach = half + 1
+    n_t = 9
     for k in range(frame_of.shape[0]):
         f = frame_of[k]
         u = row[k]
@@ -853,53 +878,75 @@ def merged_force(
         angle = 0.5 * math.atan2(2.0 * mrc[k], mrr[k] - mcc[k])
         er = math.cos(angle)
         ec = math.sin(angle)
+        along = er * er * mrr[k] + 2.0 * er * ec * mrc[k] + ec * ec * mcc[k]
         ru = math.floor(u + 0.5)
         cv = math.floor(v + 0.5)
-        # one load at (u, v)
-        num = 0.0
-        den = 0.0
-        total = 0.0
+        one, amp = _one_gain(
+            signal, label_frames, f, root[k], ru, cv, reach, u, v, kernel, step, half, floor
+        )
+        if not amp > 0.0:
+            continue
+        # how wide one load of that amplitude would read, along e
+        w0 = 0.0
+        w1 = 0.0
+        w2 = 0.0
         for r in range(max(0, ru - reach), min(rows, ru + reach + 1)):
             for c in range(max(0, cv - reach), min(cols, cv + reach + 1)):
-                lab = label_frames[f, r, c]
-                if (lab >= 0 and lab != root[k]) or not signal[f, r, c] > floor:
-                    continue
-                g = _kernel_at(kernel, step, half, u, v, r, c)
-                num += g * signal[f, r, c]
-                den += g * g
-                total += signal[f, r, c] * signal[f, r, c]
-        if not den > 0.0:
-            continue
-        one = num * num / den  # the residual's reduction by one load
-        if not total - one > gain * noise_var:
-            continue  # one load explains the signal to the noise: nothing to gain
-        best = one
+                w = amp * _kernel_at(kernel, step, half, u, v, r, c)
+                if w > threshold:
+                    x = (r - u) * er + (c - v) * ec
+                    w0 += w
+                    w1 += w * x
+                    w2 += w * x * x
+        if w0 > 0.0:
+            mean = w1 / w0
+            if not along - (w2 / w0 - mean * mean) > spread:
+                continue
+        best_one = one
+        best = -1.0
         best_force = -1.0
+        best_t = 0.0
         best_h = -1.0
-        for m in range(halves.shape[0]):
-            gained, amp = _pair_gain(
-                signal, label_frames, f, root[k], ru, cv, reach, u, v, er, ec, halves[m],
+        for it in range(n_t):
+            t = (it - (n_t - 1) / 2) / (n_t - 1)
+            g1, _ = _one_gain(
+                signal, label_frames, f, root[k], ru, cv, reach, u + t * er, v + t * ec,
                 kernel, step, half, floor,
             )  # fmt: skip
-            if gained > best:
-                best, best_force, best_h = gained, amp, halves[m]
-        if best_h < 0.0:
-            continue
-        # the response changes fast with the loads' spacing: refine it twice, each
-        # time on 17 points across the step before
-        width = halves[1] - halves[0] if halves.shape[0] > 1 else 0.125
-        for _ in range(2):
-            centre = best_h
-            for m in range(17):
-                h = centre + (m - 8) * width / 8.0
-                if h <= 0.0:
-                    continue
-                gained, amp = _pair_gain(
-                    signal, label_frames, f, root[k], ru, cv, reach, u, v, er, ec, h,
-                    kernel, step, half, floor,
+            best_one = max(best_one, g1)
+            for m in range(halves.shape[0]):
+                gained, total = _pair_gain(
+                    signal, label_frames, f, root[k], ru, cv, reach, u + t * er,
+                    v + t * ec, er, ec, halves[m], kernel, step, half, floor,
                 )  # fmt: skip
                 if gained > best:
-                    best, best_force, best_h = gained, amp, h
-            width = width / 8.0
-        if best_force >= 0.0 and best - one > gain * noise_var:
+                    best, best_force, best_t, best_h = gained, total, t, halves[m]
+        if best_h < 0.0:
+            continue
+        # the response changes fast with the loads' places: refine the centre and the
+        # spacing in turn, twice, each on 17 points across the step before
+        width_t = 1.0 / (n_t - 1)
+        width_h = halves[1] - halves[0] if halves.shape[0] > 1 else 0.125
+        for _ in range(2):
+            for which in range(2):
+                centre_t = best_t
+                centre_h = best_h
+                for m in range(17):
+                    t = centre_t
+                    h = centre_h
+                    if which == 0:
+                        t = centre_t + (m - 8) * width_t / 8.0
+                    else:
+                        h = centre_h + (m - 8) * width_h / 8.0
+                    if h <= 0.0:
+                        continue
+                    gained, total = _pair_gain(
+                        signal, label_frames, f, root[k], ru, cv, reach, u + t * er,
+                        v + t * ec, er, ec, h, kernel, step, half, floor,
+                    )  # fmt: skip
+                    if gained > best:
+                        best, best_force, best_t, best_h = gained, total, t, h
+            width_t = width_t / 8.0
+            width_h = width_h / 8.0
+        if best_force >= 0.0 and best - best_one > gain * noise_var:
             force[k] = best_force

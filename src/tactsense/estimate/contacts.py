@@ -476,7 +476,7 @@ def _grid_contacts(signal, sensor, threshold, saddle, max_contacts, method) -> C
             y = col * g.col_pitch_mm
         else:
             force = pad_contact_force(signal, labels, seg, sensor)
-        pad_merged_force(signal, labels, seg, row, col, sensor, force)
+        pad_merged_force(signal, labels, seg, row, col, sensor, threshold, force)
         major, minor, angle = _extent(
             seg["rr"], seg["cc"], seg["rc"], g.row_pitch_mm, g.col_pitch_mm
         )
@@ -632,6 +632,10 @@ MERGED_GAIN = 25.0
 """Two loads replace one in a contact's force only when they lower the residual by more
 than this many times one taxel's noise variance (:func:`pad_merged_force`) [-]."""
 
+MERGED_SPREAD = 0.1
+"""A contact is looked at for two loads only when it is wider along its major axis
+than one load would be by more than this [taxel^2] (two loads d apart add (d/2)^2)."""
+
 MERGED_HALVES = np.arange(0.25, 2.51, 0.125)
 """Half-separations of the two loads tried along a contact's major axis [taxel]."""
 
@@ -648,7 +652,7 @@ def signal_noise_variance(sensor) -> float:
     return counts / sensor.electronics.nominal_counts**2
 
 
-def pad_merged_force(signal, labels, seg, row, col, sensor, force) -> None:
+def pad_merged_force(signal, labels, seg, row, col, sensor, threshold, force) -> None:
     """A pad contact that holds two loads too close to part carries the force of both:
     ``force`` [N] is replaced in place by the two loads' summed amplitudes where two
     explain the contact's signal clearly better than one
@@ -667,7 +671,8 @@ def pad_merged_force(signal, labels, seg, row, col, sensor, force) -> None:
         merged_force(
             signal, labels, seg["frame"], seg["root"], np.asarray(row, float),
             np.asarray(col, float), seg["rr"], seg["cc"], seg["rc"], kernel, step, half,
-            MERGED_HALVES, noise_var, MERGED_GAIN, floor, force,
+            MERGED_HALVES, noise_var, MERGED_GAIN, floor, float(threshold), MERGED_SPREAD,
+            force,
         )  # fmt: skip
 
 
