@@ -786,10 +786,14 @@ def _kernel_at(kernel, step, half, qr, qc, r, c):
 
 @jit(inline="always")
 def _pair_gain(signal, label_frames, f, own, ru, cv, reach, u, v, er, ec, h, kernel, step,
-               half, floor):  # fmt: skip
+               half, floor, top, threshold):  # fmt: skip
     """Residual reduction [-^2] and summed amplitude [N] of two loads at ``(u, v) +- h e``
     with non-negative least-squares amplitudes (reduction -1 where one would be
-    negative or the two are not independent)."""
+    negative, the two are not independent, fewer than five taxels carry them (two
+    amplitudes and two places fit four readings whatever they are), either alone would
+    read more than twice the contact's largest signal ``top``, or together they would
+    read more than ``threshold`` on a taxel that reads at most ``floor``: a pair whose
+    compression and tension cancel to fit, not two loads that the signal shows)."""
     rows = signal.shape[1]
     cols = signal.shape[2]
     s11 = 0.0
@@ -797,14 +801,22 @@ def _pair_gain(signal, label_frames, f, own, ru, cv, reach, u, v, er, ec, h, ker
     s12 = 0.0
     y1 = 0.0
     y2 = 0.0
+    p1 = 0.0
+    p2 = 0.0
+    used = 0
     for r in range(max(0, ru - reach), min(rows, ru + reach + 1)):
         for c in range(max(0, cv - reach), min(cols, cv + reach + 1)):
             lab = label_frames[f, r, c]
             s = signal[f, r, c]
-            if (lab >= 0 and lab != own) or not s > floor:
+            if lab >= 0 and lab != own:
                 continue
             g1 = _kernel_at(kernel, step, half, u - h * er, v - h * ec, r, c)
             g2 = _kernel_at(kernel, step, half, u + h * er, v + h * ec, r, c)
+            p1 = max(p1, g1)
+            p2 = max(p2, g2)
+            if not s > floor:
+                continue
+            used += 1
             s11 += g1 * g1
             s22 += g2 * g2
             s12 += g1 * g2
@@ -815,8 +827,17 @@ def _pair_gain(signal, label_frames, f, own, ru, cv, reach, u, v, er, ec, h, ker
         return -1.0, 0.0
     a1 = (s22 * y1 - s12 * y2) / det
     a2 = (s11 * y2 - s12 * y1) / det
-    if a1 < 0.0 or a2 < 0.0:
+    if used < 5 or a1 < 0.0 or a2 < 0.0 or a1 * p1 > 2.0 * top or a2 * p2 > 2.0 * top:
         return -1.0, 0.0
+    for r in range(max(0, ru - reach), min(rows, ru + reach + 1)):
+        for c in range(max(0, cv - reach), min(cols, cv + reach + 1)):
+            lab = label_frames[f, r, c]
+            if (lab >= 0 and lab != own) or signal[f, r, c] > floor:
+                continue
+            g1 = _kernel_at(kernel, step, half, u - h * er, v - h * ec, r, c)
+            g2 = _kernel_at(kernel, step, half, u + h * er, v + h * ec, r, c)
+            if a1 * g1 + a2 * g2 > threshold:
+                return -1.0, 0.0
     return a1 * y1 + a2 * y2, a1 + a2
 
 
@@ -886,7 +907,13 @@ def merged_force(
         )
         if not amp > 0.0:
             continue
-        # how wide one load of that amplitude would read, along e
+        # how wide one load of that amplitude would read, along e; the contact's top
+        top = 0.0
+        for r in range(max(0, ru - reach), min(rows, ru + reach + 1)):
+            for c in range(max(0, cv - reach), min(cols, cv + reach + 1)):
+                lab = label_frames[f, r, c]
+                if lab == root[k]:
+                    top = max(top, signal[f, r, c])
         w0 = 0.0
         w1 = 0.0
         w2 = 0.0
@@ -917,7 +944,8 @@ def merged_force(
             for m in range(halves.shape[0]):
                 gained, total = _pair_gain(
                     signal, label_frames, f, root[k], ru, cv, reach, u + t * er,
-                    v + t * ec, er, ec, halves[m], kernel, step, half, floor,
+                    v + t * ec, er, ec, halves[m], kernel, step, half, floor, top,
+                    threshold,
                 )  # fmt: skip
                 if gained > best:
                     best, best_force, best_t, best_h = gained, total, t, halves[m]
@@ -942,7 +970,8 @@ def merged_force(
                         continue
                     gained, total = _pair_gain(
                         signal, label_frames, f, root[k], ru, cv, reach, u + t * er,
-                        v + t * ec, er, ec, h, kernel, step, half, floor,
+                        v + t * ec, er, ec, h, kernel, step, half, floor, top,
+                        threshold,
                     )  # fmt: skip
                     if gained > best:
                         best, best_force, best_t, best_h = gained, total, t, h
