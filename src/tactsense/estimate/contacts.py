@@ -632,7 +632,7 @@ MERGED_GAIN = 25.0
 """Two loads replace one in a contact's force only when they lower the residual by more
 than this many times one taxel's noise variance (:func:`pad_merged_force`) [-]."""
 
-MERGED_SPREAD = 0.1
+MERGED_SPREAD = 0.2
 """A contact is looked at for two loads only when it is wider along its major axis
 than one load would be by more than this [taxel^2] (two loads d apart add (d/2)^2)."""
 
