@@ -181,13 +181,15 @@ class iter_contacts:
         from tactsense.estimate.array_calibration import ArrayCalibration
         from tactsense.estimate.baseline import DriftBaseline
         from tactsense.estimate.contacts import default_threshold
-        from tactsense.estimate.creep import recording_creep
+        from tactsense.estimate.creep import creep_applied
         from tactsense.estimate.track import ContactTracker
 
         sensor = reader.sensor
         self.reader = reader
         self.compensator = None
         self.baseline = None
+        self.creep = "none"
+        """Where the creep taken out came from (:func:`~tactsense.estimate.creep.creep_applied`)."""
         array_calibration = isinstance(calibration, ArrayCalibration)
         if calibration is not None and not array_calibration:
             calibration.check_sensor(sensor)
@@ -205,7 +207,7 @@ class iter_contacts:
                 # NaN-tolerant: one unreadable value in the baseline frames does not
                 # make its taxel dead for the whole recording
                 start = np.nanmedian(reader.frames(0, baseline_frames).astype(float), axis=0)
-            creep, stiffening = recording_creep(sensor, reader.attrs)
+            creep, stiffening, self.creep = creep_applied(sensor, reader.attrs)
             self.baseline = DriftBaseline(
                 start, sensor, frame_period_s=sensor.scan_period_s,
                 threshold=default_threshold(sensor) if threshold is None else threshold,
@@ -266,7 +268,8 @@ def contacts_file(
         ``ids`` (distinct tracked contacts), ``most`` (largest number in one frame),
         ``births``, ``deaths``, ``merges``, ``splits``, ``below_baseline`` (frames with a
         taxel below its baseline by more than the threshold: the first frames were
-        probably touched).
+        probably touched), ``creep`` (the creep taken out: ``"none"`` or
+        ``"described (...)"``, :func:`~tactsense.estimate.creep.creep_applied`).
     """
     from tactsense.estimate.contacts import find_contacts
     from tactsense.estimate.output import ContactsWriter
@@ -302,6 +305,7 @@ def contacts_file(
                 writer.write_contacts(np.zeros(0), empty)
             ids = pieces.tracker.next_id
             baseline = pieces.baseline
+            creep = pieces.creep
     return {
         "frames": total,
         "rows": writer.rows,
@@ -310,4 +314,5 @@ def contacts_file(
         "most": most,
         **counts,
         "below_baseline": 0 if baseline is None else baseline.below_frames,
+        "creep": creep,
     }

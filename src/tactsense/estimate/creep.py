@@ -54,12 +54,28 @@ def described_creep(sensor) -> Viscoelastic | None:
 
 def recording_creep(sensor, attrs) -> tuple[Viscoelastic | None, float]:
     """The creep to take out of a pad's or point set's recording, and the stiffening
-    scale that acts after it.
+    scale that acts after it (:func:`creep_applied` without its label)."""
+    creep, stiffening, _ = creep_applied(sensor, attrs)
+    return creep, stiffening
 
-    From the sensor's description (:func:`described_creep`, and its
-    ``nonlinear_saturation``). A simulated recording (no ``source``, a scenario with
-    steps) says which flaws were switched on: creep or stiffening left off there is not
-    compensated. None on a finger: its creep compensation is its calibration's
+
+def creep_applied(sensor, attrs) -> tuple[Viscoelastic | None, float, str]:
+    """The creep to take out of a pad's or point set's recording, the stiffening scale
+    that acts after it, and a label saying where it came from.
+
+    Creep is compensated only where it is known:
+
+    * a simulated recording (no ``source``, a scenario with steps) with ``viscoelastic``
+      switched on: the twin's own description, which made the creep (label
+      ``"described (simulation)"``); stiffening is undone only if ``nonlinearity`` was
+      on too. Creep left off there is not compensated;
+    * a measured recording (``source`` set: imported, streamed, recorded): the
+      description's creep only when it says ``creep_known = true`` in ``[flaws]``
+      (label ``"described (sensor file)"``), else nothing (``"none"``): the default
+      values are the paper's rubber, not this sensor's, and subtracting them would
+      under-read held forces and leave readings below the baseline after a lift.
+
+    None on a finger: its creep compensation is its calibration's
     (``tactsense calibrate --steps``), so that its long table's force stays ``locate``'s.
 
     Parameters
@@ -73,9 +89,11 @@ def recording_creep(sensor, attrs) -> tuple[Viscoelastic | None, float]:
     creep : Viscoelastic or None
     stiffening : float
         The scale ``c`` of ``d_meas = d / (1 + d / c)`` [-]; 0 for none.
+    label : str
+        ``"described (simulation)"``, ``"described (sensor file)"`` or ``"none"``.
     """
     if getattr(sensor, "kind", None) == "finger":
-        return None, 0.0
+        return None, 0.0, "none"
     on = None  # the flaws a simulation switched on (None: a measured recording)
     if not str(attrs.get("source", "")):
         try:
@@ -85,18 +103,23 @@ def recording_creep(sensor, attrs) -> tuple[Viscoelastic | None, float]:
         if isinstance(scenario, dict) and scenario.get("steps"):
             on = {f for f in str(attrs.get("flaws", "")).split(",") if f}
     if on is None:
-        return described_compensation(sensor)
+        creep, stiffening = described_compensation(sensor)
+        return creep, stiffening, "none" if creep is None else "described (sensor file)"
     creep = described_creep(sensor) if "viscoelastic" in on else None
-    if creep is None or "nonlinearity" not in on:
-        return creep, 0.0
-    return creep, float(sensor.flaws.nonlinear_saturation)
+    if creep is None:
+        return None, 0.0, "none"
+    if "nonlinearity" not in on:
+        return creep, 0.0, "described (simulation)"
+    return creep, float(sensor.flaws.nonlinear_saturation), "described (simulation)"
 
 
 def described_compensation(sensor) -> tuple[Viscoelastic | None, float]:
     """The creep to take out of a pad's or point set's measured frames (a live stream,
-    a recording that is no simulation) and the stiffening scale after it: the sensor's
-    description's (:func:`described_creep`, ``nonlinear_saturation``); ``(None, 0)`` on
-    a finger, whose creep compensation is its calibration's.
+    a recording that is no simulation) and the stiffening scale after it.
+
+    The sensor description's (:func:`described_creep`, ``nonlinear_saturation``) when
+    it says its creep is known (``creep_known = true`` in ``[flaws]``); ``(None, 0)``
+    otherwise, and on a finger, whose creep compensation is its calibration's.
 
     Returns
     -------
@@ -105,6 +128,9 @@ def described_compensation(sensor) -> tuple[Viscoelastic | None, float]:
         [-]; 0 for none.
     """
     if getattr(sensor, "kind", None) == "finger":
+        return None, 0.0
+    flaws = getattr(sensor, "flaws", None)
+    if flaws is None or not getattr(flaws, "creep_known", False):
         return None, 0.0
     creep = described_creep(sensor)
     if creep is None:
