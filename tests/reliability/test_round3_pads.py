@@ -200,7 +200,7 @@ after 30 s."""
 def test_a_measured_pad_recording_with_no_creep_stated_is_not_compensated(measured_hold):
     from tactsense.batch import contacts_file
 
-    twin, lab, rec = measured_hold
+    twin, lab, _ = measured_hold
     _, count, force_twin, loaded, _ = _per_frame(twin, 2.0)
     with RecordingReader(lab) as reader:
         pieces = iter_contacts(reader, drift_s=2.0)
