@@ -890,11 +890,19 @@ def merged_force(
     cols = signal.shape[2]
     reach = half + 1
     n_t = 9
+    g_one = np.empty((2 * half + 1, 2 * half + 1))
     for k in range(frame_of.shape[0]):
         f = frame_of[k]
         u = row[k]
         v = col[k]
         if not (math.isfinite(u) and math.isfinite(v) and math.isfinite(force[k])):
+            continue
+        # the contact's second moment along its major axis: no wider than ``spread``,
+        # it cannot be wider than one load by more (one load's width is >= 0): skip
+        # before any trigonometry or table look-up (most contacts end here)
+        mid = 0.5 * (mrr[k] + mcc[k])
+        along = mid + math.sqrt(0.25 * (mrr[k] - mcc[k]) ** 2 + mrc[k] * mrc[k])
+        if not along > spread:
             continue
         angle = 0.5 * math.atan2(2.0 * mrc[k], mrr[k] - mcc[k])
         er = math.cos(angle)
@@ -902,26 +910,59 @@ def merged_force(
         along = er * er * mrr[k] + 2.0 * er * ec * mrc[k] + ec * ec * mcc[k]
         ru = math.floor(u + 0.5)
         cv = math.floor(v + 0.5)
-        one, amp = _one_gain(
-            signal, label_frames, f, root[k], ru, cv, reach, u, v, kernel, step, half, floor
-        )
+        # one pass over the taxels one load at (u, v) reaches (the table's window):
+        # its response there (kept for the width, interpolated with the weights of
+        # _kernel_at, computed once), and its least-squares amplitude; the other
+        # taxels of the wider window add nothing to either
+        own = root[k]
+        r0 = math.floor(u)
+        c0 = math.floor(v)
+        n_sub = kernel.shape[0] - 1
+        ia = min(int((u - r0) / step), n_sub - 1)
+        ib = min(int((v - c0) / step), n_sub - 1)
+        ta = (u - r0) / step - ia
+        tb = (v - c0) / step - ib
+        k00 = (1 - ta) * (1 - tb)
+        k10 = ta * (1 - tb)
+        k01 = (1 - ta) * tb
+        k11 = ta * tb
+        num = 0.0
+        den = 0.0
+        for i in range(2 * half + 1):
+            r = r0 - half + i
+            for j in range(2 * half + 1):
+                c = c0 - half + j
+                if r < 0 or r >= rows or c < 0 or c >= cols:
+                    g_one[i, j] = 0.0
+                    continue
+                g = (
+                    k00 * kernel[ia, ib, i, j]
+                    + k10 * kernel[ia + 1, ib, i, j]
+                    + k01 * kernel[ia, ib + 1, i, j]
+                    + k11 * kernel[ia + 1, ib + 1, i, j]
+                )
+                g_one[i, j] = g
+                lab = label_frames[f, r, c]
+                sig = signal[f, r, c]
+                if (lab >= 0 and lab != own) or not sig > floor:
+                    continue
+                num += g * sig
+                den += g * g
+        if not den > 0.0:
+            continue
+        one = num * num / den
+        amp = num / den
         if not amp > 0.0:
             continue
-        # how wide one load of that amplitude would read, along e; the contact's top
-        top = 0.0
-        for r in range(max(0, ru - reach), min(rows, ru + reach + 1)):
-            for c in range(max(0, cv - reach), min(cols, cv + reach + 1)):
-                lab = label_frames[f, r, c]
-                if lab == root[k]:
-                    top = max(top, signal[f, r, c])
+        # how wide one load of that amplitude would read, along e
         w0 = 0.0
         w1 = 0.0
         w2 = 0.0
-        for r in range(max(0, ru - reach), min(rows, ru + reach + 1)):
-            for c in range(max(0, cv - reach), min(cols, cv + reach + 1)):
-                w = amp * _kernel_at(kernel, step, half, u, v, r, c)
+        for i in range(2 * half + 1):
+            for j in range(2 * half + 1):
+                w = amp * g_one[i, j]
                 if w > threshold:
-                    x = (r - u) * er + (c - v) * ec
+                    x = (r0 - half + i - u) * er + (c0 - half + j - v) * ec
                     w0 += w
                     w1 += w * x
                     w2 += w * x * x
@@ -929,6 +970,12 @@ def merged_force(
             mean = w1 / w0
             if not along - (w2 / w0 - mean * mean) > spread:
                 continue
+        # the contact's top (its largest signal), for the pair's bound
+        top = 0.0
+        for r in range(max(0, ru - reach), min(rows, ru + reach + 1)):
+            for c in range(max(0, cv - reach), min(cols, cv + reach + 1)):
+                if label_frames[f, r, c] == own:
+                    top = max(top, signal[f, r, c])
         best_one = one
         best = -1.0
         best_force = -1.0
