@@ -865,7 +865,7 @@ def _one_gain(signal, label_frames, f, own, ru, cv, reach, qr, qc, kernel, step,
 @jit(nogil=True)
 def merged_force(
     signal, label_frames, frame_of, root, row, col, mrr, mcc, mrc, kernel, step, half,
-    halves, noise_var, gain, floor, threshold, spread, force,
+    halves, noise_var, gain, floor, threshold, spread, force, kernel_max,
 ):  # fmt: skip
     """Force of each contact as the sum of two loads where two explain its signal
     clearly better than one: a contact that the segmentation holds as one may cover two
@@ -885,6 +885,13 @@ def merged_force(
     ``force[k]`` when they lower the residual by more than the best single load does,
     by more than ``gain`` times ``noise_var`` (the variance of one taxel's signal
     [-^2]). Contacts whose force is NaN are left so.
+
+    Cheap where it cannot apply (the forces are those of the full check, bit for bit):
+    a contact no wider than ``spread`` along its major axis is skipped before any
+    look-up (one load's width is >= 0); the one-load amplitude interpolates the table
+    only on taxels that carry it (above ``floor``), and the width only where
+    ``kernel_max`` (each window taxel's largest tabulated response [-/N]) times the
+    amplitude can exceed ``threshold``.
     """
     rows = signal.shape[1]
     cols = signal.shape[2]
@@ -932,8 +939,13 @@ def merged_force(
             r = r0 - half + i
             for j in range(2 * half + 1):
                 c = c0 - half + j
+                g_one[i, j] = math.nan  # not looked up (yet)
                 if r < 0 or r >= rows or c < 0 or c >= cols:
                     g_one[i, j] = 0.0
+                    continue
+                lab = label_frames[f, r, c]
+                sig = signal[f, r, c]
+                if (lab >= 0 and lab != own) or not sig > floor:
                     continue
                 g = (
                     k00 * kernel[ia, ib, i, j]
@@ -942,10 +954,6 @@ def merged_force(
                     + k11 * kernel[ia + 1, ib + 1, i, j]
                 )
                 g_one[i, j] = g
-                lab = label_frames[f, r, c]
-                sig = signal[f, r, c]
-                if (lab >= 0 and lab != own) or not sig > floor:
-                    continue
                 num += g * sig
                 den += g * g
         if not den > 0.0:
@@ -960,7 +968,19 @@ def merged_force(
         w2 = 0.0
         for i in range(2 * half + 1):
             for j in range(2 * half + 1):
-                w = amp * g_one[i, j]
+                # no table position reads above the threshold here at this amplitude:
+                # neither can their interpolation (a convex combination)
+                if not amp * kernel_max[i, j] * (1.0 + 1e-9) > threshold:
+                    continue
+                g = g_one[i, j]
+                if math.isnan(g):
+                    g = (
+                        k00 * kernel[ia, ib, i, j]
+                        + k10 * kernel[ia + 1, ib, i, j]
+                        + k01 * kernel[ia, ib + 1, i, j]
+                        + k11 * kernel[ia + 1, ib + 1, i, j]
+                    )
+                w = amp * g
                 if w > threshold:
                     x = (r0 - half + i - u) * er + (c0 - half + j - v) * ec
                     w0 += w

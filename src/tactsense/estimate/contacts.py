@@ -652,6 +652,14 @@ def signal_noise_variance(sensor) -> float:
     return counts / sensor.electronics.nominal_counts**2
 
 
+@functools.lru_cache(maxsize=16)
+def _kernel_max(sensor) -> np.ndarray:
+    """The largest response of each taxel of :func:`pad_force_kernel`'s signed window
+    over every tabulated load position [-/N] (for :func:`pad_merged_force`'s skip)."""
+    kernel, _, _ = pad_force_kernel(sensor, FIT_STEPS, signed=True)
+    return np.ascontiguousarray(kernel.max(axis=(0, 1)))
+
+
 def pad_merged_force(signal, labels, seg, row, col, sensor, threshold, force) -> None:
     """A pad contact that holds two loads too close to part carries the force of both:
     ``force`` [N] is replaced in place by the two loads' summed amplitudes where two
@@ -672,7 +680,7 @@ def pad_merged_force(signal, labels, seg, row, col, sensor, threshold, force) ->
             signal, labels, seg["frame"], seg["root"], np.asarray(row, float),
             np.asarray(col, float), seg["rr"], seg["cc"], seg["rc"], kernel, step, half,
             MERGED_HALVES, noise_var, MERGED_GAIN, floor, float(threshold), MERGED_SPREAD,
-            force,
+            force, _kernel_max(sensor),
         )  # fmt: skip
 
 
