@@ -2,7 +2,9 @@
 their force.
 
 Round trips (simulate with every flaw, then ``locate``'s pipeline,
-:func:`tactsense.batch.iter_contacts`). Tolerances:
+:func:`tactsense.batch.iter_contacts`). The creep compensation there uses the twin's own
+creep parameters (perfect knowledge); what a description that is off gives is
+``scripts/creep_mismatch.py``'s table in docs/contacts.md. Tolerances:
 
 * ghost after a lift: at most 0.2 s (20 frames at 100 Hz). The compensation is causal
   and frame by frame, while the simulation integrates the memories on the scan's ticks:
