@@ -256,3 +256,20 @@ def test_a_merged_pair_carries_the_summed_force(close_pair, method):
     forces = table.force_n[hold]
     assert len(forces) >= 45
     np.testing.assert_allclose(forces, total, rtol=MERGED_TOLERANCE)
+
+
+def test_the_twins_emulator_says_its_creep_is_known_and_a_measured_one_does_not():
+    """``live`` on the twin compensates as ``locate`` does its recording; replaying a
+    measured recording does not invent a known creep."""
+    import tomllib
+
+    from tactsense.interop.importers import build_recording
+    from tactsense.stream.emulator import Emulator
+
+    pad = load_sensor("pad16")
+    rec = ts.simulate(pad, fs.press(pad, dwell_s=0.2, lift_s=0.2), rng=0)
+    sent = tomllib.loads(Emulator.from_recording(rec).identity()["sensor_toml"])
+    assert sent["flaws"][KNOWN] is True
+    lab = build_recording(pad, list(rec.frames), rec.time_s, source="lab.csv", description="x")
+    sent = tomllib.loads(Emulator.from_recording(lab).identity()["sensor_toml"])
+    assert sent["flaws"][KNOWN] is False
