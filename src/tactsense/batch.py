@@ -181,12 +181,15 @@ class iter_contacts:
         from tactsense.estimate.array_calibration import ArrayCalibration
         from tactsense.estimate.baseline import DriftBaseline
         from tactsense.estimate.contacts import default_threshold
+        from tactsense.estimate.creep import creep_applied
         from tactsense.estimate.track import ContactTracker
 
         sensor = reader.sensor
         self.reader = reader
         self.compensator = None
         self.baseline = None
+        self.creep = "none"
+        """Where the creep taken out came from (:func:`~tactsense.estimate.creep.creep_applied`)."""
         array_calibration = isinstance(calibration, ArrayCalibration)
         if calibration is not None and not array_calibration:
             calibration.check_sensor(sensor)
@@ -204,10 +207,12 @@ class iter_contacts:
                 # NaN-tolerant: one unreadable value in the baseline frames does not
                 # make its taxel dead for the whole recording
                 start = np.nanmedian(reader.frames(0, baseline_frames).astype(float), axis=0)
+            creep, stiffening, self.creep = creep_applied(sensor, reader.attrs)
             self.baseline = DriftBaseline(
                 start, sensor, frame_period_s=sensor.scan_period_s,
                 threshold=default_threshold(sensor) if threshold is None else threshold,
                 time_constant_s=math.inf if drift_s is None else drift_s,
+                creep=creep, stiffening=stiffening,
             )  # fmt: skip
         self.tracker = ContactTracker(sensor.scan_period_s, **(tracker_options or {}))
         self._options = dict(calibration=calibration, threshold=threshold,
@@ -264,7 +269,9 @@ def contacts_file(
         ``births``, ``deaths``, ``merges``, ``splits``, ``below_baseline`` (frames with a
         taxel below its baseline by more than the threshold: the first frames were
         probably touched), ``saturated`` (contacts flagged SATURATED), ``force_mean_n``
-        and ``force_max_n`` over the contacts of known force [N].
+        and ``force_max_n`` over the contacts of known force [N], ``creep`` (the creep
+        taken out: ``"none"`` or ``"described (...)"``,
+        :func:`~tactsense.estimate.creep.creep_applied`).
     """
     from tactsense.estimate.contacts import find_contacts
     from tactsense.estimate.output import ContactsWriter
@@ -307,6 +314,7 @@ def contacts_file(
                 writer.write_contacts(np.zeros(0), empty)
             ids = pieces.tracker.next_id
             baseline = pieces.baseline
+            creep = pieces.creep
     return {
         "frames": total,
         "rows": writer.rows,
@@ -318,4 +326,5 @@ def contacts_file(
         "saturated": saturated,
         "force_mean_n": force_sum / force_count if force_count else float("nan"),
         "force_max_n": force_max,
+        "creep": creep,
     }

@@ -55,7 +55,8 @@ def _locate_contacts(recording, out, force, quiet, **options) -> None:
         f"wrote {out}{also}: {summary['frames']} frames, {summary['rows']} contact rows in "
         f"{summary['frames_with_contact']} frames (at most {summary['most']} at once), "
         f"{summary['ids']} tracked ids; {summary['births']} births, {summary['deaths']} "
-        f"deaths, {summary['merges']} merges, {summary['splits']} splits"
+        f"deaths, {summary['merges']} merges, {summary['splits']} splits; "
+        f"creep: {summary['creep']}"
     )
     if summary["below_baseline"]:
         console.print(

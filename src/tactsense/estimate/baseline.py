@@ -40,6 +40,7 @@ from tactsense._jit import jit
 from tactsense._signals import deferred_interrupts
 from tactsense._validation import TactsenseInputError, check_frames
 from tactsense.estimate._fast import taxel_signal
+from tactsense.estimate.creep import CreepCompensator
 from tactsense.estimate.deflection import Flag
 
 TIME_CONSTANT_S = 2.0
@@ -48,6 +49,24 @@ finger under the ``repeated`` scenario (1 s on, 1 s off, 100 times): with 2 s th
 frames stop counting as contacts (12 of 707 against 681 with a fixed baseline); with
 10 s or more the creep left after each lift outgrows the threshold before the baseline
 catches up, and the taxel stays held (``tests/estimate/test_baseline.py``)."""
+
+
+@jit(inline="always")
+def _uncreep(d, creep, memory, r, c):
+    """One taxel's signal ``d`` freed of delayed elasticity and creep (its memories
+    ``memory[:, r, c]`` move on): stiffening undone, the causal inversion of
+    :class:`~tactsense.estimate.creep.CreepCompensator`, stiffening redone."""
+    scale = creep[5]
+    y = d
+    if scale > 0.0:  # d_meas = d / (1 + d / c_s), so d = d_meas / (1 - d_meas / c_s)
+        y = min(d, 0.999 * scale)
+        y = y / (1.0 - y / scale)
+    u = (y - creep[0] * memory[0, r, c] - creep[1] * memory[1, r, c]) * creep[2]
+    memory[0, r, c] = creep[3] * memory[0, r, c] + (1.0 - creep[3]) * u
+    memory[1, r, c] = creep[4] * memory[1, r, c] + (1.0 - creep[4]) * u
+    if scale > 0.0 and u > -0.999 * scale:
+        return u / (1.0 + u / scale)
+    return u
 
 
 @jit(nogil=True)
@@ -85,9 +104,17 @@ def below_baseline(lowest: float, highest: float, threshold: float, resistive: b
 @jit(nogil=True)
 def _follow(
     frames, baseline, unusable, full_scale, resistive, per_count, threshold, alpha, guard,
-    grid, nan_flag, sat_flag, dead_flag, below_flag,
+    grid, nan_flag, sat_flag, dead_flag, below_flag, compensate, creep, memory,
 ):  # fmt: skip
-    """Signal and flags of each frame against a baseline updated after every frame."""
+    """Signal and flags of each frame against a baseline updated after every frame.
+
+    With ``compensate``, each taxel's signal is freed of delayed elasticity and creep
+    before it is thresholded: ``creep`` holds ``(a_d e_d, a_c e_c, 1 / c, e_d, e_c,
+    c_s)`` (:class:`~tactsense.estimate.creep.CreepCompensator`'s recursion; ``c_s`` the
+    stiffening scale undone first and redone after, 0 for none) and ``memory`` (2, rows,
+    cols) the two memories, updated in place. An untouched taxel's baseline then
+    follows the reading less its predicted creep, so that the creep left after a lift
+    is neither taken for a contact nor taken into the baseline."""
     n, rows, cols = frames.shape
     signal = np.empty((n, rows, cols), np.float64)
     flags = np.zeros(n, np.int64)
@@ -111,6 +138,8 @@ def _follow(
                     resistive, per_count, nan_flag, sat_flag, dead_flag,
                 )  # fmt: skip
                 flag |= bits
+                if compensate and bits == 0 and not unusable[r, c]:
+                    d = _uncreep(d, creep, memory, r, c)
                 lowest = min(lowest, d)
                 highest = max(highest, d)
                 signal[f, r, c] = d
@@ -133,7 +162,14 @@ def _follow(
                     continue
                 if v >= full_scale:
                     continue
-                step = alpha * (v - baseline[r, c])
+                if compensate:  # the reading this signal stands for, without creep
+                    s = signal[f, r, c]
+                    if resistive:
+                        step = alpha * s / per_count
+                    else:
+                        step = alpha * baseline[r, c] * s / (1.0 - s)
+                else:
+                    step = alpha * (v - baseline[r, c])
                 baseline[r, c] += step
                 moved += step
                 n_moved += 1
@@ -167,6 +203,18 @@ class DriftBaseline:
         On a grid, taxels around a touched one that are held too (0-3) [taxel].
     rezero_frames : int
         Frames whose median makes the new baseline after :meth:`rezero`.
+    creep : Viscoelastic, optional
+        Delayed elasticity and creep to take out of every taxel's signal, causally,
+        before it is thresholded (e.g. the sensor description's,
+        :func:`~tactsense.estimate.creep.described_creep`): without it the creep left
+        after a long press reads as a contact for as long as the creep time constant
+        (a minute on the paper's skin, whatever ``time_constant_s``, since a touched
+        taxel's baseline is held).
+    stiffening : float
+        With ``creep``: the deflection scale ``c`` of the stiffening law ``d_meas = d /
+        (1 + d / c)`` that acts after the creep (the description's
+        ``nonlinear_saturation``); undone before the compensation and redone after, so
+        the signal keeps its scale [-]. 0: none.
     """
 
     def __init__(
@@ -179,6 +227,8 @@ class DriftBaseline:
         time_constant_s: float = TIME_CONSTANT_S,
         guard: int = 1,
         rezero_frames: int = 5,
+        creep=None,
+        stiffening: float = 0.0,
     ):
         for name, value in (("frame_period_s", frame_period_s), ("threshold", threshold)):
             if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
@@ -216,6 +266,20 @@ class DriftBaseline:
         self._resistive = t is not None and t.kind == "resistive"
         self._per_count = 1.0 / t.counts_per_strain if self._resistive else 1.0
         self._grid = getattr(sensor, "kind", "pad") != "points"
+        if not (isinstance(stiffening, int | float) and math.isfinite(stiffening)):
+            raise TactsenseInputError(f"stiffening must be a number >= 0; got {stiffening!r}")
+        if stiffening < 0:
+            raise TactsenseInputError(f"stiffening must be a number >= 0; got {stiffening!r}")
+        self.creep = creep
+        """The creep model taken out of the signal (None: none)."""
+        self._creep = np.zeros(6)
+        if creep is not None:
+            compensator = CreepCompensator(creep, self.frame_period_s)
+            self._creep[:5] = compensator.coefficients
+            self._creep[5] = float(stiffening)
+        self.creep_memory = np.zeros((2, *self.baseline.shape))
+        """The creep model's two memories (delayed, creep) per taxel [-], carried from
+        frame to frame; zero after a re-zero."""
 
     def rezero(self) -> None:
         """Make the next ``rezero_frames`` frames' median the baseline (taken untouched)."""
@@ -249,7 +313,8 @@ class DriftBaseline:
                 float(2**self.sensor.electronics.adc_bits - 1), self._resistive,
                 self._per_count, self.threshold, self.alpha, self.guard, self._grid,
                 int(Flag.NAN_INPUT), int(Flag.SATURATED), int(Flag.DEAD_TACTEL),
-                int(Flag.BELOW_BASELINE),
+                int(Flag.BELOW_BASELINE), self.creep is not None, self._creep,
+                self.creep_memory,
             )  # fmt: skip
         self.below_frames += int(np.count_nonzero(flags & int(Flag.BELOW_BASELINE)))
         self.frames_seen += len(frames)
@@ -263,4 +328,5 @@ class DriftBaseline:
         if len(self._collect) >= self.rezero_frames:
             self.baseline = np.ascontiguousarray(np.nanmedian(np.stack(self._collect), axis=0))
             self._collect = None
+            self.creep_memory[:] = 0.0  # the new baseline holds whatever creep is left
         return frames

@@ -476,6 +476,7 @@ def _grid_contacts(signal, sensor, threshold, saddle, max_contacts, method) -> C
             y = col * g.col_pitch_mm
         else:
             force = pad_contact_force(signal, labels, seg, sensor)
+        pad_merged_force(signal, labels, seg, row, col, sensor, threshold, force)
         major, minor, angle = _extent(
             seg["rr"], seg["cc"], seg["rc"], g.row_pitch_mm, g.col_pitch_mm
         )
@@ -548,9 +549,13 @@ def _finger_positions(signal, labels, seg, sensor, threshold, method):
 
 
 @functools.lru_cache(maxsize=16)
-def pad_force_kernel(sensor, n_sub: int = 8):
+def pad_force_kernel(sensor, n_sub: int = 8, signed: bool = False):
     """The signal of the taxels around the scenarios' probe (1.6-mm sphere) per newton,
     for the probe at ``n_sub + 1`` sub-taxel offsets along each axis.
+
+    ``signed``: a resistive taxel's strain before it is clipped at zero (a resistive
+    taxel reads compression only), so that the responses to several loads add up (the
+    tension beside one load cancels part of the compression under the next).
 
     Returns ``(kernel, step, half)``: ``kernel[a, b, i, j]`` is the signal [-/N] of the
     taxel at offset ``(i - half, j - half)`` from the taxel nearest below the probe, for
@@ -579,7 +584,7 @@ def pad_force_kernel(sensor, n_sub: int = 8):
             )
             strain = pad_strain(big, [probe])[: 2 * half + 1, : 2 * half + 1] / newtons
             if sensor.transduction.kind == "resistive":
-                kernel[a, b] = np.maximum(strain, 0.0)
+                kernel[a, b] = strain if signed else np.maximum(strain, 0.0)
             else:
                 kernel[a, b] = sensor.transduction.strain_gain * strain
     return kernel, step, half
@@ -621,6 +626,62 @@ def pad_contact_force(signal, labels, seg, sensor) -> np.ndarray:
             half, force,
         )  # fmt: skip
     return force
+
+
+MERGED_GAIN = 25.0
+"""Two loads replace one in a contact's force only when they lower the residual by more
+than this many times one taxel's noise variance (:func:`pad_merged_force`) [-]."""
+
+MERGED_SPREAD = 0.2
+"""A contact is looked at for two loads only when it is wider along its major axis
+than one load would be by more than this [taxel^2] (two loads d apart add (d/2)^2)."""
+
+MERGED_HALVES = np.arange(0.25, 2.51, 0.125)
+"""Half-separations of the two loads tried along a contact's major axis [taxel]."""
+
+
+def signal_noise_variance(sensor) -> float:
+    """Variance of one taxel's signal from read noise and quantization [-^2], from the
+    sensor's description: ``read_noise_counts^2 + 1/12`` counts^2 over counts per unit
+    strain squared (resistive) or the nominal reading squared (capacitive, eq. 4 at
+    small deflection)."""
+    counts = sensor.flaws.read_noise_counts**2 + 1.0 / 12.0
+    transduction = getattr(sensor, "transduction", None)
+    if transduction is not None and transduction.kind == "resistive":
+        return counts / transduction.counts_per_strain**2
+    return counts / sensor.electronics.nominal_counts**2
+
+
+@functools.lru_cache(maxsize=16)
+def _kernel_max(sensor) -> np.ndarray:
+    """The largest response of each taxel of :func:`pad_force_kernel`'s signed window
+    over every tabulated load position [-/N] (for :func:`pad_merged_force`'s skip)."""
+    kernel, _, _ = pad_force_kernel(sensor, FIT_STEPS, signed=True)
+    return np.ascontiguousarray(kernel.max(axis=(0, 1)))
+
+
+def pad_merged_force(signal, labels, seg, row, col, sensor, threshold, force) -> None:
+    """A pad contact that holds two loads too close to part carries the force of both:
+    ``force`` [N] is replaced in place by the two loads' summed amplitudes where two
+    explain the contact's signal clearly better than one
+    (:func:`~tactsense.estimate._contacts_fast.merged_force`, :data:`MERGED_GAIN`)."""
+    from tactsense.estimate._contacts_fast import merged_force
+
+    if len(force) == 0:
+        return
+    kernel, step, half = pad_force_kernel(sensor, FIT_STEPS, signed=True)
+    noise_var = signal_noise_variance(sensor)
+    # a resistive taxel's zero may hide tension: only the taxels clearly compressed
+    # tell the loads' sum; a capacitive taxel reads both signs
+    resistive = sensor.transduction.kind == "resistive"
+    floor = 3.0 * math.sqrt(noise_var) if resistive else -math.inf
+    with deferred_interrupts():
+        merged_force(
+            signal, labels, seg["frame"], seg["root"], np.asarray(row, float),
+            np.asarray(col, float), seg["rr"], seg["cc"], seg["rc"], kernel, step, half,
+            MERGED_HALVES, noise_var, MERGED_GAIN, floor, float(threshold), MERGED_SPREAD,
+            force, _kernel_max(sensor),
+        )  # fmt: skip
 
 
 # ---- point sets: no grid ----------------------------------------------------------------

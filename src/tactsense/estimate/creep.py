@@ -3,6 +3,7 @@ two-memory model to force steps on one tactel, and compensate frames with it."""
 
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass
 
 import numpy as np
@@ -20,6 +21,121 @@ class Viscoelastic:
     delayed_time_constant_s: float
     creep_fraction: float
     creep_time_constant_s: float
+
+
+def described_creep(sensor) -> Viscoelastic | None:
+    """The creep model a sensor's description gives (its ``[flaws]`` table), or None.
+
+    The same two-memory form as :class:`Viscoelastic` (Fig. 12 of the paper): a delayed
+    share ``delayed_fraction`` with time constant ``delayed_time_constant_s`` and creep
+    ``creep_fraction`` with ``creep_time_constant_s``, read from the description that
+    both a real sensor's TOML file and a simulation carry.
+
+    Parameters
+    ----------
+    sensor : SensorSpec, PadSpec or PointsSpec
+
+    Returns
+    -------
+    Viscoelastic or None
+        None when the description has no flaws table or describes neither delayed
+        elasticity nor creep (both fractions zero).
+    """
+    flaws = getattr(sensor, "flaws", None)
+    if flaws is None:
+        return None
+    a_d, a_c = float(flaws.delayed_fraction), float(flaws.creep_fraction)
+    if a_d <= 0.0 and a_c <= 0.0:
+        return None
+    return Viscoelastic(
+        a_d, float(flaws.delayed_time_constant_s), a_c, float(flaws.creep_time_constant_s)
+    )
+
+
+def recording_creep(sensor, attrs) -> tuple[Viscoelastic | None, float]:
+    """The creep to take out of a pad's or point set's recording, and the stiffening
+    scale that acts after it (:func:`creep_applied` without its label)."""
+    creep, stiffening, _ = creep_applied(sensor, attrs)
+    return creep, stiffening
+
+
+def creep_applied(sensor, attrs) -> tuple[Viscoelastic | None, float, str]:
+    """The creep to take out of a pad's or point set's recording, the stiffening scale
+    that acts after it, and a label saying where it came from.
+
+    Creep is compensated only where it is known:
+
+    * a simulated recording (no ``source``, a scenario with steps) with ``viscoelastic``
+      switched on: the twin's own description, which made the creep (label
+      ``"described (simulation)"``); stiffening is undone only if ``nonlinearity`` was
+      on too. Creep left off there is not compensated;
+    * a measured recording (``source`` set: imported, streamed, recorded): the
+      description's creep only when it says ``creep_known = true`` in ``[flaws]``
+      (label ``"described (sensor file)"``), else nothing (``"none"``): the default
+      values are the paper's rubber, not this sensor's, and subtracting them would
+      under-read held forces and leave readings below the baseline after a lift.
+
+    None on a finger: its creep compensation is its calibration's
+    (``tactsense calibrate --steps``), so that its long table's force stays ``locate``'s.
+
+    Parameters
+    ----------
+    sensor : SensorSpec, PadSpec or PointsSpec
+    attrs : dict
+        The recording's attributes (``RecordingReader.attrs``).
+
+    Returns
+    -------
+    creep : Viscoelastic or None
+    stiffening : float
+        The scale ``c`` of ``d_meas = d / (1 + d / c)`` [-]; 0 for none.
+    label : str
+        ``"described (simulation)"``, ``"described (sensor file)"`` or ``"none"``.
+    """
+    if getattr(sensor, "kind", None) == "finger":
+        return None, 0.0, "none"
+    on = None  # the flaws a simulation switched on (None: a measured recording)
+    if not str(attrs.get("source", "")):
+        try:
+            scenario = json.loads(str(attrs.get("scenario_json", "{}")))
+        except ValueError:
+            scenario = {}
+        if isinstance(scenario, dict) and scenario.get("steps"):
+            on = {f for f in str(attrs.get("flaws", "")).split(",") if f}
+    if on is None:
+        creep, stiffening = described_compensation(sensor)
+        return creep, stiffening, "none" if creep is None else "described (sensor file)"
+    creep = described_creep(sensor) if "viscoelastic" in on else None
+    if creep is None:
+        return None, 0.0, "none"
+    if "nonlinearity" not in on:
+        return creep, 0.0, "described (simulation)"
+    return creep, float(sensor.flaws.nonlinear_saturation), "described (simulation)"
+
+
+def described_compensation(sensor) -> tuple[Viscoelastic | None, float]:
+    """The creep to take out of a pad's or point set's measured frames (a live stream,
+    a recording that is no simulation) and the stiffening scale after it.
+
+    The sensor description's (:func:`described_creep`, ``nonlinear_saturation``) when
+    it says its creep is known (``creep_known = true`` in ``[flaws]``); ``(None, 0)``
+    otherwise, and on a finger, whose creep compensation is its calibration's.
+
+    Returns
+    -------
+    creep : Viscoelastic or None
+    stiffening : float
+        [-]; 0 for none.
+    """
+    if getattr(sensor, "kind", None) == "finger":
+        return None, 0.0
+    flaws = getattr(sensor, "flaws", None)
+    if flaws is None or not getattr(flaws, "creep_known", False):
+        return None, 0.0
+    creep = described_creep(sensor)
+    if creep is None:
+        return None, 0.0
+    return creep, max(float(sensor.flaws.nonlinear_saturation), 0.0)
 
 
 def _memory_response(u, dt, model: Viscoelastic):
@@ -182,6 +298,19 @@ class CreepCompensator:
         self._c = (1 - self._a_d) + self._a_d * (1 - self._e_d) + self._a_c * (1 - self._e_c)
         self._m_d = np.zeros(shape)
         self._m_c = np.zeros(shape)
+
+    @property
+    def coefficients(self) -> tuple[float, float, float, float, float]:
+        """``(a_d e_d, a_c e_c, 1 / c, e_d, e_c)``: ``u = (y - a_d e_d m_d - a_c e_c
+        m_c) / c``, then ``m <- e m + (1 - e) u`` for each memory (the compiled twin in
+        :mod:`tactsense.estimate.baseline`)."""
+        return (
+            self._a_d * self._e_d,
+            self._a_c * self._e_c,
+            1.0 / self._c,
+            self._e_d,
+            self._e_c,
+        )
 
     @property
     def state(self) -> np.ndarray:

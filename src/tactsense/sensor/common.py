@@ -82,6 +82,11 @@ class Flaws:
     """Creep gain relative to the elastic response, reached after long loading [-]."""
     creep_time_constant_s: float = 20.0
     """Time constant of creep and of the recovery of the elastic set [s]."""
+    creep_known: bool = False
+    """Whether the four creep values above were measured on this sensor (``true`` in its
+    TOML) rather than left at the paper's rubber (the default). Measured frames (a live
+    stream, an imported recording) get creep compensation only when it is ``true``; a
+    simulation knows its own creep. The one key a description may leave out."""
     dead_tactels: tuple[tuple[int, int], ...] = ()
     """Wired tactels (row, col) that give no signal."""
 
@@ -281,7 +286,7 @@ class SpecBase:
                 continue
             known = {f.name: f for f in dataclasses.fields(section_type)}
             if base is None:
-                missing = [key for key in known if key not in values]
+                missing = [key for key in known if key not in values and key not in OPTIONAL]
                 if missing:
                     problems.append(f"[{section}] is missing {', '.join(missing)}")
             else:
@@ -379,6 +384,11 @@ class SpecBase:
             except TypeError as error:
                 raise SensorSpecError(f"[{section}]: {error}") from None
         return dataclasses.replace(self, **updates)
+
+
+OPTIONAL = frozenset({"creep_known"})
+"""Keys a complete description may leave out: they default (``creep_known``: false, so
+that a description written before it existed is not taken to know its creep)."""
 
 
 def read_toml(path: str | Path) -> dict[str, Any]:

@@ -158,8 +158,22 @@ class Emulator:
 
     @classmethod
     def from_recording(cls, recording: Recording, **options) -> Emulator:
-        """An emulator that sends the frames of a recording."""
-        return cls(recording.sensor, recording.frames, **options)
+        """An emulator that sends the frames of a recording.
+
+        A simulation with creep on (``viscoelastic``) knows its creep: the description it
+        sends says so (``creep_known = true``), so a client compensates it as ``locate``
+        does the recording; a measured recording's description is sent as it is.
+        """
+        sensor = recording.sensor
+        flaws = getattr(sensor, "flaws", None)
+        if (
+            flaws is not None
+            and not recording.source
+            and "viscoelastic" in recording.flaws
+            and not flaws.creep_known
+        ):
+            sensor = sensor.replace(flaws__creep_known=True)
+        return cls(sensor, recording.frames, **options)
 
     @property
     def scan_period_s(self) -> float:

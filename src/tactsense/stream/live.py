@@ -347,12 +347,14 @@ class LiveContacts:
 
     def _set_baseline(self, baseline: np.ndarray) -> None:
         from tactsense.estimate.baseline import DriftBaseline
+        from tactsense.estimate.creep import described_compensation
 
+        creep, stiffening = described_compensation(self.sensor)  # as 'locate' (docs/contacts.md)
         self._drift = DriftBaseline(
             baseline, self.sensor, frame_period_s=self.frame_period_s,
             threshold=self.threshold,
             time_constant_s=float("inf") if self._drift_s is None else self._drift_s,
-            rezero_frames=self._baseline_frames,
+            rezero_frames=self._baseline_frames, creep=creep, stiffening=stiffening,
         )  # fmt: skip
 
     @property
