@@ -258,7 +258,7 @@ def test_the_force_log_checks_are_reported(bench):
                bench / "loads.csv", "--out", out)  # fmt: skip
     assert "force log checked" in line
     notes = json.loads(out.read_text())["notes"]
-    assert round(notes["force_log_scale"], 2) == 2.15
+    assert round(notes["force_log_scale"], 2) == 1.90  # with the twin's creep taken out
     assert notes["force_log_rank_correlation"] > 0.5
 
 
