@@ -28,8 +28,11 @@ def folder(tmp_path_factory):
 CASES = [
     ("calibrate pad.h5 --out OUT.json", "this is not a probe pressed on every taxel"),
     ("reproduce --sensor pad16 --out OUT", "works on finger sensors; 'pad16' is a pad"),
-    ("design bound --sensor dome12", "works on finger sensors; 'dome12' is a points"),
-    ("design sweep --sensor dome12 --out OUT.nc", "fingers and pads; 'dome12' is a points"),
+    (
+        "design bound --sensor dome12",
+        "works on finger sensors and pad sensors; 'dome12' is a point set",
+    ),
+    ("design sweep --sensor dome12 --out OUT.nc", "fingers and pads; 'dome12' is a point set"),
     ("sensor import pad.h5 --extends bogus", "--extends 'bogus' is not a preset"),
     ("sensor import taxels.json", "taxel 0 must be"),
     ("sensor import twins.json", "repeats another taxel's position"),

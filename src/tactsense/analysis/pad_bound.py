@@ -66,7 +66,7 @@ def expected_counts(spec, x_mm: float, y_mm: float, force_n: float, radius_mm: f
 def _check_pad(spec, x_mm: float, y_mm: float) -> None:
     if getattr(spec, "kind", None) != "pad":
         raise TactsenseInputError(
-            f"this bound is for pads; {spec.name!r} is a {getattr(spec, 'kind', '?')}"
+            f"this bound is for pads; {spec.name!r} is a {getattr(spec, 'kind_label', '?')}"
         )
     g = spec.grid
     for name, value, pitch, n in (
@@ -295,7 +295,7 @@ def blind_spots(
     """
     if getattr(spec, "kind", None) != "pad":
         raise TactsenseInputError(
-            f"blind spots are mapped on pads; {spec.name!r} is a {getattr(spec, 'kind', '?')}"
+            f"blind spots are mapped on pads; {spec.name!r} is a {getattr(spec, 'kind_label', '?')}"
         )
     if threshold_counts is None:
         threshold_counts = 3.0 * math.sqrt(noise_variance(spec))

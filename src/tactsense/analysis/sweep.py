@@ -84,7 +84,7 @@ def variables_of(sensor) -> dict[str, tuple[str, str]]:
         return pad_design.VARIABLES
     if sensor.kind != "finger":
         raise TactsenseInputError(
-            f"design maps are made for fingers and pads; {sensor.name!r} is a {sensor.kind}"
+            f"design maps are made for fingers and pads; {sensor.name!r} is a {sensor.kind_label}"
         )
     return VARIABLES
 

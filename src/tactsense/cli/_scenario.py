@@ -258,7 +258,7 @@ def resolve_scenario(spec, scenario: ScenarioKind | None) -> ScenarioKind:
     if scenario.value not in allowed:
         raise TactsenseInputError(
             f"--scenario {scenario.value} is for {'pads and point sets' if finger else 'fingers'}; "
-            f"{spec.name!r} is a {spec.kind}, which takes {', '.join(allowed)}"
+            f"{spec.name!r} is a {spec.kind_label}, which takes {', '.join(allowed)}"
         )
     return scenario
 

@@ -146,10 +146,10 @@ def design_bound(
             _pad_bound(spec, x_mm, y_mm, force_g, 3.2 if diameter is None else diameter,
                        as_json)  # fmt: skip
             return
+        spec.require_kind("finger", "pad", what="design bound")
         for flag, value in (("--x-mm", x_mm), ("--y-mm", y_mm)):
             if value is not None:
-                fail(f"{flag} is for pads; {spec.name!r} is a {spec.kind}: give --axial, --angle")
-        spec.require_kind("finger", what="design bound (on fingers and pads)")
+                fail(f"{flag} is for pads; {spec.name!r} is a finger: give --axial, --angle")
     except TactsenseInputError as error:
         fail(str(error))
     _finger_bound(
@@ -454,7 +454,7 @@ def design_sweep_command(
     spec = load_sensor(sensor)
     pad = spec.kind == "pad"
     if spec.kind not in ("finger", "pad"):
-        fail(f"design maps are made for fingers and pads; {spec.name!r} is a {spec.kind}")
+        fail(f"design maps are made for fingers and pads; {spec.name!r} is a {spec.kind_label}")
     depths = _grid(depth or ("0.5:4:8" if pad else "2:6:9"), "--depth", low=0.5, high=20.0)
     spacings = _grid(spacing or ("1.5:5:8" if pad else "2:3.8:7"), "--spacing", low=0.5, high=20.0)
     ratios = _grid(poisson or ("0.5" if pad else "0.4"), "--poisson", low=0.0, high=0.5)

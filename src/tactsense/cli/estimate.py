@@ -295,7 +295,9 @@ def calibrate(
         typer.Option(
             "--loads",
             help="Pads and point sets: the recording --force-log was logged with (presses "
-            "of varied force) [default: the sweep itself].",
+            "of varied force), when it is not SWEEP itself. SWEEP must still give the "
+            "gains (a probe on every taxel, or a uniform press with --press): a force "
+            "curve from weights alone, with no sweep, is not supported yet.",
         ),
     ] = None,
     force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,

@@ -106,6 +106,18 @@ def export(
                 f"{out}: say --format mcap or rerun (or csv for the frames, lerobot for a "
                 "dataset folder), or use the extension .mcap, .rrd or .csv"
             )
+    else:  # an extension that names another format is a mistake, never a file name
+        named = {suffix: kind for kind, suffix in SUFFIXES.items()}.get(out.suffix.lower())
+        if named is not None and named is not export_format:
+            fail(
+                f"--out {out}: the extension {out.suffix} is for --format {named.value}, "
+                f"not --format {export_format.value}; name the output "
+                + (
+                    "a folder without an extension"
+                    if export_format is ExportFormat.lerobot
+                    else f"with {SUFFIXES[export_format]}"
+                )
+            )
     if export_format is ExportFormat.lerobot:
         _export_lerobot(recording, out, calibration, baseline_frames, threshold, episode_split)
         return

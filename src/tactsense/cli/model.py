@@ -320,7 +320,7 @@ def sensor_list() -> None:
     """List the built-in presets: name, kind, size, pitch and what each is."""
     from tactsense.sensor import PRESETS
 
-    table = Table(title="built-in sensors (tactsense sensor show NAME prints one as TOML)")
+    table = Table(title="built-in sensors (tactsense sensor show --sensor NAME prints one as TOML)")
     for column in ("name", "kind", "size", "pitch", "description"):
         table.add_column(column)
     for name, make in PRESETS.items():
@@ -354,7 +354,7 @@ def sensor_check(
         table.add_row(label, value)
     warnings = []
     if spec.kind != "pad" and probe_g is not None:
-        fail(f"--probe-g maps the blind spots of a pad; {spec.name!r} is a {spec.kind}")
+        fail(f"--probe-g maps the blind spots of a pad; {spec.name!r} is a {spec.kind_label}")
     if spec.kind == "pad":
         label, value, warnings = _blind_spot_report(spec, 50.0 if probe_g is None else probe_g)
         table.add_row(label, value)
@@ -466,7 +466,9 @@ def sensor_import(
         if path.suffix.lower() == ".json":
             base = preset(extends or "dome12")
             if base.kind != "points":
-                fail(f"--extends {extends} is a {base.kind}; a JSON taxel list is a point set")
+                fail(
+                    f"--extends {extends} is a {base.kind_label}; a JSON taxel list is a point set"
+                )
             data = base.to_dict()
             taxels = taxels_from_json(path)
             data["name"] = name or path.stem

@@ -557,7 +557,7 @@ def load_calibration(path: str | Path, sensor=None):
     if sensor is not None and getattr(sensor, "kind", "finger") != "finger":
         calibration = Calibration.load(path)  # a finger's: named as such below
         raise ArrayCalibrationError(
-            f"{path} is a finger's calibration; {sensor.name!r} is a {sensor.kind}: "
+            f"{path} is a finger's calibration; {sensor.name!r} is a {sensor.kind_label}: "
             "calibrate it with 'tactsense calibrate' on its own recording"
         )
     return Calibration.load(path, sensor)

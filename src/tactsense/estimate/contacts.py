@@ -455,7 +455,9 @@ def _extent(rr, cc, rc, scale_r: float, scale_c: float):
 def _grid_contacts(signal, sensor, threshold, saddle, max_contacts, method) -> ContactTable:
     kind = sensor.kind
     if method == "fit" and kind != "pad":
-        raise TactsenseInputError(f"method 'fit' works on pads; {sensor.name!r} is a {kind}")
+        raise TactsenseInputError(
+            f"method 'fit' works on pads; {sensor.name!r} is a {sensor.kind_label}"
+        )
     periodic = kind == "finger" and sensor.closes_circumference
     refine = method == "interpolate" and kind == "pad"
     seg, labels = _segment(signal, threshold, saddle, periodic, max_contacts, refine)

@@ -217,12 +217,17 @@ class SpecBase:
             )
         return int(row), int(col)
 
+    @property
+    def kind_label(self) -> str:
+        """The kind in words for a message: ``finger``, ``pad`` or ``point set``."""
+        return "point set" if self.kind == "points" else self.kind
+
     def require_kind(self, *kinds: str, what: str = "this command") -> None:
         """Raise a one-line error when this sensor's kind is not one ``what`` handles."""
         if self.kind not in kinds:
             raise SensorSpecError(
                 f"{what} works on {' and '.join(f'{k} sensors' for k in kinds)}; "
-                f"{self.name!r} is a {self.kind}"
+                f"{self.name!r} is a {self.kind_label}"
             )
 
     # ---- (de)serialization ---------------------------------------------------
