@@ -129,6 +129,12 @@ def _follow(
         for c in range(cols):
             if unusable[r, c]:
                 any_unusable = True
+    n_releasing = 0
+    if release:
+        for r in range(rows):
+            for c in range(cols):
+                if releasing[r, c]:
+                    n_releasing += 1
     for f in range(n):
         flag = dead_flag if any_unusable else 0
         any_touched = False
@@ -148,19 +154,21 @@ def _follow(
                     flag |= below_flag
                 signal[f, r, c] = d
                 touched = d > threshold
-                if release:
+                if release and (touched or releasing[r, c]):
                     if releasing[r, c]:
                         if d < low[r, c]:
                             low[r, c] = d
                         if touched and d > low[r, c] + threshold:
                             releasing[r, c] = False  # risen again: a new touch
+                            n_releasing -= 1
                         else:
                             touched = False
-                    elif touched and d < release_share * max(peaks[0, r, c], peaks[1, r, c]):
+                    elif d < release_share * max(peaks[0, r, c], peaks[1, r, c]):
                         releasing[r, c] = True  # a lift: what is left is creep
+                        n_releasing += 1
                         low[r, c] = d
                         touched = False
-                    if d > peaks[0, r, c]:
+                    if touched and d > peaks[0, r, c]:
                         peaks[0, r, c] = d
                 if touched:
                     any_touched = True
@@ -179,6 +187,8 @@ def _follow(
                     for c in range(cols):
                         peaks[1, r, c] = peaks[0, r, c]
                         peaks[0, r, c] = -math.inf
+        lifting = release and n_releasing > 0
+        pulled = release and any_touched
         moved = 0.0
         n_moved = 0
         for r in range(rows):
@@ -186,12 +196,11 @@ def _follow(
                 v = float(frames[f, r, c])
                 if unusable[r, c] or not math.isfinite(v) or v <= 0.0:
                     continue
-                if held[r, c] and not (release and releasing[r, c]):
+                if lifting and releasing[r, c]:  # the creep left after a lift
+                    if v < full_scale:
+                        baseline[r, c] += release_alpha * (v - baseline[r, c])
                     continue
-                if v >= full_scale:
-                    continue
-                if release and releasing[r, c]:  # the creep left after a lift
-                    baseline[r, c] += release_alpha * (v - baseline[r, c])
+                if held[r, c] or v >= full_scale:
                     continue
                 if compensate:  # the reading this signal stands for, without creep
                     s = signal[f, r, c]
@@ -201,7 +210,7 @@ def _follow(
                         step = alpha * baseline[r, c] * s / (1.0 - s)
                 else:
                     step = alpha * (v - baseline[r, c])
-                    if release and any_touched and step < 0.0:
+                    if pulled and step < 0.0:
                         step = 0.0  # a load's flank pulls its neighbours down: no drift
                 baseline[r, c] += step
                 moved += step
@@ -212,7 +221,7 @@ def _follow(
             for r in range(rows):
                 for c in range(cols):
                     if held[r, c] and not unusable[r, c]:
-                        if not (release and releasing[r, c]):
+                        if not (lifting and releasing[r, c]):
                             baseline[r, c] += common
     return signal, flags
 
