@@ -409,3 +409,34 @@ def test_no_lift_no_rezero(unknown, name, monkeypatch):
     kept = step == 2  # the half force, or the probe that stays
     assert (probes[kept] == 1).all() and (count[kept] >= 1).all()
     np.testing.assert_allclose(force[kept], force_before[kept], rtol=REZERO_FORCE_TOLERANCE)
+
+
+SHARES = [("pad16", 2, False), ("long", 2, False), ("partial", 2, True), ("one-lifts", 2, True)]
+
+
+@pytest.mark.parametrize("name, k, stays", SHARES, ids=[s[0] for s in SHARES])
+def test_the_release_share_parts_a_lift_from_a_load_that_stays(unknown, name, k, stays):
+    """The signal 0.25 s after the change at step ``k``, over its largest in the 0.5 s
+    before, on the taxel that carries the load that stays (or the lifted one's peak):
+    under RELEASE_SHARE after a lift (10-s and 70-s presses), above it by a margin of
+    0.05 where a load stays (half the force, the other probe lifting)."""
+    from tactsense.estimate.baseline import RELEASE_SHARE, DriftBaseline
+
+    with RecordingReader(unknown[name]) as reader:
+        frames, sensor = reader.frames(0, reader.n_frames), reader.sensor
+        steps = json.loads(reader.attrs["scenario_json"])["steps"]
+    drift = DriftBaseline(
+        np.median(frames[:5].astype(float), axis=0), sensor,
+        frame_period_s=sensor.scan_period_s, threshold=5e-4, time_constant_s=np.inf,
+        release=False,
+    )  # fmt: skip
+    signal = drift.signal(frames)[0].reshape(len(frames), -1)
+    per_s = 1.0 / sensor.scan_period_s
+    change = round(sum(s["duration_s"] for s in steps[:k]) * per_s)
+    after = change + round(0.25 * per_s)
+    taxel = np.argmax(signal[after] if stays else signal[change - 1])
+    share = signal[after, taxel] / signal[change - round(0.5 * per_s) : change, taxel].max()
+    if stays:
+        assert share >= RELEASE_SHARE + 0.05, share
+    else:
+        assert share < RELEASE_SHARE, share

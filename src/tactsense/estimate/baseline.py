@@ -59,7 +59,8 @@ catches up, and the taxel stays held (``tests/estimate/test_baseline.py``)."""
 RELEASE_SHARE = 0.6
 """A touched taxel whose signal falls below this share of its largest over the last
 0.25-0.5 s is lifted [-] (creep not compensated). Measured on pad16 with the twin's
-creep (``tests/reliability/test_round3_pads.py``): 0.25 s after a lift the signal is
+creep (``test_the_release_share_parts_a_lift_from_a_load_that_stays`` in
+``tests/reliability/test_round3_pads.py``): 0.25 s after a lift the signal is
 0.31-0.33 of its peak after a 10-s press and 0.53-0.55 after a 70-s one (the creep
 stored, up to ``creep_fraction`` = 1.14 of the elastic response, over the peak, which
 also holds the delayed elasticity, 0.538); a force stepped down to half after 60 s
