@@ -24,7 +24,15 @@ recording is read in one piece or in many):
   contact reads tension, up to the contact's peak), says the baseline was taken under
   load (or the load was still on when the baseline was made): such frames are counted
   in :attr:`DriftBaseline.below_frames` and flagged ``BELOW_BASELINE``; the baseline
-  follows them down like any untouched taxel.
+  follows them down like any untouched taxel;
+* where the creep is not known (no ``creep`` to take out), a touched taxel whose signal
+  falls quickly to under :data:`RELEASE_SHARE` of its peak is lifted: the creep left
+  behind, which would read as a contact for as long as it stays above the threshold
+  (a minute on the paper's skin), is taken into its baseline within a fraction of a
+  second (:data:`RELEASE_TIME_CONSTANT_S`), until the taxel rises above the threshold
+  again (a new touch); and while a taxel is touched, no untouched taxel's baseline
+  follows its reading down (a load pulls its neighbours below their baselines on a
+  dome, and a baseline taken down under a press reads as a contact after the lift).
 
 :meth:`DriftBaseline.rezero` replaces the baseline by the next frames' median on demand
 (a key or a command in ``live`` and ``view``).
@@ -49,6 +57,30 @@ finger under the ``repeated`` scenario (1 s on, 1 s off, 100 times): with 2 s th
 frames stop counting as contacts (12 of 707 against 681 with a fixed baseline); with
 10 s or more the creep left after each lift outgrows the threshold before the baseline
 catches up, and the taxel stays held (``tests/estimate/test_baseline.py``)."""
+
+RELEASE_SHARE = 0.6
+"""A touched taxel whose signal falls below this share of its largest over the last
+0.25-0.5 s is lifted [-] (creep not compensated). Measured on pad16 with the twin's
+creep (``test_the_release_share_parts_a_lift_from_a_load_that_stays`` in
+``tests/reliability/test_round3_pads.py``): 0.25 s after a lift the signal is
+0.31-0.33 of its peak after a 10-s press and 0.53-0.55 after a 70-s one (the creep
+stored, up to ``creep_fraction`` = 1.14 of the elastic response, over the peak, which
+also holds the delayed elasticity, 0.538); a force stepped down to half after 60 s
+keeps 0.72-0.76 (the delayed elasticity and the creep leave more slowly than the
+force); the peak taxel of a probe 8 mm from one that lifts keeps 0.66."""
+
+RELEASE_WINDOW_S = 0.25
+"""The peak :data:`RELEASE_SHARE` is taken of: the largest signal over the last one to
+two blocks of this length [s]. Long enough to span a lift (the delayed elasticity, 0.042
+s on the paper's skin, is gone in 0.2 s) and short enough that a slow fall (the creep of
+a neighbouring load recovering, tens of seconds) never counts as a lift."""
+
+RELEASE_TIME_CONSTANT_S = 0.1
+"""Time constant with which a lifted taxel's baseline follows its reading [s]: the lag
+is the creep's rate of fall times this, under the threshold for peaks up to about 400
+thresholds (creep 0.45 of the peak falling with 20 s: 0.002 of the peak per 0.1 s); a
+new press ramped faster than the threshold per 0.1 s (any press of under ~10 s to a
+peak of 100 thresholds) still rises above it and is a new touch."""
 
 
 @jit(inline="always")
@@ -105,6 +137,7 @@ def below_baseline(lowest: float, highest: float, threshold: float, resistive: b
 def _follow(
     frames, baseline, unusable, full_scale, resistive, per_count, threshold, alpha, guard,
     grid, nan_flag, sat_flag, dead_flag, below_flag, compensate, creep, memory,
+    release, release_alpha, release_share, block, releasing, low, peaks, phase,
 ):  # fmt: skip
     """Signal and flags of each frame against a baseline updated after every frame.
 
@@ -114,7 +147,14 @@ def _follow(
     stiffening scale undone first and redone after, 0 for none) and ``memory`` (2, rows,
     cols) the two memories, updated in place. An untouched taxel's baseline then
     follows the reading less its predicted creep, so that the creep left after a lift
-    is neither taken for a contact nor taken into the baseline."""
+    is neither taken for a contact nor taken into the baseline.
+
+    With ``release`` (creep not compensated), a touched taxel whose signal falls below
+    ``release_share`` of its largest signal over the last ``block`` to ``2 block`` frames
+    (``peaks[0]`` this block's, ``peaks[1]`` the last block's; ``phase[0]`` the frames
+    into this block) is *releasing*: not touched, its baseline following its reading by
+    ``release_alpha`` of the difference each frame, until its signal rises more than the
+    threshold above its lowest since the release (``low``), which is a new touch."""
     n, rows, cols = frames.shape
     signal = np.empty((n, rows, cols), np.float64)
     flags = np.zeros(n, np.int64)
@@ -124,8 +164,15 @@ def _follow(
         for c in range(cols):
             if unusable[r, c]:
                 any_unusable = True
+    n_releasing = 0
+    if release:
+        for r in range(rows):
+            for c in range(cols):
+                if releasing[r, c]:
+                    n_releasing += 1
     for f in range(n):
         flag = dead_flag if any_unusable else 0
+        any_touched = False
         for r in range(rows):
             for c in range(cols):
                 held[r, c] = False
@@ -143,7 +190,25 @@ def _follow(
                 lowest = min(lowest, d)
                 highest = max(highest, d)
                 signal[f, r, c] = d
-                if d > threshold:
+                touched = d > threshold
+                if release and (touched or releasing[r, c]):
+                    if releasing[r, c]:
+                        if d < low[r, c]:
+                            low[r, c] = d
+                        if touched and d > low[r, c] + threshold:
+                            releasing[r, c] = False  # risen again: a new touch
+                            n_releasing -= 1
+                        else:
+                            touched = False
+                    elif d < release_share * max(peaks[0, r, c], peaks[1, r, c]):
+                        releasing[r, c] = True  # a lift: what is left is creep
+                        n_releasing += 1
+                        low[r, c] = d
+                        touched = False
+                    if touched and d > peaks[0, r, c]:
+                        peaks[0, r, c] = d
+                if touched:
+                    any_touched = True
                     if grid:
                         for rr in range(max(0, r - guard), min(rows, r + guard + 1)):
                             for cc in range(max(0, c - guard), min(cols, c + guard + 1)):
@@ -153,14 +218,28 @@ def _follow(
         if below_baseline(lowest, highest, threshold, resistive):
             flag |= below_flag
         flags[f] = flag
+        if release:
+            phase[0] += 1
+            if phase[0] >= block:  # a new block: this one's peaks become the last one's
+                phase[0] = 0
+                for r in range(rows):
+                    for c in range(cols):
+                        peaks[1, r, c] = peaks[0, r, c]
+                        peaks[0, r, c] = -math.inf
+        lifting = release and n_releasing > 0
+        pulled = release and any_touched
         moved = 0.0
         n_moved = 0
         for r in range(rows):
             for c in range(cols):
                 v = float(frames[f, r, c])
-                if held[r, c] or unusable[r, c] or not math.isfinite(v) or v <= 0.0:
+                if unusable[r, c] or not math.isfinite(v) or v <= 0.0:
                     continue
-                if v >= full_scale:
+                if lifting and releasing[r, c]:  # the creep left after a lift
+                    if v < full_scale:
+                        baseline[r, c] += release_alpha * (v - baseline[r, c])
+                    continue
+                if held[r, c] or v >= full_scale:
                     continue
                 if compensate:  # the reading this signal stands for, without creep
                     s = signal[f, r, c]
@@ -170,6 +249,8 @@ def _follow(
                         step = alpha * baseline[r, c] * s / (1.0 - s)
                 else:
                     step = alpha * (v - baseline[r, c])
+                    if pulled and step < 0.0:
+                        step = 0.0  # a load's flank pulls its neighbours down: no drift
                 baseline[r, c] += step
                 moved += step
                 n_moved += 1
@@ -179,7 +260,8 @@ def _follow(
             for r in range(rows):
                 for c in range(cols):
                     if held[r, c] and not unusable[r, c]:
-                        baseline[r, c] += common
+                        if not (lifting and releasing[r, c]):
+                            baseline[r, c] += common
     return signal, flags
 
 
@@ -215,6 +297,14 @@ class DriftBaseline:
         (1 + d / c)`` that acts after the creep (the description's
         ``nonlinear_saturation``); undone before the compensation and redone after, so
         the signal keeps its scale [-]. 0: none.
+    release : bool, optional
+        Without ``creep``: a touched taxel whose signal falls quickly below
+        :data:`RELEASE_SHARE` of its peak (:data:`RELEASE_WINDOW_S`) is taken as lifted,
+        and its baseline follows its reading (:data:`RELEASE_TIME_CONSTANT_S`) until it
+        rises above the threshold again: the creep left after a lift, which nothing
+        takes out, is re-zeroed in a fraction of a second instead of reading as a
+        contact for as long as it stays above the threshold (the whole minute after a
+        10-s press on the paper's skin). Default: on exactly when ``creep`` is None.
     """
 
     def __init__(
@@ -229,6 +319,7 @@ class DriftBaseline:
         rezero_frames: int = 5,
         creep=None,
         stiffening: float = 0.0,
+        release: bool | None = None,
     ):
         for name, value in (("frame_period_s", frame_period_s), ("threshold", threshold)):
             if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
@@ -280,6 +371,19 @@ class DriftBaseline:
         self.creep_memory = np.zeros((2, *self.baseline.shape))
         """The creep model's two memories (delayed, creep) per taxel [-], carried from
         frame to frame; zero after a re-zero."""
+        self.release = creep is None if release is None else bool(release)
+        """Whether a lift's creep is re-zeroed (``release``)."""
+        self._release_alpha = -math.expm1(-self.frame_period_s / RELEASE_TIME_CONSTANT_S)
+        self._block = max(1, round(RELEASE_WINDOW_S / self.frame_period_s))
+        self._reset_release()
+
+    def _reset_release(self) -> None:
+        shape = self.baseline.shape
+        self.releasing = np.zeros(shape, np.bool_)
+        """Taxels taken as lifted, whose baseline follows their reading."""
+        self._low = np.zeros(shape)
+        self._peaks = np.full((2, *shape), -np.inf)
+        self._phase = np.zeros(1, np.int64)
 
     def rezero(self) -> None:
         """Make the next ``rezero_frames`` frames' median the baseline (taken untouched)."""
@@ -314,7 +418,8 @@ class DriftBaseline:
                 self._per_count, self.threshold, self.alpha, self.guard, self._grid,
                 int(Flag.NAN_INPUT), int(Flag.SATURATED), int(Flag.DEAD_TACTEL),
                 int(Flag.BELOW_BASELINE), self.creep is not None, self._creep,
-                self.creep_memory,
+                self.creep_memory, self.release, self._release_alpha, RELEASE_SHARE,
+                self._block, self.releasing, self._low, self._peaks, self._phase,
             )  # fmt: skip
         self.below_frames += int(np.count_nonzero(flags & int(Flag.BELOW_BASELINE)))
         self.frames_seen += len(frames)
@@ -329,4 +434,5 @@ class DriftBaseline:
             self.baseline = np.ascontiguousarray(np.nanmedian(np.stack(self._collect), axis=0))
             self._collect = None
             self.creep_memory[:] = 0.0  # the new baseline holds whatever creep is left
+            self._reset_release()
         return frames
