@@ -363,6 +363,35 @@ def test_live_warms_the_locator_before_opening_a_format_device(monkeypatch):
     assert calls == ["locator", "open"]
 
 
+def test_the_first_native_frame_compiles_nothing():
+    """Over tactsense's own protocol (COBS packets) the first frames and the first
+    contact compile and load nothing: the frames the reader decodes are of the type the
+    warm-up compiled (they were read-only views of the packet, another Numba type:
+    _follow compiled at the first frame after the baseline, 0.9-2 s on a cold cache)."""
+    import numba
+
+    from tactsense.stream.live import LiveContacts, warm_frames
+
+    frames = np.stack([f.counts for f in _touch_frames(SPEC, 5, 9)])
+    emulator = Emulator(SPEC, frames, speed=0)
+    _, port = emulator.start_tcp()
+    locator = LiveContacts(SPEC)
+    try:
+        with open_source(f"socket://127.0.0.1:{port}", sensor=SPEC) as stream:
+            jitted, modules = _loaded()
+            got = list(stream.frames(max_frames=len(frames), duration_s=10))
+            estimates = [locator(frame) for frame in got]
+            jitted_after, modules_after = _loaded()
+    finally:
+        emulator.stop()
+    assert len(got) == len(frames) and estimates[5]["n_contacts"] >= 1
+    warmed = numba.typeof(warm_frames(SPEC)[0].counts)
+    assert {numba.typeof(f.counts) for f in got} == {warmed}
+    grown = [name for key, (name, n) in jitted_after.items() if n > jitted.get(key, ("", 0))[1]]
+    assert not grown, f"compiled or loaded at the first native frames: {grown[:5]}"
+    assert not modules_after - modules, f"imported: {sorted(modules_after - modules)[:5]}"
+
+
 def test_frames_queued_behind_a_busy_reader_keep_their_spread():
     """Ten text frames arrive 0.1 s apart while the reader is busy for 1.3 s: their
     stamps spread over the wait (they all had the time of the one read that took them,
