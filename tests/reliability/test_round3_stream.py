@@ -47,7 +47,7 @@ def _burst_stamps(source_of, frames=FRAMES):
         if fmt is None:
             stream = StreamReader(url, sensor=SPEC)
         else:
-            stream = open_source(f"{fmt.spec()}:{url}", sensor=SPEC)
+            stream = open_source(f"{fmt.spec()}:{url}", sensor=fmt.sensor_as_sent(SPEC))
         with stream:
             got = list(stream.frames(max_frames=len(frames)))
     finally:
@@ -121,7 +121,8 @@ def test_a_marker_frame_before_a_stall_is_stamped_when_it_arrived():
         (b"".join(b"\xaa\x55" + s for s in samples[1:]), 0.8),
     ]
     port, sent = _serve_once(chunks)
-    with open_source(f"marker:socket://127.0.0.1:{port}", sensor=SPEC) as stream:
+    as_sent = parse_format("marker").sensor_as_sent(SPEC)  # 8-bit samples: an 8-bit converter
+    with open_source(f"marker:socket://127.0.0.1:{port}", sensor=as_sent) as stream:
         got = list(stream.frames())
     assert len(got) == 4
     assert got[0].counts[0, 0] == 0
@@ -260,7 +261,8 @@ def test_a_format_emulator_on_a_pty_waits_for_the_host_to_open_it(spec):
         time.sleep(1.0)  # the host comes later than the emulator's boot time (0.25 s)
         # a pty never closes: the last marker frame waits for a marker that never comes
         n = 50 if spec == "text" else 49
-        with open_source(f"{fmt.spec()}:{path}", sensor=SPEC, timeout_s=0.5) as stream:
+        as_sent = fmt.sensor_as_sent(SPEC)
+        with open_source(f"{fmt.spec()}:{path}", sensor=as_sent, timeout_s=0.5) as stream:
             got = list(stream.frames(max_frames=n, duration_s=10))
     finally:
         emulator.stop()
@@ -407,3 +409,58 @@ def test_frames_queued_behind_a_busy_reader_keep_their_spread():
     assert (np.diff(stamps) > 0).all() and stamps[0] > first.arrival
     assert stamps[-1] - stamps[0] > 0.5  # spread over the wait, not one instant
     assert abs(stamps[-1] - sent[-1]) < 0.5
+
+
+# ---- samples narrower than the converter (8-bit marker frames of a 12-bit sensor) -------
+
+
+def _marker8_device(frames):
+    """A marker device of 8-bit samples (the top 8 of pad16's 12 bits) on 127.0.0.1."""
+    fmt = parse_format("marker,width=8")
+    emulator = Emulator(SPEC, frames, speed=0, wire_format=fmt)
+    _, port = emulator.start_tcp()
+    return emulator, f"{fmt.spec()}:socket://127.0.0.1:{port}"
+
+
+@pytest.mark.parametrize("command, suffix", [("record", ".h5"), ("live", ".jsonl")])
+def test_8_bit_samples_under_a_12_bit_description_are_refused(tmp_path, command, suffix):
+    """8-bit samples read under pad16's 12-bit description were kept silently (its
+    nominal counts 16x the device's, 5x fewer contacts found by locate). Refused, with
+    the description that fits what the device sends; nothing written."""
+    bits = SPEC.electronics.adc_bits
+    nominal = SPEC.electronics.nominal_counts / 2 ** (bits - 8)
+    emulator, source = _marker8_device(FRAMES[:40])
+    out = tmp_path / f"out{suffix}"
+    try:
+        code, message = _cli([command, source, "--sensor", "pad16", "--frames", "20",
+                              "--out", str(out)])  # fmt: skip
+    finally:
+        emulator.stop()
+    assert code == 2, message
+    assert f"{bits}-bit converter" in message and "8-bit samples" in message
+    assert f"adc_bits = 8 and nominal_counts = {nominal:g}" in message
+    assert not out.exists()
+
+
+def test_8_bit_samples_described_as_sent_are_recorded(tmp_path):
+    """The same device described as it sends (adc_bits 8, nominal counts scaled) records
+    every frame as sent, under that description."""
+    from tactsense.io.recording import read_recording
+
+    nominal = SPEC.electronics.nominal_counts / 2 ** (SPEC.electronics.adc_bits - 8)
+    toml = tmp_path / "pad16_8bit.toml"
+    toml.write_text(
+        f'kind = "pad"\nextends = "pad16"\nname = "pad16_8bit"\n\n'
+        f"[electronics]\nadc_bits = 8\nnominal_counts = {nominal}\n"
+    )
+    emulator, source = _marker8_device(FRAMES[:40])
+    out = tmp_path / "out.h5"
+    try:
+        code, message = _cli(["record", source, "--sensor", str(toml), "--frames", "30",
+                              "--out", str(out)])  # fmt: skip
+    finally:
+        emulator.stop()
+    assert code == 0, message
+    recording = read_recording(out)
+    assert recording.sensor.electronics.adc_bits == 8
+    np.testing.assert_array_equal(recording.frames, emulator.frames[:30])
