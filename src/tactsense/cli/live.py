@@ -854,7 +854,9 @@ def view(
             streams_at_once = not source.startswith(LSL_PREFIX) and sensor is not None
             if streams_at_once and split_source(source)[0] is not None:
                 # a device of another format streams once its line opens: locator first
-                locator = make_locator(load_sensor(sensor))
+                spec = load_sensor(sensor)
+                split_source(source)[0].check_converter(spec)  # refused before it compiles
+                locator = make_locator(spec)
                 reader = _open_reader(source, sensor, timeout, start=False)
             else:
                 reader = _open_reader(source, sensor, timeout, start=False)
