@@ -1,8 +1,9 @@
 """``tactsense live``'s latency at the start of a run, on a cold and a warm compile cache.
 
-A text-format twin of the 16x16 pad (``tactsense emulate --sensor pad16 --scenario press
---format text --loop``, 100 frames/s) streams as soon as a host connects; ``tactsense
-live`` reads it and writes one estimate per frame. The cache is a fresh
+A twin of the 16x16 pad (``tactsense emulate --sensor pad16 --scenario press --loop``,
+100 frames/s) speaks tactsense's native protocol (COBS packets, streaming after START)
+or, with ``--format text``, text lines (streaming as soon as a host connects);
+``tactsense live`` reads it and writes one estimate per frame. The cache is a fresh
 ``NUMBA_CACHE_DIR`` (cold: everything compiles), then the same directory again (warm).
 Reported per run: the latency of the first estimate, the largest, the median, and the
 first contact's latency beside the median (a stall while the contact path compiles),
@@ -10,7 +11,7 @@ each "from the frame's last byte to its estimate" as ``live`` prints it; and the
 of ``host_time_s`` against the frame index (frames queued behind a stall keep their own
 arrival, so a stall shows in the latency, not only in the host times).
 
-    PYTHONPATH=src python benchmarks/bench_live_latency.py [--method fit]
+    PYTHONPATH=src python benchmarks/bench_live_latency.py [--method fit] [--format native]
 """
 
 from __future__ import annotations
@@ -25,13 +26,15 @@ from pathlib import Path
 import numpy as np
 
 CLI = [sys.executable, "-m", "tactsense.cli"]
+WIRES = ("native", "text")
+"""The emulator's wire formats: the native COBS protocol (START, IDENTIFY) and text lines."""
 
 
-def run_live(cache: str, method: str, frames: int = 300) -> list[dict]:
+def run_live(cache: str, method: str, wire: str = "text", frames: int = 300) -> list[dict]:
     env = {**os.environ, "NUMBA_CACHE_DIR": cache}
     emulator = subprocess.Popen(
-        [*CLI, "emulate", "--sensor", "pad16", "--scenario", "press", "--format", "text",
-         "--port", "0", "--loop"],
+        [*CLI, "emulate", "--sensor", "pad16", "--scenario", "press",
+         *([] if wire == "native" else ["--format", wire]), "--port", "0", "--loop"],
         stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, env=env,
     )  # fmt: skip
     url = emulator.stdout.readline().strip()
@@ -63,9 +66,12 @@ def summary(estimates: list[dict]) -> str:
 
 def main() -> None:
     method = sys.argv[sys.argv.index("--method") + 1] if "--method" in sys.argv else "interpolate"
-    with tempfile.TemporaryDirectory() as cache:
-        for label in ("cold", "warm"):
-            print(f"{label} cache, --method {method}: {summary(run_live(cache, method))}")
+    wires = [sys.argv[sys.argv.index("--format") + 1]] if "--format" in sys.argv else WIRES
+    for wire in wires:
+        with tempfile.TemporaryDirectory() as cache:
+            for label in ("cold", "warm"):
+                estimates = run_live(cache, method, wire)
+                print(f"{wire}, {label} cache, --method {method}: {summary(estimates)}")
 
 
 if __name__ == "__main__":

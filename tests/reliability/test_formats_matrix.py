@@ -58,7 +58,8 @@ def test_bad_format_options(tmp_path, line, names):
     "spec, names",
     [
         ("text", "the device prints lines of 256 values, but the sensor has 8x8 = 64"),
-        ("marker", "sends 256 samples of 8 bits between markers, but the sensor has 8x8"),
+        # 16 bits: 8-bit samples of a 12-bit sensor are refused before the line opens
+        ("marker,width=16", "sends 256 samples of 16 bits between markers, but the sensor has 8x8"),
         ("justfloat", "sends 256 floats between tails, but the sensor has 8x8 = 64"),
     ],
 )
@@ -90,7 +91,7 @@ def test_a_silent_device_is_an_error(tmp_path):
     try:
         result = runner.invoke(
             app,
-            ["record", f"marker:socket://127.0.0.1:{port}", "--sensor", "pad16", "-o",
+            ["record", f"marker,width=16:socket://127.0.0.1:{port}", "--sensor", "pad16", "-o",
              str(out), "--quiet"],
         )  # fmt: skip
     finally:

@@ -47,7 +47,7 @@ def _burst_stamps(source_of, frames=FRAMES):
         if fmt is None:
             stream = StreamReader(url, sensor=SPEC)
         else:
-            stream = open_source(f"{fmt.spec()}:{url}", sensor=SPEC)
+            stream = open_source(f"{fmt.spec()}:{url}", sensor=fmt.sensor_as_sent(SPEC))
         with stream:
             got = list(stream.frames(max_frames=len(frames)))
     finally:
@@ -121,7 +121,8 @@ def test_a_marker_frame_before_a_stall_is_stamped_when_it_arrived():
         (b"".join(b"\xaa\x55" + s for s in samples[1:]), 0.8),
     ]
     port, sent = _serve_once(chunks)
-    with open_source(f"marker:socket://127.0.0.1:{port}", sensor=SPEC) as stream:
+    as_sent = parse_format("marker").sensor_as_sent(SPEC)  # 8-bit samples: an 8-bit converter
+    with open_source(f"marker:socket://127.0.0.1:{port}", sensor=as_sent) as stream:
         got = list(stream.frames())
     assert len(got) == 4
     assert got[0].counts[0, 0] == 0
@@ -260,7 +261,8 @@ def test_a_format_emulator_on_a_pty_waits_for_the_host_to_open_it(spec):
         time.sleep(1.0)  # the host comes later than the emulator's boot time (0.25 s)
         # a pty never closes: the last marker frame waits for a marker that never comes
         n = 50 if spec == "text" else 49
-        with open_source(f"{fmt.spec()}:{path}", sensor=SPEC, timeout_s=0.5) as stream:
+        as_sent = fmt.sensor_as_sent(SPEC)
+        with open_source(f"{fmt.spec()}:{path}", sensor=as_sent, timeout_s=0.5) as stream:
             got = list(stream.frames(max_frames=n, duration_s=10))
     finally:
         emulator.stop()
@@ -363,6 +365,35 @@ def test_live_warms_the_locator_before_opening_a_format_device(monkeypatch):
     assert calls == ["locator", "open"]
 
 
+def test_the_first_native_frame_compiles_nothing():
+    """Over tactsense's own protocol (COBS packets) the first frames and the first
+    contact compile and load nothing: the frames the reader decodes are of the type the
+    warm-up compiled (they were read-only views of the packet, another Numba type:
+    _follow compiled at the first frame after the baseline, 0.9-2 s on a cold cache)."""
+    import numba
+
+    from tactsense.stream.live import LiveContacts, warm_frames
+
+    frames = np.stack([f.counts for f in _touch_frames(SPEC, 5, 9)])
+    emulator = Emulator(SPEC, frames, speed=0)
+    _, port = emulator.start_tcp()
+    locator = LiveContacts(SPEC)
+    try:
+        with open_source(f"socket://127.0.0.1:{port}", sensor=SPEC) as stream:
+            jitted, modules = _loaded()
+            got = list(stream.frames(max_frames=len(frames), duration_s=10))
+            estimates = [locator(frame) for frame in got]
+            jitted_after, modules_after = _loaded()
+    finally:
+        emulator.stop()
+    assert len(got) == len(frames) and estimates[5]["n_contacts"] >= 1
+    warmed = numba.typeof(warm_frames(SPEC)[0].counts)
+    assert {numba.typeof(f.counts) for f in got} == {warmed}
+    grown = [name for key, (name, n) in jitted_after.items() if n > jitted.get(key, ("", 0))[1]]
+    assert not grown, f"compiled or loaded at the first native frames: {grown[:5]}"
+    assert not modules_after - modules, f"imported: {sorted(modules_after - modules)[:5]}"
+
+
 def test_frames_queued_behind_a_busy_reader_keep_their_spread():
     """Ten text frames arrive 0.1 s apart while the reader is busy for 1.3 s: their
     stamps spread over the wait (they all had the time of the one read that took them,
@@ -378,3 +409,58 @@ def test_frames_queued_behind_a_busy_reader_keep_their_spread():
     assert (np.diff(stamps) > 0).all() and stamps[0] > first.arrival
     assert stamps[-1] - stamps[0] > 0.5  # spread over the wait, not one instant
     assert abs(stamps[-1] - sent[-1]) < 0.5
+
+
+# ---- samples narrower than the converter (8-bit marker frames of a 12-bit sensor) -------
+
+
+def _marker8_device(frames):
+    """A marker device of 8-bit samples (the top 8 of pad16's 12 bits) on 127.0.0.1."""
+    fmt = parse_format("marker,width=8")
+    emulator = Emulator(SPEC, frames, speed=0, wire_format=fmt)
+    _, port = emulator.start_tcp()
+    return emulator, f"{fmt.spec()}:socket://127.0.0.1:{port}"
+
+
+@pytest.mark.parametrize("command, suffix", [("record", ".h5"), ("live", ".jsonl")])
+def test_8_bit_samples_under_a_12_bit_description_are_refused(tmp_path, command, suffix):
+    """8-bit samples read under pad16's 12-bit description were kept silently (its
+    nominal counts 16x the device's, 5x fewer contacts found by locate). Refused, with
+    the description that fits what the device sends; nothing written."""
+    bits = SPEC.electronics.adc_bits
+    nominal = SPEC.electronics.nominal_counts / 2 ** (bits - 8)
+    emulator, source = _marker8_device(FRAMES[:40])
+    out = tmp_path / f"out{suffix}"
+    try:
+        code, message = _cli([command, source, "--sensor", "pad16", "--frames", "20",
+                              "--out", str(out)])  # fmt: skip
+    finally:
+        emulator.stop()
+    assert code == 2, message
+    assert f"{bits}-bit converter" in message and "8-bit samples" in message
+    assert f"adc_bits = 8 and nominal_counts = {nominal:g}" in message
+    assert not out.exists()
+
+
+def test_8_bit_samples_described_as_sent_are_recorded(tmp_path):
+    """The same device described as it sends (adc_bits 8, nominal counts scaled) records
+    every frame as sent, under that description."""
+    from tactsense.io.recording import read_recording
+
+    nominal = SPEC.electronics.nominal_counts / 2 ** (SPEC.electronics.adc_bits - 8)
+    toml = tmp_path / "pad16_8bit.toml"
+    toml.write_text(
+        f'kind = "pad"\nextends = "pad16"\nname = "pad16_8bit"\n\n'
+        f"[electronics]\nadc_bits = 8\nnominal_counts = {nominal}\n"
+    )
+    emulator, source = _marker8_device(FRAMES[:40])
+    out = tmp_path / "out.h5"
+    try:
+        code, message = _cli(["record", source, "--sensor", str(toml), "--frames", "30",
+                              "--out", str(out)])  # fmt: skip
+    finally:
+        emulator.stop()
+    assert code == 0, message
+    recording = read_recording(out)
+    assert recording.sensor.electronics.adc_bits == 8
+    np.testing.assert_array_equal(recording.frames, emulator.frames[:30])

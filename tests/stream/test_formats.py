@@ -37,7 +37,9 @@ def _run(spec: str, faults: FaultRates | None = None, frames=FRAMES):
     emulator = Emulator(SPEC, frames, speed=0, faults=faults, rng=1, wire_format=fmt)
     _, port = emulator.start_tcp()
     try:
-        with open_source(f"{fmt.spec()}:socket://127.0.0.1:{port}", sensor=SPEC) as stream:
+        # 8-bit samples: pad16 described as it sends them (an 8-bit converter)
+        as_sent = fmt.sensor_as_sent(SPEC)
+        with open_source(f"{fmt.spec()}:socket://127.0.0.1:{port}", sensor=as_sent) as stream:
             got = list(stream.frames())
     finally:
         emulator.stop()

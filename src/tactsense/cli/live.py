@@ -93,6 +93,19 @@ DurationLimit = Annotated[
 ]
 
 
+def _note_narrow_samples(fmt, spec) -> None:
+    """Say so when a format's samples carry fewer bits than the sensor's converter: the
+    emulator sends the top bits, which a reader takes only under a description of them."""
+    bits, width = int(spec.electronics.adc_bits), getattr(fmt, "sample_bits", None)
+    if width is not None and bits > width:
+        nominal = spec.electronics.nominal_counts / 2 ** (bits - width)
+        console.print(
+            f"note: {width}-bit samples carry the top {width} of {spec.name}'s {bits} bits "
+            f"(counts >> {bits - width}); read them as a sensor with [electronics] adc_bits "
+            f"= {width}, nominal_counts = {nominal:g} (docs/devices.md)"
+        )
+
+
 def _check_duration(duration: float | None) -> None:
     """Refuse a --duration that would record nothing (0), or is not a number [s]."""
     if duration is not None and not 0 < duration <= 1e7:
@@ -169,10 +182,15 @@ def _stream_and_locator(
     except TactsenseInputError as error:
         fail(str(error))
     if wire_format is not None and sensor is not None:
+        spec = load_sensor(sensor)
+        try:  # refused before the estimator compiles, not after
+            wire_format.check_converter(spec)
+        except TactsenseInputError as error:
+            fail(str(error))
         # a device of another format streams once the line opens (it has no START):
         # compile and warm the estimator first, or the first frames queue behind it
         locator = _locator_for(
-            load_sensor(sensor), calibration, baseline_frames, threshold,
+            spec, calibration, baseline_frames, threshold,
             keep_deflection=keep_deflection, contact_options=contact_options,
         )  # fmt: skip
         return _open_reader(source, sensor, timeout, start=False), locator
@@ -355,6 +373,7 @@ def emulate(
         )
     except TactsenseInputError as error:
         fail(str(error))
+    _note_narrow_samples(fmt, source.sensor)
     try:
         if port is None:
             # the protocol's twin keeps the slave open (no EIO); another format's closes
@@ -835,7 +854,9 @@ def view(
             streams_at_once = not source.startswith(LSL_PREFIX) and sensor is not None
             if streams_at_once and split_source(source)[0] is not None:
                 # a device of another format streams once its line opens: locator first
-                locator = make_locator(load_sensor(sensor))
+                spec = load_sensor(sensor)
+                split_source(source)[0].check_converter(spec)  # refused before it compiles
+                locator = make_locator(spec)
                 reader = _open_reader(source, sensor, timeout, start=False)
             else:
                 reader = _open_reader(source, sensor, timeout, start=False)

@@ -413,7 +413,8 @@ class DriftBaseline:
             frames.astype(np.float64))  # fmt: skip
         with deferred_interrupts():
             signal, flags = _follow(
-                np.ascontiguousarray(source), self.baseline, unusable,
+                # writable: a read-only array is another signature to compile
+                np.require(source, requirements=("C", "W")), self.baseline, unusable,
                 float(2**self.sensor.electronics.adc_bits - 1), self._resistive,
                 self._per_count, self.threshold, self.alpha, self.guard, self._grid,
                 int(Flag.NAN_INPUT), int(Flag.SATURATED), int(Flag.DEAD_TACTEL),

@@ -16,6 +16,7 @@ the device time of a frame is its host arrival time since the first frame.
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import select
 import time
@@ -89,8 +90,42 @@ class WireFormat:
         """The format and its options as a source prefix (``marker,start=AA55,...``)."""
         raise NotImplementedError
 
+    sample_bits: int | None = None
+    """Bits a sample carries (None: any count, as text or floats)."""
+
     def check_shape(self, shape: tuple[int, int]) -> None:
         """Raise :class:`FormatError` if frames of this shape cannot be carried."""
+
+    def sensor_as_sent(self, sensor: SensorSpec) -> SensorSpec:
+        """The sensor as a device of this format sends it: with samples narrower than its
+        converter, a converter of the samples' bits on the same range (``adc_bits`` the
+        sample's, ``nominal_counts`` scaled by the bits dropped); otherwise as it is."""
+        bits, width = int(sensor.electronics.adc_bits), self.sample_bits
+        if width is None or bits <= width:
+            return sensor
+        el = sensor.electronics
+        scaled = dataclasses.replace(
+            el, adc_bits=width, nominal_counts=el.nominal_counts / 2 ** (bits - width)
+        )
+        return dataclasses.replace(sensor, electronics=scaled)
+
+    def check_converter(self, sensor: SensorSpec, url: str = "") -> None:
+        """Raise :class:`~tactsense.stream.StreamError` if the samples cannot carry the
+        counts of the sensor's converter (``adc_bits`` above ``sample_bits``): read as
+        the described converter's counts, the device's would be silently too small."""
+        bits, width = int(sensor.electronics.adc_bits), self.sample_bits
+        if width is None or bits <= width:
+            return
+        scale = 2 ** (bits - width)
+        nominal = sensor.electronics.nominal_counts
+        raise StreamError(
+            f"{url or self.spec()}: the device sends {width}-bit samples, but the sensor "
+            f"{sensor.name!r} describes a {bits}-bit converter (nominal {nominal:g} counts): "
+            f"read against it, every count would be {scale}x too small. Describe the device as "
+            "it sends: "
+            f"a sensor TOML with [electronics] adc_bits = {width} and nominal_counts = "
+            f'{nominal / scale:g} (docs/devices.md, "Samples narrower than the converter")'
+        )
 
     def decoder(self, shape: tuple[int, int], stats: LossCounters, url: str):
         """A new decoder: ``feed(bytes) -> list[ndarray]`` and ``finish() -> list``, and
@@ -279,6 +314,7 @@ class FormatReader:
                 "give the sensor (--sensor: a preset such as pad16, or a TOML file)"
             )
         wire_format.check_shape(sensor.shape)
+        wire_format.check_converter(sensor, self.url)
         self.sensor = sensor
         self.stats = LossCounters()
         self.identity: dict = {"device": f"{wire_format.name} device", "format": wire_format.spec()}

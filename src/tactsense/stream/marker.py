@@ -44,6 +44,7 @@ class MarkerFrames(WireFormat):
         if str(width).strip() not in ("8", "16"):
             raise FormatError(f"format marker: width={width!r} must be 8 or 16 bits a sample")
         self.width = int(width)
+        self.sample_bits = self.width
         if order not in ORDERS:
             raise FormatError(f"format marker: order={order!r} must be little or big")
         self.order = order
