@@ -390,9 +390,13 @@ def test_pad_contacts_with_ids_trails_and_rezero(page, tmp_path):  # noqa: F811
         a, b = centres[state["index"]]
         for mark in marks:
             contact = next(c for c in state["est"]["contacts"] if c["id"] == mark["id"])
-            # drawn where the estimate says, in the page's millimetres
-            assert mark["x"] == pytest.approx(m["left"] + (contact["u_mm"] - m["u0"]) * m["scale"])
-            assert mark["y"] == pytest.approx(m["top"] + (m["v1"] - contact["v_mm"]) * m["scale"])
+            # drawn where the estimate says, in the page's millimetres, to half a pixel: the
+            # map's metrics read after the draw can move by a hundredth of a pixel when the
+            # side panel re-lays the page (seen once in CI: 406.4348 against 406.4264)
+            x = m["left"] + (contact["u_mm"] - m["u0"]) * m["scale"]
+            y = m["top"] + (m["v1"] - contact["v_mm"]) * m["scale"]
+            assert mark["x"] == pytest.approx(x, abs=0.5)
+            assert mark["y"] == pytest.approx(y, abs=0.5)
             # and the estimate within half a taxel (1.25 mm) of the bump's centre: the
             # bumps are sampled at 2.5 mm with sigma 2.5 mm, which the windowed sinc
             # interpolates to about 0.1 mm (test_contacts.py); half a taxel is the bound

@@ -304,7 +304,9 @@ class DriftBaseline:
         rises above the threshold again: the creep left after a lift, which nothing
         takes out, is re-zeroed in a fraction of a second instead of reading as a
         contact for as long as it stays above the threshold (the whole minute after a
-        10-s press on the paper's skin). Default: on exactly when ``creep`` is None.
+        10-s press on the paper's skin). Default: on for a pad or a point set exactly
+        when ``creep`` is None; off on a finger, whose creep compensation is its
+        calibration's (``tactsense calibrate --steps``), as its documented figures are.
     """
 
     def __init__(
@@ -371,7 +373,9 @@ class DriftBaseline:
         self.creep_memory = np.zeros((2, *self.baseline.shape))
         """The creep model's two memories (delayed, creep) per taxel [-], carried from
         frame to frame; zero after a re-zero."""
-        self.release = creep is None if release is None else bool(release)
+        if release is None:  # a finger's creep is its calibration's (calibrate --steps)
+            release = creep is None and getattr(sensor, "kind", "finger") != "finger"
+        self.release = bool(release)
         """Whether a lift's creep is re-zeroed (``release``)."""
         self._release_alpha = -math.expm1(-self.frame_period_s / RELEASE_TIME_CONSTANT_S)
         self._block = max(1, round(RELEASE_WINDOW_S / self.frame_period_s))
