@@ -128,27 +128,12 @@ def export_rerun(
                     low = min(low, float(np.nanmin(values)))
                     high = max(high, float(np.nanmax(values)))
             deflection_range = (low, high if high > low else low + 1e-3)
-        low, high = map(float, deflection_range)
-        if not (np.isfinite(low) and np.isfinite(high) and high > low):
-            raise TactsenseInputError(
-                f"deflection range ({low}, {high}) must be two finite numbers, low < high"
-            )
-
-        stream = rr.RecordingStream("tactsense", recording_id=recording_id)
-        stream.save(str(out))
-        stream.send_recording_name(Path(recording).stem)
-        stream.send_property(
-            "tactsense",
-            rr.AnyValues(
-                recording_id=recording_id,
-                source=str(recording),
-                sensor=sensor.name,
-                deflection_units="1 (fraction of the undeflected reading, eq. 4)",
-                deflection_range=[low, high],
-                force_units="g",
-                time_units="s (device clock)",
-            ),
-        )
+        low, high = _checked_range("deflection", deflection_range)
+        stream = _open_stream(
+            rr, out, recording, recording_id, sensor=sensor.name,
+            deflection_units="1 (fraction of the undeflected reading, eq. 4)",
+            deflection_range=[low, high], force_units="g", time_units="s (device clock)",
+        )  # fmt: skip
         stream.log("finger/force_g", rr.SeriesLines(names="force [g]"), static=True)
         pieces = iter_locate(
             reader,
@@ -233,23 +218,12 @@ def _export_array(
 
     if signal_range is None:
         signal_range = _range_of(reader.chunks(), signal)
-    low, high = map(float, signal_range)
-    if not (np.isfinite(low) and np.isfinite(high) and high > low):
-        raise TactsenseInputError(
-            f"signal range ({low}, {high}) must be two finite numbers, low < high"
-        )
-    stream = rr.RecordingStream("tactsense", recording_id=recording_id)
-    stream.save(str(out))
-    stream.send_recording_name(Path(recording).stem)
-    stream.send_property(
-        "tactsense",
-        rr.AnyValues(
-            recording_id=recording_id, source=str(recording), sensor=sensor.name,
-            kind=sensor.kind,
-            signal_units="1 (fractional deflection, or strain for resistive taxels)",
-            signal_range=[low, high], force_units="g", position_units="mm",
-            time_units="s (device clock)",
-        ),
+    low, high = _checked_range("signal", signal_range)
+    stream = _open_stream(
+        rr, out, recording, recording_id, sensor=sensor.name, kind=sensor.kind,
+        signal_units="1 (fractional deflection, or strain for resistive taxels)",
+        signal_range=[low, high], force_units="g", position_units="mm",
+        time_units="s (device clock)",
     )  # fmt: skip
     stream.log(f"{root}/force_g", rr.SeriesLines(names="force [g]"), static=True)
     stream.log(f"{root}/taxels", rr.Points3D(sensor.taxel_positions_mm(), radii=0.3), static=True)
@@ -297,3 +271,26 @@ def _export_array(
         "frames": frames_written, "contacts": contacts, "recording_id": recording_id,
         "deflection_range": (low, high), "kind": sensor.kind,
     }  # fmt: skip
+
+
+def _checked_range(what: str, value_range) -> tuple[float, float]:
+    """``(low, high)`` of a colour scale, refused unless finite with low < high."""
+    low, high = map(float, value_range)
+    if not (np.isfinite(low) and np.isfinite(high) and high > low):
+        raise TactsenseInputError(
+            f"{what} range ({low}, {high}) must be two finite numbers, low < high"
+        )
+    return low, high
+
+
+def _open_stream(rr, out, recording, recording_id: str, **properties):
+    """A Rerun stream saved to ``out``, named after the recording, with the recording
+    property ``tactsense`` (its id, source and ``properties``)."""
+    stream = rr.RecordingStream("tactsense", recording_id=recording_id)
+    stream.save(str(out))
+    stream.send_recording_name(Path(recording).stem)
+    stream.send_property(
+        "tactsense",
+        rr.AnyValues(recording_id=recording_id, source=str(recording), **properties),
+    )
+    return stream
