@@ -374,7 +374,12 @@ def test_pad_contacts_with_ids_trails_and_rezero(page, tmp_path):  # noqa: F811
             " && s.drawnIndex === s.latest.index; }",
             timeout=15000,
         )
-        page.click("#play")  # pause
+        # pause, unless the 0.3-s recording has already ended (then "play" would start it
+        # over from its untouched first frames)
+        page.evaluate(
+            "() => { const b = document.getElementById('play');"
+            " if (b.textContent === 'pause') b.click(); }"
+        )
         page.wait_for_function("() => document.getElementById('play').textContent === 'play'")
         page.wait_for_function(
             "() => { const s = window.tactsenseView; return s.drawnIndex === s.lastIndex"
