@@ -122,6 +122,7 @@ def test_page_says_ended_when_the_recording_is_over(page, short_file, opened):  
         )
         assert page.text_content("#play") == "play"
         assert page.text_content("#position").startswith(f"frame {n - 1} ")
+        feed.speed = n * feed.period_s / 4.0  # slow enough that the page sees the restart
         page.click("#play")  # starts over
         page.wait_for_function(f"() => window.tactsenseView.lastIndex < {n - 1}", timeout=5000)
     finally:
