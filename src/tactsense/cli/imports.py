@@ -17,8 +17,8 @@ def import_(
     source: Annotated[
         Path,
         typer.Argument(
-            help="MCAP (.mcap), rosbag2 bag (folder or .db3), XDF (.xdf), CSV (.csv) or a "
-            "LeRobot dataset folder."
+            help="MCAP (.mcap), rosbag2 bag (folder or .db3), XDF (.xdf), CSV (.csv), a "
+            "LeRobot dataset folder, or an iCub grasp trial (.txt)."
         ),
     ],
     out: Annotated[Path, typer.Option("--out", "-o", help="New HDF5 recording.")],
@@ -41,12 +41,39 @@ def import_(
         str | None,
         typer.Option("--stream", help="XDF: the stream's name or source_id, if several."),
     ] = None,
+    format: Annotated[
+        str,
+        typer.Option(
+            "--format",
+            help="'auto' (by extension; a .txt by its first line) or 'icub-grasp' (a trial "
+            "of the iCub grasp dataset, docs/interop.md).",
+        ),
+    ] = "auto",
+    finger: Annotated[
+        str | None,
+        typer.Option(
+            "--finger",
+            help="iCub grasp trial: the fingertip to import (thumb, index, middle, ring, "
+            "little); its sensor is the icub_fingertip preset unless --sensor.",
+        ),
+    ] = None,
+    period: Annotated[
+        float | None,
+        typer.Option(
+            "--period",
+            min=1e-6,
+            max=1e6,
+            help="iCub grasp trial: time between slices [s]. The files carry no times: "
+            "without it a slice counts 1 s (frame times are slice numbers).",
+        ),
+    ] = None,
     force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
 ) -> None:
     """Import frames and their times from another tool's file into a recording.
 
     TactileState messages (ROS 2) from MCAP or rosbag2, one stream of an XDF file
-    (LabRecorder), one frame per CSV row, or a LeRobot dataset written by tactsense.
+    (LabRecorder), one frame per CSV row, a LeRobot dataset written by tactsense, or one
+    fingertip of an iCub grasp trial.
     """
     from tactsense.interop.importers import read_source
     from tactsense.io.recording import write_recording
@@ -54,11 +81,17 @@ def import_(
     sensor_input = [] if sensor is None else sensor_file(sensor)
     check_output(out, force, inputs=[source, *sensor_input])
     recording = read_source(
-        source, sensor=sensor, time_column=time_column, topic=topic, stream=stream
-    )
+        source, sensor=sensor, time_column=time_column, topic=topic, stream=stream,
+        format=format, finger=finger, period_s=period,
+    )  # fmt: skip
     with atomic_output(out) as temporary:
         write_recording(temporary, recording)
     console.print(
         f"wrote {out}: {len(recording)} frames of {recording.sensor.name} "
         f"({recording.sensor.shape[0]} x {recording.sensor.shape[1]})"
     )
+    if "the file carries no times" in recording.scenario.get("description", ""):
+        console.print(
+            "note: the iCub grasp trial carries no times; frame times are slice numbers "
+            "(1 s apart): give --period S if the slices' period is known"
+        )

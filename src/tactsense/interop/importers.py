@@ -16,6 +16,10 @@ Sources, told apart by their extension (a folder by what it holds):
   in row-major order in the other columns; ``--sensor`` gives the shape.
 * **LeRobot** (a folder with ``meta/info.json``): :func:`tactsense.interop.lerobot.
   import_lerobot`.
+* **iCub grasp trial** (``--format icub-grasp``, or a ``.txt`` whose first line is
+  ``-10000``): one fingertip (``--finger``) of a trial of the iCub grasp dataset (Soh et
+  al., 2012), :mod:`tactsense.interop.icub_grasp`; the files carry no times
+  (``--period``).
 
 Times: a ``TactileState``'s header stamp, the XDF time stamp, the CSV time. Stamps on the
 Unix clock (after 2001, as ``tactsense export`` writes when the recording has host
@@ -485,6 +489,23 @@ def read_csv(source: Path, *, sensor=None, time_column: str = "time"):
 # ---- dispatch -------------------------------------------------------------------------
 
 
+FORMATS = ("auto", "icub-grasp")
+"""``--format``: ``auto`` tells sources apart by extension (and a ``.txt`` by its first
+line); ``icub-grasp`` reads an iCub grasp trial whatever its name."""
+
+
+def _is_icub_grasp(source: Path) -> bool:
+    """A ``.txt`` file whose first line is the iCub grasp trials' ``-10000``."""
+    from tactsense.interop.icub_grasp import HEADER
+
+    try:
+        with open(source, "rb") as stream:
+            first = stream.readline(64)
+    except OSError:
+        return False
+    return first.strip() == HEADER.encode()
+
+
 def read_source(
     source: str | Path,
     *,
@@ -492,11 +513,31 @@ def read_source(
     time_column: str = "time",
     topic: str | None = None,
     stream: str | None = None,
+    format: str = "auto",
+    finger: str | None = None,
+    period_s: float | None = None,
 ):
     """Any supported source as a :class:`~tactsense.io.recording.Recording`."""
     source = Path(source)
+    if format not in FORMATS:
+        raise ImportError_(f"--format {format!r}: expected one of {', '.join(FORMATS)}")
     if not source.exists():
         raise ImportError_(f"{source} does not exist")
+    icub = format == "icub-grasp" or (
+        format == "auto" and source.is_file() and source.suffix.lower() == ".txt"
+        and _is_icub_grasp(source)
+    )  # fmt: skip
+    if icub:
+        from tactsense.interop.icub_grasp import read_icub_grasp
+
+        if source.is_dir():
+            raise ImportError_(
+                f"{source} is a folder; --format icub-grasp reads one trial file (book_8.txt)"
+            )
+        return read_icub_grasp(source, finger=finger, sensor=sensor, period_s=period_s)
+    for name, value in (("--finger", finger), ("--period", period_s)):
+        if value is not None:
+            raise ImportError_(f"{name} applies to iCub grasp trials (--format icub-grasp) only")
     if source.is_dir():
         if (source / "meta" / "info.json").is_file():
             from tactsense.interop.lerobot import import_lerobot
@@ -519,7 +560,14 @@ def read_source(
         return read_xdf(source, sensor=sensor, stream=stream)
     if suffix == ".csv":
         return read_csv(source, sensor=sensor, time_column=time_column)
+    if suffix == ".txt":
+        raise ImportError_(
+            f"{source}: unknown kind of file .txt (its first line is not -10000, so it is no "
+            "iCub grasp trial); expected .mcap, .db3 or a rosbag2 folder, .xdf, .csv, a "
+            "LeRobot dataset folder, or an iCub grasp trial (--format icub-grasp)"
+        )
     raise ImportError_(
         f"{source}: unknown kind of file {suffix or '(no extension)'}; expected .mcap, .db3 "
-        "or a rosbag2 folder, .xdf, .csv, or a LeRobot dataset folder"
+        "or a rosbag2 folder, .xdf, .csv, a LeRobot dataset folder, or an iCub grasp trial "
+        "(.txt)"
     )

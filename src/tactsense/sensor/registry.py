@@ -143,6 +143,63 @@ def dome12() -> PointsSpec:
     )
 
 
+def icub_fingertip() -> PointsSpec:
+    """The iCub humanoid's capacitive fingertip: 12 taxels, 8 bits, readings fall under load.
+
+    Taxel centres and normals: the layout IIT publishes for the fingertip's flexible PCB
+    (:data:`ICUB_FTX2_TAXELS`, positions precise to about 0.5 mm by its own note). That
+    is the current fingertip's board; the fingertips of 2010-2014 (Schmitz et al., IROS
+    2010: 12 taxels on a flexible PCB over silicone foam, 14.5 mm long, 13 mm wide) have
+    no published taxel coordinates, and the 12-taxel layout is taken to be the same.
+    Electronics: 8-bit readings (the AD7147 capacitance-to-digital converter's output as
+    the skin firmware sends it) of 255 in principle and about 241-248 untouched in fact
+    (the iCub grasp dataset, Soh et al. 2012), falling under pressure; the rest reading
+    is taken as 245. Assumed, not measured: electrode area (12 mm^2), layer (2 mm, the
+    paper's rubber) and the 50-Hz scan.
+    """
+    positions = tuple(tuple(float(v) for v in p) for _, p, _ in ICUB_FTX2_TAXELS)
+    normals = tuple(tuple(float(v) for v in n) for _, _, n in ICUB_FTX2_TAXELS)
+    return PointsSpec(
+        name="icub_fingertip",
+        description=(
+            "iCub fingertip: 12 capacitive taxels, 8-bit readings that fall under load "
+            "(rest about 245). Taxel centres and normals: IIT's published layout of the "
+            "fingertip's flexible PCB (icub-tech-iit/electronics-boards-public, "
+            "sensor-boards/ftx2). Electrode area, layer and scan rate are assumptions, not "
+            "taken from a datasheet."
+        ),
+        taxels=Taxels(positions_mm=positions, normals=normals, area_mm2=(12.0,) * 12),
+        layer=Layer(
+            thickness_mm=2.0, youngs_modulus_pa=2.5e5, poisson_ratio=0.5, sensing_depth_mm=1.5
+        ),
+        transduction=Transduction(kind="capacitive"),
+        electronics=Electronics(adc_bits=8, nominal_counts=245.0, scan_rate_hz=50.0),
+        flaws=Flaws(),
+    )
+
+
+ICUB_FTX2_TAXELS = (
+    # (taxel, centre [mm], outward normal) in taxel order, as published for the iCub
+    # fingertip's flexible PCB ("ftx2"): icub-tech-iit/electronics-boards-public,
+    # sensor-boards/ftx2/README.md (commit 81734f5903de5d72ec09c02317186ed51c6b32ab).
+    # Root frame at the centre of the rotation axis of the fingertip's support; x runs
+    # along the finger towards its base (the tip end is taxel 11 at x = -20.9 mm).
+    (0, (-10.3, 2.2, -3.8), (0.0, 0.5, -0.866025)),
+    (1, (-10.3, 4.4, 0.0), (0.0, 1.0, 0.0)),
+    (2, (-10.3, 2.2, 3.8), (0.0, 0.5, 0.866025)),
+    (3, (-12.5, -1.4, 4.4), (0.0, 0.0, 1.0)),
+    (4, (-12.5, -1.4, -4.4), (0.0, 0.0, -1.0)),
+    (5, (-14.1, 2.2, 3.8), (0.0, 0.5, 0.866025)),
+    (6, (-14.1, 4.4, 0.0), (0.0, 1.0, 0.0)),
+    (7, (-14.1, 2.2, -3.8), (0.0, 0.5, -0.866025)),
+    (8, (-18.7, 1.6, -2.5), (-0.5, 0.471671, -0.72631)),
+    (9, (-18.7, 3.15, 0.0), (-0.5, 0.866025, 0.0)),
+    (10, (-18.7, 1.6, 2.5), (-0.5, 0.471671, 0.72631)),
+    (11, (-20.9, 0.0, 0.0), (-1.0, 0.0, 0.0)),
+)
+"""The iCub fingertip's 12 taxels: published centres [mm] and normals, in frame order."""
+
+
 PRESETS = {
     "initial": fearing1990_initial,
     "improved": fearing1990_improved,
@@ -150,6 +207,7 @@ PRESETS = {
     "pad16": pad16,
     "pad12x32": pad12x32,
     "dome12": dome12,
+    "icub_fingertip": icub_fingertip,
 }
 """Built-in sensors by short name (the fingers also answer to ``fearing1990_...``)."""
 
