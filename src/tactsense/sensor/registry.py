@@ -172,7 +172,7 @@ def icub_fingertip() -> PointsSpec:
         layer=Layer(
             thickness_mm=2.0, youngs_modulus_pa=2.5e5, poisson_ratio=0.5, sensing_depth_mm=1.5
         ),
-        transduction=Transduction(kind="capacitive"),
+        transduction=Transduction(kind="capacitive", polarity="falling"),
         electronics=Electronics(adc_bits=8, nominal_counts=245.0, scan_rate_hz=50.0),
         flaws=Flaws(),
     )
