@@ -536,7 +536,7 @@ def read_source(
             )
         return read_icub_grasp(source, finger=finger, sensor=sensor, period_s=period_s)
     for name, value in (("--finger", finger), ("--period", period_s)):
-        if value is not None:
+        if value is not None and source.suffix.lower() != ".txt":  # a .txt: said below
             raise ImportError_(f"{name} applies to iCub grasp trials (--format icub-grasp) only")
     if source.is_dir():
         if (source / "meta" / "info.json").is_file():
