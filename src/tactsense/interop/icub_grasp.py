@@ -7,7 +7,8 @@ dataset's README gives it: a first line ``-10000`` (a marker, to be ignored), th
 
 1. the 9 joint encoders of the hand (joints 7-15) [deg];
 2. ``max(255 - reading)`` of each of the 5 fingertips [counts] (the logger's own
-   summary; it was sampled apart from the taxels and may differ from them by a count);
+   summary; it was sampled apart from the taxel lines and can differ from them by a few
+   counts, so it is kept but not used);
 3. to 7. the 12 taxel readings of the thumb, index, middle, ring and little fingertips
    [counts], 8 bits, 255 untouched in principle (about 241-248 in fact), falling under
    pressure.
