@@ -32,6 +32,7 @@ from tactsense.physics.pad_response import deflection_batch_flat, resistive_coun
 from tactsense.physics.transduction import (
     amplifier_gain,
     divider_voltage,
+    polarized,
     sample_offsets,
     voltage_to_counts,
 )
@@ -637,8 +638,11 @@ def _frame_blocks(spec: SensorSpec, run: _Run):
             sampled = stiffening(sampled, spec.flaws.nonlinear_saturation)
         if _capacitive(spec):
             sampled = np.minimum(sampled, 0.95)  # plates cannot touch
-            counts = voltage_to_counts(
-                spec, gain_v * divider_voltage(spec, c0 / (1.0 - sampled)), quantize=False
+            counts = polarized(
+                spec,
+                voltage_to_counts(
+                    spec, gain_v * divider_voltage(spec, c0 / (1.0 - sampled)), quantize=False
+                ),
             )
         else:
             counts = resistive_counts(spec, sampled)
