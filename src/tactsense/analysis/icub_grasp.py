@@ -69,6 +69,8 @@ class GraspResult:
     fingertip [-] (the signal: fractional plate deflection, about counts / 245 here)."""
     threshold: float
     """The threshold it was judged with [-]."""
+    largest: float = 0.0
+    """The largest signal of any taxel in any slice [-] (contact where above the threshold)."""
 
     @property
     def contact(self) -> bool:
@@ -88,6 +90,8 @@ class ObjectRow:
     """Grasps with a contact on each fingertip [-]."""
     total_signal_median: float
     """Median over the grasps of :attr:`GraspResult.total_signal` [-]."""
+    largest_median: float = 0.0
+    """Median over the grasps of :attr:`GraspResult.largest` [-]."""
 
     @property
     def share(self) -> float:
@@ -125,6 +129,7 @@ class GraspReport:
                     fingertips_mean=float(touched.sum(axis=1).mean()),
                     per_finger=tuple(int(v) for v in touched.sum(axis=0)),
                     total_signal_median=float(np.median([r.total_signal for r in mine])),
+                    largest_median=float(np.median([r.largest for r in mine])),
                 )
             )
         return out
@@ -192,7 +197,9 @@ def judge(
         if len(table):
             s = signal[:, k, :]
             total += np.where(s > threshold, s, 0.0).sum(axis=1)
-    return GraspResult(obj, number, tuple(touched), float(total.max()), float(threshold))
+    return GraspResult(
+        obj, number, tuple(touched), float(total.max()), float(threshold), float(signal.max())
+    )
 
 
 def analyse(folder: str | Path, *, sensor=None) -> GraspReport:
@@ -225,19 +232,23 @@ def markdown(report: GraspReport) -> str:
     kinds |= {**dict.fromkeys(UNRELIABLE, "unreliable upstream"), NOTHING: "nothing"}
     lines = [
         "| object | kind | grasps | with a contact | fingertips in contact per grasp "
-        "(mean) | grasps touching thumb / index / middle / ring / little | total signal "
-        "(median) [-] |",
-        "|---|---|---|---|---|---|---|",
+        "(mean) | grasps touching thumb / index / middle / ring / little | largest taxel "
+        "signal (median) [-] | total signal (median) [-] |",
+        "|---|---|---|---|---|---|---|---|",
     ]
     for row in report.rows():
         lines.append(
             f"| {row.obj} | {kinds.get(row.obj, '')} | {row.grasps} | {row.with_contact} "
             f"({100 * row.share:.0f} %) | {row.fingertips_mean:.2f} | "
             + " / ".join(str(v) for v in row.per_finger)
-            + f" | {row.total_signal_median:.3f} |"
+            + f" | {row.largest_median:.4f} | {row.total_signal_median:.3f} |"
         )
     low, high = min(report.nothing_thresholds), max(report.nothing_thresholds)
     rigid, nothing = report.share(RIGID), report.share([NOTHING])
+    weakest = min((r for r in report.results if r.obj in RIGID), key=lambda r: r.largest)
+    closest = max(
+        (r for r in report.results if r.obj == NOTHING), key=lambda r: r.largest / r.threshold
+    )
     lines += [
         "",
         f"Rigid objects: {100 * rigid:.1f} % of their grasps with a contact (goal >= "
@@ -245,7 +256,11 @@ def markdown(report: GraspReport) -> str:
         f"{100 * GOAL_NOTHING:.0f} %). Threshold from all {len(report.nothing_thresholds)} "
         f"grasps of nothing: {report.threshold:.4f} (about "
         f"{_counts(report):.1f} counts below the baseline); each grasp of nothing was judged "
-        f"with the threshold of the others, {low:.4f} to {high:.4f}.",
+        f"with the threshold of the others, {low:.4f} to {high:.4f}. Closest calls: the "
+        f"rigid grasp with the least signal ({weakest.obj}_{weakest.trial}) reached "
+        f"{weakest.largest / weakest.threshold:.1f} times the threshold; the grasp of nothing "
+        f"nearest to its own (none_{closest.trial}), {closest.largest / closest.threshold:.2f} "
+        "times.",
     ]
     return "\n".join(lines) + "\n"
 
