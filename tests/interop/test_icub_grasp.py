@@ -3,6 +3,7 @@ its licence in LICENSE_AND_README_upstream.txt) imported and judged by tactsense
 estimators; the goals of issue 32 item 5 and the table of docs/contacts.md."""
 
 import importlib.util
+import re
 import shutil
 import tarfile
 from pathlib import Path
@@ -146,9 +147,44 @@ def test_a_grasp_of_nothing_never_sets_its_own_threshold(dataset, tmp_path):
 
 
 def test_the_docs_table_is_what_the_script_gives(report):
+    doc = (ROOT / "docs" / "contacts.md").read_text(encoding="utf-8")
+    assert _numbers_script().block(report) in doc
+
+
+def _numbers_script():
     spec = importlib.util.spec_from_file_location(
         "icub_grasp_numbers", ROOT / "scripts" / "icub_grasp_numbers.py"
     )
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
-    assert module.block(report) in (ROOT / "docs" / "contacts.md").read_text(encoding="utf-8")
+    return module
+
+
+def test_the_command_line_agrees_with_the_analysis(dataset, report, tmp_path):
+    """The docs' example: ``import`` then ``locate --calibration`` (the baseline of the
+    grasps of nothing) finds contacts on a fingertip exactly when the analysis does, and
+    prints the line the docs quote."""
+    from tactsense.analysis.icub_grasp import NOTHING
+
+    doc = " ".join((ROOT / "docs" / "contacts.md").read_text(encoding="utf-8").split())
+    threshold = re.search(r"icub_index_nothing\.json --threshold ([0-9.]+)", doc).group(1)
+    assert float(threshold) == round(report.threshold, 4)
+    _numbers_script().calibrations(report, tmp_path / "cal")
+    for obj, trial in (("book", 1), (NOTHING, 3)):
+        name = f"{obj}_{trial}"
+        code, said = _cli("import", str(dataset / f"{name}.txt"), "--finger", "index",
+                          "--out", f"{name}.h5", cwd=tmp_path)  # fmt: skip
+        assert code == 0, said
+        code, said = _cli("locate", f"{name}.h5", "--calibration", "cal/icub_index_nothing.json",
+                          "--threshold", threshold, "--drift-s", "0", "--out", f"{name}.csv",
+                          cwd=tmp_path)  # fmt: skip
+        assert code == 0, said
+        found = int(re.search(r"contact rows in (\d+) frames", said).group(1))
+        judged = next(r for r in report.results if r.obj == obj and r.trial == trial)
+        if obj != NOTHING:  # judged with the threshold of all the grasps of nothing
+            assert (found > 0) == judged.fingertips[1]
+        else:
+            assert found == 0 and not judged.fingertips[1]
+        if obj == "book":
+            line = re.search(r"wrote book_1\.csv .*? creep: none", said).group(0)
+            assert line.replace("book_1", "book_1_index") in doc
