@@ -188,3 +188,25 @@ def test_the_command_line_agrees_with_the_analysis(dataset, report, tmp_path):
         if obj == "book":
             line = re.search(r"wrote book_1\.csv .*? creep: none", said).group(0)
             assert line.replace("book_1", "book_1_index") in doc
+
+
+def test_the_preset_falls_in_the_twin_as_the_real_fingertip_does(report):
+    """The twin of ``icub_fingertip`` rests at 245 and reads lower under a press (as the
+    real fingertips: their untouched readings, the baseline here, lie within a few
+    counts of it); its estimators find the press."""
+    import tactsense as ts
+    from tactsense.estimate.contacts import find_contacts
+    from tactsense.flat_scenarios import press
+    from tactsense.sensor import load_sensor
+
+    spec = load_sensor("icub_fingertip")
+    assert abs(report.baseline_counts.mean() - spec.electronics.nominal_counts) < 5
+    positions, normals = spec.taxel_positions_mm(), spec.taxel_normals()
+    np.testing.assert_allclose(np.linalg.norm(normals, axis=1), 1.0, atol=1e-5)
+    extent = positions.max(axis=0) - positions.min(axis=0)
+    assert np.all(extent < 14.5)  # inside the fingertip (14.5 mm long, 13 mm wide)
+    rec = ts.simulate(spec, press(spec, at_taxel=6), rng=0)
+    assert rec.frames[0].max() <= spec.electronics.nominal_counts + 1
+    assert rec.frames.min() < spec.electronics.nominal_counts - 5
+    table = find_contacts(rec.frames, spec, baseline=rec.frames[0].astype(float))
+    assert len(table) > 0
