@@ -109,6 +109,12 @@ class GraspReport:
     """Threshold from all the grasps of nothing [-] (the one the objects are judged with)."""
     nothing_thresholds: list[float] = field(default_factory=list)
     """Threshold each grasp of nothing was judged with (from the other grasps) [-]."""
+    default_threshold: float = float("nan")
+    """The estimators' default threshold for the sensor [-]
+    (:func:`~tactsense.estimate.contacts.default_threshold`)."""
+    default_nothing: int = 0
+    """Grasps of nothing with a contact at the default threshold (each against the
+    baseline of the others) [-]."""
 
     def rows(self) -> list[ObjectRow]:
         """One row per object, in the order rigid, soft, unreliable, nothing."""
@@ -212,18 +218,23 @@ def analyse(folder: str | Path, *, sensor=None) -> GraspReport:
     keys = list(nothing)
     baseline = baseline_of(list(nothing.values()))
     threshold = threshold_of(list(nothing.values()))
-    results, thresholds = [], []
+    from tactsense.estimate.contacts import default_threshold
+
+    usual = default_threshold(nothing[keys[0]][0].sensor)
+    results, thresholds, at_default = [], [], 0
     for key in keys:  # each grasp of nothing against the others only
         others = [nothing[k] for k in keys if k != key]
         own = threshold_of(others)
         thresholds.append(own)
-        results.append(judge(nothing[key], baseline_of(others), own, obj=NOTHING, number=key))
+        base = baseline_of(others)
+        results.append(judge(nothing[key], base, own, obj=NOTHING, number=key))
+        at_default += judge(nothing[key], base, usual, obj=NOTHING, number=key).contact
     for obj, grasps in hands.items():
         if obj == NOTHING:
             continue
         for number, h in grasps.items():
             results.append(judge(h, baseline, threshold, obj=obj, number=number))
-    return GraspReport(results, baseline, threshold, thresholds)
+    return GraspReport(results, baseline, threshold, thresholds, usual, at_default)
 
 
 def markdown(report: GraspReport) -> str:
@@ -255,18 +266,24 @@ def markdown(report: GraspReport) -> str:
         f"{100 * GOAL_RIGID:.0f} %); grasps of nothing: {100 * nothing:.1f} % (goal <= "
         f"{100 * GOAL_NOTHING:.0f} %). Threshold from all {len(report.nothing_thresholds)} "
         f"grasps of nothing: {report.threshold:.4f} (about "
-        f"{_counts(report):.1f} counts below the baseline); each grasp of nothing was judged "
-        f"with the threshold of the others, {low:.4f} to {high:.4f}. Closest calls: the "
-        f"rigid grasp with the least signal ({weakest.obj}_{weakest.trial}) reached "
+        f"{_counts(report, report.threshold):.1f} counts below the baseline); each grasp of "
+        f"nothing was judged with the threshold of the others, {low:.4f} to {high:.4f}. "
+        "Closest calls: the rigid grasp with the least signal "
+        f"({weakest.obj}_{weakest.trial}) reached "
         f"{weakest.largest / weakest.threshold:.1f} times the threshold; the grasp of nothing "
         f"nearest to its own (none_{closest.trial}), {closest.largest / closest.threshold:.2f} "
         "times.",
+        "",
+        f"At the estimators' default threshold ({report.default_threshold:g}, about "
+        f"{_counts(report, report.default_threshold):.1f} counts at this rest reading) "
+        f"{report.default_nothing} of the {len(report.nothing_thresholds)} grasps of nothing "
+        "show a contact: on this fingertip the threshold has to come from untouched data.",
     ]
     return "\n".join(lines) + "\n"
 
 
-def _counts(report: GraspReport, sensor=None) -> float:
-    """The threshold as a drop below the mean baseline [counts]: the drop whose signal,
+def _counts(report: GraspReport, threshold: float, sensor=None) -> float:
+    """A threshold [-] as a drop below the mean baseline [counts]: the drop whose signal,
     through :func:`~tactsense.estimate.contacts.signal_from_counts`, is the threshold."""
     from tactsense.estimate.contacts import signal_from_counts
     from tactsense.sensor import load_sensor
@@ -276,4 +293,4 @@ def _counts(report: GraspReport, sensor=None) -> float:
     drops = np.linspace(0.0, 0.5 * rest, 2001)
     frames = (rest - drops)[:, np.newaxis, np.newaxis] * np.ones((1, *spec.shape))
     signal, _ = signal_from_counts(frames, np.full(spec.shape, rest), spec)
-    return float(np.interp(report.threshold, signal[:, 0, 0], drops))
+    return float(np.interp(threshold, signal[:, 0, 0], drops))
