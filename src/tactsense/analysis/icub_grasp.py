@@ -115,6 +115,11 @@ class GraspReport:
     default_nothing: int = 0
     """Grasps of nothing with a contact at the default threshold (each against the
     baseline of the others) [-]."""
+    untouched: dict = field(default_factory=dict)
+    """The grasps of nothing's readings [counts]: ``low``, ``high`` (the range of the
+    taxels' grasp means), ``between`` (the largest range of one taxel's grasp means over
+    the grasps), ``within`` (the scatter within a grasp: standard deviation over its
+    slices, mean over taxels and grasps)."""
 
     def rows(self) -> list[ObjectRow]:
         """One row per object, in the order rigid, soft, unreliable, nothing."""
@@ -234,14 +239,28 @@ def analyse(folder: str | Path, *, sensor=None) -> GraspReport:
             continue
         for number, h in grasps.items():
             results.append(judge(h, baseline, threshold, obj=obj, number=number))
-    return GraspReport(results, baseline, threshold, thresholds, usual, at_default)
+    means = np.array([[r.frames[:, 0, :].mean(axis=0) for r in h] for h in nothing.values()])
+    scatter = [np.mean([r.frames[:, 0, :].std(axis=0) for r in h]) for h in nothing.values()]
+    untouched = {
+        "low": float(means.min()),
+        "high": float(means.max()),
+        "between": float((means.max(axis=0) - means.min(axis=0)).max()),
+        "within": float(np.mean(scatter)),
+    }
+    return GraspReport(results, baseline, threshold, thresholds, usual, at_default, untouched)
 
 
 def markdown(report: GraspReport) -> str:
     """The table of ``docs/contacts.md`` and the figures around it."""
     kinds = {**dict.fromkeys(RIGID, "rigid"), **dict.fromkeys(SOFT, "soft toy")}
     kinds |= {**dict.fromkeys(UNRELIABLE, "unreliable upstream"), NOTHING: "nothing"}
+    u = report.untouched
     lines = [
+        f"Untouched (the grasps of nothing): the taxels' mean readings lie between "
+        f"{u['low']:.1f} and {u['high']:.1f} counts; a taxel's mean moves by up to "
+        f"{u['between']:.1f} counts from one grasp to another, while within a grasp its "
+        f"readings scatter by {u['within']:.2f} counts (standard deviation).",
+        "",
         "| object | kind | grasps | with a contact | fingertips in contact per grasp "
         "(mean) | grasps touching thumb / index / middle / ring / little | largest taxel "
         "signal (median) [-] | total signal (median) [-] |",
