@@ -293,7 +293,7 @@ def markdown(report: GraspReport) -> str:
         f"nearest to its own (none_{closest.trial}), {closest.largest / closest.threshold:.2f} "
         "times.",
         "",
-        f"At the estimators' default threshold ({report.default_threshold:g}, about "
+        f"At the estimators' default threshold ({report.default_threshold:.4f}, about "
         f"{_counts(report, report.default_threshold):.1f} counts at this rest reading) "
         f"{report.default_nothing} of the {len(report.nothing_thresholds)} grasps of nothing "
         "show a contact: on this fingertip the threshold has to come from untouched data.",
