@@ -374,11 +374,13 @@ def find_contacts(
         table = _grid_contacts(signal, sensor, threshold, saddle, max_contacts, method)
     table.flags |= flags[table.frame]
     if array_calibration:
-        table.force_n = calibration.force(table.force_n)
+        table.force_n, beyond = calibration.contact_force(table)
+        table.flags[beyond] |= int(Flag.BEYOND_CALIBRATION)
     if saturated is not None:
         _mark_saturated(table, saturated, sensor)
     table.extra.pop("_labels", None)
     table.extra.pop("_root", None)
+    table.extra.pop("_total", None)
     table.n_frames = 1 if lead_2d else len(signal)
     table.frame = table.frame + int(first_frame)
     return table
@@ -501,6 +503,7 @@ def _grid_contacts(signal, sensor, threshold, saddle, max_contacts, method) -> C
         extra = {"axial_mm": axial, "angle_deg": angle_deg}
     extra["_root"] = seg["root"]
     extra["_labels"] = labels
+    extra["_total"] = seg["total"]  # the contact's summed signal (a weight curve's input)
     table = ContactTable(
         frame=seg["frame"], contact=seg["contact"], x_mm=x, y_mm=y, z_mm=z, row=row, col=col,
         force_n=force, peak=peak, major_mm=major, minor_mm=minor, orientation_deg=angle,
@@ -854,8 +857,9 @@ def _points_contacts(signal, sensor, threshold, saddle, max_contacts, method) ->
         table = ContactTable.empty(len(signal))
         table.extra["_root"] = np.zeros(0, np.int64)
         table.extra["_labels"] = labels
+        table.extra["_total"] = np.zeros(0)
         return table
-    rank, _, frame, point, peak, force, major, minor, angle, taxels, flag, root = zip(
+    rank, total, frame, point, peak, force, major, minor, angle, taxels, flag, root = zip(
         *rows, strict=True
     )
     point = np.array(point)
@@ -866,5 +870,6 @@ def _points_contacts(signal, sensor, threshold, saddle, max_contacts, method) ->
         peak=np.array(peak), major_mm=np.array(major, float), minor_mm=np.array(minor, float),
         orientation_deg=np.array(angle, float), taxels=np.array(taxels, np.int64),
         flags=np.array(flag, np.int64), n_frames=len(signal),
-        extra={"_root": np.array(root, np.int64), "_labels": labels},
+        extra={"_root": np.array(root, np.int64), "_labels": labels,
+               "_total": np.array(total, float)},
     )  # fmt: skip
