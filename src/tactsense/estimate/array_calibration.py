@@ -78,6 +78,15 @@ class ArrayCalibration:
     force is NaN and flagged ``BEYOND_CALIBRATION`` (``"signal_total"`` only)."""
 
     @property
+    def contact_threshold(self) -> float | None:
+        """The contact threshold a weight curve's totals were taken with [-] (None for
+        other calibrations): ``find_contacts`` uses it unless told otherwise."""
+        if self.curve_input != "signal_total":
+            return None
+        value = self.notes.get("threshold")
+        return float(value) if isinstance(value, int | float) and value > 0 else None
+
+    @property
     def sensor(self):
         from tactsense.estimate.calibrate import sensor_of
 
@@ -769,10 +778,13 @@ def weight_curve(presses: Presses) -> dict:
             f"{force[0]:.3g} N): use lighter weights, or a wider contact"
         )
     if end < len(force):
-        drop = total[end] < 0.9 * total[end - 1]
-        rise = np.any(total[end:] > 1.1 * total[end - 1])
-        if (drop and not sat[end]) or rise:
-            k = end if drop else end + int(np.argmax(total[end:] > 1.1 * total[end - 1]))
+        # past a knee the total stays put; one at the rail may read anything
+        drop = total[end] < 0.9 * total[end - 1] and not sat[end]
+        again = (
+            (total[end:] > 1.1 * total[end - 1]) & ~sat[end:] & (np.arange(end, len(force)) > end)
+        )
+        if drop or again.any():
+            k = end if drop else end + int(np.argmax(again))
             raise ArrayCalibrationError(
                 f"the total signal does not rise with the load: {total[end - 1]:.3g} at "
                 f"{force[end - 1]:.3g} N, {total[end]:.3g} at {force[end]:.3g} N"

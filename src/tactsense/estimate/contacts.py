@@ -310,7 +310,8 @@ def find_contacts(
         raise TactsenseInputError(f"max_contacts must be an integer in 1-64; got {max_contacts!r}")
     if not (isinstance(saddle, float | int) and 0.0 < saddle <= 1.0):
         raise TactsenseInputError(f"saddle must be in (0, 1]; got {saddle!r}")
-    threshold = default_threshold(sensor) if threshold is None else threshold
+    if threshold is None:  # a weight curve's own, else the default
+        threshold = getattr(calibration, "contact_threshold", None) or default_threshold(sensor)
     if not (isinstance(threshold, float | int) and math.isfinite(threshold) and threshold > 0):
         raise TactsenseInputError(f"threshold must be a positive number; got {threshold!r}")
     frames = check_frames(frames, sensor.shape)
