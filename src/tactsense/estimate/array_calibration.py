@@ -742,6 +742,13 @@ def weight_curve(presses: Presses) -> dict:
         ``saturation`` (the lightest saturated weight [N] and why, or None),
         ``loo_max_error_percent`` (over the predicted weights).
     """
+    loads = presses.force_n
+    if np.max(loads) < 1.5 * np.min(loads):
+        raise ArrayCalibrationError(
+            f"the log holds one load ({np.median(loads):.3g} N in all {len(loads)} presses, "
+            f"{np.min(loads):.3g}-{np.max(loads):.3g} N): a curve needs weights from light to "
+            "heavy (the heaviest at least 1.5 times the lightest)"
+        )
     force, total, count, sat, _ = _groups(presses.force_n, presses.total, presses.saturated)
     if len(force) < 3:
         raise ArrayCalibrationError(
