@@ -504,6 +504,10 @@ def _calibrate_array(recording, out, *, press, force_log, loads, baseline_frames
     console_err.print(table)
 
 
+LOO_GOAL_PERCENT = 5.0
+"""A held-out weight predicted further off than this [%] gets a hint to add weights."""
+
+
 def _print_weight_curve(calibration, table, console) -> None:
     """The weight curve's summary and its leave-one-out table, as kept in the notes."""
     notes = calibration.notes
@@ -526,11 +530,18 @@ def _print_weight_curve(calibration, table, console) -> None:
         if saturation
         else f"none up to the heaviest weight, {weights[-1]['force_n']:.4g} N",
     )
-    loo = notes["loo_max_error_percent"]
-    table.add_row(
-        "leave-one-out",
-        "no weight could be held out" if loo is None else f"largest error {loo:.1f} %",
-    )
+    loo, lightest = notes["loo_max_error_percent"], notes["loo_lightest_error_percent"]
+    said = [] if loo is None else [f"largest error {loo:.1f} % (weights between two others)"]
+    if lightest is not None:
+        said.append(f"the lightest {lightest:+.1f} % (from the origin)")
+    bends = [w["force_n"] for w in weights if w.get("loo_between") and
+             abs(w["loo_error_percent"]) > LOO_GOAL_PERCENT]  # fmt: skip
+    if bends:
+        said.append(
+            f"[bold]above {LOO_GOAL_PERCENT:g} % at {', '.join(f'{f:.3g}' for f in bends)} N: "
+            "add weights there, where the curve bends[/]"
+        )
+    table.add_row("leave-one-out", "; ".join(said) or "no weight could be held out")
     hysteresis = notes["hysteresis"]
     table.add_row(
         "hysteresis",

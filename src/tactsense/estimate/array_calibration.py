@@ -740,7 +740,9 @@ def weight_curve(presses: Presses) -> dict:
         :data:`TOP_MARGIN`), ``weights`` (one entry per distinct weight: load [N],
         presses, total, saturated, and its leave-one-out prediction [N] and error [%]),
         ``saturation`` (the lightest saturated weight [N] and why, or None),
-        ``loo_max_error_percent`` (over the predicted weights).
+        ``loo_max_error_percent`` (the largest error [%] of the weights held out between
+        two others), ``loo_lightest_error_percent`` (the lightest's, read between the
+        origin and the next weight, where a response bends most).
     """
     loads = presses.force_n
     if np.max(loads) < 1.5 * np.min(loads):
@@ -817,13 +819,17 @@ def weight_curve(presses: Presses) -> dict:
             xo, yo = _knots(force[:end][others], total[:end][others], count[:end][others])
             if total[k] <= xo[-1]:
                 predicted = float(np.interp(total[k], xo, yo))
-                entry.update(loo_n=predicted, loo_error_percent=100 * (predicted / force[k] - 1))
+                entry.update(loo_n=predicted, loo_error_percent=100 * (predicted / force[k] - 1),
+                             loo_between=bool(total[k] >= xo[1]))  # fmt: skip
+                if total[k] < xo[1]:
+                    entry["loo_note"] = "below the others: read between the origin and the next"
             else:
                 entry.update(loo_n=None, loo_error_percent=None,
                              loo_note="beyond the others' range: not extrapolated")  # fmt: skip
         weights.append(entry)
-    errors = [abs(w["loo_error_percent"]) for w in weights
-              if w.get("loo_error_percent") is not None]  # fmt: skip
+    errors = [abs(w["loo_error_percent"]) for w in weights if w.get("loo_between")]
+    lightest = [w["loo_error_percent"] for w in weights
+                if w.get("loo_error_percent") is not None and not w["loo_between"]]  # fmt: skip
     return {
         "signal_total": x,
         "force_n": y,
@@ -832,6 +838,7 @@ def weight_curve(presses: Presses) -> dict:
         "saturation": None if end == len(force) else {"from_n": float(force[end]),
                                                        "reason": reason},
         "loo_max_error_percent": float(max(errors)) if errors else None,
+        "loo_lightest_error_percent": float(lightest[0]) if lightest else None,
     }  # fmt: skip
 
 
@@ -1161,6 +1168,7 @@ def _add_weight_curve(calibration, sensor, loads, weights, baseline_frames, thre
         weights=curve["weights"],
         saturation=curve["saturation"],
         loo_max_error_percent=curve["loo_max_error_percent"],
+        loo_lightest_error_percent=curve["loo_lightest_error_percent"],
         hysteresis=hysteresis(presses, curve),
         temperature=temperature_coefficient(presses, curve),
     )  # fmt: skip
