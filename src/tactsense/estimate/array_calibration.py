@@ -554,17 +554,27 @@ than this share of the recording's range (or 8 times the untouched frames' noise
 total, if larger) [-], and ends where it falls back below half its rise."""
 
 
+SMOOTH_FRAMES = 9
+"""Frames of the running median the total is followed through (a weight is held for
+seconds; noise spikes, and a contact's noise amplified by creep compensation, last a
+frame or two) [-]."""
+
+MIN_PRESS_FRAMES = 10
+"""A run shorter than this is no weight placed (a bump, or noise) [-]."""
+
+
 def segment_presses(total, *, rest_frames: int = 5, level: float = PRESS_LEVEL):
     """The presses of a recording of weights placed, held and removed in turn, found in
     its frames' total signal alone.
 
-    The total, median-filtered over 3 frames, is followed frame by frame: while unloaded, a
+    The total, median-filtered over :data:`SMOOTH_FRAMES` frames, is followed frame by
+    frame: while unloaded, a
     press starts when the total rises above the lowest of the last 5 unloaded frames by
     more than ``level`` of the recording's range (or 8 times the noise of the first
     ``rest_frames``, if larger); its level before is the median of the last 3 unloaded
     frames; it ends when the total falls below that level plus half the press's largest
     rise (the weight lifted: creep left after it is less than half the press). Runs
-    shorter than 3 frames are dropped.
+    shorter than :data:`MIN_PRESS_FRAMES` are dropped.
 
     Returns
     -------
@@ -573,7 +583,7 @@ def segment_presses(total, *, rest_frames: int = 5, level: float = PRESS_LEVEL):
     """
     from scipy.ndimage import median_filter
 
-    t = median_filter(np.asarray(total, dtype=float), size=3, mode="nearest")
+    t = median_filter(np.asarray(total, dtype=float), size=SMOOTH_FRAMES, mode="nearest")
     rest = t[:rest_frames]
     noise = 1.4826 * np.median(np.abs(rest - np.median(rest)))
     span = np.percentile(t, 99.5) - np.median(rest)
@@ -593,11 +603,11 @@ def segment_presses(total, *, rest_frames: int = 5, level: float = PRESS_LEVEL):
         else:
             peak = max(peak, value)
             if value < floor + 0.5 * (peak - floor):
-                if i - start >= 3:
+                if i - start >= MIN_PRESS_FRAMES:
                     presses.append((start, i, floor))
                 start = None
                 unloaded = [value]  # the level after it, not before
-    if start is not None and len(t) - start >= 3:
+    if start is not None and len(t) - start >= MIN_PRESS_FRAMES:
         presses.append((start, len(t), floor))
     return presses
 
@@ -609,7 +619,8 @@ def _plateau(start: int, end: int) -> slice:
     return slice(start + n // 2, max(start + n // 2 + 1, end - max(1, n // 10)))
 
 
-def weight_presses(totals, saturated, log: WeightsLog, *, time_s=None, rest_frames: int = 5):
+def weight_presses(totals, saturated, log: WeightsLog, *, time_s=None, rest_frames: int = 5,
+                   timing=None):  # fmt: skip
     """The presses of a weights recording and their known loads.
 
     Parameters
@@ -619,14 +630,20 @@ def weight_presses(totals, saturated, log: WeightsLog, *, time_s=None, rest_fram
     saturated : ndarray of bool, shape (T,)
         Frames with a taxel at the converter's rail.
     log : WeightsLog
-        One row per press (the presses are found in ``totals``,
+        One row per press (the presses are found in ``timing``,
         :func:`segment_presses`), or timed (the presses are the runs where the logged
         load exceeds 5 % of its largest, at the frames' times ``time_s`` [s]).
+    timing : ndarray, shape (T,), optional
+        The total the presses are found in (default ``totals``): one with less noise,
+        e.g. without creep compensation, which amplifies the noise.
+
+    Each press's total is the median of ``totals`` over its settled part (its second
+    half, less its last tenth) less their median over the 5 frames before it.
     """
     totals = np.asarray(totals, dtype=float)
     temperature = None
     if log.time_s is None:
-        found = segment_presses(totals, rest_frames=rest_frames)
+        found = segment_presses(totals if timing is None else timing, rest_frames=rest_frames)
         if len(found) != len(log.force_n):
             raise ArrayCalibrationError(
                 f"found {len(found)} presses in the recording (runs where the total signal "
@@ -655,9 +672,8 @@ def weight_presses(totals, saturated, log: WeightsLog, *, time_s=None, rest_fram
         edges = np.flatnonzero(np.diff(np.r_[False, loaded, False].astype(int)))
         found = []
         for a, b in zip(edges[::2], edges[1::2], strict=True):
-            before = totals[max(0, a - 5) : a] if a > 0 else totals[:rest_frames]
-            if b - a >= 3:
-                found.append((a, b, float(np.median(before))))
+            if b - a >= 3:  # the log says a load was on: kept however short
+                found.append((a, b, 0.0))
         force = np.array([np.median(logged[_plateau(a, b)]) for a, b, _ in found])
         if log.temperature_c is not None:
             tc = np.interp(time_s, log.time_s, log.temperature_c)
@@ -666,15 +682,22 @@ def weight_presses(totals, saturated, log: WeightsLog, *, time_s=None, rest_fram
         raise ArrayCalibrationError(f"no press found in the recording of {log.source}")
     start = np.array([a for a, _, _ in found])
     end = np.array([b for _, b, _ in found])
-    total = np.array([np.median(totals[_plateau(a, b)]) - f for a, b, f in found])
+    before = [totals[max(0, a - 5) : a] if a > 0 else totals[:1] for a, _, _ in found]
+    total = np.array([np.median(totals[_plateau(a, b)]) - np.median(f)
+                      for (a, b, _), f in zip(found, before, strict=True)])  # fmt: skip
     sat = np.array([bool(np.any(saturated[_plateau(a, b)])) for a, b, _ in found])
     return Presses(start, end, total, np.asarray(force, float), sat, temperature)
 
 
 SATURATION_SLOPE = 0.2
-"""The total has saturated where it grows, from one weight to the next, by less than
-this share of its mean sensitivity below (the total over the load of the lighter
-weight) [-]."""
+"""The total has saturated from the weight on which it never again exceeds the lighter
+weight's total by more than this share of the mean sensitivity below (the total over
+the load of the lighter weight) times the step in load [-]."""
+
+MONOTONE_RANK = 0.8
+"""Smallest rank (Spearman) correlation between the weights below the rail and their
+totals: below it the log does not follow the recording (weights listed out of order,
+another session's log) [-]."""
 
 SAME_WEIGHT = 0.01
 """Presses whose loads differ by less than this share are the same weight (pooled, and
@@ -728,10 +751,12 @@ def weight_curve(presses: Presses) -> dict:
     Each distinct weight (:data:`SAME_WEIGHT`) gives a knot at its presses' median total
     signal; the knots, through the origin, are made monotone (isotonic regression). The
     calibrated range ends before the first weight that saturated: a taxel at the rail,
-    or a total that grew by less than :data:`SATURATION_SLOPE` of the mean sensitivity
-    below it. Each calibrated weight is then held out and predicted from the curve of the
-    others (leave-one-out); the heaviest lies beyond the others' range and is not
-    predicted (the curve is never extrapolated).
+    or a total that, from that weight on, never grows again by more than
+    :data:`SATURATION_SLOPE` of the mean sensitivity below it. Totals that do not rise
+    with the load (:data:`MONOTONE_RANK`) are refused. Each calibrated weight is then
+    held out and predicted from the curve of the others (leave-one-out); the heaviest
+    lies beyond the others' range and is not predicted (the curve is never
+    extrapolated).
 
     Returns
     -------
@@ -764,43 +789,35 @@ def weight_curve(presses: Presses) -> dict:
             f"the {force[k]:.3g}-N weight raised the total signal by {total[k]:.3g}: no "
             "response (a weight off the array, or below the contact threshold)"
         )
-    end, reason = len(force), None
-    for k in range(len(force)):
-        if sat[k]:
-            end, reason = k, "taxels at the converter's rail"
-            break
-        if k >= 1:
-            mean = total[k - 1] / force[k - 1]
-            slope = (total[k] - total[k - 1]) / (force[k] - force[k - 1])
-            if slope < SATURATION_SLOPE * mean:
-                end, reason = (
-                    k,
-                    (
-                        f"the total grew by {slope / mean:.0%} of the mean sensitivity below "
-                        f"(less than {SATURATION_SLOPE:.0%})"
-                    ),
-                )
-                break
-    if end == 0:
+    rail = int(np.argmax(sat)) if sat.any() else len(force)
+    if rail == 0:
         raise ArrayCalibrationError(
-            f"every weight saturated the array ({reason}, from the lightest, "
-            f"{force[0]:.3g} N): use lighter weights, or a wider contact"
+            f"every weight saturated the array (taxels at the converter's rail from the "
+            f"lightest, {force[0]:.3g} N): use lighter weights, or a wider contact"
         )
-    if end < len(force):
-        # past a knee the total stays put; one at the rail may read anything
-        drop = total[end] < 0.9 * total[end - 1] and not sat[end]
-        again = (
-            (total[end:] > 1.1 * total[end - 1]) & ~sat[end:] & (np.arange(end, len(force)) > end)
+    from scipy.stats import spearmanr
+
+    rank = spearmanr(force[:rail], total[:rail]).statistic if rail >= 3 else 1.0
+    if not rank >= MONOTONE_RANK:
+        raise ArrayCalibrationError(
+            "the total signal does not rise with the load (rank correlation "
+            f"{rank:.2f} over the {rail} weights "
+            f"below the rail, at least {MONOTONE_RANK:g} expected; "
+            + ", ".join(f"{t:.3g} at {f:.3g} N" for f, t in zip(force[:4], total[:4], strict=True))
+            + "...): are the weights listed in the order they were placed, and is it this "
+            "recording's log?"
         )
-        if drop or again.any():
-            k = end if drop else end + int(np.argmax(again))
-            raise ArrayCalibrationError(
-                f"the total signal does not rise with the load: {total[end - 1]:.3g} at "
-                f"{force[end - 1]:.3g} N, {total[end]:.3g} at {force[end]:.3g} N"
-                + (f", {total[k]:.3g} at {force[k]:.3g} N" if k != end else "")
-                + ": are the weights listed in the order they were placed, and is it this "
-                "recording's log?"
+    end, reason = rail, None if rail == len(force) else "taxels at the converter's rail"
+    for k in range(1, rail):  # a knee: from k on, the total never grows again
+        mean = total[k - 1] / force[k - 1]
+        growth = SATURATION_SLOPE * mean * (force[k] - force[k - 1])
+        if np.all(total[k:rail] < total[k - 1] + growth):
+            end = k
+            reason = (
+                f"the total stopped growing (less than {SATURATION_SLOPE:.0%} of the mean "
+                "sensitivity below, from there on)"
             )
+            break
     if end < 3:
         raise ArrayCalibrationError(
             f"{end} weight{'s' if end != 1 else ''} below saturation (it starts at "
@@ -1148,8 +1165,18 @@ def _add_weight_curve(calibration, sensor, loads, weights, baseline_frames, thre
         load_frames, sensor, calibration, baseline_frames=baseline_frames,
         threshold=threshold, attrs=attrs, drift_s=drift_s,
     )  # fmt: skip
+    # the presses are found in the totals without creep compensation (which amplifies
+    # the noise), on the recording's own first frames
+    own = ArrayCalibration(
+        sensor_toml=calibration.sensor_toml,
+        baseline=np.nanmedian(load_frames[:baseline_frames].astype(float), axis=0),
+        gains=calibration.gains, dead=calibration.dead,
+    )  # fmt: skip
+    signal = own.signal(load_frames, sensor)[0].reshape(len(load_frames), -1)
+    timing = np.where(signal > threshold, signal, 0.0).sum(axis=1)
+    del signal
     presses = weight_presses(totals, saturated, weights, time_s=time_s,
-                             rest_frames=baseline_frames)  # fmt: skip
+                             rest_frames=baseline_frames, timing=timing)  # fmt: skip
     curve = weight_curve(presses)
     calibration.force_curve = (curve["signal_total"], curve["force_n"])
     calibration.curve_input = "signal_total"
