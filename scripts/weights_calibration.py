@@ -21,6 +21,9 @@ from pathlib import Path
 
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from docblock import replace_block, save_figure
+
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "calibration.md"
 FIGURE = ROOT / "docs" / "images" / "calibration_weights.png"
@@ -194,6 +197,19 @@ def summary(result: dict) -> dict:
         "top_n": cal.force_curve[1][-1],
         "saturation": notes["saturation"],
         "loo": notes["loo_max_error_percent"],
+        "loo_off": [
+            (w["force_n"], w["loo_error_percent"])
+            for w in notes["weights"]
+            if w.get("loo_between") and abs(w["loo_error_percent"]) > 5.0
+        ],
+        "loo_rest": max(
+            (
+                abs(w["loo_error_percent"])
+                for w in notes["weights"]
+                if w.get("loo_between") and abs(w["loo_error_percent"]) <= 5.0
+            ),
+            default=float("nan"),
+        ),
         "lightest": notes["loo_lightest_error_percent"],
         "check_within": len(inside),
         "check_error": max(abs(e) for e in errors) if errors else float("nan"),
@@ -232,6 +248,9 @@ def block(results) -> str:
          if v["saturation"] else "none seen" for v in s])  # fmt: skip
     row("leave-one-out, weights between two others (largest error)",
         [f"{v['loo']:.1f} %" for v in s])  # fmt: skip
+    row("  of which above 5 % / the largest of the others",
+        [(", ".join(f"{f / GRAM:.0f} g ({e:+.1f} %)" for f, e in v["loo_off"]) or "none")
+         + f" / {v['loo_rest']:.1f} %" for v in s])  # fmt: skip
     row("leave-one-out, the lightest (from the origin)", [f"{v['lightest']:+.1f} %" for v in s])
     row("second series within the range: presses, largest error",
         [f"{v['check_within']}, {v['check_error']:.1f} %" for v in s])  # fmt: skip
@@ -255,8 +274,6 @@ def figure(results, path: Path) -> None:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-
-    from docblock import save_figure
 
     fig, axes = plt.subplots(len(results), 2, figsize=(10, 3.6 * len(results)), squeeze=False)
     for (left, right), result in zip(axes, results, strict=True):
@@ -296,9 +313,6 @@ def measure(sensors) -> list[dict]:
 
 
 def main(argv=None) -> None:
-    sys.path.insert(0, str(Path(__file__).resolve().parent))
-    from docblock import replace_block
-
     sensors = (argv if argv is not None else sys.argv[1:]) or ["pad16"]
     results = measure(sensors)
     text = block(results)
