@@ -646,10 +646,11 @@ def weight_presses(totals, saturated, log: WeightsLog, *, time_s=None, rest_fram
         found = segment_presses(totals if timing is None else timing, rest_frames=rest_frames)
         if len(found) != len(log.force_n):
             raise ArrayCalibrationError(
-                f"found {len(found)} presses in the recording (runs where the total signal "
-                f"rises more than {PRESS_LEVEL:.0%} of its range above the level before it) and "
-                f"{log.source} lists {len(log.force_n)} weights: one row per weight placed, "
-                "each placed, held and removed, in the order placed (or give time_s)"
+                f"found {len(found)} presses in the recording and {log.source} lists "
+                f"{len(log.force_n)} weight{'s' if len(log.force_n) != 1 else ''}: one row per "
+                "weight, each placed, held and removed, in the order placed (a press: the total "
+                f"signal {PRESS_LEVEL:.0%} of its range above the level before, for "
+                f"{MIN_PRESS_FRAMES} frames or more), or give time_s"
             )
         force = log.force_n
         temperature = log.temperature_c

@@ -1,0 +1,129 @@
+"""Round four (issue 32, item 4), calibration from weights: each case of a weights log
+or weights recording gone wrong is one line, exit 2, no calibration written. Before,
+every one of them was refused for the wrong reason ("needs the columns time_s and
+force_n", or "this is not a probe pressed on every taxel in turn"), or passed."""
+
+import json
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+import tactsense as ts
+from tactsense import flat_scenarios as fs
+from tactsense.cli import app
+from tactsense.physics.contact import grams_force
+
+runner = CliRunner()
+
+
+def _series(pad, grams, seed=1):
+    """Weights placed 0.6 s and lifted 0.6 s, each in turn, on the twin."""
+    scene = fs.loads(pad, forces_n=[grams_force(g) for g in grams], dwell_s=0.6, lift_s=0.6)
+    return ts.simulate(pad, scene, rng=seed)
+
+
+@pytest.fixture(scope="module")
+def bench(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("weights")
+    pad = ts.preset("pad16")
+    ts.write_recording(folder / "w.h5", _series(pad, [10, 20, 30, 40, 50, 60]))
+    ts.write_recording(folder / "one.h5", _series(pad, [50]))
+    ts.write_recording(folder / "heavy.h5", _series(pad, [200, 250, 300]))
+    files = {
+        "good": "press,mass_g\n1,10\n2,20\n3,30\n4,40\n5,50\n6,60\n",
+        "one": "press,mass_g\n1,50\n",
+        "reversed": "press,mass_g\n1,60\n2,50\n3,40\n4,30\n5,20\n6,10\n",
+        "nounit": "press,mass\n1,10\n2,20\n3,30\n4,40\n5,50\n6,60\n",
+        "negative": "press,mass_g\n1,10\n2,-20\n3,30\n4,40\n5,50\n6,60\n",
+        "longer": "press,mass_g\n" + "".join(f"{k},{10 * k}\n" for k in range(1, 10)),
+        "heavy": "press,mass_g\n1,200\n2,250\n3,300\n",
+        "blank": "press,mass_g\n1,10\n2,\n",
+        "twounits": "press,mass_g,force_n\n1,10,0.1\n",
+        "temperature": "press,mass_g,temperature\n1,10,20\n",
+        "timedlong": "time_s,mass_g\n0,0\n1,10\n2,0\n60,50\n61,0\n",
+    }
+    for name, text in files.items():
+        (folder / f"{name}.csv").write_text(text)
+    return folder
+
+
+BAD = [
+    (
+        "W --force-log DIR/one.csv",
+        "found 6 presses in the recording and DIR/one.csv lists 1 weight:",
+    ),
+    ("ONE --force-log DIR/one.csv", "holds one load"),
+    ("W --force-log DIR/reversed.csv", "does not rise with the load"),
+    ("W --force-log DIR/nounit.csv", "column 'mass' has no unit"),
+    ("W --force-log DIR/negative.csv", "line 3: mass_g is -20"),
+    ("W --force-log DIR/longer.csv", "found 6 presses in the recording"),
+    ("W --force-log DIR/timedlong.csv", "outside the recording"),
+    ("HEAVY --force-log DIR/heavy.csv", "every weight saturated the array"),
+    ("W --force-log DIR/blank.csv", "line 3: mass_g is blank"),
+    ("W --force-log DIR/twounits.csv", "are both loads"),
+    ("W --force-log DIR/temperature.csv", "name the temperature column temperature_c"),
+]
+
+
+@pytest.mark.parametrize(("line", "message"), BAD, ids=[b[1] for b in BAD])
+def test_a_weights_calibration_gone_wrong_is_one_line(bench, tmp_path, line, message):
+    out = tmp_path / "cal.json"
+    recordings = {"HEAVY": "heavy.h5", "ONE": "one.h5", "W ": "w.h5 "}
+    for key, name in recordings.items():
+        line = line.replace(key, str(bench / name))
+    args = line.replace("DIR", str(bench)).split()
+    message = message.replace("DIR", str(bench))
+    done = runner.invoke(app, ["calibrate", *args, "--out", str(out)])
+    said = " ".join(done.output.split())
+    assert done.exit_code == 2, said
+    assert message in said, said
+    assert said.startswith("error:") and "Traceback" not in said
+    assert not out.exists()
+
+
+def test_a_weights_calibration_that_works_and_its_file_damaged(bench, tmp_path):
+    """The good log passes (the LOO table printed); then the file's curve damaged is
+    refused by locate in one line."""
+    out = tmp_path / "cal.json"
+    done = runner.invoke(app, ["calibrate", str(bench / "w.h5"), "--force-log",
+                               str(bench / "good.csv"), "--out", str(out)])  # fmt: skip
+    assert done.exit_code == 0, done.output
+    assert "each weight held out" in done.output
+    data = json.loads(out.read_text())
+    assert data["force_curve"]["input"] == "signal_total"
+    for change, message in [
+        (lambda d: d["force_curve"].pop("signal_total_max"), "signal_total_max"),
+        (lambda d: d["force_curve"].update(signal_total_max=0.0), "signal_total_max must be"),
+        (lambda d: d["force_curve"].update(force_n=d["force_curve"]["force_n"][::-1]),
+         "increasing in both"),
+    ]:  # fmt: skip
+        bad = json.loads(out.read_text())
+        change(bad)
+        path = tmp_path / "bad.json"
+        path.write_text(json.dumps(bad))
+        done = runner.invoke(app, ["locate", str(bench / "w.h5"), "--calibration", str(path),
+                                   "--out", str(tmp_path / "e.csv")])  # fmt: skip
+        said = " ".join(done.output.split())
+        assert done.exit_code == 2 and message in said, said
+        assert not (tmp_path / "e.csv").exists()
+
+
+def test_threshold_is_for_arrays(tmp_path):
+    finger = tmp_path / "f.h5"
+    spec = ts.fearing1990_initial()
+    ts.write_recording(finger, ts.simulate(spec, ts.calibration_sweep(spec), rng=0))
+    done = runner.invoke(app, ["calibrate", str(finger), "--threshold", "0.01", "--out",
+                               str(tmp_path / "c.json")])  # fmt: skip
+    said = " ".join(done.output.split())
+    assert done.exit_code == 2 and "--threshold is for pads and point sets" in said, said
+
+
+def test_every_press_saturated_is_said_with_its_load(bench):
+    """The lightest weight's load is named (1.96 N = 200 g)."""
+    from tactsense.estimate.array_calibration import ArrayCalibrationError, Presses, weight_curve
+
+    with pytest.raises(ArrayCalibrationError, match=r"the lightest, 1\.96 N"):
+        weight_curve(Presses(np.arange(3), np.arange(3) + 1, np.ones(3),
+                             grams_force(np.array([200.0, 250.0, 300.0])),
+                             np.ones(3, bool)))  # fmt: skip
