@@ -356,7 +356,7 @@ class DriftBaseline:
         it in place, as a calibration's gains do, leaves it scaled)."""
         self._collect: list[np.ndarray] | None = None
         t = getattr(sensor, "transduction", None)
-        self._resistive = t is not None and t.kind == "resistive"
+        self._resistive = t is not None and t.kind != "capacitive"
         self._per_count = 1.0 / t.counts_per_strain if self._resistive else 1.0
         self._grid = getattr(sensor, "kind", "pad") != "points"
         if not (isinstance(stiffening, int | float) and math.isfinite(stiffening)):

@@ -174,15 +174,20 @@ BLOCK = 4096
 
 
 def default_threshold(sensor) -> float:
-    """Smallest signal that counts as contact [-]: 10 counts above the baseline.
+    """Smallest signal that counts as contact [-]: 10 counts above the baseline, or five
+    standard deviations of the sensor's read noise when that is more.
 
     Capacitive taxels: a fractional deflection of 0.005 (10 counts at the nominal
-    2000, the finger's rule); resistive ones: ``10 / counts_per_strain`` of strain.
+    2000, the finger's rule); resistive and piezoresistive ones: ``10 /
+    counts_per_strain`` of strain. A sensor whose read noise is 1-2 % of full scale (40-80
+    counts at 12 bits, as FSR and piezoresistive arrays read) would cross 10 counts in
+    every frame; five standard deviations are crossed by chance once in 3.5 million.
     """
+    counts = max(10.0, 5.0 * float(sensor.flaws.read_noise_counts))
     transduction = getattr(sensor, "transduction", None)
-    if transduction is not None and transduction.kind == "resistive":
-        return 10.0 / transduction.counts_per_strain
-    return 0.005
+    if transduction is not None and transduction.kind != "capacitive":
+        return counts / transduction.counts_per_strain
+    return 0.005 * counts / 10.0
 
 
 def signal_from_counts(frames, baseline, sensor, *, dead=None):
@@ -212,7 +217,7 @@ def signal_from_counts(frames, baseline, sensor, *, dead=None):
             raise TactsenseInputError(f"dead has shape {dead.shape}; expected {sensor.shape}")
         unusable = unusable | dead
     transduction = getattr(sensor, "transduction", None)
-    resistive = transduction is not None and transduction.kind == "resistive"
+    resistive = transduction is not None and transduction.kind != "capacitive"
     per_count = 1.0 / transduction.counts_per_strain if resistive else 1.0
     source = frames.reshape(-1, *sensor.shape)
     if source.dtype not in (np.uint16, np.int32, np.int64, np.float64):
@@ -585,7 +590,7 @@ def pad_force_kernel(sensor, n_sub: int = 8, signed: bool = False):
                 (half + a * step) * g.row_pitch_mm, (half + b * step) * g.col_pitch_mm, newtons
             )
             strain = pad_strain(big, [probe])[: 2 * half + 1, : 2 * half + 1] / newtons
-            if sensor.transduction.kind == "resistive":
+            if sensor.transduction.kind != "capacitive":
                 kernel[a, b] = strain if signed else np.maximum(strain, 0.0)
             else:
                 kernel[a, b] = sensor.transduction.strain_gain * strain
@@ -649,7 +654,7 @@ def signal_noise_variance(sensor) -> float:
     small deflection)."""
     counts = sensor.flaws.read_noise_counts**2 + 1.0 / 12.0
     transduction = getattr(sensor, "transduction", None)
-    if transduction is not None and transduction.kind == "resistive":
+    if transduction is not None and transduction.kind != "capacitive":
         return counts / transduction.counts_per_strain**2
     return counts / sensor.electronics.nominal_counts**2
 
@@ -675,7 +680,7 @@ def pad_merged_force(signal, labels, seg, row, col, sensor, threshold, force) ->
     noise_var = signal_noise_variance(sensor)
     # a resistive taxel's zero may hide tension: only the taxels clearly compressed
     # tell the loads' sum; a capacitive taxel reads both signs
-    resistive = sensor.transduction.kind == "resistive"
+    resistive = sensor.transduction.kind != "capacitive"
     floor = 3.0 * math.sqrt(noise_var) if resistive else -math.inf
     with deferred_interrupts():
         merged_force(
@@ -724,7 +729,7 @@ def points_force_kernel(sensor):
     kernel = np.empty((n, n))
     for i in range(n):
         strain = points_strain(sensor, [SphereProbe(0.0, 0.0, newtons, at_taxel=i)])[0] / newtons
-        if sensor.transduction.kind == "resistive":
+        if sensor.transduction.kind != "capacitive":
             kernel[i] = np.maximum(strain, 0.0)
         else:
             kernel[i] = sensor.transduction.strain_gain * strain
