@@ -45,7 +45,9 @@ class Electronics:
     adc_full_scale_v: float = 5.0
     """Input voltage at the A/D converter's full scale [V]."""
     nominal_counts: float = 2000.0
-    """Reading of an untouched taxel (V_o of the paper, about 2000 A/D units) [counts]."""
+    """Reading of an untouched taxel (V_o of the paper, about 2000 A/D units) [counts].
+    0 is allowed where the reading is not the capacitive chain's (a resistive or
+    piezoresistive cell reads 0 at rest); below ``2**adc_bits`` always."""
     scan_rate_hz: float = 7.0
     """Frame rate of the row/column scan [Hz]."""
 
@@ -142,11 +144,18 @@ class Transduction:
     ``piezoresistive``: an FSR or conductive-rubber cell read through a voltage divider:
     conductance as a power of the compressive strain, a reading that saturates at the
     converter's full scale (:mod:`tactsense.physics.piezo`).
+
+    ``polarity = "falling"`` mirrors the reading about its rest value: it reads
+    ``nominal_counts`` minus the change the rising sensor would read (iCub's capacitive
+    fingertips read about 245 untouched and less when pressed), down to 0.
     """
 
     kind: str = "capacitive"
     """``capacitive`` (the paper's chain), ``resistive`` (a generic gain) or
     ``piezoresistive`` (power law through a divider)."""
+    polarity: str = "rising"
+    """``rising``: the reading rises under load (the paper's finger, FSR and
+    piezoresistive cells); ``falling``: it falls from its rest reading."""
     strain_gain: float = 1.0
     """Capacitive: fractional plate deflection per unit compressive strain (eq. 3: 1) [-]."""
     dielectric_thickness_mm: float = 0.5
@@ -428,6 +437,7 @@ class SpecBase:
 OPTIONAL = frozenset(
     {
         "creep_known",
+        "polarity",
         "exponent",
         "hysteresis",
         "drift_per_decade",
@@ -437,7 +447,8 @@ OPTIONAL = frozenset(
     }
 )
 """Keys a complete description may leave out: they default (``creep_known``: false, so
-that a description written before it existed is not taken to know its creep; the
+that a description written before it existed is not taken to know its creep;
+``polarity``: ``rising``, as every description written before it existed; the
 piezoresistive exponent and the habits of issue 32, off, so that every description
 written before them reads as it did)."""
 
@@ -468,18 +479,51 @@ def positive(problems: list[str], section: str, key: str, value: Any) -> None:
         problems.append(f"[{section}] {key} must be positive; got {value!r}")
 
 
-def check_electronics(el: Electronics, problems: list[str]) -> None:
-    """Every problem with the electronics section."""
+def check_electronics(
+    el: Electronics, problems: list[str], transduction: Transduction | None = None
+) -> None:
+    """Every problem with the electronics section.
+
+    ``transduction`` is the sensor's (None: a finger, whose chain is the capacitive one).
+    The rest reading ``nominal_counts`` may be 0 (a resistive cell at rest) except where
+    the reading comes from the capacitive chain, whose amplifier is set so that the
+    untouched junction reads ``nominal_counts`` and whose signal (eq. 4) divides by the
+    reading: there it must be positive. A falling reading must rest above 0 to fall.
+    """
     for fld in dataclasses.fields(el):
-        positive(problems, "electronics", fld.name, getattr(el, fld.name))
+        if fld.name != "nominal_counts":
+            positive(problems, "electronics", fld.name, getattr(el, fld.name))
+    nominal = el.nominal_counts
+    kind = "capacitive" if transduction is None else transduction.kind
+    falling = transduction is not None and transduction.polarity == "falling"
+    if not (
+        isinstance(nominal, int | float)
+        and not isinstance(nominal, bool)
+        and math.isfinite(nominal)
+        and nominal >= 0
+    ):
+        problems.append(
+            f"[electronics] nominal_counts (the reading at rest) must be 0 or more; got {nominal!r}"
+        )
+    elif nominal == 0 and kind == "capacitive":
+        problems.append(
+            "[electronics] nominal_counts = 0: the capacitive chain's reading is "
+            "proportional to the plates' capacitance (eqs. 1-4), so it must rest above 0; "
+            'describe a cell that reads 0 at rest as kind = "resistive"'
+        )
+    elif nominal == 0 and falling:
+        problems.append(
+            '[electronics] nominal_counts = 0 with polarity = "falling": a reading that '
+            'rests at 0 cannot fall; give the rest reading, or polarity = "rising"'
+        )
     if problems:
         return
     if not 1 <= el.adc_bits <= 24:
         problems.append(f"[electronics] adc_bits = {el.adc_bits} must lie in 1..24")
-    elif el.nominal_counts >= 2**el.adc_bits:
+    elif nominal >= 2**el.adc_bits:
         problems.append(
-            f"[electronics] nominal_counts = {el.nominal_counts:g} does not fit in a "
-            f"{el.adc_bits}-bit converter (max {2**el.adc_bits - 1})"
+            f"[electronics] nominal_counts = {nominal:g} does not fit in a "
+            f"{el.adc_bits}-bit converter (0 to {2**el.adc_bits - 1})"
         )
 
 
@@ -553,12 +597,21 @@ def check_layer(layer: Layer, problems: list[str]) -> None:
         )
 
 
+POLARITIES = ("rising", "falling")
+"""Which way a reading moves under load (:attr:`Transduction.polarity`)."""
+
+
 def check_transduction(t: Transduction, problems: list[str]) -> None:
     """Every problem with a transduction section."""
     if t.kind not in TRANSDUCTION_KINDS:
         problems.append(
             f"[transduction] kind = {t.kind!r}; expected "
             + ", ".join(repr(k) for k in TRANSDUCTION_KINDS)
+        )
+    if t.polarity not in POLARITIES:
+        problems.append(
+            f"[transduction] polarity = {t.polarity!r}; expected 'rising' (the reading rises "
+            "under load) or 'falling' (it falls from its rest reading, as iCub's fingertips)"
         )
     for key in ("strain_gain", "dielectric_thickness_mm", "dielectric_constant"):
         positive(problems, "transduction", key, getattr(t, key))
