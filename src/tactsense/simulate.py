@@ -27,8 +27,8 @@ from tactsense._validation import TactsenseInputError, check_positive
 from tactsense.io.recording import Recording
 from tactsense.physics.array_response import deflection_batch
 from tactsense.physics.contact import Probe, contact_from_dict, grams_force, knife_edge
-from tactsense.physics.flaws import FLAW_NAMES, draw_gains, stiffening
 from tactsense.physics.crosstalk import scan_conductance
+from tactsense.physics.flaws import FLAW_NAMES, draw_gains, stiffening
 from tactsense.physics.pad_response import deflection_batch_flat, resistive_counts
 from tactsense.physics.piezo import piezo_counts
 from tactsense.physics.transduction import (

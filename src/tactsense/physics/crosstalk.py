@@ -60,7 +60,7 @@ def effective_conductance(g) -> np.ndarray:
     scale = np.where(scale > 0, scale, 1.0)
     unit = g / scale + LEAK
     n = rows + cols
-    lap = np.zeros(g.shape[:-2] + (n, n))
+    lap = np.zeros((*g.shape[:-2], n, n))
     r, c = np.arange(rows), rows + np.arange(cols)
     lap[..., r, r] = unit.sum(axis=-1)
     lap[..., c, c] = unit.sum(axis=-2)

@@ -566,9 +566,10 @@ def check_flaws(f: Flaws, shape: tuple[int, int], problems: list[str]) -> None:
         value = getattr(f, key)
         if not math.isfinite(value):
             problems.append(f"[flaws] {key} must be a finite number; got {value!r}")
-    if math.isfinite(f.temperature_coefficient_per_k) and abs(f.temperature_coefficient_per_k) > 0.1:
+    coefficient = f.temperature_coefficient_per_k
+    if math.isfinite(coefficient) and abs(coefficient) > 0.1:
         problems.append(
-            f"[flaws] temperature_coefficient_per_k = {f.temperature_coefficient_per_k!r} is "
+            f"[flaws] temperature_coefficient_per_k = {coefficient!r} is "
             "more than 10 % per kelvin; an FSR's is about 0.003/K"
         )
     rows, cols = shape
