@@ -606,8 +606,8 @@ def check_transduction(t: Transduction, problems: list[str]) -> None:
     """Every problem with a transduction section."""
     if t.kind not in TRANSDUCTION_KINDS:
         problems.append(
-            f"[transduction] kind = {t.kind!r}; expected "
-            + ", ".join(repr(k) for k in TRANSDUCTION_KINDS)
+            f"[transduction] kind = {t.kind!r}; expected 'capacitive', 'resistive' or "
+            "'piezoresistive'"
         )
     if t.polarity not in POLARITIES:
         problems.append(
