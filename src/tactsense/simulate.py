@@ -688,7 +688,9 @@ def simulate(
         Contacts over time.
     flaws : "all", "none" or iterable of str
         Flaws to switch on, from ``gain_spread``, ``jitter``, ``noise``,
-        ``quantization``, ``nonlinearity``, ``viscoelastic``, ``dead``.
+        ``quantization``, ``nonlinearity``, ``viscoelastic``, ``dead``, and the habits
+        of resistive arrays ``hysteresis``, ``drift`` (piezoresistive cells) and
+        ``crosstalk`` (resistive and piezoresistive matrices).
         Their parameters come from ``spec.flaws``.
     rng : int, numpy.random.Generator or None
         Source of every random draw (gains, jitter, noise).
