@@ -34,6 +34,7 @@ from tactsense.physics.piezo import piezo_counts
 from tactsense.physics.transduction import (
     amplifier_gain,
     divider_voltage,
+    polarized,
     sample_offsets,
     voltage_to_counts,
 )
@@ -639,8 +640,11 @@ def _frame_blocks(spec: SensorSpec, run: _Run):
             sampled = stiffening(sampled, spec.flaws.nonlinear_saturation)
         if _capacitive(spec):
             sampled = np.minimum(sampled, 0.95)  # plates cannot touch
-            counts = voltage_to_counts(
-                spec, gain_v * divider_voltage(spec, c0 / (1.0 - sampled)), quantize=False
+            counts = polarized(
+                spec,
+                voltage_to_counts(
+                    spec, gain_v * divider_voltage(spec, c0 / (1.0 - sampled)), quantize=False
+                ),
             )
         elif spec.transduction.kind == "piezoresistive":
             times = np.arange(first, last) * period

@@ -267,6 +267,6 @@ def piezo_counts(spec, strain, times_s, active, state: PiezoState | None = None)
     if "crosstalk" in active and f.crosstalk > 0:
         g = scan_conductance(g, f.crosstalk)
     full = 2**el.adc_bits - 1
-    if getattr(t, "polarity", "rising") == "falling":  # the divider the other way up
+    if t.polarity == "falling":  # the divider the other way up
         return el.nominal_counts - divider_counts(g, 0.0, el.nominal_counts), state
     return divider_counts(g, el.nominal_counts, full), state
