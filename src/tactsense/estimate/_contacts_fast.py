@@ -25,12 +25,14 @@ _TAYLOR = 1e-4
 
 @jit(nogil=True)
 def prepare_signal(
-    frames, baseline, unusable, full_scale, resistive, per_count, nan_flag, sat_flag, dead_flag
-):
+    frames, baseline, unusable, full_scale, resistive, falling, per_count, nan_flag, sat_flag,
+    dead_flag,
+):  # fmt: skip
     """Signal of every taxel and the flags of each frame, in one pass.
 
-    Capacitive taxels: eq. 4, ``(V - V_o) / V``; resistive ones: ``(V - V_o) * per_count``
-    (compression positive). Unusable taxels (dead, NaN, reading zero) read 0.
+    Compression positive whichever way the reading moves (``falling``):
+    :func:`~tactsense.estimate._fast.taxel_signal`. Unusable taxels (excluded, NaN, an
+    open capacitive junction) read 0.
     """
     n, rows, cols = frames.shape
     signal = np.empty((n, rows, cols), np.float64)
@@ -46,7 +48,7 @@ def prepare_signal(
             for c in range(cols):
                 d, bits = taxel_signal(
                     float(frames[f, r, c]), baseline[r, c], unusable[r, c], full_scale,
-                    resistive, per_count, nan_flag, sat_flag, dead_flag,
+                    resistive, falling, per_count, nan_flag, sat_flag, dead_flag,
                 )  # fmt: skip
                 flag |= bits
                 signal[f, r, c] = d

@@ -366,22 +366,40 @@ def locate_into(
 
 @jit(inline="always")
 def taxel_signal(
-    v, base, unusable, full_scale, resistive, per_count, nan_flag, sat_flag, dead_flag
+    v, base, unusable, full_scale, resistive, falling, per_count, nan_flag, sat_flag, dead_flag
 ):
     """The signal of one reading ``v`` [counts] against its baseline ``base`` and the flag
-    bits it sets: eq. 4, ``(v - base) / v``, for a capacitive taxel; the strain,
-    ``(v - base) * per_count``, for a resistive one; 0 where the reading is unusable
-    (NaN: ``nan_flag``; excluded; zero or below: ``dead_flag``). One definition for the
-    finger's kernel, the contacts' and the drift-following baseline's."""
+    bits it sets, compression positive whichever way the reading moves:
+
+    * capacitive, rising: eq. 4, ``(v - base) / v``; a reading of 0 or below is an open
+      junction (0, ``dead_flag``);
+    * capacitive, falling (``falling``): eq. 4 of the reading mirrored about its rest,
+      ``w = 2 base - v``: ``(base - v) / (2 base - v)``, the inverse of the twin's falling
+      chain (0, ``dead_flag`` where ``w`` is not positive);
+    * resistive: the strain, ``(v - base) * per_count``, or ``(base - v) * per_count``
+      falling; any reading, 0 included, is valid (a cell at rest reads 0).
+
+    ``sat_flag`` where the reading is at the rail it moves toward (full scale rising, 0
+    falling); 0 where it is unusable (NaN: ``nan_flag``; excluded: no flag). One
+    definition for the finger's kernel, the contacts' and the drift-following
+    baseline's."""
     if not math.isfinite(v):
         return 0.0, nan_flag
     if unusable:
         return 0.0, 0
-    if v <= 0.0:
-        return 0.0, dead_flag
+    if falling:
+        flag = sat_flag if v <= 0.0 else 0
+        if resistive:
+            return (base - v) * per_count, flag
+        w = 2.0 * base - v
+        if w <= 0.0:
+            return 0.0, dead_flag
+        return (base - v) / w, flag
     flag = sat_flag if v >= full_scale else 0
     if resistive:
         return (v - base) * per_count, flag
+    if v <= 0.0:
+        return 0.0, dead_flag
     return (v - base) / v, flag
 
 
@@ -416,7 +434,7 @@ def prepare_frames(frames, baseline, unusable, full_scale, nan_flag, saturated_f
             for c in range(cols):
                 d, bits = taxel_signal(
                     float(frames[f, r, c]), baseline[r, c], unusable[r, c], full_scale,
-                    False, 1.0, nan_flag, saturated_flag, dead_flag,
+                    False, False, 1.0, nan_flag, saturated_flag, dead_flag,
                 )  # fmt: skip
                 flag |= bits
                 deflection[f, r, c] = d

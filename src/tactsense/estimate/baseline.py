@@ -135,7 +135,8 @@ def below_baseline(lowest: float, highest: float, threshold: float, resistive: b
 
 @jit(nogil=True)
 def _follow(
-    frames, baseline, unusable, full_scale, resistive, per_count, threshold, alpha, guard,
+    frames, baseline, unusable, full_scale, resistive, falling, per_count, threshold, alpha,
+    guard,
     grid, nan_flag, sat_flag, dead_flag, below_flag, compensate, creep, memory,
     release, release_alpha, release_share, block, releasing, low, peaks, phase,
 ):  # fmt: skip
@@ -182,7 +183,7 @@ def _follow(
             for c in range(cols):
                 d, bits = taxel_signal(
                     float(frames[f, r, c]), baseline[r, c], unusable[r, c], full_scale,
-                    resistive, per_count, nan_flag, sat_flag, dead_flag,
+                    resistive, falling, per_count, nan_flag, sat_flag, dead_flag,
                 )  # fmt: skip
                 flag |= bits
                 if compensate and bits == 0 and not unusable[r, c]:
@@ -233,7 +234,11 @@ def _follow(
         for r in range(rows):
             for c in range(cols):
                 v = float(frames[f, r, c])
-                if unusable[r, c] or not math.isfinite(v) or v <= 0.0:
+                if unusable[r, c] or not math.isfinite(v):
+                    continue
+                # a reading of 0: an open capacitive junction, or a falling reading's
+                # rail; a rising resistive cell at rest (it follows)
+                if v <= 0.0 and (falling or not resistive):
                     continue
                 if lifting and releasing[r, c]:  # the creep left after a lift
                     if v < full_scale:
@@ -247,9 +252,11 @@ def _follow(
                         step = alpha * s / per_count
                     else:
                         step = alpha * baseline[r, c] * s / (1.0 - s)
+                    if falling:  # the reading moves the other way
+                        step = -step
                 else:
                     step = alpha * (v - baseline[r, c])
-                    if pulled and step < 0.0:
+                    if pulled and (step > 0.0 if falling else step < 0.0):
                         step = 0.0  # a load's flank pulls its neighbours down: no drift
                 baseline[r, c] += step
                 moved += step
@@ -355,9 +362,9 @@ class DriftBaseline:
         """The signal of the frames last given to :meth:`signal` (a caller that scales
         it in place, as a calibration's gains do, leaves it scaled)."""
         self._collect: list[np.ndarray] | None = None
-        t = getattr(sensor, "transduction", None)
-        self._resistive = t is not None and t.kind == "resistive"
-        self._per_count = 1.0 / t.counts_per_strain if self._resistive else 1.0
+        from tactsense.estimate.contacts import reading_mode
+
+        self._resistive, self._falling, self._per_count = reading_mode(sensor)
         self._grid = getattr(sensor, "kind", "pad") != "points"
         if not (isinstance(stiffening, int | float) and math.isfinite(stiffening)):
             raise TactsenseInputError(f"stiffening must be a number >= 0; got {stiffening!r}")
@@ -410,7 +417,9 @@ class DriftBaseline:
         frames = check_frames(frames, self.sensor.shape).reshape(-1, *self.sensor.shape)
         if self._collect is not None:
             frames = self._take_rezero(frames)
-        unusable = ~np.isfinite(self.baseline) | (self.baseline <= 0)
+        from tactsense.estimate.contacts import unusable_baseline
+
+        unusable = unusable_baseline(self.baseline, self.sensor)
         if dead is not None:
             unusable = unusable | np.asarray(dead, dtype=bool)
         source = frames if frames.dtype in (np.uint16, np.int32, np.int64, np.float64) else (
@@ -420,7 +429,8 @@ class DriftBaseline:
                 # writable: a read-only array is another signature to compile
                 np.require(source, requirements=("C", "W")), self.baseline, unusable,
                 float(2**self.sensor.electronics.adc_bits - 1), self._resistive,
-                self._per_count, self.threshold, self.alpha, self.guard, self._grid,
+                self._falling, self._per_count, self.threshold, self.alpha, self.guard,
+                self._grid,
                 int(Flag.NAN_INPUT), int(Flag.SATURATED), int(Flag.DEAD_TACTEL),
                 int(Flag.BELOW_BASELINE), self.creep is not None, self._creep,
                 self.creep_memory, self.release, self._release_alpha, RELEASE_SHARE,

@@ -174,24 +174,73 @@ BLOCK = 4096
 
 
 def default_threshold(sensor) -> float:
-    """Smallest signal that counts as contact [-]: 10 counts above the baseline.
+    """Smallest signal that counts as contact [-]: 10 counts from the baseline, or five
+    standard deviations of the sensor's read noise when that is more.
 
     Capacitive taxels: a fractional deflection of 0.005 (10 counts at the nominal
-    2000, the finger's rule); resistive ones: ``10 / counts_per_strain`` of strain.
+    2000, the finger's rule); resistive and piezoresistive ones: ``10 /
+    counts_per_strain`` of strain, whatever the rest reading (0 included) and the
+    polarity. 10 counts is 0.24 % of a 12-bit converter's range and some 25 times its
+    quantization and read noise (0.3 counts); on an 8-bit converter it is 3.9 % of the
+    range, still 10 quantization steps, so the rule stays in counts rather than in a
+    share of the range (which would fall under one count there). A sensor whose read
+    noise is 1-2 % of full scale (40-80 counts at 12 bits, as FSR and piezoresistive
+    arrays read) would cross 10 counts in every frame: there five standard deviations
+    (crossed by chance once in 3.5 million readings) set it.
     """
+    counts = max(10.0, 5.0 * float(sensor.flaws.read_noise_counts))
     transduction = getattr(sensor, "transduction", None)
-    if transduction is not None and transduction.kind == "resistive":
-        return 10.0 / transduction.counts_per_strain
-    return 0.005
+    if transduction is not None and transduction.kind != "capacitive":
+        return counts / transduction.counts_per_strain
+    return 0.005 * counts / 10.0
+
+
+def reading_mode(sensor) -> tuple[bool, bool, float]:
+    """``(resistive, falling, per_count)`` of a sensor's readings: whether its taxels are
+    resistive, whether their reading falls under load (``[transduction] polarity``; a
+    finger's rises) and the strain per count of a resistive one (1 otherwise)."""
+    transduction = getattr(sensor, "transduction", None)
+    resistive = transduction is not None and transduction.kind != "capacitive"
+    falling = transduction is not None and transduction.polarity == "falling"
+    per_count = 1.0 / transduction.counts_per_strain if resistive else 1.0
+    return resistive, falling, per_count
+
+
+def unusable_baseline(baseline, sensor) -> np.ndarray:
+    """Taxels whose baseline [counts] gives no signal, (rows, cols) bool: NaN or
+    infinite; at or below 0 where the reading is the capacitive chain's (eq. 4 needs a
+    positive rest reading: 0 is an open junction) or falls under load (a reading resting
+    at 0 cannot fall). A resistive taxel rising from 0 (an FSR at rest) is usable."""
+    baseline = np.asarray(baseline, dtype=float)
+    resistive, falling, _ = reading_mode(sensor)
+    unusable = ~np.isfinite(baseline)
+    if falling or not resistive:
+        unusable |= ~(baseline > 0)
+    return unusable
+
+
+def at_rail(frames, sensor) -> np.ndarray:
+    """Readings at the converter's rail the reading moves toward under load (full scale
+    rising, 0 falling): saturated, the load there unknown; bool of ``frames``' shape."""
+    if reading_mode(sensor)[1]:
+        return frames <= 0
+    return frames >= 2**sensor.electronics.adc_bits - 1
 
 
 def signal_from_counts(frames, baseline, sensor, *, dead=None):
     """The signal of every taxel from A/D counts, and the flags of each frame.
 
-    Capacitive taxels (the finger, capacitive pads and point sets): the fractional plate
-    deflection of eq. 4, ``(V - V_o) / V``; resistive ones: the strain,
-    ``(V - V_o) / counts_per_strain``. Unusable taxels (dead, NaN, reading zero) read 0
-    and set the frame's flags as in
+    Compression positive, whichever way the reading moves under load
+    (``[transduction] polarity``). Capacitive taxels (the finger, capacitive pads and
+    point sets): the fractional plate deflection of eq. 4, ``(V - V_o) / V``; falling,
+    the same of the reading mirrored about its rest (the twin's falling chain reads
+    ``2 V_o - V``), ``(V_o - V) / (2 V_o - V)``. Resistive ones: the strain,
+    ``(V - V_o) / counts_per_strain``, or ``(V_o - V) / counts_per_strain`` falling. A
+    baseline of 0 is valid for a rising resistive taxel (an FSR at rest).
+
+    Unusable taxels (``dead``, a NaN baseline, one that gives no signal:
+    :func:`unusable_baseline`) read 0 and set ``DEAD_TACTEL``; a reading at the rail the
+    reading moves toward (full scale rising, 0 falling) sets ``SATURATED``; otherwise as
     :func:`~tactsense.estimate.deflection.deflection_from_counts`.
 
     Returns
@@ -205,15 +254,13 @@ def signal_from_counts(frames, baseline, sensor, *, dead=None):
     baseline = check_frames(baseline, sensor.shape, "baseline").astype(float)
     if baseline.ndim != 2:
         raise TactsenseInputError(f"baseline has shape {baseline.shape}; expected {sensor.shape}")
-    unusable = ~np.isfinite(baseline) | (baseline <= 0)
+    unusable = unusable_baseline(baseline, sensor)
     if dead is not None:
         dead = np.asarray(dead, dtype=bool)
         if dead.shape != tuple(sensor.shape):
             raise TactsenseInputError(f"dead has shape {dead.shape}; expected {sensor.shape}")
         unusable = unusable | dead
-    transduction = getattr(sensor, "transduction", None)
-    resistive = transduction is not None and transduction.kind == "resistive"
-    per_count = 1.0 / transduction.counts_per_strain if resistive else 1.0
+    resistive, falling, per_count = reading_mode(sensor)
     source = frames.reshape(-1, *sensor.shape)
     if source.dtype not in (np.uint16, np.int32, np.int64, np.float64):
         source = source.astype(np.float64)
@@ -224,6 +271,7 @@ def signal_from_counts(frames, baseline, sensor, *, dead=None):
             unusable,
             float(2**sensor.electronics.adc_bits - 1),
             resistive,
+            falling,
             per_count,
             int(Flag.NAN_INPUT),
             int(Flag.SATURATED),
@@ -368,7 +416,7 @@ def find_contacts(
             signal[:, np.asarray(dead, dtype=bool)] = 0.0
     saturated = None
     if counts and (flags & int(Flag.SATURATED)).any():
-        saturated = frames >= 2**sensor.electronics.adc_bits - 1
+        saturated = at_rail(frames, sensor)
     if kind == "points":
         table = _points_contacts(signal, sensor, threshold, saddle, max_contacts, method)
     else:
@@ -589,7 +637,7 @@ def pad_force_kernel(sensor, n_sub: int = 8, signed: bool = False):
                 (half + a * step) * g.row_pitch_mm, (half + b * step) * g.col_pitch_mm, newtons
             )
             strain = pad_strain(big, [probe])[: 2 * half + 1, : 2 * half + 1] / newtons
-            if sensor.transduction.kind == "resistive":
+            if sensor.transduction.kind != "capacitive":
                 kernel[a, b] = strain if signed else np.maximum(strain, 0.0)
             else:
                 kernel[a, b] = sensor.transduction.strain_gain * strain
@@ -653,7 +701,7 @@ def signal_noise_variance(sensor) -> float:
     small deflection)."""
     counts = sensor.flaws.read_noise_counts**2 + 1.0 / 12.0
     transduction = getattr(sensor, "transduction", None)
-    if transduction is not None and transduction.kind == "resistive":
+    if transduction is not None and transduction.kind != "capacitive":
         return counts / transduction.counts_per_strain**2
     return counts / sensor.electronics.nominal_counts**2
 
@@ -679,7 +727,7 @@ def pad_merged_force(signal, labels, seg, row, col, sensor, threshold, force) ->
     noise_var = signal_noise_variance(sensor)
     # a resistive taxel's zero may hide tension: only the taxels clearly compressed
     # tell the loads' sum; a capacitive taxel reads both signs
-    resistive = sensor.transduction.kind == "resistive"
+    resistive = sensor.transduction.kind != "capacitive"
     floor = 3.0 * math.sqrt(noise_var) if resistive else -math.inf
     with deferred_interrupts():
         merged_force(
@@ -728,7 +776,7 @@ def points_force_kernel(sensor):
     kernel = np.empty((n, n))
     for i in range(n):
         strain = points_strain(sensor, [SphereProbe(0.0, 0.0, newtons, at_taxel=i)])[0] / newtons
-        if sensor.transduction.kind == "resistive":
+        if sensor.transduction.kind != "capacitive":
             kernel[i] = np.maximum(strain, 0.0)
         else:
             kernel[i] = sensor.transduction.strain_gain * strain

@@ -288,11 +288,15 @@ def deflection_batch_flat(spec: PadSpec | PointsSpec, applied) -> np.ndarray:
 
 
 def resistive_counts(spec: PadSpec | PointsSpec, strain: np.ndarray) -> np.ndarray:
-    """Reading of a resistive taxel: ``nominal_counts + counts_per_strain * max(strain, 0)``,
-    unquantized and unclipped [counts].
+    """Reading of a resistive taxel: ``nominal_counts + counts_per_strain * max(strain, 0)``
+    (``-`` for a falling sensor, ``[transduction] polarity``), unquantized and unclipped
+    [counts].
 
     A piezoresistive element responds to compression; the tension beside a contact (an
     incompressible layer bulges there) leaves its reading at rest.
     """
     compression = np.maximum(strain, 0.0)
-    return spec.electronics.nominal_counts + spec.transduction.counts_per_strain * compression
+    change = spec.transduction.counts_per_strain * compression
+    if spec.transduction.polarity == "falling":
+        return spec.electronics.nominal_counts - change
+    return spec.electronics.nominal_counts + change

@@ -5,6 +5,11 @@ capacitance C_L and resistance R_L (eq. 1); an amplifier and an A/D
 converter turn the voltage into counts. The amplifier gain is set so that
 an undeflected tactel reads the sensor's ``nominal_counts`` (V_o of the
 paper, about 2000 A/D units).
+
+A pad or point set whose ``[transduction] polarity`` is ``falling`` reads the rising
+reading mirrored about its rest value (:func:`polarized`): ``2 V_o - V``, so that it
+falls from ``nominal_counts`` by the change the rising chain would read, and saturates
+at 0 (the converter's bottom) instead of at full scale.
 """
 
 from __future__ import annotations
@@ -63,6 +68,22 @@ def deflection_to_voltage(spec: SensorSpec, deflection):
     return amplifier_gain(spec) * divider_voltage(spec, junction_capacitance(spec, deflection))
 
 
+def falling(spec) -> bool:
+    """Whether the sensor's reading falls under load (``[transduction] polarity``; a
+    finger, which has no transduction section, rises)."""
+    t = getattr(spec, "transduction", None)
+    return t is not None and t.polarity == "falling"
+
+
+def polarized(spec, rising):
+    """The reading of ``spec`` given the reading ``rising`` a rising sensor would give,
+    unquantized [counts]: itself, or for a falling sensor ``2 nominal_counts - rising``
+    (the same change, downward from the rest reading)."""
+    if not falling(spec):
+        return rising
+    return 2.0 * spec.electronics.nominal_counts - np.asarray(rising, dtype=float)
+
+
 def voltage_to_counts(spec: SensorSpec, voltage, *, quantize: bool = True):
     """A/D reading of a voltage; saturates at 0 and 2^bits - 1 [counts].
 
@@ -76,8 +97,16 @@ def voltage_to_counts(spec: SensorSpec, voltage, *, quantize: bool = True):
 
 
 def deflection_to_counts(spec: SensorSpec, deflection, *, quantize: bool = True):
-    """A/D counts for a fractional deflection, through eqs. 1-2 and the converter."""
-    return voltage_to_counts(spec, deflection_to_voltage(spec, deflection), quantize=quantize)
+    """A/D counts for a fractional deflection, through eqs. 1-2 and the converter (a
+    falling sensor's mirrored, :func:`polarized`)."""
+    if not falling(spec):
+        return voltage_to_counts(spec, deflection_to_voltage(spec, deflection), quantize=quantize)
+    counts = polarized(
+        spec, voltage_to_counts(spec, deflection_to_voltage(spec, deflection), quantize=False)
+    )
+    if not quantize:
+        return counts
+    return np.clip(np.rint(counts), 0, 2**spec.electronics.adc_bits - 1)
 
 
 def fractional_deflection(reading, baseline):

@@ -45,7 +45,9 @@ class Electronics:
     adc_full_scale_v: float = 5.0
     """Input voltage at the A/D converter's full scale [V]."""
     nominal_counts: float = 2000.0
-    """Reading of an untouched taxel (V_o of the paper, about 2000 A/D units) [counts]."""
+    """Reading of an untouched taxel (V_o of the paper, about 2000 A/D units) [counts].
+    0 is allowed where the reading is not the capacitive chain's (a resistive or
+    piezoresistive cell reads 0 at rest); below ``2**adc_bits`` always."""
     scan_rate_hz: float = 7.0
     """Frame rate of the row/column scan [Hz]."""
 
@@ -89,6 +91,30 @@ class Flaws:
     simulation knows its own creep. The one key a description may leave out."""
     dead_tactels: tuple[tuple[int, int], ...] = ()
     """Wired tactels (row, col) that give no signal."""
+    hysteresis: float = 0.0
+    """Piezoresistive cells: excess conductance of the unloading branch over the loading
+    one, at light load after a press, relative [-] (0: none). The unloading branch is
+    ``g (1 + hysteresis (1 - g / g_peak))`` (:func:`tactsense.physics.piezo.hysteresis`);
+    its mean excess over the branch is half this value (the FSR 400 data sheet's "+10 %
+    average" is 0.2). Switched on by the flaw ``hysteresis``."""
+    drift_per_decade: float = 0.0
+    """Piezoresistive cells: rise of the conductance under a constant load per decade of
+    time under load, relative [-] (FSR 400 data sheet: < 0.05 per log10(time)). Switched
+    on by the flaw ``drift``."""
+    temperature_coefficient_per_k: float = 0.0
+    """Piezoresistive cells: relative change of the conductance per kelvin of warming
+    [1/K] (FSR 400 data sheet: resistance -15 % after 1 h at +85 degC, about 0.003/K).
+    Switched on by the flaw ``drift``."""
+    temperature_rate_k_per_s: float = 0.0
+    """Warming of the sensor during a simulated recording, from the start [K/s] (0: held
+    at its calibration temperature). Switched on by the flaw ``drift``."""
+    crosstalk: float = 0.0
+    """Resistive and piezoresistive matrices: share of the conductance of the parallel
+    paths through the other cells of a row/column scan that reaches a reading, in [0, 1]
+    (0: isolated scan, the unscanned lines held at the sensed potential; 1: every
+    unscanned line floating, the full ghost of a passive matrix;
+    :func:`tactsense.physics.crosstalk.scan_conductance`). Switched on by the flaw
+    ``crosstalk``."""
 
 
 @dataclass(frozen=True)
@@ -115,10 +141,21 @@ class Transduction:
     ``strain_gain * eps`` of their separation (eq. 3 when 1) and the reading rises as
     the capacitance, from ``nominal_counts`` untouched. ``resistive``: a generic
     linear transducer, reading ``nominal_counts + counts_per_strain * eps``.
+    ``piezoresistive``: an FSR or conductive-rubber cell read through a voltage divider:
+    conductance as a power of the compressive strain, a reading that saturates at the
+    converter's full scale (:mod:`tactsense.physics.piezo`).
+
+    ``polarity = "falling"`` mirrors the reading about its rest value: it reads
+    ``nominal_counts`` minus the change the rising sensor would read (iCub's capacitive
+    fingertips read about 245 untouched and less when pressed), down to 0.
     """
 
     kind: str = "capacitive"
-    """``capacitive`` (the paper's chain) or ``resistive`` (a generic gain)."""
+    """``capacitive`` (the paper's chain), ``resistive`` (a generic gain) or
+    ``piezoresistive`` (power law through a divider)."""
+    polarity: str = "rising"
+    """``rising``: the reading rises under load (the paper's finger, FSR and
+    piezoresistive cells); ``falling``: it falls from its rest reading."""
     strain_gain: float = 1.0
     """Capacitive: fractional plate deflection per unit compressive strain (eq. 3: 1) [-]."""
     dielectric_thickness_mm: float = 0.5
@@ -126,7 +163,13 @@ class Transduction:
     dielectric_constant: float = 4.0
     """Capacitive: relative permittivity K_o of the dielectric [-]."""
     counts_per_strain: float = 20000.0
-    """Resistive: change of the reading per unit compressive strain [counts]."""
+    """Resistive: change of the reading per unit compressive strain [counts].
+    Piezoresistive: the span of the divider (full scale minus the rest reading) over the
+    strain at which the cell's conductance equals the divider resistor's (half the span);
+    the slope of the reading at small strain when ``exponent`` is 1."""
+    exponent: float = 1.0
+    """Piezoresistive: the cell's conductance rises as the compressive strain to this power
+    (an FSR's resistance falls roughly as 1/force: 1) [-]."""
 
 
 def convert(annotation: Any, value: Any) -> Any:
@@ -391,9 +434,23 @@ class SpecBase:
         return dataclasses.replace(self, **updates)
 
 
-OPTIONAL = frozenset({"creep_known"})
+OPTIONAL = frozenset(
+    {
+        "creep_known",
+        "polarity",
+        "exponent",
+        "hysteresis",
+        "drift_per_decade",
+        "temperature_coefficient_per_k",
+        "temperature_rate_k_per_s",
+        "crosstalk",
+    }
+)
 """Keys a complete description may leave out: they default (``creep_known``: false, so
-that a description written before it existed is not taken to know its creep)."""
+that a description written before it existed is not taken to know its creep;
+``polarity``: ``rising``, as every description written before it existed; the
+piezoresistive exponent and the habits of issue 32, off, so that every description
+written before them reads as it did)."""
 
 
 def read_toml(path: str | Path) -> dict[str, Any]:
@@ -422,18 +479,51 @@ def positive(problems: list[str], section: str, key: str, value: Any) -> None:
         problems.append(f"[{section}] {key} must be positive; got {value!r}")
 
 
-def check_electronics(el: Electronics, problems: list[str]) -> None:
-    """Every problem with the electronics section."""
+def check_electronics(
+    el: Electronics, problems: list[str], transduction: Transduction | None = None
+) -> None:
+    """Every problem with the electronics section.
+
+    ``transduction`` is the sensor's (None: a finger, whose chain is the capacitive one).
+    The rest reading ``nominal_counts`` may be 0 (a resistive cell at rest) except where
+    the reading comes from the capacitive chain, whose amplifier is set so that the
+    untouched junction reads ``nominal_counts`` and whose signal (eq. 4) divides by the
+    reading: there it must be positive. A falling reading must rest above 0 to fall.
+    """
     for fld in dataclasses.fields(el):
-        positive(problems, "electronics", fld.name, getattr(el, fld.name))
+        if fld.name != "nominal_counts":
+            positive(problems, "electronics", fld.name, getattr(el, fld.name))
+    nominal = el.nominal_counts
+    kind = "capacitive" if transduction is None else transduction.kind
+    falling = transduction is not None and transduction.polarity == "falling"
+    if not (
+        isinstance(nominal, int | float)
+        and not isinstance(nominal, bool)
+        and math.isfinite(nominal)
+        and nominal >= 0
+    ):
+        problems.append(
+            f"[electronics] nominal_counts (the reading at rest) must be 0 or more; got {nominal!r}"
+        )
+    elif nominal == 0 and kind == "capacitive":
+        problems.append(
+            "[electronics] nominal_counts = 0: the capacitive chain's reading is "
+            "proportional to the plates' capacitance (eqs. 1-4), so it must rest above 0; "
+            'describe a cell that reads 0 at rest as kind = "resistive"'
+        )
+    elif nominal == 0 and falling:
+        problems.append(
+            '[electronics] nominal_counts = 0 with polarity = "falling": a reading that '
+            'rests at 0 cannot fall; give the rest reading, or polarity = "rising"'
+        )
     if problems:
         return
     if not 1 <= el.adc_bits <= 24:
         problems.append(f"[electronics] adc_bits = {el.adc_bits} must lie in 1..24")
-    elif el.nominal_counts >= 2**el.adc_bits:
+    elif nominal >= 2**el.adc_bits:
         problems.append(
-            f"[electronics] nominal_counts = {el.nominal_counts:g} does not fit in a "
-            f"{el.adc_bits}-bit converter (max {2**el.adc_bits - 1})"
+            f"[electronics] nominal_counts = {nominal:g} does not fit in a "
+            f"{el.adc_bits}-bit converter (0 to {2**el.adc_bits - 1})"
         )
 
 
@@ -463,6 +553,25 @@ def check_flaws(f: Flaws, shape: tuple[int, int], problems: list[str]) -> None:
         )
     if not 0.0 <= f.delayed_fraction <= 1.0:
         problems.append(f"[flaws] delayed_fraction must lie in [0, 1]; got {f.delayed_fraction!r}")
+    for key in ("hysteresis", "drift_per_decade"):
+        value = getattr(f, key)
+        if not (math.isfinite(value) and 0.0 <= value <= 1.0):
+            problems.append(f"[flaws] {key} must lie in [0, 1]; got {value!r}")
+    if not (math.isfinite(f.crosstalk) and 0.0 <= f.crosstalk <= 1.0):
+        problems.append(
+            f"[flaws] crosstalk must lie in [0, 1] (0: isolated scan, 1: every unscanned "
+            f"line floating); got {f.crosstalk!r}"
+        )
+    for key in ("temperature_coefficient_per_k", "temperature_rate_k_per_s"):
+        value = getattr(f, key)
+        if not math.isfinite(value):
+            problems.append(f"[flaws] {key} must be a finite number; got {value!r}")
+    coefficient = f.temperature_coefficient_per_k
+    if math.isfinite(coefficient) and abs(coefficient) > 0.1:
+        problems.append(
+            f"[flaws] temperature_coefficient_per_k = {coefficient!r} is "
+            "more than 10 % per kelvin; an FSR's is about 0.003/K"
+        )
     rows, cols = shape
     for row, col in f.dead_tactels:
         if not (0 <= row < rows and 0 <= col < cols):
@@ -489,13 +598,35 @@ def check_layer(layer: Layer, problems: list[str]) -> None:
         )
 
 
+POLARITIES = ("rising", "falling")
+"""Which way a reading moves under load (:attr:`Transduction.polarity`)."""
+
+
 def check_transduction(t: Transduction, problems: list[str]) -> None:
     """Every problem with a transduction section."""
-    if t.kind not in ("capacitive", "resistive"):
-        problems.append(f"[transduction] kind = {t.kind!r}; expected 'capacitive' or 'resistive'")
+    if t.kind not in TRANSDUCTION_KINDS:
+        problems.append(
+            f"[transduction] kind = {t.kind!r}; expected 'capacitive', 'resistive' or "
+            "'piezoresistive'"
+        )
+    if t.polarity not in POLARITIES:
+        problems.append(
+            f"[transduction] polarity = {t.polarity!r}; expected 'rising' (the reading rises "
+            "under load) or 'falling' (it falls from its rest reading, as iCub's fingertips)"
+        )
     for key in ("strain_gain", "dielectric_thickness_mm", "dielectric_constant"):
         positive(problems, "transduction", key, getattr(t, key))
     positive(problems, "transduction", "counts_per_strain", t.counts_per_strain)
+    positive(problems, "transduction", "exponent", t.exponent)
+    if not problems and t.kind == "piezoresistive" and not 0.2 <= t.exponent <= 5.0:
+        problems.append(
+            f"[transduction] exponent = {t.exponent:g} is outside 0.2..5: a piezoresistive "
+            "cell's conductance rises as a moderate power of the load (an FSR: about 1)"
+        )
+
+
+TRANSDUCTION_KINDS = ("capacitive", "resistive", "piezoresistive")
+"""The kinds of ``[transduction]`` (a finger is always capacitive)."""
 
 
 def capacitance_f(t: Transduction, area_mm2: float) -> float:

@@ -128,7 +128,11 @@ class PadSpec(SpecBase):
                 "sensing depth / pitch",
                 f"{layer.sensing_depth_mm / max(g.row_pitch_mm, g.col_pitch_mm):.2f}",
             ),
-            ("transduction", t.kind),
+            ("transduction", f"{t.kind}, reading {t.polarity} under load"),
+            (
+                "rest reading",
+                f"{self.electronics.nominal_counts:g} counts of {2**self.electronics.adc_bits - 1}",
+            ),
         ]
         if t.kind == "capacitive":
             rows.append(("junction capacitance", f"{self.junction_capacitance_f * 1e12:.3f} pF"))
@@ -160,7 +164,7 @@ def _validate(spec: PadSpec) -> list[str]:
             problems.append(f"[grid] {g.rows} x {g.cols} taxels: at most 65,536 are supported")
     check_layer(spec.layer, problems)
     check_transduction(spec.transduction, problems)
-    check_electronics(spec.electronics, problems)
+    check_electronics(spec.electronics, problems, spec.transduction)
     if not problems:
         check_flaws(spec.flaws, spec.shape, problems)
     return problems

@@ -94,7 +94,14 @@ class PointsSpec(SpecBase):
                 "layer",
                 f"{self.layer.thickness_mm:g} mm, sensing depth {self.layer.sensing_depth_mm:g} mm",
             ),
-            ("transduction", self.transduction.kind),
+            (
+                "transduction",
+                f"{self.transduction.kind}, reading {self.transduction.polarity} under load",
+            ),
+            (
+                "rest reading",
+                f"{self.electronics.nominal_counts:g} counts of {2**self.electronics.adc_bits - 1}",
+            ),
         ]
 
     def taxel_positions_mm(self) -> np.ndarray:
@@ -187,7 +194,7 @@ def _validate(spec: PointsSpec) -> list[str]:
             )
     check_layer(spec.layer, problems)
     check_transduction(spec.transduction, problems)
-    check_electronics(spec.electronics, problems)
+    check_electronics(spec.electronics, problems, spec.transduction)
     if not problems:
         check_flaws(spec.flaws, spec.shape, problems)
     return problems

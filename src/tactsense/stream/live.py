@@ -38,7 +38,8 @@ FIELDS = (
 
 def warm_frames(sensor, baseline=None, amplitude: float = 0.3) -> list[StreamFrame]:
     """Synthetic frames that take an estimator down every path a real touch takes: a
-    bump of ``amplitude`` (a fraction of the baseline) pressed both ways (counts up and
+    bump of ``amplitude`` (a fraction of the baseline, or of a tenth of the full scale
+    where the baseline is 0) pressed both ways (counts up and
     down: the sign depends on the transducer), and the baseline itself [counts, uint16].
     """
     rows, cols = sensor.shape
@@ -50,10 +51,10 @@ def warm_frames(sensor, baseline=None, amplitude: float = 0.3) -> list[StreamFra
     r, c = np.mgrid[0:rows, 0:cols]
     bump = np.exp(-((r - (rows - 1) / 2) ** 2 + (c - (cols - 1) / 2) ** 2) / 2.0)
     top = 2 ** min(int(sensor.electronics.adc_bits), 16) - 1
+    # a taxel resting at 0 (a resistive cell) moves by a share of the full scale instead
+    step = amplitude * bump * np.where(base > 0, base, 0.1 * top)
     frames = []
-    for k, counts in enumerate(
-        (base * (1 + amplitude * bump), base * (1 - amplitude * bump), base, base)
-    ):
+    for k, counts in enumerate((base + step, base - step, base, base)):
         counts = np.clip(np.nan_to_num(np.rint(counts)), 0, top).astype(np.uint16)
         frames.append(StreamFrame(k, k, k * sensor.scan_period_s, 0.0, time.perf_counter(), counts))
     return frames

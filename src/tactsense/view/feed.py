@@ -295,16 +295,27 @@ def layout_message(sensor: SpecBase, source: dict) -> dict:
 
 def _capacitive_deflection(counts, baseline, sensor) -> np.ndarray:
     # eq. 4, (counts - baseline) / counts; 0 where a taxel reads nothing usable
+    if sensor.transduction.polarity == "falling":  # the mirrored reading's eq. 4
+        from tactsense.estimate.contacts import signal_from_counts
+
+        counts = np.asarray(counts, dtype=float)
+        return signal_from_counts(counts, baseline, sensor)[0].reshape(counts.shape)
     return deflection_from_counts(counts, baseline, sensor)[0]
 
 
 def _resistive_deflection(counts, baseline, sensor) -> np.ndarray:
-    # the compressive strain: the reading rises by counts_per_strain per unit strain
+    # the compressive strain: the reading moves by counts_per_strain per unit strain
     strain = (np.asarray(counts, dtype=float) - baseline) / sensor.transduction.counts_per_strain
+    if sensor.transduction.polarity == "falling":
+        strain = -strain
     return np.where(np.isfinite(strain), strain, 0.0)
 
 
-DEFLECTION = {"capacitive": _capacitive_deflection, "resistive": _resistive_deflection}
+DEFLECTION = {
+    "capacitive": _capacitive_deflection,
+    "resistive": _resistive_deflection,
+    "piezoresistive": _resistive_deflection,
+}
 """Transduction kind -> the deflection [-] of a frame from its counts and the baseline."""
 
 
