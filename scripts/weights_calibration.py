@@ -33,32 +33,32 @@ NOISE_SHARE = 0.01
 """The twin's read noise [share of the converter's full scale]: 1 %, as real arrays read
 (issue 32), not the paper's 0.3 counts."""
 
-THRESHOLD_SIGMAS = 5.0
-"""The contact threshold, in standard deviations of that noise (a lab's rule of thumb:
-below it noise reads as contact)."""
-
-WEIGHTS_G = "10:150:15"
-"""The box of weights [g]: 10 to 150 g in 10-g steps, past pad16's saturation."""
-
-CHECK_G = "15:145:14"
-"""The second series, located with the calibration [g]: weights between the first's."""
-
-UP_DOWN_G = "10,20,30,40,50,60,70,80,70,60,50,40,30,20,10"
-"""Light to heavy and back [g], for the hysteresis."""
+SERIES_G = {
+    "pad16": ("10:150:15", "15:145:14", "10,20,30,40,50,60,70,80,70,60,50,40,30,20,10"),
+    "fsr16": ("20:400:20", "30:390:19", "20,60,100,140,180,220,260,220,180,140,100,60,20"),
+}
+"""Per sensor, the box of weights [g] (past saturation), a second series between the
+first's, located with the calibration, and weights light to heavy and back (the
+hysteresis). fsr16 reads 10 g within a few noise deviations of its threshold, where
+``locate`` loses the held contact: its box starts at 20 g."""
 
 COMMANDS = [
     "simulate --sensor SENSOR.toml --scenario loads --forces-g {weights} --dwell-s 2 "
     "--lift-s 2 --out weights.h5",
-    "calibrate weights.h5 --force-log weights.csv --threshold {threshold} --out cal.json",
+    "calibrate weights.h5 --force-log weights.csv --out cal.json",
     "simulate --sensor SENSOR.toml --scenario loads --forces-g {check} --dwell-s 2 "
     "--lift-s 2 --seed 7 --out check.h5",
     "locate check.h5 --calibration cal.json --out check.csv",
     "simulate --sensor SENSOR.toml --scenario loads --forces-g {updown} --dwell-s 2 "
     "--lift-s 2 --seed 3 --out updown.h5",
-    "calibrate updown.h5 --force-log updown.csv --threshold {threshold} --out updown.json",
+    "calibrate updown.h5 --force-log updown.csv --out updown.json",
 ]
 """The commands, with SENSOR.toml the twin described with :data:`NOISE_SHARE` of noise
 and exact weights (:func:`describe`)."""
+
+
+SENSORS = ("pad16", "fsr16")
+"""The twins measured by default."""
 
 
 def grams(spec: str) -> np.ndarray:
@@ -72,7 +72,7 @@ def grams(spec: str) -> np.ndarray:
 def describe(sensor: str, folder: Path) -> tuple[Path, float]:
     """The twin of ``sensor`` as a lab's description: read noise :data:`NOISE_SHARE` of
     full scale, no force jitter (a weight's mass is exact). Returns the TOML's path and
-    the threshold [-] of :data:`THRESHOLD_SIGMAS` times that noise."""
+    the default contact threshold [-] (five standard deviations of that noise)."""
     import tactsense as ts
 
     spec = ts.load_sensor(sensor)
@@ -85,13 +85,9 @@ def describe(sensor: str, folder: Path) -> tuple[Path, float]:
         "force_jitter_n = 0.0\n",
         encoding="utf-8",
     )
-    described = ts.load_sensor(path)
-    per_count = (
-        1.0 / described.transduction.counts_per_strain
-        if described.transduction.kind == "resistive"
-        else 1.0 / described.electronics.nominal_counts
-    )
-    return path, float(f"{THRESHOLD_SIGMAS * noise * per_count:.3g}")
+    from tactsense.estimate.contacts import default_threshold
+
+    return path, default_threshold(ts.load_sensor(path))
 
 
 def as_measured(path: Path) -> None:
@@ -126,16 +122,22 @@ def run(sensor: str, folder: Path) -> dict:
     from tactsense.estimate.array_calibration import load_calibration
 
     toml, threshold = describe(sensor, folder)
-    _weights_csv(folder / "weights.csv", grams(WEIGHTS_G))
-    _weights_csv(folder / "updown.csv", grams(UP_DOWN_G))
+    weights, check, updown = SERIES_G[ts.load_sensor(sensor).name]
+    _weights_csv(folder / "weights.csv", grams(weights))
+    _weights_csv(folder / "updown.csv", grams(updown))
     runner = CliRunner()
     here = os.getcwd()
     os.chdir(folder)
     try:
         for line in COMMANDS:
-            line = line.format(weights=WEIGHTS_G, check=CHECK_G, updown=UP_DOWN_G,
-                               threshold=threshold).replace("SENSOR.toml", toml.name)  # fmt: skip
+            line = line.format(weights=weights, check=check, updown=updown).replace(
+                "SENSOR.toml", toml.name
+            )
             result = runner.invoke(app, line.split())
+            if result.exit_code == 2 and line.startswith("calibrate weights.h5"):
+                # refused with a reason (one line): that is the finding for this sensor
+                said = " ".join(result.output.split()).removeprefix("error: ")
+                return {"sensor": ts.load_sensor(toml), "refused": said}
             if result.exit_code != 0:
                 raise RuntimeError(f"tactsense {line}: {result.output}")
             if line.startswith("simulate"):
@@ -229,12 +231,13 @@ GRAM = 9.80665e-3
 
 def block(results) -> str:
     """The Markdown between the markers, from :func:`run` of each sensor."""
-    s = [summary(r) for r in results]
+    refused = [r for r in results if "refused" in r]
+    s = [summary(r) for r in results if "refused" not in r]
     rows = [
         "| measured on the twin (`python scripts/weights_calibration.py`) | "
         + " | ".join(f"`{v['name']}`" for v in s)
         + " |",
-        "|---" * (len(results) + 1) + "|",
+        "|---" * (len(s) + 1) + "|",
     ]
 
     def row(label, cells):
@@ -260,10 +263,14 @@ def block(results) -> str:
     row("second series beyond the range: presses, frames flagged (force NaN)",
         [f"{v['check_beyond']}, {100 * v['beyond_flagged']:.0f} % ({100 * v['beyond_nan']:.0f} %)"
          for v in s])  # fmt: skip
-    row("hysteresis, 10-80-10 g (largest difference, share of full scale)",
+    row("hysteresis, light to heavy and back (largest difference, share of full scale)",
         [f"{v['hysteresis']['max_difference_n'] / GRAM:.1f} g, "
          f"{v['hysteresis']['percent_of_full_scale']:.1f} %"
          if v["hysteresis"]["measured"] else "not measured" for v in s])  # fmt: skip
+    for r in refused:
+        weights = SERIES_G[r["sensor"].name][0]
+        rows.append(f"\n`{r['sensor'].name}` (weights {weights} g): `calibrate` refuses: "
+                    f"\"{r['refused']}\"")  # fmt: skip
     return f"{START}\n" + "\n".join(rows) + f"\n{END}"
 
 
@@ -275,6 +282,7 @@ def figure(results, path: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    results = [r for r in results if "refused" not in r]
     fig, axes = plt.subplots(len(results), 2, figsize=(10, 3.6 * len(results)), squeeze=False)
     for (left, right), result in zip(axes, results, strict=True):
         cal = result["cal"]
@@ -313,7 +321,7 @@ def measure(sensors) -> list[dict]:
 
 
 def main(argv=None) -> None:
-    sensors = (argv if argv is not None else sys.argv[1:]) or ["pad16"]
+    sensors = (argv if argv is not None else sys.argv[1:]) or list(SENSORS)
     results = measure(sensors)
     text = block(results)
     replace_block(DOC, START, END, text)

@@ -55,7 +55,7 @@ def _weights_script():
 @pytest.fixture(scope="module")
 def weights_run():
     script = _weights_script()
-    return script, script.measure(["pad16"])
+    return script, script.measure(list(script.SENSORS))
 
 
 def test_the_doc_holds_what_the_weights_give(weights_run):

@@ -319,7 +319,8 @@ def calibrate(
             min=1e-9,
             max=1e6,
             help="Pads and point sets with weights: the contact threshold of the total "
-            "signal [-] (default 10 counts' worth; raise it above a noisy array's noise). "
+            "signal [-] (default: 10 counts' worth, or 5 standard deviations of the "
+            "description's read noise if more). "
             "Kept in the calibration, and used by locate with it unless given there.",
         ),
     ] = None,

@@ -19,8 +19,8 @@ bench:
   interpolated to the frames' times.
 
 * **A weight curve** from known weights alone (no sweep, no stage): each weight placed,
-  held and removed in turn, the contacts' total signal of every press (its plateau,
-  less the level just before it) against the weight, piecewise linear and monotone
+  held and removed in turn, the contacts' total signal of every press (over its
+  settled part) against the weight, piecewise linear and monotone
   through the origin (:func:`weight_curve`). Saturation (taxels at the converter's rail,
   or a total that stops growing with the load) ends the calibrated range; a contact
   whose total lies beyond it gets no force (NaN, flag ``BEYOND_CALIBRATION``), never an
@@ -221,7 +221,8 @@ class ArrayCalibration:
                 )
         from tactsense.estimate.calibrate import check_in_use
 
-        check_in_use(source, ~calibration.dead, calibration, ArrayCalibrationError, "taxel")
+        check_in_use(source, ~calibration.dead, calibration, ArrayCalibrationError, "taxel",
+                     sensor=sensor)  # fmt: skip
         if calibration.force_curve is not None:
             x, y = (np.asarray(v) for v in calibration.force_curve)
             if len(x) < 2 or len(x) != len(y) or np.any(np.diff(x) <= 0) or np.any(np.diff(y) < 0):
@@ -539,7 +540,7 @@ class Presses:
     end: np.ndarray
     """One past its last frame [-]."""
     total: np.ndarray
-    """Total signal of the press's plateau over the level just before it [-]."""
+    """Total signal of the press's settled part [-]."""
     force_n: np.ndarray
     """The known load [N]."""
     saturated: np.ndarray
@@ -563,6 +564,11 @@ MIN_PRESS_FRAMES = 10
 """A run shorter than this is no weight placed (a bump, or noise) [-]."""
 
 
+SHORT_PRESS = 0.3
+"""A run held less than this share of the series' median hold is no weight placed (a
+bump of the residual an FSR keeps after a lift, or noise) [-]."""
+
+
 def segment_presses(total, *, rest_frames: int = 5, level: float = PRESS_LEVEL):
     """The presses of a recording of weights placed, held and removed in turn, found in
     its frames' total signal alone.
@@ -574,7 +580,8 @@ def segment_presses(total, *, rest_frames: int = 5, level: float = PRESS_LEVEL):
     ``rest_frames``, if larger); its level before is the median of the last 3 unloaded
     frames; it ends when the total falls below that level plus half the press's largest
     rise (the weight lifted: creep left after it is less than half the press). Runs
-    shorter than :data:`MIN_PRESS_FRAMES` are dropped.
+    shorter than :data:`MIN_PRESS_FRAMES`, or than :data:`SHORT_PRESS` of the median
+    run, are dropped.
 
     Returns
     -------
@@ -609,6 +616,9 @@ def segment_presses(total, *, rest_frames: int = 5, level: float = PRESS_LEVEL):
                 unloaded = [value]  # the level after it, not before
     if start is not None and len(t) - start >= MIN_PRESS_FRAMES:
         presses.append((start, len(t), floor))
+    if presses:  # the weights of a series are held alike: a short run is a bump
+        held = np.median([b - a for a, b, _ in presses])
+        presses = [p for p in presses if p[1] - p[0] >= SHORT_PRESS * held]
     return presses
 
 
@@ -638,7 +648,7 @@ def weight_presses(totals, saturated, log: WeightsLog, *, time_s=None, rest_fram
         e.g. without creep compensation, which amplifies the noise.
 
     Each press's total is the median of ``totals`` over its settled part (its second
-    half, less its last tenth) less their median over the 5 frames before it.
+    half, less its last tenth).
     """
     totals = np.asarray(totals, dtype=float)
     temperature = None
@@ -683,9 +693,9 @@ def weight_presses(totals, saturated, log: WeightsLog, *, time_s=None, rest_fram
         raise ArrayCalibrationError(f"no press found in the recording of {log.source}")
     start = np.array([a for a, _, _ in found])
     end = np.array([b for _, b, _ in found])
-    before = [totals[max(0, a - 5) : a] if a > 0 else totals[:1] for a, _, _ in found]
-    total = np.array([np.median(totals[_plateau(a, b)]) - np.median(f)
-                      for (a, b, _), f in zip(found, before, strict=True)])  # fmt: skip
+    # no tare: what is left of the last press (creep, an FSR's hysteresis) is in what
+    # locate reads under the next load too
+    total = np.array([np.median(totals[_plateau(a, b)]) for a, b, _ in found])
     sat = np.array([bool(np.any(saturated[_plateau(a, b)])) for a, b, _ in found])
     return Presses(start, end, total, np.asarray(force, float), sat, temperature)
 
@@ -978,7 +988,6 @@ def calibrate_array(
     weights: WeightsLog | None = None,
     threshold: float | None = None,
     attrs: dict | None = None,
-    drift_s: float | None = 2.0,
 ) -> ArrayCalibration:
     """A pad's or a point set's calibration from a recording (and a force log, or the
     log of known weights).
@@ -1009,8 +1018,8 @@ def calibrate_array(
         The contact threshold of the totals [-] (:func:`~tactsense.estimate.contacts.
         default_threshold`); ``locate`` should use the same.
     attrs : dict, optional
-        The weights recording's attributes, and ``drift_s`` [s] the baseline's drift time
-        constant: the totals are taken as ``locate`` takes them (:func:`contact_totals`).
+        The weights recording's attributes: its creep is taken out as ``locate`` takes
+        it out (:func:`contact_totals`).
     """
     from tactsense.estimate.contacts import find_contacts
 
@@ -1040,7 +1049,7 @@ def calibrate_array(
         if force_log is not None:
             raise ArrayCalibrationError("give a force log or a weights log, not both")
         return _add_weight_curve(calibration, sensor, loads, weights, baseline_frames, threshold,
-                                 attrs=attrs, drift_s=drift_s)  # fmt: skip
+                                 attrs=attrs)  # fmt: skip
     if force_log is None:
         return calibration
     if loads is None:
@@ -1105,7 +1114,8 @@ def contact_totals(frames, sensor, calibration, *, baseline_frames=5, threshold=
     calibration sees them, and the frames with a contact at the converter's rail [bool].
 
     The baseline is the frames' own first ``baseline_frames``, then follows drift with
-    ``drift_s`` [s] (``locate``'s default 2; None: fixed), and the creep a recording's
+    ``drift_s`` [s] (``locate``'s default 2; None: fixed) and is re-zeroed where a
+    taxel's reading falls quickly (a weight lifted), and the creep a recording's
     attributes ``attrs`` call for is taken out
     (:func:`~tactsense.estimate.creep.creep_applied`; None: a measured recording), as
     ``locate`` does: the weight curve then reads the totals ``locate`` will give it.
@@ -1146,8 +1156,30 @@ def contact_totals(frames, sensor, calibration, *, baseline_frames=5, threshold=
     return totals, saturated, label
 
 
+def _explain_falling(error, presses, timing) -> None:
+    """Raise a clearer error when the totals ``locate`` reads fall with the load but the
+    readings against the recording's first frames rise: ``locate``'s re-zero after each
+    lift has taken up what the array kept of the last load."""
+    from scipy.stats import spearmanr
+
+    if "does not rise with the load" not in str(error) or len(presses.force_n) < 3:
+        return
+    fixed = np.array([np.median(timing[_plateau(a, b)])
+                      for a, b in zip(presses.start, presses.end, strict=True)])  # fmt: skip
+    seen = spearmanr(presses.force_n, presses.total).statistic
+    raw = spearmanr(presses.force_n, fixed).statistic
+    if raw >= MONOTONE_RANK:
+        raise ArrayCalibrationError(
+            f"the totals locate reads fall as the weights grow (rank correlation {seen:.2f}) "
+            f"while the readings against the recording's first frames rise ({raw:.2f}): "
+            "locate's re-zero after each lift takes up what the array keeps of a load (an "
+            "FSR's hysteresis, creep), so a heavier weight reads less; let the array "
+            "recover between weights, or describe its creep (creep_known) so it is taken out"
+        ) from None
+
+
 def _add_weight_curve(calibration, sensor, loads, weights, baseline_frames, threshold,
-                      attrs=None, drift_s=2.0):  # fmt: skip
+                      attrs=None):  # fmt: skip
     """:func:`calibrate_array`'s weight curve, on the recording ``loads``."""
     from tactsense.estimate.contacts import default_threshold
 
@@ -1164,7 +1196,7 @@ def _add_weight_curve(calibration, sensor, loads, weights, baseline_frames, thre
     threshold = default_threshold(sensor) if threshold is None else float(threshold)
     totals, saturated, creep = contact_totals(
         load_frames, sensor, calibration, baseline_frames=baseline_frames,
-        threshold=threshold, attrs=attrs, drift_s=drift_s,
+        threshold=threshold, attrs=attrs,
     )  # fmt: skip
     # the presses are found in the totals without creep compensation (which amplifies
     # the noise), on the recording's own first frames
@@ -1178,7 +1210,11 @@ def _add_weight_curve(calibration, sensor, loads, weights, baseline_frames, thre
     del signal
     presses = weight_presses(totals, saturated, weights, time_s=time_s,
                              rest_frames=baseline_frames, timing=timing)  # fmt: skip
-    curve = weight_curve(presses)
+    try:
+        curve = weight_curve(presses)
+    except ArrayCalibrationError as error:
+        _explain_falling(error, presses, timing)
+        raise
     calibration.force_curve = (curve["signal_total"], curve["force_n"])
     calibration.curve_input = "signal_total"
     calibration.curve_top = curve["signal_total_max"]
