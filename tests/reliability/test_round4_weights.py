@@ -127,3 +127,46 @@ def test_every_press_saturated_is_said_with_its_load(bench):
         weight_curve(Presses(np.arange(3), np.arange(3) + 1, np.ones(3),
                              grams_force(np.array([200.0, 250.0, 300.0])),
                              np.ones(3, bool)))  # fmt: skip
+
+
+def test_locate_gives_newtons_and_flags_what_lies_beyond(bench, tmp_path):
+    """Issue 32, item 6: with the weights' calibration, locate's force column is the
+    curve's: each press of the calibration series reads its weight as logged (within
+    2 %: the curve passes through each weight's median total, which locate's frames
+    scatter about; the twin's applied force itself is jittered by 1 g, which the log
+    does not know), and a series far heavier than the heaviest weight gets no force
+    (NaN, flagged BEYOND_CALIBRATION or SATURATED), with the warning."""
+    import pandas as pd
+
+    from tactsense.estimate.array_calibration import _plateau
+    from tactsense.estimate.deflection import Flag
+
+    cal = tmp_path / "cal.json"
+    runner.invoke(app, ["calibrate", str(bench / "w.h5"), "--force-log", str(bench / "good.csv"),
+                        "--out", str(cal)])  # fmt: skip
+    out = tmp_path / "e.csv"
+    done = runner.invoke(app, ["locate", str(bench / "w.h5"), "--calibration", str(cal),
+                               "--out", str(out)])  # fmt: skip
+    assert done.exit_code == 0, done.output
+    table = pd.read_csv(out)
+    rec = ts.read_recording(bench / "w.h5")
+    step = np.asarray(rec.truth["frame_step"])
+    force = np.asarray(rec.truth["step_force_n"])
+    per_frame = table.groupby("frame").force_n.sum()
+    pressed = [k for k in np.unique(step) if force[k] > 0]
+    for k, grams in zip(pressed[:-1], [10, 20, 30, 40, 50], strict=True):  # the 60 g: the top
+        frames = np.flatnonzero(step == k)
+        settled = np.arange(len(step))[_plateau(int(frames[0]), int(frames[-1]) + 1)]
+        got = np.median([per_frame.get(f, 0.0) for f in settled])
+        assert abs(got / grams_force(grams) - 1) < 0.02, (grams, got)
+    heavy = tmp_path / "h.csv"
+    done = runner.invoke(app, ["locate", str(bench / "heavy.h5"), "--calibration", str(cal),
+                               "--out", str(heavy)])  # fmt: skip
+    assert done.exit_code == 0, done.output
+    rows = pd.read_csv(heavy)
+    loaded = rows[rows.frame.isin(np.flatnonzero(force[np.asarray(
+        ts.read_recording(bench / "heavy.h5").truth["frame_step"])] > 0))]  # fmt: skip
+    assert len(loaded) and loaded.force_n.isna().all()
+    flags = loaded["flags"].to_numpy()
+    assert np.all(flags & int(Flag.BEYOND_CALIBRATION | Flag.SATURATED))
+    assert "beyond the calibrated range" in " ".join(done.output.split())
