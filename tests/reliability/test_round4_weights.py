@@ -170,3 +170,32 @@ def test_locate_gives_newtons_and_flags_what_lies_beyond(bench, tmp_path):
     flags = loaded["flags"].to_numpy()
     assert np.all(flags & int(Flag.BEYOND_CALIBRATION | Flag.SATURATED))
     assert "beyond the calibrated range" in " ".join(done.output.split())
+
+
+def test_gains_from_a_sweep_on_top_of_the_weights(tmp_path):
+    """Issue 32, item 2: a sweep given first and the weights as --loads: per-taxel gains
+    from the sweep, the weight curve from the weights (total signal, LOO table). On
+    pad4 (28 % gain spread), weights placed on two taxels in turn: without the gains
+    the two taxels' totals differ by their gains, so the curve through both scatters;
+    with them it does not (the largest leave-one-out error falls)."""
+    pad = ts.preset("pad4")
+    g = pad.grid
+    places = [(1 * g.row_pitch_mm, 1 * g.col_pitch_mm), (2 * g.row_pitch_mm, 2 * g.col_pitch_mm)]
+    grams = np.repeat([10.0, 20, 30, 40, 50, 60, 70, 80], 2)
+    scene = fs.loads(pad, forces_n=[grams_force(v) for v in grams], places=places,
+                     dwell_s=0.6, lift_s=0.6)  # fmt: skip
+    ts.write_recording(tmp_path / "w.h5", ts.simulate(pad, scene, rng=2))
+    ts.write_recording(tmp_path / "sweep.h5", ts.simulate(pad, fs.raster(pad), rng=1))
+    (tmp_path / "w.csv").write_text("mass_g\n" + "".join(f"{v:g}\n" for v in grams))
+    loo = {}
+    for name, args in [("alone", ["w.h5"]), ("gains", ["sweep.h5", "--loads", "w.h5"])]:
+        out = tmp_path / f"{name}.json"
+        paths = [str(tmp_path / a) if a.endswith(".h5") else a for a in args]
+        log = str(tmp_path / "w.csv")
+        done = runner.invoke(app, ["calibrate", *paths, "--force-log", log, "--out", str(out)])
+        assert done.exit_code == 0, done.output
+        notes = json.loads(out.read_text())["notes"]
+        expected = "probe sweep" if name == "gains" else "none (uniform gains"
+        assert notes["method"].startswith(expected)
+        loo[name] = notes["loo_max_error_percent"]
+    assert loo["gains"] < loo["alone"], loo
