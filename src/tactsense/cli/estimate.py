@@ -332,10 +332,13 @@ def calibrate(
     that stops at a bound of its parameters or leaves a residual above 10 % of full
     scale, is an error: such a calibration would be applied without anyone knowing.
 
-    A pad or a point set: per-taxel gains from a probe on every taxel in turn
-    (simulate --scenario calibration) or a uniform press (--press), dead taxels, and a
-    force curve from a load cell's log (--force-log); applied by locate, live and view
-    with --calibration.
+    A pad or a point set: newtons from known weights alone (--force-log WEIGHTS.csv,
+    one row per weight placed, held and removed, the unit in the header): a curve from
+    the contacts' total signal, saturation flagged, a leave-one-out error per weight,
+    hysteresis and temperature where the log has them (docs/calibration.md). Per-taxel
+    gains on top from a probe on every taxel in turn (simulate --scenario calibration)
+    or a uniform press (--press), given first with the weights as --loads. Applied by
+    locate, live and view with --calibration.
     """
     from tactsense.estimate import calibrate as cal
 
