@@ -222,3 +222,26 @@ def test_dead_stuck_and_unreadable_taxels_are_found_and_named(zero_pad, tmp_path
     table = pd.read_csv(out)
     assert len(table) > 0 and table["flag_names"].str.contains("DEAD_TACTEL").all()
     assert not table["flag_names"].str.contains("SATURATED").any()  # the stuck one left out
+
+
+def test_the_examples_in_docs_sensors_md_are_valid_and_print_what_it_says(tmp_path):
+    """docs/sensors.md's two descriptions load, and ``sensor check`` prints the lines the
+    doc quotes for the first."""
+    from pathlib import Path
+
+    doc = (Path(__file__).parents[2] / "docs" / "sensors.md").read_text(encoding="utf-8")
+    blocks = re.findall(r"```toml\n(.*?)```", doc, re.S)
+    ours = [b for b in blocks if 'name = "zero16"' in b or 'name = "fingertip"' in b]
+    assert len(ours) == 2
+    for k, text in enumerate(ours):
+        path = tmp_path / f"example{k}.toml"
+        path.write_text(text, encoding="utf-8")
+        result = runner.invoke(app, ["sensor", "check", str(path)])
+        assert result.exit_code == 0, result.output
+        rows = dict(load_sensor(path).summary())
+        if "zero16" in text:
+            flat = " ".join(doc.split())
+            assert f"`transduction: {rows['transduction']}`" in flat
+            assert f"`rest reading: {rows['rest reading']}`" in flat
+        else:
+            assert rows["transduction"] == "capacitive, reading falling under load"
