@@ -58,6 +58,11 @@ def _locate_contacts(recording, out, force, quiet, **options) -> None:
         f"deaths, {summary['merges']} merges, {summary['splits']} splits; "
         f"creep: {summary['creep']}"
     )
+    for line in (summary.get("unusable"), summary.get("movement")):
+        if line:
+            console.print(
+                f"warning: {line}", soft_wrap=True, markup=False, highlight=False, emoji=False
+            )
     if summary["below_baseline"]:
         console.print(
             f"warning: {summary['below_baseline']} frames read below the baseline by more "
