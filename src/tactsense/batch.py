@@ -162,7 +162,14 @@ class iter_contacts:
     counting from the recording's first frame.
 
     The baseline, as :func:`contacts_file` describes it, and the tracker are kept in
-    :attr:`baseline` (None with a calibration) and :attr:`tracker` for the caller.
+    :attr:`baseline` (None with a finger's calibration) and :attr:`tracker` for the
+    caller. Unless a finger's calibration says which taxels are dead, the recording is
+    read once first for every taxel's range of readings (:attr:`extremes`), from which
+    the taxels that give no signal are found (:attr:`health`,
+    :func:`~tactsense.estimate.baseline.taxel_health`: no finite reading, stuck at the
+    rail, or never changing while the others do); the first two are left out (flag
+    ``DEAD_TACTEL``; with an array calibration, its own dead taxels are left out
+    instead).
     """
 
     def __init__(
@@ -179,7 +186,7 @@ class iter_contacts:
         drift_s: float | None = None,
     ):
         from tactsense.estimate.array_calibration import ArrayCalibration
-        from tactsense.estimate.baseline import DriftBaseline
+        from tactsense.estimate.baseline import DriftBaseline, ReadingRange, taxel_health
         from tactsense.estimate.contacts import default_threshold
         from tactsense.estimate.creep import creep_applied
         from tactsense.estimate.track import ContactTracker
@@ -188,6 +195,16 @@ class iter_contacts:
         self.reader = reader
         self.compensator = None
         self.baseline = None
+        self.start = None
+        """The baseline the recording starts from [counts] (None with a finger's
+        calibration)."""
+        self.extremes = None
+        """Every taxel's smallest and largest reading over the recording
+        (:class:`~tactsense.estimate.baseline.ReadingRange`; None with a finger's
+        calibration)."""
+        self.health = None
+        """:func:`~tactsense.estimate.baseline.taxel_health` of the recording."""
+        self.dead = None
         self.creep = "none"
         """Where the creep taken out came from (:func:`~tactsense.estimate.creep.creep_applied`)."""
         array_calibration = isinstance(calibration, ArrayCalibration)
@@ -209,6 +226,13 @@ class iter_contacts:
                 # NaN-tolerant: one unreadable value in the baseline frames does not
                 # make its taxel dead for the whole recording
                 start = np.nanmedian(reader.frames(0, baseline_frames).astype(float), axis=0)
+            self.start = np.array(start, dtype=float)
+            self.extremes = ReadingRange(sensor.shape)
+            for _, frames, _ in reader.chunks(chunk_frames):
+                self.extremes.update(frames)
+            self.health = taxel_health(self.extremes, self.start, sensor)
+            if self.health["excluded"].any() and not array_calibration:
+                self.dead = self.health["excluded"]
             creep, stiffening, self.creep = creep_applied(sensor, reader.attrs)
             self.baseline = DriftBaseline(
                 start, sensor, frame_period_s=sensor.scan_period_s,
@@ -229,7 +253,7 @@ class iter_contacts:
         for start, frames, time_s in self.reader.chunks(self._chunk_frames):
             table = find_contacts(
                 frames, sensor, baseline=self.baseline, compensator=self.compensator,
-                first_frame=start,
+                first_frame=start, dead=self.dead,
                 frame_period_s=sensor.scan_period_s if calibrated else None, **self._options,
             )  # fmt: skip
             tracked, events = self.tracker.update(table, first_frame=start)
@@ -275,9 +299,15 @@ def contacts_file(
         ``force_mean_n``
         and ``force_max_n`` over the contacts of known force [N], ``creep`` (the creep
         taken out: ``"none"`` or ``"described (...)"``,
-        :func:`~tactsense.estimate.creep.creep_applied`).
+        :func:`~tactsense.estimate.creep.creep_applied`), ``unusable`` (a sentence
+        naming the taxels found to give no signal,
+        :func:`~tactsense.estimate.baseline.health_warning`, or None) and
+        ``movement`` (what the way the readings moved says is wrong: against the
+        polarity, or no contact although they moved by more than the threshold,
+        :func:`~tactsense.estimate.baseline.movement_warning`; else None).
     """
-    from tactsense.estimate.contacts import find_contacts
+    from tactsense.estimate.baseline import health_warning, movement_warning
+    from tactsense.estimate.contacts import default_threshold, find_contacts
     from tactsense.estimate.output import ContactsWriter
 
     output_format(out)
@@ -320,6 +350,15 @@ def contacts_file(
             ids = pieces.tracker.next_id
             baseline = pieces.baseline
             creep = pieces.creep
+            unusable = movement = None
+            if pieces.health is not None:
+                unusable = health_warning(pieces.health, sensor)
+                movement = movement_warning(
+                    pieces.extremes, pieces.start, sensor,
+                    default_threshold(sensor) if threshold is None else threshold,
+                    found=writer.rows > 0, dead=pieces.health["dead"],
+                    baseline_frames=baseline_frames,
+                )  # fmt: skip
     return {
         "frames": total,
         "rows": writer.rows,
@@ -333,4 +372,6 @@ def contacts_file(
         "force_mean_n": force_sum / force_count if force_count else float("nan"),
         "force_max_n": force_max,
         "creep": creep,
+        "unusable": unusable,
+        "movement": movement,
     }

@@ -177,3 +177,25 @@ def test_the_new_flaws_leave_earlier_sensors_as_they_were(name):
               if f not in ("hysteresis", "drift", "crosstalk")]  # fmt: skip
     assert len(before) == 7
     np.testing.assert_array_equal(every, ts.simulate(spec, scenario, flaws=before, rng=5).frames)
+
+
+def test_the_simulator_carries_the_habits_across_its_blocks_of_frames():
+    """The simulator computes frames 128 at a time; its hysteresis and drift equal the
+    habits applied to the whole flawless series at once (from the flawless readings
+    through the inverse divider)."""
+    spec = ts.preset("dsa9205")  # 30 Hz: 20 s is 600 frames, five blocks
+    g = spec.grid
+    at = (5 * g.row_pitch_mm, 3 * g.col_pitch_mm)
+    steps = [Step((), 0.5, "rest")]
+    for force, hold in ((3.0, 6.0), (1.0, 3.0), (0.0, 1.0), (2.0, 9.5)):
+        steps.append(Step((SphereProbe(*at, force),) if force else (), hold, f"{force} N"))
+    scenario = Scenario(tuple(steps))
+    plain = ts.simulate(spec, scenario, flaws="none")
+    habits = ts.simulate(spec, scenario, flaws=["hysteresis", "drift"])
+    assert len(plain.frames) > 4 * 128
+    full = 2**spec.electronics.adc_bits - 1
+    conductance = divider_conductance(plain.frames, 0.0, full)
+    conductance, _ = hysteresis(conductance, spec.flaws.hysteresis)
+    conductance, _ = load_drift(conductance, plain.time_s, spec.flaws.drift_per_decade)
+    np.testing.assert_allclose(habits.frames, divider_counts(conductance, 0.0, full),
+                               rtol=1e-9, atol=1e-9)  # fmt: skip

@@ -130,3 +130,14 @@ def test_new_presets_simulate_and_locate_through_the_cli(name, tmp_path):
     during = [r for r in rows if int(r["frame"]) in set(loaded.tolist())]
     assert len({r["frame"] for r in during}) >= 0.9 * len(loaded)
     assert len({r["id"] for r in during}) == 1
+
+
+def test_the_fsr_example_of_docs_sensors_is_valid():
+    """docs/sensors.md's FSR matrix of one's own loads, with the habits it names."""
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[2] / "docs" / "sensors.md").read_text()
+    block = text.split("An FSR matrix of your own", 1)[1].split("```toml\n", 1)[1]
+    spec = ts.sensor.SpecBase.from_toml_string(block.split("```", 1)[0])
+    assert spec.shape == (8, 8) and spec.transduction.kind == "piezoresistive"
+    assert (spec.flaws.crosstalk, spec.flaws.hysteresis) == (1.0, 0.2)

@@ -78,7 +78,8 @@ class Row:
     position_taxel: float
     """Mean position error of the probes found [taxel]."""
     force_pct: float
-    """Median |force error| of the probes found [%]."""
+    """Median |force error| of the probes found whose force is given [%] (a contact on a
+    saturated taxel has its force withheld)."""
 
 
 def _placements(spec: PadSpec, n: int, rng) -> list[tuple[tuple[int, int], ...]]:
@@ -179,7 +180,7 @@ def pad_robustness_study(
                 ghosts / n,
                 missed / n,
                 float(np.mean(errors)) if errors else float("nan"),
-                float(np.median(forces)) if forces else float("nan"),
+                float(np.nanmedian(forces)) if np.isfinite(forces).any() else float("nan"),
             )
         )
     return out

@@ -84,9 +84,10 @@ ContactThresholdOption = Annotated[
     typer.Option(
         "--threshold",
         callback=_threshold,
-        help="Smallest signal that counts as contact, as a fraction [default: 0.005 for "
-        "capacitive taxels (fractional deflection: 0.5 %, about 10 counts at 2000); 10 "
-        "counts' worth of strain for resistive ones (10 / counts_per_strain)].",
+        help="Smallest signal that counts as contact, as a fraction [default: 10 counts' "
+        "worth (3 on an 8-bit converter): for capacitive taxels the fractional deflection "
+        "of 10 counts from the rest reading, at least 0.005 (0.5 %, 10 counts at 2000); "
+        "for resistive ones 10 / counts_per_strain of strain].",
     ),
 ]
 

@@ -64,6 +64,11 @@ def _locate_contacts(recording, out, force, quiet, **options) -> None:
             "range (flag BEYOND_CALIBRATION): heavier than the heaviest unsaturated weight, "
             "their force is NaN, not extrapolated"
         )
+    for line in (summary.get("unusable"), summary.get("movement")):
+        if line:
+            console.print(
+                f"warning: {line}", soft_wrap=True, markup=False, highlight=False, emoji=False
+            )
     if summary["below_baseline"]:
         console.print(
             f"warning: {summary['below_baseline']} frames read below the baseline by more "

@@ -173,26 +173,36 @@ BLOCK = 4096
 """Frames per block of the compiled passes."""
 
 
-def default_threshold(sensor) -> float:
-    """Smallest signal that counts as contact [-]: 10 counts from the baseline, or five
-    standard deviations of the sensor's read noise when that is more.
+def threshold_counts(sensor) -> float:
+    """The change of reading that counts as contact by default [counts]: 10 counts on a
+    converter of 12 bits or more (0.24 % of a 12-bit range, some 25 times the read noise
+    of 0.3 counts with quantization, 0.39 counts rms); on fewer bits the same share of
+    the range, but at least 3 counts (7.7 times that rms), so that an 8-bit converter
+    (iCub's fingertips) is not held to 10 counts, 3.9 % of its range. A sensor whose
+    described read noise is larger (1-2 % of full scale, 40-80 counts at 12 bits, as FSR
+    and piezoresistive arrays read) would cross that in every frame: there five standard
+    deviations of its ``read_noise_counts`` (crossed by chance once in 3.5 million
+    readings) set it."""
+    bits = int(sensor.electronics.adc_bits)
+    counts = 10.0 if bits >= 12 else max(3.0, 10.0 * 2.0 ** (bits - 12))
+    return max(counts, 5.0 * float(sensor.flaws.read_noise_counts))
 
-    Capacitive taxels: a fractional deflection of 0.005 (10 counts at the nominal
-    2000, the finger's rule); resistive and piezoresistive ones: ``10 /
-    counts_per_strain`` of strain, whatever the rest reading (0 included) and the
-    polarity. 10 counts is 0.24 % of a 12-bit converter's range and some 25 times its
-    quantization and read noise (0.3 counts); on an 8-bit converter it is 3.9 % of the
-    range, still 10 quantization steps, so the rule stays in counts rather than in a
-    share of the range (which would fall under one count there). A sensor whose read
-    noise is 1-2 % of full scale (40-80 counts at 12 bits, as FSR and piezoresistive
-    arrays read) would cross 10 counts in every frame: there five standard deviations
-    (crossed by chance once in 3.5 million readings) set it.
+
+def default_threshold(sensor) -> float:
+    """Smallest signal that counts as contact [-]: :func:`threshold_counts` from the
+    baseline (10 counts on 12 bits, more on a noisy sensor).
+
+    Capacitive taxels: the signal of that change from the rest reading ``V_o``
+    (``nominal_counts``), ``n / (V_o + n)`` whichever the polarity, but at least 0.005
+    (10 counts at the nominal 2000, the finger's rule); resistive and piezoresistive
+    ones: ``n / counts_per_strain`` of strain, whatever the rest reading (0 included)
+    and the polarity.
     """
-    counts = max(10.0, 5.0 * float(sensor.flaws.read_noise_counts))
+    n = threshold_counts(sensor)
     transduction = getattr(sensor, "transduction", None)
     if transduction is not None and transduction.kind != "capacitive":
-        return counts / transduction.counts_per_strain
-    return 0.005 * counts / 10.0
+        return n / transduction.counts_per_strain
+    return max(0.005, n / (sensor.electronics.nominal_counts + n))
 
 
 def reading_mode(sensor) -> tuple[bool, bool, float]:

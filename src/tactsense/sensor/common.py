@@ -625,6 +625,35 @@ def check_transduction(t: Transduction, problems: list[str]) -> None:
         )
 
 
+def habit_rows(spec) -> list[tuple[str, str]]:
+    """Rows for ``sensor check`` on a pad or point set's piezoresistive response and its
+    habits (issue 32), the ones that are on."""
+    t, f, el = spec.transduction, spec.flaws, spec.electronics
+    rows = []
+    if t.kind == "piezoresistive":
+        half = (2**el.adc_bits - 1 - el.nominal_counts) / t.counts_per_strain
+        rows.append(
+            (
+                "piezoresistive response",
+                f"conductance ~ strain^{t.exponent:g} through a divider: half the span at "
+                f"strain {half:.3g}, saturating at {2**el.adc_bits - 1} counts",
+            )
+        )
+    habits = [
+        f"{label} {value:g}"
+        for label, value in (
+            ("hysteresis", f.hysteresis),
+            ("drift per decade", f.drift_per_decade),
+            ("temperature coefficient [1/K]", f.temperature_coefficient_per_k),
+            ("crosstalk", f.crosstalk),
+        )
+        if value
+    ]
+    if habits:
+        rows.append(("habits (flaws)", ", ".join(habits)))
+    return rows
+
+
 TRANSDUCTION_KINDS = ("capacitive", "resistive", "piezoresistive")
 """The kinds of ``[transduction]`` (a finger is always capacitive)."""
 

@@ -166,7 +166,9 @@ def fsr16() -> PadSpec:
     proportional to the load, hysteresis (+10 % average: ``hysteresis = 0.2``), drift
     under load (< 5 % per decade of time: 0.05), about 0.003/K with temperature; a
     passive matrix scanned with its unscanned lines floating (``crosstalk = 1``). Read
-    noise 1 % of full scale (41 counts of 12 bits), the issue's 1-2 %. Assumed: the
+    noise 1 % of full scale (41 counts of 12 bits), the issue's 1-2 %. The creep is the
+    FSR's own (``drift_per_decade``), not the paper's rubber's: the viscoelastic
+    fractions are 0 (the overlay is taken not to creep). Assumed: the
     geometry (4 mm pitch, 3.5-mm cells, under 4 mm of the paper's rubber, sensed 3 mm
     deep), the divider's resistor (equal to a cell's resistance under about 1 N, the
     geometric middle of the FSR 402's 0.1-10 N, as Sensitronics' AN-1 advises), and
@@ -198,6 +200,8 @@ def fsr16() -> PadSpec:
             drift_per_decade=0.05,
             temperature_coefficient_per_k=0.003,
             crosstalk=1.0,
+            delayed_fraction=0.0,
+            creep_fraction=0.0,
         ),
     )
 
@@ -211,7 +215,8 @@ def dsa9205() -> PadSpec:
     3.4-mm pitch and 12 bits are the DSA 9205's commonly quoted figures, not checked
     against a Weiss datasheet here. The conductive rubber's habits are taken as an FSR's
     (hysteresis 0.2, drift 0.05 per decade, an assumption); its controller is taken to
-    isolate the scan (``crosstalk = 0``, an assumption). Read noise 1 % of full scale.
+    isolate the scan (``crosstalk = 0``, an assumption). Read noise 1 % of full scale;
+    creep as ``fsr16``'s (the drift, no viscoelastic fractions).
     Assumed: 3 mm of rubber sensed 2 mm deep, 3-mm cells, the divider at 1 N, 30 Hz.
     """
     return PadSpec(
@@ -242,6 +247,8 @@ def dsa9205() -> PadSpec:
             drift_per_decade=0.05,
             temperature_coefficient_per_k=0.003,
             crosstalk=0.0,
+            delayed_fraction=0.0,
+            creep_fraction=0.0,
         ),
     )
 
