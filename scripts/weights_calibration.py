@@ -301,7 +301,8 @@ def figure(results, path: Path) -> None:
         left.legend(fontsize=8)
         held = [(w["force_n"] / GRAM, w["loo_error_percent"]) for w in weights
                 if w.get("loo_error_percent") is not None]  # fmt: skip
-        right.bar([h[0] for h in held], [h[1] for h in held], width=6, color="C0")
+        step = float(np.min(np.diff(np.unique(g)))) if len(g) > 1 else 10.0
+        right.bar([h[0] for h in held], [h[1] for h in held], width=0.6 * step, color="C0")
         right.axhline(5, color="C3", ls="--", lw=1)
         right.axhline(-5, color="C3", ls="--", lw=1)
         right.set_xlabel("weight held out [g]")
