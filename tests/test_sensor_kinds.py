@@ -137,7 +137,7 @@ def test_json_taxel_list_imports_as_a_point_set(tmp_path):
         ({"layer": {"sensing_depth_mm": 5.0}}, "lies below the layer"),
         ({"layer": {"poisson_ratio": 0.7}}, "Poisson's ratio lies in (-1, 0.5]"),
         ({"layer": {"substrate": "foam"}}, "only 'rigid' is modelled"),
-        ({"transduction": {"kind": "optical"}}, "expected 'capacitive' or 'resistive'"),
+        ({"transduction": {"kind": "optical"}}, "'resistive' or 'piezoresistive'"),
         ({"flaws": {"dead_tactels": [[16, 0]]}}, "outside the wired array 16x16"),
         ({"grid": {"pitch": 2.0}}, "unknown key 'pitch' in [grid]"),
     ],

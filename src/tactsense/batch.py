@@ -208,6 +208,8 @@ class iter_contacts:
         self.creep = "none"
         """Where the creep taken out came from (:func:`~tactsense.estimate.creep.creep_applied`)."""
         array_calibration = isinstance(calibration, ArrayCalibration)
+        if threshold is None and array_calibration:  # a weight curve's own threshold
+            threshold = calibration.contact_threshold
         if calibration is not None and not array_calibration:
             calibration.check_sensor(sensor)
             self.compensator = calibration.compensator(sensor.scan_period_s, sensor.shape)
@@ -292,7 +294,9 @@ def contacts_file(
         ``ids`` (distinct tracked contacts), ``most`` (largest number in one frame),
         ``births``, ``deaths``, ``merges``, ``splits``, ``below_baseline`` (frames with a
         taxel below its baseline by more than the threshold: the first frames were
-        probably touched), ``saturated`` (contacts flagged SATURATED), ``force_mean_n``
+        probably touched), ``saturated`` (contacts flagged SATURATED),
+        ``beyond_calibration`` (contacts beyond a weight curve's range, force NaN),
+        ``force_mean_n``
         and ``force_max_n`` over the contacts of known force [N], ``creep`` (the creep
         taken out: ``"none"`` or ``"described (...)"``,
         :func:`~tactsense.estimate.creep.creep_applied`), ``unusable`` (a sentence
@@ -308,7 +312,7 @@ def contacts_file(
 
     output_format(out)
     counts = {"births": 0, "deaths": 0, "merges": 0, "splits": 0}
-    frames_with = most = saturated = 0
+    frames_with = most = saturated = beyond = 0
     force_sum, force_count, force_max = 0.0, 0, float("nan")
     with RecordingReader(recording) as reader:
         sensor = reader.sensor
@@ -327,6 +331,7 @@ def contacts_file(
                 frames_with += int(np.count_nonzero(per_frame))
                 most = max(most, int(per_frame.max(initial=0)))
                 saturated += int(np.count_nonzero(tracked.flags & int(Flag.SATURATED)))
+                beyond += int(np.count_nonzero(tracked.flags & int(Flag.BEYOND_CALIBRATION)))
                 finite = tracked.force_n[np.isfinite(tracked.force_n)]
                 if finite.size:
                     force_sum += float(finite.sum())
@@ -363,6 +368,7 @@ def contacts_file(
         **counts,
         "below_baseline": 0 if baseline is None else baseline.below_frames,
         "saturated": saturated,
+        "beyond_calibration": beyond,
         "force_mean_n": force_sum / force_count if force_count else float("nan"),
         "force_max_n": force_max,
         "creep": creep,

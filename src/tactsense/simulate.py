@@ -27,8 +27,10 @@ from tactsense._validation import TactsenseInputError, check_positive
 from tactsense.io.recording import Recording
 from tactsense.physics.array_response import deflection_batch
 from tactsense.physics.contact import Probe, contact_from_dict, grams_force, knife_edge
+from tactsense.physics.crosstalk import scan_conductance
 from tactsense.physics.flaws import FLAW_NAMES, draw_gains, stiffening
 from tactsense.physics.pad_response import deflection_batch_flat, resistive_counts
+from tactsense.physics.piezo import piezo_counts
 from tactsense.physics.transduction import (
     amplifier_gain,
     divider_voltage,
@@ -600,7 +602,7 @@ def _frame_blocks(spec: SensorSpec, run: _Run):
     gain_v = amplifier_gain(spec)
     c0 = spec.junction_capacitance_f
     full_scale = 2**spec.electronics.adc_bits - 1
-    state = None
+    state = piezo = None
     for first in range(0, run.n_frames, _CHUNK_FRAMES):
         last = min(run.n_frames, first + _CHUNK_FRAMES)
         ticks = np.arange(first * ticks_per_frame, last * ticks_per_frame)
@@ -644,7 +646,12 @@ def _frame_blocks(spec: SensorSpec, run: _Run):
                     spec, gain_v * divider_voltage(spec, c0 / (1.0 - sampled)), quantize=False
                 ),
             )
+        elif spec.transduction.kind == "piezoresistive":
+            times = np.arange(first, last) * period
+            counts, piezo = piezo_counts(spec, sampled, times, active, piezo)
         else:
+            if "crosstalk" in active and spec.flaws.crosstalk > 0:
+                sampled = scan_conductance(np.maximum(sampled, 0.0), spec.flaws.crosstalk)
             counts = resistive_counts(spec, sampled)
         if "noise" in active:
             counts = counts + rng.normal(0.0, spec.flaws.read_noise_counts, counts.shape)
@@ -685,7 +692,9 @@ def simulate(
         Contacts over time.
     flaws : "all", "none" or iterable of str
         Flaws to switch on, from ``gain_spread``, ``jitter``, ``noise``,
-        ``quantization``, ``nonlinearity``, ``viscoelastic``, ``dead``.
+        ``quantization``, ``nonlinearity``, ``viscoelastic``, ``dead``, and the habits
+        of resistive arrays ``hysteresis``, ``drift`` (piezoresistive cells) and
+        ``crosstalk`` (resistive and piezoresistive matrices).
         Their parameters come from ``spec.flaws``.
     rng : int, numpy.random.Generator or None
         Source of every random draw (gains, jitter, noise).

@@ -165,7 +165,7 @@ BAD = [
     ("calibrate PAD --steps PAD --out OUT", "--steps is for fingers"),
     ("calibrate PAD --loads PAD --out OUT", "--loads goes with --force-log"),
     ("calibrate BENCH/press.h5 --out OUT", "this is not a probe pressed on every taxel"),
-    ("calibrate PAD --force-log BENCH/one_load.csv --out OUT", "the force log holds one load"),
+    ("calibrate PAD --force-log BENCH/one_load.csv --out OUT", "the log holds one load"),
     ("calibrate PAD --force-log DIR/missing.csv --out OUT", "cannot read"),
     (
         "calibrate PAD --force-log DIR/nocolumns.csv --out OUT",

@@ -161,3 +161,12 @@ def test_the_default_threshold_is_in_counts_whatever_the_rest_and_the_bits():
     assert default_threshold(icub) == pytest.approx(3 / 248)  # 3 counts from 245
     for name in ("pad4", "dome12", "initial"):  # the presets keep 0.005
         assert default_threshold(load_sensor(name)) == 0.005
+
+
+def test_a_baseline_of_zeros_on_a_capacitive_pad_is_an_open_junction():
+    pad = load_sensor("pad4")
+    frames = np.full((1, *pad.shape), 2000.0)
+    baseline = np.full(pad.shape, 2000.0)
+    baseline[1, 1] = 0.0
+    signal, flags = signal_from_counts(frames, baseline, pad)
+    assert flags[0] & Flag.DEAD_TACTEL and signal[0, 1, 1] == 0.0

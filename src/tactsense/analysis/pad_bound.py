@@ -53,6 +53,12 @@ def counts_from_strain(spec, strain) -> np.ndarray:
             spec, spec.junction_capacitance_f / (1.0 - closing)
         )
         return voltage_to_counts(spec, voltage, quantize=False)
+    if t.kind == "piezoresistive":
+        from tactsense.physics.piezo import conductance_ratio, divider_counts, half_scale_strain
+
+        el = spec.electronics
+        g = conductance_ratio(strain, half_scale_strain(spec), t.exponent)
+        return divider_counts(g, el.nominal_counts, 2**el.adc_bits - 1)
     return spec.electronics.nominal_counts + t.counts_per_strain * np.maximum(strain, 0.0)
 
 

@@ -66,6 +66,11 @@ def _counts(spec: PadSpec, strain: np.ndarray) -> np.ndarray:
     if t.kind == "capacitive":
         deflection = np.minimum(t.strain_gain * strain, 0.95)
         return nominal * deflection / (1.0 - deflection)
+    if t.kind == "piezoresistive":
+        from tactsense.physics.piezo import conductance_ratio, divider_counts, half_scale_strain
+
+        g = conductance_ratio(strain, half_scale_strain(spec), t.exponent)
+        return divider_counts(g, 0.0, 2**spec.electronics.adc_bits - 1 - nominal)
     return t.counts_per_strain * np.maximum(strain, 0.0)
 
 

@@ -41,7 +41,9 @@ SensorOption = Annotated[
         "--sensor",
         help="A preset: the paper's fingers 'initial' (3.8 mm x 45 deg) and 'improved' "
         "(3.3 mm x 18 deg), the pads 'pad4' (4x4, 5 mm), 'pad16' (16x16, 2.5 mm), "
-        "'pad12x32' (12x32, 2 mm), the point sets 'dome12' (docs/sensors.md) and "
+        "'pad12x32' (12x32, 2 mm), "
+        "the piezoresistive pads 'fsr16' (16x16 FSR, 4 mm) and 'dsa9205' (6x14, 3.4 mm), "
+        "the point sets 'dome12' (docs/sensors.md) and "
         "'icub_fingertip' (the iCub's, 8 bits, falling; docs/contacts.md); "
         "or the path of a sensor TOML file.",
     ),

@@ -51,8 +51,9 @@ ScenarioOption = Annotated[
         "--increment mm along y (Fig. 7 on a pad), 'knife-edge' presses a knife edge "
         "across the middle, 'punch' a flat punch (a uniform press), 'calibration' a "
         "sphere on every taxel in turn (for 'calibrate'), 'loads' presses a sphere with "
-        "each of --forces-g in turn (for 'calibrate --force-log'; write the log with "
-        "--force-log)."
+        "each of --forces-g in turn, lifted between (a box of weights, or a load cell: "
+        "for 'calibrate --force-log', with the log --force-log writes or a CSV of the "
+        "masses in order)."
     ),
 ]
 XOption = Annotated[

@@ -58,6 +58,12 @@ def _locate_contacts(recording, out, force, quiet, **options) -> None:
         f"deaths, {summary['merges']} merges, {summary['splits']} splits; "
         f"creep: {summary['creep']}"
     )
+    if summary.get("beyond_calibration"):
+        console.print(
+            f"warning: {summary['beyond_calibration']} contacts read beyond the calibrated "
+            "range (flag BEYOND_CALIBRATION): heavier than the heaviest unsaturated weight, "
+            "their force is NaN, not extrapolated"
+        )
     for line in (summary.get("unusable"), summary.get("movement")):
         if line:
             console.print(
@@ -290,9 +296,15 @@ def calibrate(
         Path | None,
         typer.Option(
             "--force-log",
-            help="Pads and point sets: a reference load cell's log of the same recording, "
-            "CSV with columns time_s [s, the recording's clock] and force_n [N]; fits the "
-            "piecewise-linear force curve (docs/contacts.md).",
+            help="Pads and point sets: the known loads of the presses. A box of weights: a "
+            "CSV with one row per weight placed (each placed, held and removed, in the "
+            "order placed), the unit in the header: mass_g, mass_kg, force_n or force_mn "
+            "(optional temperature_c [degC]); the presses are found in the recording. Or a "
+            "timed log (a load cell's) with time_s [s, the recording's clock]. Gives a "
+            "weight curve from the contacts' total signal with saturation flagged and a "
+            "leave-one-out error per weight (docs/calibration.md); with --loads and a "
+            "load cell's time_s/force_n log, the force curve of the layer model's force "
+            "(docs/contacts.md).",
         ),
     ] = None,
     loads: Annotated[
@@ -300,9 +312,21 @@ def calibrate(
         typer.Option(
             "--loads",
             help="Pads and point sets: the recording --force-log was logged with (presses "
-            "of varied force), when it is not SWEEP itself. SWEEP must still give the "
-            "gains (a probe on every taxel, or a uniform press with --press): a force "
-            "curve from weights alone, with no sweep, is not supported yet.",
+            "of varied force), SWEEP then giving the per-taxel gains (a probe on every "
+            "taxel, or a uniform press with --press). Without --loads, SWEEP is the "
+            "recording of the weights itself, and the gains are 1 (or from it, with "
+            "--press: weights on a plate over the whole array).",
+        ),
+    ] = None,
+    threshold: Annotated[
+        float | None,
+        typer.Option(
+            min=1e-9,
+            max=1e6,
+            help="Pads and point sets with weights: the contact threshold of the total "
+            "signal [-] (default: 10 counts' worth, or 5 standard deviations of the "
+            "description's read noise if more). "
+            "Kept in the calibration, and used by locate with it unless given there.",
         ),
     ] = None,
     force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
@@ -313,10 +337,13 @@ def calibrate(
     that stops at a bound of its parameters or leaves a residual above 10 % of full
     scale, is an error: such a calibration would be applied without anyone knowing.
 
-    A pad or a point set: per-taxel gains from a probe on every taxel in turn
-    (simulate --scenario calibration) or a uniform press (--press), dead taxels, and a
-    force curve from a load cell's log (--force-log); applied by locate, live and view
-    with --calibration.
+    A pad or a point set: newtons from known weights alone (--force-log WEIGHTS.csv,
+    one row per weight placed, held and removed, the unit in the header): a curve from
+    the contacts' total signal, saturation flagged, a leave-one-out error per weight,
+    hysteresis and temperature where the log has them (docs/calibration.md). Per-taxel
+    gains on top from a probe on every taxel in turn (simulate --scenario calibration)
+    or a uniform press (--press), given first with the weights as --loads. Applied by
+    locate, live and view with --calibration.
     """
     from tactsense.estimate import calibrate as cal
 
@@ -333,10 +360,11 @@ def calibrate(
             if loads is not None and force_log is None:
                 raise TactsenseInputError("--loads goes with --force-log (the load cell's log)")
             _calibrate_array(sweep, out, press=press, force_log=force_log, loads=loads,
-                             baseline_frames=baseline_frames, partial=partial)  # fmt: skip
+                             baseline_frames=baseline_frames, partial=partial,
+                             threshold=threshold)  # fmt: skip
             return
         for name, value in (("--press", press or None), ("--force-log", force_log),
-                            ("--loads", loads)):  # fmt: skip
+                            ("--loads", loads), ("--threshold", threshold)):  # fmt: skip
             if value is not None:
                 raise TactsenseInputError(
                     f"{name} is for pads and point sets; {sweep} holds a finger"
@@ -428,21 +456,34 @@ def calibrate(
     Console(stderr=True).print(table)
 
 
-def _calibrate_array(recording, out, *, press, force_log, loads, baseline_frames, partial):
+def _calibrate_array(recording, out, *, press, force_log, loads, baseline_frames, partial,
+                     threshold=None):  # fmt: skip
     """``calibrate`` on a pad or a point set (tactsense.estimate.array_calibration)."""
-    from tactsense.estimate.array_calibration import calibrate_array, read_force_log
+    from tactsense.estimate.array_calibration import calibrate_array, read_weights_log
+    from tactsense.io.recording import RecordingReader
 
-    log = read_force_log(force_log) if force_log is not None else None
+    log = read_weights_log(force_log) if force_log is not None else None
+    # a load cell's time_s/force_n log of a --loads recording: the model-force curve
+    cell = log is not None and loads is not None and log.time_s is not None
+    cell = cell and log.column == "force_n" and log.temperature_c is None and threshold is None
     rec = read_recording(recording)
-    load_rec = rec
-    if loads is not None:
-        load_rec = read_recording(loads)
-        if load_rec.sensor != rec.sensor:
-            raise TactsenseInputError(f"{loads} comes from another sensor than {recording}")
+    load_path = recording if loads is None else loads
+    load_rec = rec if loads is None else read_recording(loads)
+    if load_rec.sensor != rec.sensor:
+        raise TactsenseInputError(f"{loads} comes from another sensor than {recording}")
+    method = "press" if press else "sweep"
+    options = {}
+    if log is not None and not cell:
+        if loads is None and not press:
+            method = "none"  # the weights alone: no per-taxel gains
+        with RecordingReader(load_path) as reader:
+            attrs = dict(reader.attrs)
+        options = dict(weights=log, threshold=threshold, attrs=attrs)
+    elif log is not None:
+        options = dict(force_log=(log.time_s, log.force_n))
     calibration = calibrate_array(
-        rec.frames, rec.sensor, method="press" if press else "sweep",
-        baseline_frames=baseline_frames, force_log=log,
-        loads=(load_rec.frames, load_rec.time_s), partial=partial,
+        rec.frames, rec.sensor, method=method, baseline_frames=baseline_frames,
+        loads=(load_rec.frames, load_rec.time_s), partial=partial, **options,
     )  # fmt: skip
     with atomic_output(out) as temporary:
         calibration.save(temporary)
@@ -452,6 +493,10 @@ def _calibrate_array(recording, out, *, press, force_log, loads, baseline_frames
     table.add_row("gains from", calibration.notes["method"])
     table.add_row("gain spread (max/min)", f"{used.max() / used.min():.2f}")
     table.add_row("dead taxels", f"{int(dead.sum())} of {dead.size}")
+    console_err = Console(stderr=True)
+    if calibration.curve_input == "signal_total":
+        _print_weight_curve(calibration, table, console_err)
+        return
     if calibration.force_curve is not None:
         x, y = calibration.force_curve
         table.add_row(
@@ -465,7 +510,77 @@ def _calibrate_array(recording, out, *, press, force_log, loads, baseline_frames
             f"positive; {notes['force_log_scale']:.3g} x the model's force; rank "
             f"correlation {notes['force_log_rank_correlation']:.2f}",
         )
-    Console(stderr=True).print(table)
+    console_err.print(table)
+
+
+LOO_GOAL_PERCENT = 5.0
+"""A held-out weight predicted further off than this [%] gets a hint to add weights."""
+
+
+def _print_weight_curve(calibration, table, console) -> None:
+    """The weight curve's summary and its leave-one-out table, as kept in the notes."""
+    notes = calibration.notes
+    x, y = calibration.force_curve
+    weights = notes["weights"]
+    table.add_row(
+        "weights",
+        f"{len(notes['presses'])} presses of {len(weights)} weights ({notes['weights_column']} "
+        f"in {notes['weights_log']}); threshold {notes['threshold']:.4g}",
+    )
+    table.add_row(
+        "weight curve",
+        f"{len(x)} knots, 0-{y[-1]:.4g} N (total signal up to {calibration.curve_top:.4g}; "
+        "beyond: force NaN, flag BEYOND_CALIBRATION)",
+    )
+    saturation = notes["saturation"]
+    table.add_row(
+        "saturation",
+        f"[bold]from {saturation['from_n']:.4g} N[/]: {saturation['reason']}"
+        if saturation
+        else f"none up to the heaviest weight, {weights[-1]['force_n']:.4g} N",
+    )
+    loo, lightest = notes["loo_max_error_percent"], notes["loo_lightest_error_percent"]
+    said = [] if loo is None else [f"largest error {loo:.1f} % (weights between two others)"]
+    if lightest is not None:
+        said.append(f"the lightest {lightest:+.1f} % (from the origin)")
+    bends = [w["force_n"] for w in weights if w.get("loo_between") and
+             abs(w["loo_error_percent"]) > LOO_GOAL_PERCENT]  # fmt: skip
+    if bends:
+        said.append(
+            f"[bold]above {LOO_GOAL_PERCENT:g} % at {', '.join(f'{f:.3g}' for f in bends)} N: "
+            "add weights there, where the curve bends[/]"
+        )
+    table.add_row("leave-one-out", "; ".join(said) or "no weight could be held out")
+    hysteresis = notes["hysteresis"]
+    table.add_row(
+        "hysteresis",
+        f"{hysteresis['max_difference_n']:.4g} N, {hysteresis['percent_of_full_scale']:.1f} % "
+        f"of full scale ({hysteresis['full_scale_n']:.4g} N)"
+        if hysteresis["measured"]
+        else f"not measured: {hysteresis['why']}",
+    )
+    temperature = notes["temperature"]
+    table.add_row(
+        "temperature",
+        f"{100 * temperature['coefficient_per_c']:+.3g} % of the total per degC about "
+        f"{temperature['reference_c']:.3g} degC (not applied by locate)"
+        if temperature["calibrated"]
+        else f"not calibrated: {temperature['why']}",
+    )
+    console.print(table)
+    loo_table = Table(title="each weight held out, predicted from the others' curve")
+    for name in ("load [N]", "presses", "total signal", "predicted [N]", "error [%]"):
+        loo_table.add_column(name, justify="right")
+    for w in weights:
+        if w["saturated"]:
+            predicted, error = "saturated", "flagged"
+        elif w.get("loo_n") is None:
+            predicted, error = "beyond the others", "not extrapolated"
+        else:
+            predicted, error = f"{w['loo_n']:.4g}", f"{w['loo_error_percent']:+.1f}"
+        loo_table.add_row(f"{w['force_n']:.4g}", str(w["presses"]),
+                          f"{w['signal_total']:.4g}", predicted, error)  # fmt: skip
+    console.print(loo_table)
 
 
 def _deflection_of(rec, row, col, baseline_frames):

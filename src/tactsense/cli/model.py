@@ -403,7 +403,7 @@ def _blind_spot_report(spec, probe_g: float) -> tuple[str, str, list[str]]:
     # what locate needs: a rise above its contact threshold
     _, _, _, rise = signal_map(spec, force)
     level = default_threshold(spec)
-    if spec.transduction.kind == "resistive":
+    if spec.transduction.kind != "capacitive":
         needed = level * spec.transduction.counts_per_strain
     else:  # the signal is (V - V_o) / V: a rise of level V_o / (1 - level)
         needed = level * spec.electronics.nominal_counts / (1.0 - level)

@@ -507,7 +507,9 @@ def taxel_health(extremes: ReadingRange, baseline, sensor) -> dict:
       capacitive junction reading 0: open; a falling reading resting at 0);
     * ``constant``: one value throughout (dead), when most taxels do change (their read
       noise, or a touch): where most never change (a cell reading exactly 0 at rest, as
-      FSR arrays do, or a twin without noise) an unchanging taxel is no sign of a fault.
+      FSR arrays do, or a twin without noise) an unchanging taxel is no sign of a fault;
+      nor is one value at the rail opposite the load (0 rising, full scale falling),
+      where an untouched cell resting there reads its noise clipped.
 
     A taxel that reads 0 at rest is none of these by itself. Returns the three masks
     (rows, cols), their union ``dead`` (the taxels that give no signal) and ``excluded``
@@ -527,7 +529,10 @@ def taxel_health(extremes: ReadingRange, baseline, sensor) -> dict:
     changing = ~no_reading & ~constant
     if np.count_nonzero(changing) <= changing.size // 2:
         constant = np.zeros_like(constant)
-    constant &= ~stuck
+    # at the other rail (0 rising, full scale falling) an untouched cell resting there
+    # reads its noise clipped: one value throughout is what a healthy one may do
+    floor = float(2**sensor.electronics.adc_bits - 1) if falling else 0.0
+    constant &= ~stuck & (extremes.low != floor)
     return {
         "no_reading": no_reading,
         "stuck": stuck,

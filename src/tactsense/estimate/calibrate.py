@@ -419,12 +419,18 @@ def jitter_statistics(readings, counts_per_gram):
 # ---- the calibration object ---------------------------------------------------------
 
 
-def check_in_use(source, used, calibration, error, word: str) -> None:
+def check_in_use(source, used, calibration, error, word: str, sensor=None) -> None:
     """Raise ``error`` unless the gains and the baseline of every ``used`` cell of a
     calibration read from ``source`` are positive finite numbers (a finger's and an
-    array's calibration alike; ``word``: tactel or taxel)."""
+    array's calibration alike; ``word``: tactel or taxel). With ``sensor``, a baseline
+    is checked by its reading's rule instead (a resistive taxel may rest at 0,
+    :func:`~tactsense.estimate.contacts.unusable_baseline`)."""
     for name, values in (("gains", calibration.gains), ("baseline_counts", calibration.baseline)):
         bad = used & ~(np.isfinite(values) & (values > 0))
+        if name == "baseline_counts" and sensor is not None:
+            from tactsense.estimate.contacts import unusable_baseline
+
+            bad = used & unusable_baseline(values, sensor)
         if bad.any():
             where = ", ".join(f"({r}, {c})" for r, c in np.argwhere(bad)[:8])
             raise error(

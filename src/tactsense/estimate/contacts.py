@@ -178,24 +178,29 @@ def threshold_counts(sensor) -> float:
     converter of 12 bits or more (0.24 % of a 12-bit range, some 25 times the read noise
     of 0.3 counts with quantization, 0.39 counts rms); on fewer bits the same share of
     the range, but at least 3 counts (7.7 times that rms), so that an 8-bit converter
-    (iCub's fingertips) is not held to 10 counts, 3.9 % of its range."""
+    (iCub's fingertips) is not held to 10 counts, 3.9 % of its range. A sensor whose
+    described read noise is larger (1-2 % of full scale, 40-80 counts at 12 bits, as FSR
+    and piezoresistive arrays read) would cross that in every frame: there five standard
+    deviations of its ``read_noise_counts`` (crossed by chance once in 3.5 million
+    readings) set it."""
     bits = int(sensor.electronics.adc_bits)
-    return 10.0 if bits >= 12 else max(3.0, 10.0 * 2.0 ** (bits - 12))
+    counts = 10.0 if bits >= 12 else max(3.0, 10.0 * 2.0 ** (bits - 12))
+    return max(counts, 5.0 * float(sensor.flaws.read_noise_counts))
 
 
 def default_threshold(sensor) -> float:
     """Smallest signal that counts as contact [-]: :func:`threshold_counts` from the
-    baseline (10 counts on 12 bits).
+    baseline (10 counts on 12 bits, more on a noisy sensor).
 
     Capacitive taxels: the signal of that change from the rest reading ``V_o``
     (``nominal_counts``), ``n / (V_o + n)`` whichever the polarity, but at least 0.005
-    (10 counts at the nominal 2000, the finger's rule); resistive ones: ``n /
-    counts_per_strain`` of strain, whatever the rest reading (0 included) and the
-    polarity.
+    (10 counts at the nominal 2000, the finger's rule); resistive and piezoresistive
+    ones: ``n / counts_per_strain`` of strain, whatever the rest reading (0 included)
+    and the polarity.
     """
     n = threshold_counts(sensor)
     transduction = getattr(sensor, "transduction", None)
-    if transduction is not None and transduction.kind == "resistive":
+    if transduction is not None and transduction.kind != "capacitive":
         return n / transduction.counts_per_strain
     return max(0.005, n / (sensor.electronics.nominal_counts + n))
 
@@ -205,7 +210,7 @@ def reading_mode(sensor) -> tuple[bool, bool, float]:
     resistive, whether their reading falls under load (``[transduction] polarity``; a
     finger's rises) and the strain per count of a resistive one (1 otherwise)."""
     transduction = getattr(sensor, "transduction", None)
-    resistive = transduction is not None and transduction.kind == "resistive"
+    resistive = transduction is not None and transduction.kind != "capacitive"
     falling = transduction is not None and transduction.polarity == "falling"
     per_count = 1.0 / transduction.counts_per_strain if resistive else 1.0
     return resistive, falling, per_count
@@ -363,7 +368,8 @@ def find_contacts(
         raise TactsenseInputError(f"max_contacts must be an integer in 1-64; got {max_contacts!r}")
     if not (isinstance(saddle, float | int) and 0.0 < saddle <= 1.0):
         raise TactsenseInputError(f"saddle must be in (0, 1]; got {saddle!r}")
-    threshold = default_threshold(sensor) if threshold is None else threshold
+    if threshold is None:  # a weight curve's own, else the default
+        threshold = getattr(calibration, "contact_threshold", None) or default_threshold(sensor)
     if not (isinstance(threshold, float | int) and math.isfinite(threshold) and threshold > 0):
         raise TactsenseInputError(f"threshold must be a positive number; got {threshold!r}")
     frames = check_frames(frames, sensor.shape)
@@ -427,11 +433,13 @@ def find_contacts(
         table = _grid_contacts(signal, sensor, threshold, saddle, max_contacts, method)
     table.flags |= flags[table.frame]
     if array_calibration:
-        table.force_n = calibration.force(table.force_n)
+        table.force_n, beyond = calibration.contact_force(table)
+        table.flags[beyond] |= int(Flag.BEYOND_CALIBRATION)
     if saturated is not None:
         _mark_saturated(table, saturated, sensor)
     table.extra.pop("_labels", None)
     table.extra.pop("_root", None)
+    table.extra.pop("_total", None)
     table.n_frames = 1 if lead_2d else len(signal)
     table.frame = table.frame + int(first_frame)
     return table
@@ -554,6 +562,7 @@ def _grid_contacts(signal, sensor, threshold, saddle, max_contacts, method) -> C
         extra = {"axial_mm": axial, "angle_deg": angle_deg}
     extra["_root"] = seg["root"]
     extra["_labels"] = labels
+    extra["_total"] = seg["total"]  # the contact's summed signal (a weight curve's input)
     table = ContactTable(
         frame=seg["frame"], contact=seg["contact"], x_mm=x, y_mm=y, z_mm=z, row=row, col=col,
         force_n=force, peak=peak, major_mm=major, minor_mm=minor, orientation_deg=angle,
@@ -638,7 +647,7 @@ def pad_force_kernel(sensor, n_sub: int = 8, signed: bool = False):
                 (half + a * step) * g.row_pitch_mm, (half + b * step) * g.col_pitch_mm, newtons
             )
             strain = pad_strain(big, [probe])[: 2 * half + 1, : 2 * half + 1] / newtons
-            if sensor.transduction.kind == "resistive":
+            if sensor.transduction.kind != "capacitive":
                 kernel[a, b] = strain if signed else np.maximum(strain, 0.0)
             else:
                 kernel[a, b] = sensor.transduction.strain_gain * strain
@@ -702,7 +711,7 @@ def signal_noise_variance(sensor) -> float:
     small deflection)."""
     counts = sensor.flaws.read_noise_counts**2 + 1.0 / 12.0
     transduction = getattr(sensor, "transduction", None)
-    if transduction is not None and transduction.kind == "resistive":
+    if transduction is not None and transduction.kind != "capacitive":
         return counts / transduction.counts_per_strain**2
     return counts / sensor.electronics.nominal_counts**2
 
@@ -728,7 +737,7 @@ def pad_merged_force(signal, labels, seg, row, col, sensor, threshold, force) ->
     noise_var = signal_noise_variance(sensor)
     # a resistive taxel's zero may hide tension: only the taxels clearly compressed
     # tell the loads' sum; a capacitive taxel reads both signs
-    resistive = sensor.transduction.kind == "resistive"
+    resistive = sensor.transduction.kind != "capacitive"
     floor = 3.0 * math.sqrt(noise_var) if resistive else -math.inf
     with deferred_interrupts():
         merged_force(
@@ -777,7 +786,7 @@ def points_force_kernel(sensor):
     kernel = np.empty((n, n))
     for i in range(n):
         strain = points_strain(sensor, [SphereProbe(0.0, 0.0, newtons, at_taxel=i)])[0] / newtons
-        if sensor.transduction.kind == "resistive":
+        if sensor.transduction.kind != "capacitive":
             kernel[i] = np.maximum(strain, 0.0)
         else:
             kernel[i] = sensor.transduction.strain_gain * strain
@@ -907,8 +916,9 @@ def _points_contacts(signal, sensor, threshold, saddle, max_contacts, method) ->
         table = ContactTable.empty(len(signal))
         table.extra["_root"] = np.zeros(0, np.int64)
         table.extra["_labels"] = labels
+        table.extra["_total"] = np.zeros(0)
         return table
-    rank, _, frame, point, peak, force, major, minor, angle, taxels, flag, root = zip(
+    rank, total, frame, point, peak, force, major, minor, angle, taxels, flag, root = zip(
         *rows, strict=True
     )
     point = np.array(point)
@@ -919,5 +929,6 @@ def _points_contacts(signal, sensor, threshold, saddle, max_contacts, method) ->
         peak=np.array(peak), major_mm=np.array(major, float), minor_mm=np.array(minor, float),
         orientation_deg=np.array(angle, float), taxels=np.array(taxels, np.int64),
         flags=np.array(flag, np.int64), n_frames=len(signal),
-        extra={"_root": np.array(root, np.int64), "_labels": labels},
+        extra={"_root": np.array(root, np.int64), "_labels": labels,
+               "_total": np.array(total, float)},
     )  # fmt: skip

@@ -42,6 +42,10 @@ class Flag(IntFlag):
     the skin reads as much tension as compression around the contact (as the solid 3-D
     skin can, whose tensile side lobes cancel its compression, ``docs/model.md``
     sections 3a-3b), so the sum is no measure of the load; the force is NaN."""
+    BEYOND_CALIBRATION = 1024
+    """The contact's total signal lies beyond the range its array calibration's weights
+    covered (above the heaviest unsaturated weight): its force would be an extrapolation,
+    so it is NaN (:mod:`~tactsense.estimate.array_calibration`)."""
 
     @classmethod
     def describe(cls, value: int) -> str:

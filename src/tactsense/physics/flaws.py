@@ -19,7 +19,14 @@ FLAW_NAMES = (
     "nonlinearity",
     "viscoelastic",
     "dead",
+    "hysteresis",
+    "drift",
+    "crosstalk",
 )
+"""Flaws a simulation can switch on. The last three are the habits of resistive arrays
+(issue 32): their parameters in ``[flaws]`` default to off, so ``"all"`` reads every
+earlier sensor as before (:mod:`tactsense.physics.piezo`,
+:mod:`tactsense.physics.crosstalk`)."""
 
 
 def draw_gains(spec: SensorSpec, rng=None) -> np.ndarray:

@@ -91,6 +91,30 @@ class Flaws:
     simulation knows its own creep. The one key a description may leave out."""
     dead_tactels: tuple[tuple[int, int], ...] = ()
     """Wired tactels (row, col) that give no signal."""
+    hysteresis: float = 0.0
+    """Piezoresistive cells: excess conductance of the unloading branch over the loading
+    one, at light load after a press, relative [-] (0: none). The unloading branch is
+    ``g (1 + hysteresis (1 - g / g_peak))`` (:func:`tactsense.physics.piezo.hysteresis`);
+    its mean excess over the branch is half this value (the FSR 400 data sheet's "+10 %
+    average" is 0.2). Switched on by the flaw ``hysteresis``."""
+    drift_per_decade: float = 0.0
+    """Piezoresistive cells: rise of the conductance under a constant load per decade of
+    time under load, relative [-] (FSR 400 data sheet: < 0.05 per log10(time)). Switched
+    on by the flaw ``drift``."""
+    temperature_coefficient_per_k: float = 0.0
+    """Piezoresistive cells: relative change of the conductance per kelvin of warming
+    [1/K] (FSR 400 data sheet: resistance -15 % after 1 h at +85 degC, about 0.003/K).
+    Switched on by the flaw ``drift``."""
+    temperature_rate_k_per_s: float = 0.0
+    """Warming of the sensor during a simulated recording, from the start [K/s] (0: held
+    at its calibration temperature). Switched on by the flaw ``drift``."""
+    crosstalk: float = 0.0
+    """Resistive and piezoresistive matrices: share of the conductance of the parallel
+    paths through the other cells of a row/column scan that reaches a reading, in [0, 1]
+    (0: isolated scan, the unscanned lines held at the sensed potential; 1: every
+    unscanned line floating, the full ghost of a passive matrix;
+    :func:`tactsense.physics.crosstalk.scan_conductance`). Switched on by the flaw
+    ``crosstalk``."""
 
 
 @dataclass(frozen=True)
@@ -117,6 +141,9 @@ class Transduction:
     ``strain_gain * eps`` of their separation (eq. 3 when 1) and the reading rises as
     the capacitance, from ``nominal_counts`` untouched. ``resistive``: a generic
     linear transducer, reading ``nominal_counts + counts_per_strain * eps``.
+    ``piezoresistive``: an FSR or conductive-rubber cell read through a voltage divider:
+    conductance as a power of the compressive strain, a reading that saturates at the
+    converter's full scale (:mod:`tactsense.physics.piezo`).
 
     ``polarity = "falling"`` mirrors the reading about its rest value: it reads
     ``nominal_counts`` minus the change the rising sensor would read (iCub's capacitive
@@ -124,7 +151,8 @@ class Transduction:
     """
 
     kind: str = "capacitive"
-    """``capacitive`` (the paper's chain) or ``resistive`` (a generic gain)."""
+    """``capacitive`` (the paper's chain), ``resistive`` (a generic gain) or
+    ``piezoresistive`` (power law through a divider)."""
     polarity: str = "rising"
     """``rising``: the reading rises under load (the paper's finger, FSR and
     piezoresistive cells); ``falling``: it falls from its rest reading."""
@@ -135,7 +163,13 @@ class Transduction:
     dielectric_constant: float = 4.0
     """Capacitive: relative permittivity K_o of the dielectric [-]."""
     counts_per_strain: float = 20000.0
-    """Resistive: change of the reading per unit compressive strain [counts]."""
+    """Resistive: change of the reading per unit compressive strain [counts].
+    Piezoresistive: the span of the divider (full scale minus the rest reading) over the
+    strain at which the cell's conductance equals the divider resistor's (half the span);
+    the slope of the reading at small strain when ``exponent`` is 1."""
+    exponent: float = 1.0
+    """Piezoresistive: the cell's conductance rises as the compressive strain to this power
+    (an FSR's resistance falls roughly as 1/force: 1) [-]."""
 
 
 def convert(annotation: Any, value: Any) -> Any:
@@ -400,10 +434,23 @@ class SpecBase:
         return dataclasses.replace(self, **updates)
 
 
-OPTIONAL = frozenset({"creep_known", "polarity"})
+OPTIONAL = frozenset(
+    {
+        "creep_known",
+        "polarity",
+        "exponent",
+        "hysteresis",
+        "drift_per_decade",
+        "temperature_coefficient_per_k",
+        "temperature_rate_k_per_s",
+        "crosstalk",
+    }
+)
 """Keys a complete description may leave out: they default (``creep_known``: false, so
 that a description written before it existed is not taken to know its creep;
-``polarity``: ``rising``, as every description written before it existed)."""
+``polarity``: ``rising``, as every description written before it existed; the
+piezoresistive exponent and the habits of issue 32, off, so that every description
+written before them reads as it did)."""
 
 
 def read_toml(path: str | Path) -> dict[str, Any]:
@@ -506,6 +553,25 @@ def check_flaws(f: Flaws, shape: tuple[int, int], problems: list[str]) -> None:
         )
     if not 0.0 <= f.delayed_fraction <= 1.0:
         problems.append(f"[flaws] delayed_fraction must lie in [0, 1]; got {f.delayed_fraction!r}")
+    for key in ("hysteresis", "drift_per_decade"):
+        value = getattr(f, key)
+        if not (math.isfinite(value) and 0.0 <= value <= 1.0):
+            problems.append(f"[flaws] {key} must lie in [0, 1]; got {value!r}")
+    if not (math.isfinite(f.crosstalk) and 0.0 <= f.crosstalk <= 1.0):
+        problems.append(
+            f"[flaws] crosstalk must lie in [0, 1] (0: isolated scan, 1: every unscanned "
+            f"line floating); got {f.crosstalk!r}"
+        )
+    for key in ("temperature_coefficient_per_k", "temperature_rate_k_per_s"):
+        value = getattr(f, key)
+        if not math.isfinite(value):
+            problems.append(f"[flaws] {key} must be a finite number; got {value!r}")
+    coefficient = f.temperature_coefficient_per_k
+    if math.isfinite(coefficient) and abs(coefficient) > 0.1:
+        problems.append(
+            f"[flaws] temperature_coefficient_per_k = {coefficient!r} is "
+            "more than 10 % per kelvin; an FSR's is about 0.003/K"
+        )
     rows, cols = shape
     for row, col in f.dead_tactels:
         if not (0 <= row < rows and 0 <= col < cols):
@@ -538,8 +604,11 @@ POLARITIES = ("rising", "falling")
 
 def check_transduction(t: Transduction, problems: list[str]) -> None:
     """Every problem with a transduction section."""
-    if t.kind not in ("capacitive", "resistive"):
-        problems.append(f"[transduction] kind = {t.kind!r}; expected 'capacitive' or 'resistive'")
+    if t.kind not in TRANSDUCTION_KINDS:
+        problems.append(
+            f"[transduction] kind = {t.kind!r}; expected 'capacitive', 'resistive' or "
+            "'piezoresistive'"
+        )
     if t.polarity not in POLARITIES:
         problems.append(
             f"[transduction] polarity = {t.polarity!r}; expected 'rising' (the reading rises "
@@ -548,6 +617,45 @@ def check_transduction(t: Transduction, problems: list[str]) -> None:
     for key in ("strain_gain", "dielectric_thickness_mm", "dielectric_constant"):
         positive(problems, "transduction", key, getattr(t, key))
     positive(problems, "transduction", "counts_per_strain", t.counts_per_strain)
+    positive(problems, "transduction", "exponent", t.exponent)
+    if not problems and t.kind == "piezoresistive" and not 0.2 <= t.exponent <= 5.0:
+        problems.append(
+            f"[transduction] exponent = {t.exponent:g} is outside 0.2..5: a piezoresistive "
+            "cell's conductance rises as a moderate power of the load (an FSR: about 1)"
+        )
+
+
+def habit_rows(spec) -> list[tuple[str, str]]:
+    """Rows for ``sensor check`` on a pad or point set's piezoresistive response and its
+    habits (issue 32), the ones that are on."""
+    t, f, el = spec.transduction, spec.flaws, spec.electronics
+    rows = []
+    if t.kind == "piezoresistive":
+        half = (2**el.adc_bits - 1 - el.nominal_counts) / t.counts_per_strain
+        rows.append(
+            (
+                "piezoresistive response",
+                f"conductance ~ strain^{t.exponent:g} through a divider: half the span at "
+                f"strain {half:.3g}, saturating at {2**el.adc_bits - 1} counts",
+            )
+        )
+    habits = [
+        f"{label} {value:g}"
+        for label, value in (
+            ("hysteresis", f.hysteresis),
+            ("drift per decade", f.drift_per_decade),
+            ("temperature coefficient [1/K]", f.temperature_coefficient_per_k),
+            ("crosstalk", f.crosstalk),
+        )
+        if value
+    ]
+    if habits:
+        rows.append(("habits (flaws)", ", ".join(habits)))
+    return rows
+
+
+TRANSDUCTION_KINDS = ("capacitive", "resistive", "piezoresistive")
+"""The kinds of ``[transduction]`` (a finger is always capacitive)."""
 
 
 def capacitance_f(t: Transduction, area_mm2: float) -> float:

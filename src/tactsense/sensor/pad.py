@@ -28,6 +28,7 @@ from tactsense.sensor.common import (
     check_flaws,
     check_layer,
     check_transduction,
+    habit_rows,
     positive,
 )
 
@@ -136,6 +137,7 @@ class PadSpec(SpecBase):
         ]
         if t.kind == "capacitive":
             rows.append(("junction capacitance", f"{self.junction_capacitance_f * 1e12:.3f} pF"))
+        rows += habit_rows(self)
         return rows
 
     @property

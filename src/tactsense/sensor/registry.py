@@ -200,6 +200,116 @@ ICUB_FTX2_TAXELS = (
 """The iCub fingertip's 12 taxels: published centres [mm] and normals, in frame order."""
 
 
+_FSR_SHEET = (
+    "Interlink FSR 400 Series Data Sheet: open at rest (> 10 MOhm), hysteresis +10 % "
+    "average, drift < 5 % per log10(time), resistance -15 % after 1 h at +85 degC"
+)
+_FSR_GUIDE = (
+    "Interlink FSR Integration Guide: resistance about 1/force (conductance exponent 1), "
+    "read through a voltage divider"
+)
+
+
+def _percent_of_full_scale(percent: float, bits: int = 12) -> float:
+    """Read noise of ``percent`` of a ``bits``-bit converter's full scale [counts]."""
+    return round(percent / 100.0 * (2**bits - 1), 1)
+
+
+def fsr16() -> PadSpec:
+    """A 16x16 force-sensing-resistor matrix, zero at rest, read through a divider.
+
+    The cells' habits come from Interlink's FSR 400 data sheet and integration guide
+    (:mod:`tactsense.physics.piezo`): open at rest (reads 0), conductance about
+    proportional to the load, hysteresis (+10 % average: ``hysteresis = 0.2``), drift
+    under load (< 5 % per decade of time: 0.05), about 0.003/K with temperature; a
+    passive matrix scanned with its unscanned lines floating (``crosstalk = 1``). Read
+    noise 1 % of full scale (41 counts of 12 bits), the issue's 1-2 %. The creep is the
+    FSR's own (``drift_per_decade``), not the paper's rubber's: the viscoelastic
+    fractions are 0 (the overlay is taken not to creep). Assumed: the
+    geometry (4 mm pitch, 3.5-mm cells, under 4 mm of the paper's rubber, sensed 3 mm
+    deep), the divider's resistor (equal to a cell's resistance under about 1 N, the
+    geometric middle of the FSR 402's 0.1-10 N, as Sensitronics' AN-1 advises), and
+    100 Hz.
+    """
+    return PadSpec(
+        name="fsr16",
+        description=(
+            "16x16 FSR matrix, 4 mm pitch, reads 0 at rest, 12-bit divider readout. "
+            f"Cells: {_FSR_SHEET}; {_FSR_GUIDE}. Assumed: geometry, 4 mm rubber overlay, "
+            "divider at 1 N, 100 Hz, noise 1 % of full scale."
+        ),
+        grid=Grid(
+            rows=16,
+            cols=16,
+            row_pitch_mm=4.0,
+            col_pitch_mm=4.0,
+            electrode_x_mm=3.5,
+            electrode_y_mm=3.5,
+        ),
+        layer=Layer(
+            thickness_mm=4.0, youngs_modulus_pa=2.5e5, poisson_ratio=0.5, sensing_depth_mm=3.0
+        ),
+        transduction=Transduction(kind="piezoresistive", counts_per_strain=40000.0, exponent=1.0),
+        electronics=Electronics(adc_bits=12, nominal_counts=0.0, scan_rate_hz=100.0),
+        flaws=Flaws(
+            read_noise_counts=_percent_of_full_scale(1.0),
+            hysteresis=0.2,
+            drift_per_decade=0.05,
+            temperature_coefficient_per_k=0.003,
+            crosstalk=1.0,
+            delayed_fraction=0.0,
+            creep_fraction=0.0,
+        ),
+    )
+
+
+def dsa9205() -> PadSpec:
+    """A piezoresistive robot-hand matrix like the Weiss Robotics DSA 9205 of the
+    Schunk SDH: 14 rows of 6 cells at 3.4 mm pitch, 12 bits, zero at rest.
+
+    Sizes: the SDH's six pads are 6 cells wide and 14 (proximal) or 13 (distal) long
+    (SDHLibrary-C++ ``dsa.h``: ``DSA_MAX_PREAMBLE_SEARCH = 2*3*(6*(14+13)) + 16``); the
+    3.4-mm pitch and 12 bits are the DSA 9205's commonly quoted figures, not checked
+    against a Weiss datasheet here. The conductive rubber's habits are taken as an FSR's
+    (hysteresis 0.2, drift 0.05 per decade, an assumption); its controller is taken to
+    isolate the scan (``crosstalk = 0``, an assumption). Read noise 1 % of full scale;
+    creep as ``fsr16``'s (the drift, no viscoelastic fractions).
+    Assumed: 3 mm of rubber sensed 2 mm deep, 3-mm cells, the divider at 1 N, 30 Hz.
+    """
+    return PadSpec(
+        name="dsa9205",
+        description=(
+            "6x14 piezoresistive robot-hand matrix (Weiss Robotics DSA 9205-like, Schunk "
+            "SDH), 3.4 mm pitch, reads 0 at rest, 12 bits. Sizes: SDHLibrary dsa.h (6x14 "
+            "and 6x13 pads); pitch and bits: the DSA 9205's quoted figures. Assumed: "
+            "FSR-like habits, isolated scan, 3 mm rubber, divider at 1 N, 30 Hz, noise "
+            "1 % of full scale."
+        ),
+        grid=Grid(
+            rows=14,
+            cols=6,
+            row_pitch_mm=3.4,
+            col_pitch_mm=3.4,
+            electrode_x_mm=3.0,
+            electrode_y_mm=3.0,
+        ),
+        layer=Layer(
+            thickness_mm=3.0, youngs_modulus_pa=2.5e5, poisson_ratio=0.5, sensing_depth_mm=2.0
+        ),
+        transduction=Transduction(kind="piezoresistive", counts_per_strain=24000.0, exponent=1.0),
+        electronics=Electronics(adc_bits=12, nominal_counts=0.0, scan_rate_hz=30.0),
+        flaws=Flaws(
+            read_noise_counts=_percent_of_full_scale(1.0),
+            hysteresis=0.2,
+            drift_per_decade=0.05,
+            temperature_coefficient_per_k=0.003,
+            crosstalk=0.0,
+            delayed_fraction=0.0,
+            creep_fraction=0.0,
+        ),
+    )
+
+
 PRESETS = {
     "initial": fearing1990_initial,
     "improved": fearing1990_improved,
@@ -208,6 +318,8 @@ PRESETS = {
     "pad12x32": pad12x32,
     "dome12": dome12,
     "icub_fingertip": icub_fingertip,
+    "fsr16": fsr16,
+    "dsa9205": dsa9205,
 }
 """Built-in sensors by short name (the fingers also answer to ``fearing1990_...``)."""
 

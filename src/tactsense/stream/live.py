@@ -310,6 +310,8 @@ class LiveContacts:
             calibration.check_sensor(sensor)
         self.calibration = calibration
         self.sensor = sensor
+        if threshold is None:  # a weight curve's own threshold, else the sensor's
+            threshold = getattr(calibration, "contact_threshold", None)
         self.threshold = default_threshold(sensor) if threshold is None else float(threshold)
         self.frame_period_s = float(frame_period_s or sensor.scan_period_s)
         self._baseline_frames = max(1, int(baseline_frames))

@@ -311,7 +311,11 @@ def _resistive_deflection(counts, baseline, sensor) -> np.ndarray:
     return np.where(np.isfinite(strain), strain, 0.0)
 
 
-DEFLECTION = {"capacitive": _capacitive_deflection, "resistive": _resistive_deflection}
+DEFLECTION = {
+    "capacitive": _capacitive_deflection,
+    "resistive": _resistive_deflection,
+    "piezoresistive": _resistive_deflection,
+}
 """Transduction kind -> the deflection [-] of a frame from its counts and the baseline."""
 
 

@@ -384,7 +384,7 @@ function planeTaxelAt(px, py) {
 // `d`: a capacitive taxel's eq. 4 solved for the reading, a resistive taxel's linear law
 function countsAt(f, counts, d) {
   const t = state.layout.transduction;
-  if (t.kind === "resistive") return counts - d * t.counts_per_strain + f * t.counts_per_strain;
+  if (t.kind !== "capacitive") return counts - d * t.counts_per_strain + f * t.counts_per_strain;
   return (counts * (1 - d)) / Math.max(1 - f, 1e-3);
 }
 
