@@ -129,7 +129,10 @@ def locate_file(
     -------
     dict
         ``frames``, ``contacts`` (frames with a contact), ``saturated`` (frames flagged
-        SATURATED), ``force_mean_n`` and ``force_max_n`` over the contacts [N].
+        SATURATED), ``force_mean_n`` and ``force_max_n`` over the contacts [N], and
+        ``movement``: when no frame has a contact although the readings moved by more
+        than the threshold, why (:func:`~tactsense.estimate.baseline.movement_warning`);
+        else None.
     """
     output_format(out)
     tally = Tally()
@@ -153,7 +156,22 @@ def locate_file(
             empty = Estimates(*(np.zeros(0) for _ in fields(Estimates)))
             writer.write(0, np.zeros(0), empty)
             writer.rows = 0
-    return {"frames": total, **tally.summary()}
+        movement = None
+        if tally.contacts == 0 and total >= baseline_frames:  # why none: from the readings
+            from tactsense.estimate.baseline import ReadingRange, movement_warning
+
+            extremes = ReadingRange(reader.sensor.shape)
+            for _, frames, _ in reader.chunks(chunk_frames):
+                extremes.update(frames)
+            if calibration is not None:
+                baseline = calibration.baseline
+            else:
+                baseline = np.nanmedian(reader.frames(0, baseline_frames).astype(float), axis=0)
+            movement = movement_warning(
+                extremes, baseline, reader.sensor, threshold, found=False,
+                baseline_frames=None if calibration is not None else baseline_frames,
+            )  # fmt: skip
+    return {"frames": total, **tally.summary(), "movement": movement}
 
 
 class iter_contacts:

@@ -245,3 +245,16 @@ def test_the_examples_in_docs_sensors_md_are_valid_and_print_what_it_says(tmp_pa
             assert f"`rest reading: {rows['rest reading']}`" in flat
         else:
             assert rows["transduction"] == "capacitive, reading falling under load"
+
+
+def test_the_finger_s_per_frame_locate_warns_of_presses_it_does_not_find(tmp_path):
+    finger = ts.fearing1990_initial()
+    path = tmp_path / "finger.h5"
+    ts.write_recording(path, ts.simulate(finger, ts.probe_sweep(finger), rng=0))
+    result = _locate(path, tmp_path / "est.csv", "--threshold", "0.9")
+    assert result.exit_code == 0, result.output
+    said = _said(result)
+    assert "0 with a contact" in said
+    assert "warning: no contact found, yet the readings moved" in said, said
+    result = _locate(path, tmp_path / "est2.csv")  # found: nothing to say
+    assert result.exit_code == 0 and "warning" not in _said(result), result.output

@@ -217,6 +217,11 @@ def locate(
     console.print(
         f"wrote {out}: {summary['frames']} frames, {summary['contacts']} with a contact{note}"
     )
+    if summary.get("movement"):
+        console.print(
+            f"warning: {summary['movement']}",
+            soft_wrap=True, markup=False, highlight=False, emoji=False,
+        )  # fmt: skip
 
 
 @app.command()
