@@ -31,8 +31,11 @@ def _bump_recording(spec, centre_mm, peak, path, *, sigma_mm=2.0, n_frames=40):
     r2 = ((positions[:, :2] - np.asarray(centre_mm)) ** 2).sum(axis=1)
     d = (peak * np.exp(-r2 / (2 * sigma_mm**2))).reshape(spec.shape)
     v0 = spec.electronics.nominal_counts
+    falling = spec.transduction.polarity == "falling"
     if spec.transduction.kind == "resistive":
-        loaded = v0 + spec.transduction.counts_per_strain * d
+        loaded = v0 + (-1 if falling else 1) * spec.transduction.counts_per_strain * d
+    elif falling:  # d = (V_o - V) / (2 V_o - V) solved for the reading
+        loaded = v0 * (1.0 - 2.0 * d) / (1.0 - d)
     else:  # eq. 4 solved for the reading
         loaded = v0 / (1.0 - d)
     frames = np.full((n_frames, *spec.shape), v0)
@@ -154,8 +157,12 @@ def _contacts_panel(view, n=None):
         assert view.locator("#contact-rows tr").count() == n
 
 
-@pytest.mark.parametrize("kind", ["resistive", "capacitive"])
-def test_pad_is_a_grid_in_millimetres_hottest_at_the_touch(page, tmp_path, kind):  # noqa: F811
+@pytest.mark.parametrize(
+    "kind, polarity",
+    [("resistive", "rising"), ("capacitive", "rising"), ("resistive", "falling"),
+     ("capacitive", "falling")],
+)  # fmt: skip
+def test_pad_is_a_grid_in_millimetres_hottest_at_the_touch(page, tmp_path, kind, polarity):  # noqa: F811
     # unequal pitches, so a swapped axis or a squashed aspect ratio shows
     spec = PadSpec(
         name="testpad",
@@ -167,9 +174,10 @@ def test_pad_is_a_grid_in_millimetres_hottest_at_the_touch(page, tmp_path, kind)
             electrode_x_mm=3.0,
             electrode_y_mm=2.0,
         ),
-        transduction=Transduction(kind=kind),
+        transduction=Transduction(kind=kind, polarity=polarity),
         electronics=Electronics(
-            nominal_counts=100.0 if kind == "resistive" else 2000.0, scan_rate_hz=50.0
+            nominal_counts=100.0 if (kind, polarity) == ("resistive", "rising") else 3000.0,
+            scan_rate_hz=50.0,
         ),
     )
     row, col = 4, 7
@@ -230,6 +238,11 @@ def test_pad_is_a_grid_in_millimetres_hottest_at_the_touch(page, tmp_path, kind)
         far = ((centres[0, 0] + centres[0, 1]) / 2).tolist()
         (between, far_seen) = page.evaluate(READ_JS, [mid.tolist(), far])
         counts_seen = _seen_dots(page, 6, 10)
+        # a falling sensor's touched taxel reads the fewest counts: the coldest
+        top = len(page.evaluate("() => window.tactsenseView.layout.colormap.lut")) - 1
+        if polarity == "falling":
+            counts_seen, between = top - counts_seen, [top - between[0], between[1]]
+            far_seen = [top - far_seen[0], far_seen[1]]
         assert np.unravel_index(np.argmax(counts_seen), counts_seen.shape) == (row, col)
         assert between[1] < 6 and between[0] > 120, between
         assert far_seen[1] < 6 and abs(far_seen[0] - counts_seen[0, 0]) <= 3, far_seen

@@ -120,7 +120,11 @@ def _flat_weights(n: int) -> tuple[np.ndarray, np.ndarray]:
 def _transduction(sensor) -> dict:
     """How a reading follows from the deflection (the page's counts mode needs it)."""
     t = sensor.transduction
-    return {"kind": t.kind, "counts_per_strain": float(t.counts_per_strain)}
+    return {
+        "kind": t.kind,
+        "counts_per_strain": float(t.counts_per_strain),
+        "falling": t.polarity == "falling",
+    }
 
 
 def _pad_geometry(sensor) -> dict:

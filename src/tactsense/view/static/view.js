@@ -381,10 +381,19 @@ function planeTaxelAt(px, py) {
 }
 
 // the reading a deflection f gives at a taxel whose frame reads `counts` at deflection
-// `d`: a capacitive taxel's eq. 4 solved for the reading, a resistive taxel's linear law
+// `d`: a capacitive taxel's eq. 4 solved for the reading, a resistive taxel's linear law;
+// a falling sensor's reading moves the other way (capacitive: d = (V_o - V)/(2V_o - V),
+// so V = V_o (1 - 2d)/(1 - d))
 function countsAt(f, counts, d) {
   const t = state.layout.transduction;
-  if (t.kind !== "capacitive") return counts - d * t.counts_per_strain + f * t.counts_per_strain;
+  if (t.kind !== "capacitive") {
+    const sign = t.falling ? -1 : 1;
+    return counts + sign * (f - d) * t.counts_per_strain;
+  }
+  if (t.falling) {
+    const rest = (counts * (1 - d)) / Math.max(1 - 2 * d, 1e-3);
+    return (rest * (1 - 2 * f)) / Math.max(1 - f, 1e-3);
+  }
   return (counts * (1 - d)) / Math.max(1 - f, 1e-3);
 }
 
