@@ -147,13 +147,149 @@ def _surface(s, label, own, u, v, periodic, kr0, kr1, kr2, kc0, kc1, kc2):
     return f, fu, fv, fuu, fvv, fuv
 
 
+@jit(inline="always")
+def _find(uf, a):
+    while uf[a] != a:
+        a = uf[a]
+    return a
+
+
+@jit(nogil=True)
+def _ridge_groups(
+    s, above, active, parent, root_of, final, top, significant, edge_a, edge_b, edge_v,
+    n_edges, ring, periodic, link, group_size, group_top, group_ring, reach, stack,
+):  # fmt: skip
+    """Merge (in ``final``) the regions of one frame that make one extended contact:
+    those joined by ridges (saddles of at least ``ring`` of the lower maximum) into a
+    group holding three or more significant maxima (not bumps of the noise), and those
+    around a hole (taxels below the threshold that the array's border does not reach
+    through taxels below it: a stamp's or a punch's rim around its unstrained middle)."""
+    rows, cols = s.shape
+    n_regions = 0
+    for t in range(above):
+        p = active[t]
+        if parent[p] == p:
+            link[p] = p
+            group_size[p] = 0
+            group_top[p] = -1
+            group_ring[p] = False
+            if final[p] == p:
+                n_regions += 1
+    if n_regions < 2:
+        return
+    for t in range(n_edges):
+        a = _find(final, edge_a[t])
+        b = _find(final, edge_b[t])
+        if a == b or edge_v[t] < ring * min(top[a], top[b]):
+            continue
+        a = _find(link, a)
+        b = _find(link, b)
+        if a != b:
+            link[b] = a
+    # holes: flood the taxels below the threshold from the border (4-connected)
+    n = rows * cols
+    for p in range(n):
+        reach[p] = 0  # 0: not reached, 1: reached from the border, 2: a hole's, seen
+    top_ = 0
+    for p in range(n):
+        r = p // cols
+        c = p - r * cols
+        border = r == 0 or r == rows - 1 or (not periodic and (c == 0 or c == cols - 1))
+        if border and parent[p] < 0:
+            reach[p] = 1
+            stack[top_] = p
+            top_ += 1
+    while top_ > 0:
+        top_ -= 1
+        p = stack[top_]
+        r = p // cols
+        c = p - r * cols
+        for k in range(4):
+            rr = r + (1 if k == 0 else -1 if k == 1 else 0)
+            cc = c + (1 if k == 2 else -1 if k == 3 else 0)
+            if rr < 0 or rr >= rows:
+                continue
+            if periodic:
+                cc %= cols
+            elif cc < 0 or cc >= cols:
+                continue
+            q = rr * cols + cc
+            if reach[q] == 0 and parent[q] < 0:
+                reach[q] = 1
+                stack[top_] = q
+                top_ += 1
+    for p0 in range(n):
+        if reach[p0] != 0 or parent[p0] >= 0:
+            continue
+        # a hole: every region that touches it is one contact
+        anchor = -1
+        reach[p0] = 2
+        stack[0] = p0
+        top_ = 1
+        while top_ > 0:
+            top_ -= 1
+            p = stack[top_]
+            r = p // cols
+            c = p - r * cols
+            for dr in range(-1, 2):
+                rr = r + dr
+                if rr < 0 or rr >= rows:
+                    continue
+                for dc in range(-1, 2):
+                    cc = c + dc
+                    if periodic:
+                        cc %= cols
+                    elif cc < 0 or cc >= cols:
+                        continue
+                    q = rr * cols + cc
+                    if parent[q] >= 0:
+                        m = _find(link, _find(final, root_of[q]))
+                        if anchor < 0:
+                            anchor = m
+                        elif m != anchor:
+                            link[m] = anchor
+                    elif reach[q] == 0 and (dr == 0 or dc == 0):
+                        reach[q] = 2
+                        stack[top_] = q
+                        top_ += 1
+        if anchor >= 0:
+            group_ring[anchor] = True
+    for t in range(above):
+        p = active[t]
+        if parent[p] != p:
+            continue
+        g = _find(link, _find(final, p))
+        if group_ring[p]:
+            group_ring[g] = True
+        if significant[p]:
+            group_size[g] += 1
+    for t in range(above):
+        p = active[t]
+        if parent[p] == p and final[p] == p:
+            g = _find(link, p)
+            if group_top[g] < 0 or top[p] > top[group_top[g]]:
+                group_top[g] = p
+    for t in range(above):
+        p = active[t]
+        if parent[p] == p and final[p] == p:
+            g = _find(link, p)
+            if (group_size[g] >= 3 or group_ring[g]) and group_top[g] != p:
+                final[p] = group_top[g]
+
+
 @jit(nogil=True)
 def segment_into(
     signal, threshold, ratio, periodic, max_contacts, refine, tolerance, max_iterations,
     count, peak_row, peak_col, row, col, value, total, mrr, mcc, mrc, taxels, converged,
-    root, labels,
+    root, labels, dip_floor, ring, weak,
 ):  # fmt: skip
     """Segment every frame into contacts and estimate each (see ``find_contacts``).
+
+    Merging (``find_contacts``): two maxima are one contact when the saddle between them
+    is at least ``ratio`` of the lower or dips from it by less than ``dip_floor``; then
+    maxima joined by ridges (saddles of at least ``ring`` of the lower maximum; taxels
+    above ``weak`` but below ``threshold`` bridge regions they touch) into a group of
+    three or more are one contact (a flat stamp's corners and edges, a punch's rim).
 
     Per frame ``f`` and contact ``k < count[f]`` (by decreasing summed signal): the peak
     taxel, the fractional peak (Newton on the interpolated surface when ``refine``,
@@ -166,9 +302,19 @@ def segment_into(
     p_all = rows * cols
     parent = np.empty(p_all, np.int64)
     root_of = np.empty(p_all, np.int64)
-    edge_a = np.empty(4 * p_all, np.int64)
-    edge_b = np.empty(4 * p_all, np.int64)
-    edge_v = np.empty(4 * p_all, np.float64)
+    n_cap = 4 * p_all + 28 * p_all  # 4 forward pairs a taxel, 28 pairs a bridge
+    edge_a = np.empty(n_cap, np.int64)
+    edge_b = np.empty(n_cap, np.int64)
+    edge_v = np.empty(n_cap, np.float64)
+    edge_weak = np.zeros(n_cap, np.bool_)  # a bridge: for the ridges of the groups only
+    link = np.empty(p_all, np.int64)
+    group_size = np.empty(p_all, np.int64)
+    group_top = np.empty(p_all, np.int64)
+    touched = np.empty(8, np.int64)
+    significant = np.empty(p_all, np.bool_)
+    group_ring = np.empty(p_all, np.bool_)
+    reach = np.empty(p_all, np.int64)
+    stack = np.empty(p_all, np.int64)
     top = np.empty(p_all, np.float64)
     sums = np.empty((p_all, 7), np.float64)  # w, w dr, w dc, w dr2, w dc2, w dr dc, count
     final = np.empty(p_all, np.int64)
@@ -180,7 +326,7 @@ def segment_into(
     kc1 = np.empty_like(kr0)
     kc2 = np.empty_like(kr0)
     active = np.empty(p_all, np.int64)
-    edge_order = np.empty(4 * p_all, np.int64)
+    edge_order = np.empty(n_cap, np.int64)
     ranked = np.empty(p_all, np.int64)
     for f in range(n):
         s = signal[f]
@@ -254,12 +400,49 @@ def segment_into(
                 edge_a[n_edges] = root_of[p]
                 edge_b[n_edges] = root_of[q]
                 edge_v[n_edges] = min(s[r, c], s[rr, cc])
+                edge_weak[n_edges] = False
                 n_edges += 1
+        # ... and taxels above ``weak`` but below the threshold that touch two regions
+        # bridge them (at their own value): a rim broken by a low-gain taxel
+        if weak < threshold:
+            for r in range(rows):
+                for c in range(cols):
+                    w = s[r, c]
+                    if not (w > weak and w <= threshold):
+                        continue
+                    n_touched = 0
+                    for dr in range(-1, 2):
+                        rr = r + dr
+                        if rr < 0 or rr >= rows:
+                            continue
+                        for dc in range(-1, 2):
+                            cc = _wrap(c + dc, cols, periodic)
+                            if cc < 0 or (dr == 0 and dc == 0):
+                                continue
+                            q = rr * cols + cc
+                            if parent[q] < 0:
+                                continue
+                            m = root_of[q]
+                            seen = False
+                            for u in range(n_touched):
+                                if touched[u] == m:
+                                    seen = True
+                            if not seen:
+                                touched[n_touched] = m
+                                n_touched += 1
+                    for u in range(n_touched):
+                        for u2 in range(u + 1, n_touched):
+                            edge_a[n_edges] = touched[u]
+                            edge_b[n_edges] = touched[u2]
+                            edge_v[n_edges] = w
+                            edge_weak[n_edges] = True
+                            n_edges += 1
         for t in range(above):
             p = active[t]
             if parent[p] == p:
                 final[p] = p  # union-find parent among maxima
                 top[p] = s[p // cols, p % cols]
+                significant[p] = True
         if n_edges > 0:
             # highest saddle first: an insertion sort (few edges), no allocation
             for t in range(n_edges):
@@ -273,6 +456,8 @@ def segment_into(
                 edge_order[q + 1] = e
             for t in range(n_edges):
                 e = edge_order[t]
+                if edge_weak[e]:
+                    continue
                 a = edge_a[e]
                 while final[a] != a:
                     a = final[a]
@@ -283,11 +468,21 @@ def segment_into(
                     continue
                 low = min(top[a], top[b])
                 saddle = edge_v[e]
-                if saddle >= ratio * low or low - saddle < threshold:
+                if saddle >= ratio * low or low - saddle < dip_floor:
+                    # the lower maximum is a bump of the noise, or a shoulder of the
+                    # higher one (it counts for the ridge groups, a noise bump does not)
+                    lower = b if top[a] >= top[b] else a
+                    significant[lower] = low - saddle >= dip_floor
                     if top[a] >= top[b]:
                         final[b] = a
                     else:
                         final[a] = b
+            if ring > 0.0:
+                _ridge_groups(
+                    s, above, active, parent, root_of, final, top, significant, edge_a, edge_b,
+                    edge_v, n_edges, ring, periodic, link, group_size, group_top, group_ring,
+                    reach, stack,
+                )  # fmt: skip
         # 4. label each taxel with its merged maximum and accumulate its moments about
         # that maximum (columns unwrapped across the seam of a closed ring)
         for t in range(above):

@@ -79,6 +79,10 @@ class ContactTable:
     """[mm/s]"""
     slip: np.ndarray | None = None
     """True where the contact moves under a roughly constant force (tracker), bool."""
+    area_mm2: np.ndarray | None = None
+    """Area of the contact's taxels, each its cell of the grid (a pad's row pitch times
+    column pitch; a finger's axial step times its arc) [mm^2]; NaN on point sets (set
+    by :func:`find_contacts`; None in a table made otherwise)."""
     extra: dict = field(default_factory=dict)
     """Further per-row columns (name -> 1-D array), e.g. ``axial_mm`` on a finger."""
 
@@ -97,6 +101,7 @@ class ContactTable:
         "minor_mm": "mm",
         "orientation_deg": "deg",
         "taxels": "1",
+        "area_mm2": "mm2",
         "flags": "bits",
         "vx_mm_s": "mm/s",
         "vy_mm_s": "mm/s",
@@ -162,6 +167,27 @@ SADDLE_RATIO = 0.8
 this share of the lower one (and by more than the contact threshold) [-]; otherwise the
 lower is a bump on the same contact and the two regions are merged."""
 
+NOISE_DIP = 3.0
+"""... and only if that dip exceeds this many standard deviations of the difference of
+two taxels' read noise (``NOISE_DIP * sqrt(2) * sigma``, sigma from the sensor's
+``read_noise_counts``; :func:`signal_noise_variance`) [-]: a noisy plateau's bumps are
+not contacts."""
+
+RING_RATIO = 0.1
+"""Maxima joined by ridges (saddles of at least this share of the lower one) into a
+group of three or more are one contact [-]: a flat stamp on a layer reads its rim
+(its corners highest), a punch its ring, each split into bumps by the taxels' gains;
+two probes make two maxima, and stay two. 0 switches the rule off."""
+
+WEAK_SHARE = 0.4
+"""Taxels above this share of the threshold (but below it) that touch two regions join
+them for :data:`RING_RATIO`'s ridges (a rim broken by a low-gain taxel) [-]; they stay
+out of every contact's taxels."""
+
+NOISE_THRESHOLD = 5.0
+"""The default threshold is at least this many standard deviations of the read noise
+(:func:`default_threshold`) [-]."""
+
 METHODS = ("interpolate", "cop", "fit")
 """``interpolate``: the paper's method on the grid (Hann-windowed sinc over 3 taxels on
 each side of the maximum, Newton to 0.01 taxel); ``cop``: the centre of pressure (the
@@ -174,15 +200,23 @@ BLOCK = 4096
 
 
 def default_threshold(sensor) -> float:
-    """Smallest signal that counts as contact [-]: 10 counts above the baseline.
+    """Smallest signal that counts as contact [-]: 10 counts above the baseline, or
+    :data:`NOISE_THRESHOLD` standard deviations of the read noise when that is more.
 
     Capacitive taxels: a fractional deflection of 0.005 (10 counts at the nominal
-    2000, the finger's rule); resistive ones: ``10 / counts_per_strain`` of strain.
+    2000, the finger's rule); resistive ones: ``10 / counts_per_strain`` of strain. An
+    array that reads 1-2 % of its full scale of noise (40-80 counts of 12 bits) needs
+    more: the noise of :func:`signal_noise_variance` sets the floor (pads and point
+    sets; the finger keeps the paper's 10 counts).
     """
     transduction = getattr(sensor, "transduction", None)
     if transduction is not None and transduction.kind == "resistive":
-        return 10.0 / transduction.counts_per_strain
-    return 0.005
+        counts = 10.0 / transduction.counts_per_strain
+    else:
+        counts = 0.005
+    if getattr(sensor, "kind", None) not in ("pad", "points"):
+        return counts
+    return max(counts, NOISE_THRESHOLD * math.sqrt(signal_noise_variance(sensor)))
 
 
 def signal_from_counts(frames, baseline, sensor, *, dead=None):
@@ -246,13 +280,16 @@ def find_contacts(
     saddle: float = SADDLE_RATIO,
     frame_period_s: float | None = None,
     compensator=None,
+    ring: float = RING_RATIO,
 ) -> ContactTable:
     """Every contact of every frame, on any kind of array.
 
     Each frame is segmented into contacts: the taxels above ``threshold`` are assigned
     to a local maximum by steepest ascent (a watershed on the taxel grid, or on the
     neighbour graph of a point set), and maxima separated by a shallow saddle (see
-    :data:`SADDLE_RATIO`) are merged into one contact. Each contact gets a position
+    :data:`SADDLE_RATIO`; or a dip within the read noise, :data:`NOISE_DIP`) are merged
+    into one contact, and on a grid so are maxima joined by ridges into a group of three
+    or more (a flat stamp's rim, :data:`RING_RATIO`). Each contact gets a position
     (``method``), the interpolated peak, its force, its extent (second moments of its
     taxels' signal) and its taxel count.
 
@@ -293,6 +330,8 @@ def find_contacts(
         Added to the ``frame`` column (pieces of a longer recording).
     saddle : float
         :data:`SADDLE_RATIO`, in (0, 1].
+    ring : float
+        :data:`RING_RATIO`, in [0, 1) (0: off; grids only).
 
     Returns
     -------
@@ -310,6 +349,8 @@ def find_contacts(
         raise TactsenseInputError(f"max_contacts must be an integer in 1-64; got {max_contacts!r}")
     if not (isinstance(saddle, float | int) and 0.0 < saddle <= 1.0):
         raise TactsenseInputError(f"saddle must be in (0, 1]; got {saddle!r}")
+    if not (isinstance(ring, float | int) and not isinstance(ring, bool) and 0.0 <= ring < 1.0):
+        raise TactsenseInputError(f"ring must be in [0, 1) (0: off); got {ring!r}")
     threshold = default_threshold(sensor) if threshold is None else threshold
     if not (isinstance(threshold, float | int) and math.isfinite(threshold) and threshold > 0):
         raise TactsenseInputError(f"threshold must be a positive number; got {threshold!r}")
@@ -321,7 +362,7 @@ def find_contacts(
         # creep state runs through the whole batch, so it is applied in one piece)
         options = dict(baseline=baseline, counts=counts, dead=dead, threshold=threshold,
                        max_contacts=max_contacts, method=method, saddle=saddle,
-                       calibration=calibration)  # fmt: skip
+                       calibration=calibration, ring=ring)  # fmt: skip
         return ContactTable.concatenate(
             find_contacts(frames[lo : lo + BLOCK], sensor, first_frame=first_frame + lo, **options)
             for lo in range(0, len(frames), BLOCK)
@@ -371,7 +412,7 @@ def find_contacts(
     if kind == "points":
         table = _points_contacts(signal, sensor, threshold, saddle, max_contacts, method)
     else:
-        table = _grid_contacts(signal, sensor, threshold, saddle, max_contacts, method)
+        table = _grid_contacts(signal, sensor, threshold, saddle, max_contacts, method, ring)
     table.flags |= flags[table.frame]
     if array_calibration:
         table.force_n = calibration.force(table.force_n)
@@ -396,7 +437,17 @@ def _mark_saturated(table: ContactTable, saturated: np.ndarray, sensor) -> None:
             table.flags[k] &= ~int(Flag.SATURATED)
 
 
-def _segment(signal, threshold, saddle, periodic, max_contacts, refine):
+def dip_floor(sensor, threshold: float) -> float:
+    """Smallest dip from the lower maximum to the saddle that keeps two maxima apart
+    [-]: the threshold, or :data:`NOISE_DIP` standard deviations of two taxels' read
+    noise difference when that is more (pads and point sets)."""
+    if getattr(sensor, "kind", None) not in ("pad", "points"):
+        return float(threshold)
+    noise = NOISE_DIP * math.sqrt(2.0 * signal_noise_variance(sensor))
+    return max(float(threshold), noise)
+
+
+def _segment(signal, threshold, saddle, periodic, max_contacts, refine, floor=None, ring=0.0):
     """The compiled segmentation of (N, rows, cols) signal, block by block."""
     from tactsense.estimate._contacts_fast import segment_into
     from tactsense.estimate.localize import MAX_ITERATIONS, TOLERANCE
@@ -420,6 +471,8 @@ def _segment(signal, threshold, saddle, periodic, max_contacts, refine):
                 out["row"][lo:hi], out["col"][lo:hi], out["value"][lo:hi], out["total"][lo:hi],
                 out["rr"][lo:hi], out["cc"][lo:hi], out["rc"][lo:hi], taxels[lo:hi],
                 converged[lo:hi], root[lo:hi], labels[lo:hi],
+                float(threshold if floor is None else floor), float(ring),
+                float(WEAK_SHARE * threshold if ring > 0 else threshold),
             )  # fmt: skip
     keep = np.arange(k)[np.newaxis, :] < count[:, np.newaxis]
     frame = np.broadcast_to(np.arange(n)[:, np.newaxis], (n, k))[keep]
@@ -452,7 +505,9 @@ def _extent(rr, cc, rc, scale_r: float, scale_c: float):
     return major, minor, angle
 
 
-def _grid_contacts(signal, sensor, threshold, saddle, max_contacts, method) -> ContactTable:
+def _grid_contacts(
+    signal, sensor, threshold, saddle, max_contacts, method, ring=RING_RATIO
+) -> ContactTable:
     kind = sensor.kind
     if method == "fit" and kind != "pad":
         raise TactsenseInputError(
@@ -460,7 +515,8 @@ def _grid_contacts(signal, sensor, threshold, saddle, max_contacts, method) -> C
         )
     periodic = kind == "finger" and sensor.closes_circumference
     refine = method == "interpolate" and kind == "pad"
-    seg, labels = _segment(signal, threshold, saddle, periodic, max_contacts, refine)
+    floor = dip_floor(sensor, threshold)
+    seg, labels = _segment(signal, threshold, saddle, periodic, max_contacts, refine, floor, ring)
     n = len(seg["frame"])
     rows, cols = sensor.shape
     flags = np.zeros(n, np.int64)
@@ -482,6 +538,7 @@ def _grid_contacts(signal, sensor, threshold, saddle, max_contacts, method) -> C
         major, minor, angle = _extent(
             seg["rr"], seg["cc"], seg["rc"], g.row_pitch_mm, g.col_pitch_mm
         )
+        cell_mm2 = g.row_pitch_mm * g.col_pitch_mm
         flags[(method == "interpolate") & ~seg["converged"]] |= int(Flag.NOT_CONVERGED)
         with np.errstate(invalid="ignore"):
             edge = (row < 0.5) | (row > rows - 1.5) | (col < 0.5) | (col > cols - 1.5)
@@ -498,13 +555,15 @@ def _grid_contacts(signal, sensor, threshold, saddle, max_contacts, method) -> C
         step_axial = float(np.diff(tactel_to_surface(sensor, np.array([1.0, 2.0]), 0.0)[0])[0])
         step_arc = sensor.radius_mm * math.radians(sensor.array.spacing_angle_deg)
         major, minor, angle = _extent(seg["rr"], seg["cc"], seg["rc"], abs(step_axial), step_arc)
+        cell_mm2 = abs(step_axial) * step_arc
         extra = {"axial_mm": axial, "angle_deg": angle_deg}
     extra["_root"] = seg["root"]
     extra["_labels"] = labels
     table = ContactTable(
         frame=seg["frame"], contact=seg["contact"], x_mm=x, y_mm=y, z_mm=z, row=row, col=col,
         force_n=force, peak=peak, major_mm=major, minor_mm=minor, orientation_deg=angle,
-        taxels=seg["taxels"], flags=flags, n_frames=len(signal), extra=extra,
+        taxels=seg["taxels"], area_mm2=seg["taxels"] * cell_mm2, flags=flags,
+        n_frames=len(signal), extra=extra,
     )  # fmt: skip
     return table
 
@@ -731,8 +790,10 @@ def points_force_kernel(sensor):
     return kernel
 
 
-def _points_segment(s, threshold, saddle, neighbours):
-    """Labels (the maximum each taxel climbs to, -1 below the threshold) of one frame."""
+def _points_segment(s, threshold, saddle, neighbours, floor=None):
+    """Labels (the maximum each taxel climbs to, -1 below the threshold) of one frame
+    (``floor``: the smallest dip that keeps two maxima apart, :func:`dip_floor`)."""
+    floor = threshold if floor is None else floor
     n = len(s)
     parent = np.full(n, -1)
     for i in range(n):
@@ -766,7 +827,7 @@ def _points_segment(s, threshold, saddle, neighbours):
         if a == b:
             continue
         low = min(s[a], s[b])
-        if value >= saddle * low or low - value < threshold:
+        if value >= saddle * low or low - value < floor:
             if s[a] >= s[b]:
                 final[b] = a
             else:
@@ -815,11 +876,12 @@ def _points_peak(s, own, peak, positions, normals, neighbours):
 def _points_contacts(signal, sensor, threshold, saddle, max_contacts, method) -> ContactTable:
     positions, normals, neighbours = _points_geometry(sensor)
     kernel = points_force_kernel(sensor)
+    floor = dip_floor(sensor, threshold)
     rows = []
     labels = np.full(signal.shape, -1, dtype=np.int64)
     for f in range(len(signal)):
         s = signal[f, 0]
-        label = _points_segment(s, threshold, saddle, neighbours)
+        label = _points_segment(s, threshold, saddle, neighbours, floor)
         labels[f, 0] = label
         found = []
         for r in np.unique(label[label >= 0]):
@@ -865,6 +927,6 @@ def _points_contacts(signal, sensor, threshold, saddle, max_contacts, method) ->
         y_mm=point[:, 1], z_mm=point[:, 2], row=nan, col=nan.copy(), force_n=np.array(force),
         peak=np.array(peak), major_mm=np.array(major, float), minor_mm=np.array(minor, float),
         orientation_deg=np.array(angle, float), taxels=np.array(taxels, np.int64),
-        flags=np.array(flag, np.int64), n_frames=len(signal),
+        area_mm2=np.full(len(rows), np.nan), flags=np.array(flag, np.int64), n_frames=len(signal),
         extra={"_root": np.array(root, np.int64), "_labels": labels},
     )  # fmt: skip
