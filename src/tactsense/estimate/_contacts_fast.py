@@ -157,13 +157,17 @@ def _find(uf, a):
 @jit(nogil=True)
 def _ridge_groups(
     s, above, active, parent, root_of, final, top, significant, edge_a, edge_b, edge_v,
-    n_edges, ring, periodic, link, group_size, group_top, group_ring, reach, stack,
+    n_edges, ring, periodic, link, group_size, group_top, group_ring, reach, stack, extended,
+    weak,
 ):  # fmt: skip
     """Merge (in ``final``) the regions of one frame that make one extended contact:
     those joined by ridges (saddles of at least ``ring`` of the lower maximum) into a
     group holding three or more significant maxima (not bumps of the noise), and those
-    around a hole (taxels below the threshold that the array's border does not reach
-    through taxels below it: a stamp's or a punch's rim around its unstrained middle)."""
+    around a hole (taxels below ``weak`` that the array's border does not reach through
+    taxels below it: a stamp's or a punch's rim around its unstrained middle, taxels
+    between ``weak`` and the threshold counting as rim).
+    The maximum a group is merged into is marked ``extended`` (its position is the
+    centre of its signal, not a peak)."""
     rows, cols = s.shape
     n_regions = 0
     for t in range(above):
@@ -186,74 +190,96 @@ def _ridge_groups(
         b = _find(link, b)
         if a != b:
             link[b] = a
-    # holes: flood the taxels below the threshold from the border (4-connected)
+    # holes: flood the taxels below the threshold from the border (4-connected), once
+    # through all of them and once through those below ``weak`` only (the others a rim)
     n = rows * cols
-    for p in range(n):
-        reach[p] = 0  # 0: not reached, 1: reached from the border, 2: a hole's, seen
-    top_ = 0
-    for p in range(n):
-        r = p // cols
-        c = p - r * cols
-        border = r == 0 or r == rows - 1 or (not periodic and (c == 0 or c == cols - 1))
-        if border and parent[p] < 0:
-            reach[p] = 1
-            stack[top_] = p
-            top_ += 1
-    while top_ > 0:
-        top_ -= 1
-        p = stack[top_]
-        r = p // cols
-        c = p - r * cols
-        for k in range(4):
-            rr = r + (1 if k == 0 else -1 if k == 1 else 0)
-            cc = c + (1 if k == 2 else -1 if k == 3 else 0)
-            if rr < 0 or rr >= rows:
-                continue
-            if periodic:
-                cc %= cols
-            elif cc < 0 or cc >= cols:
-                continue
-            q = rr * cols + cc
-            if reach[q] == 0 and parent[q] < 0:
-                reach[q] = 1
-                stack[top_] = q
+    for pass_ in range(2):
+        limit = np.inf if pass_ == 0 else weak
+        for p in range(n):
+            reach[p] = 0  # 0: not reached, 1: reached from the border, 2: a hole's, seen
+        top_ = 0
+        for p in range(n):
+            r = p // cols
+            c = p - r * cols
+            border = r == 0 or r == rows - 1 or (not periodic and (c == 0 or c == cols - 1))
+            if border and parent[p] < 0 and s[r, c] <= limit:
+                reach[p] = 1
+                stack[top_] = p
                 top_ += 1
-    for p0 in range(n):
-        if reach[p0] != 0 or parent[p0] >= 0:
-            continue
-        # a hole: every region that touches it is one contact
-        anchor = -1
-        reach[p0] = 2
-        stack[0] = p0
-        top_ = 1
         while top_ > 0:
             top_ -= 1
             p = stack[top_]
             r = p // cols
             c = p - r * cols
-            for dr in range(-1, 2):
-                rr = r + dr
+            for k in range(4):
+                rr = r + (1 if k == 0 else -1 if k == 1 else 0)
+                cc = c + (1 if k == 2 else -1 if k == 3 else 0)
                 if rr < 0 or rr >= rows:
                     continue
-                for dc in range(-1, 2):
-                    cc = c + dc
-                    if periodic:
-                        cc %= cols
-                    elif cc < 0 or cc >= cols:
+                if periodic:
+                    cc %= cols
+                elif cc < 0 or cc >= cols:
+                    continue
+                q = rr * cols + cc
+                if reach[q] == 0 and parent[q] < 0 and s[rr, cc] <= limit:
+                    reach[q] = 1
+                    stack[top_] = q
+                    top_ += 1
+        for p0 in range(n):
+            if reach[p0] != 0 or parent[p0] >= 0 or s[p0 // cols, p0 % cols] > limit:
+                continue
+            # a hole: every region that touches it is one contact
+            anchor = -1
+            reach[p0] = 2
+            stack[0] = p0
+            top_ = 1
+            while top_ > 0:
+                top_ -= 1
+                p = stack[top_]
+                r = p // cols
+                c = p - r * cols
+                for dr in range(-1, 2):
+                    rr = r + dr
+                    if rr < 0 or rr >= rows:
                         continue
-                    q = rr * cols + cc
-                    if parent[q] >= 0:
-                        m = _find(link, _find(final, root_of[q]))
-                        if anchor < 0:
-                            anchor = m
-                        elif m != anchor:
-                            link[m] = anchor
-                    elif reach[q] == 0 and (dr == 0 or dc == 0):
-                        reach[q] = 2
-                        stack[top_] = q
-                        top_ += 1
-        if anchor >= 0:
-            group_ring[anchor] = True
+                    for dc in range(-1, 2):
+                        cc = c + dc
+                        if periodic:
+                            cc %= cols
+                        elif cc < 0 or cc >= cols:
+                            continue
+                        q = rr * cols + cc
+                        if parent[q] >= 0:
+                            m = _find(link, _find(final, root_of[q]))
+                            if anchor < 0:
+                                anchor = m
+                            elif m != anchor:
+                                link[m] = anchor
+                        elif s[rr, cc] > limit:
+                            # a wall taxel below the threshold: the regions it touches
+                            for dr2 in range(-1, 2):
+                                r2 = rr + dr2
+                                if r2 < 0 or r2 >= rows:
+                                    continue
+                                for dc2 in range(-1, 2):
+                                    c2 = cc + dc2
+                                    if periodic:
+                                        c2 %= cols
+                                    elif c2 < 0 or c2 >= cols:
+                                        continue
+                                    q2 = r2 * cols + c2
+                                    if parent[q2] >= 0:
+                                        m = _find(link, _find(final, root_of[q2]))
+                                        if anchor < 0:
+                                            anchor = m
+                                        elif m != anchor:
+                                            link[m] = anchor
+                        elif reach[q] == 0 and (dr == 0 or dc == 0):
+                            reach[q] = 2
+                            stack[top_] = q
+                            top_ += 1
+            if anchor >= 0:
+                group_ring[anchor] = True
     for t in range(above):
         p = active[t]
         if parent[p] != p:
@@ -275,13 +301,14 @@ def _ridge_groups(
             g = _find(link, p)
             if (group_size[g] >= 3 or group_ring[g]) and group_top[g] != p:
                 final[p] = group_top[g]
+                extended[group_top[g]] = True
 
 
 @jit(nogil=True)
 def segment_into(
     signal, threshold, ratio, periodic, max_contacts, refine, tolerance, max_iterations,
     count, peak_row, peak_col, row, col, value, total, mrr, mcc, mrc, taxels, converged,
-    root, labels, dip_floor, ring, weak,
+    root, labels, dip_floor, ring, weak, wide,
 ):  # fmt: skip
     """Segment every frame into contacts and estimate each (see ``find_contacts``).
 
@@ -289,7 +316,9 @@ def segment_into(
     is at least ``ratio`` of the lower or dips from it by less than ``dip_floor``; then
     maxima joined by ridges (saddles of at least ``ring`` of the lower maximum; taxels
     above ``weak`` but below ``threshold`` bridge regions they touch) into a group of
-    three or more are one contact (a flat stamp's corners and edges, a punch's rim).
+    three or more are one contact (a flat stamp's corners and edges, a punch's rim), as
+    are regions around a hole; ``wide[f, k]``: the contact is such a group (its
+    position is the centre of its signal).
 
     Per frame ``f`` and contact ``k < count[f]`` (by decreasing summed signal): the peak
     taxel, the fractional peak (Newton on the interpolated surface when ``refine``,
@@ -315,6 +344,7 @@ def segment_into(
     group_ring = np.empty(p_all, np.bool_)
     reach = np.empty(p_all, np.int64)
     stack = np.empty(p_all, np.int64)
+    extended = np.zeros(p_all, np.bool_)
     top = np.empty(p_all, np.float64)
     sums = np.empty((p_all, 7), np.float64)  # w, w dr, w dc, w dr2, w dc2, w dr dc, count
     final = np.empty(p_all, np.int64)
@@ -443,6 +473,7 @@ def segment_into(
                 final[p] = p  # union-find parent among maxima
                 top[p] = s[p // cols, p % cols]
                 significant[p] = True
+                extended[p] = False
         if n_edges > 0:
             # highest saddle first: an insertion sort (few edges), no allocation
             for t in range(n_edges):
@@ -481,7 +512,7 @@ def segment_into(
                 _ridge_groups(
                     s, above, active, parent, root_of, final, top, significant, edge_a, edge_b,
                     edge_v, n_edges, ring, periodic, link, group_size, group_top, group_ring,
-                    reach, stack,
+                    reach, stack, extended, weak,
                 )  # fmt: skip
         # 4. label each taxel with its merged maximum and accumulate its moments about
         # that maximum (columns unwrapped across the seam of a closed ring)
@@ -553,7 +584,7 @@ def segment_into(
             u = float(mr)
             v = float(mc)
             ok = False
-            if refine:
+            if refine and not extended[m]:
                 # Newton on the interpolated surface of this contact, from its maximum
                 for _ in range(max_iterations):
                     f0, fu, fv, fuu, fvv, fuv = _surface(
@@ -586,6 +617,7 @@ def segment_into(
             )
             value[f, k] = f0
             converged[f, k] = ok
+            wide[f, k] = extended[m]
             if periodic:
                 col[f, k] = col[f, k] % cols
 
@@ -716,7 +748,7 @@ def _move_track(i, to, t_pos, t_vel, t_force, t_dforce, t_last, t_id):
 @jit(nogil=True)
 def track_into(
     frame, pos, force, start, end, t_pos, t_vel, t_force, t_dforce, t_last, t_id, counters,
-    dt, gate, weight, max_missing, smoothing, slip_speed, slip_rate, far,
+    dt, gate, weight, max_missing, smoothing, slip_speed, slip_rate, far, reach,
     out_id, out_vel, out_slip, ev_frame, ev_kind, ev_id, ev_other,
 ):  # fmt: skip
     """The compiled :class:`~tactsense.estimate.track.ContactTracker` (same rules, same
@@ -725,7 +757,8 @@ def track_into(
     Tracks live in ``t_*[:counters[0]]``; ``counters`` = (tracks alive, next id,
     events written). Event kinds: 0 birth, 1 death, 2 merge, 3 split. Returns -1 when
     the track or event arrays are full (the caller grows them and runs again from its
-    saved state), else 0.
+    saved state), else 0. ``reach[k]``: the gate of row ``k``'s contact [mm] (the gate,
+    or more for a contact larger than it).
     """
     n = frame.shape[0]
     cap = t_id.shape[0]
@@ -767,7 +800,7 @@ def track_into(
                     d2 += diff * diff
                 d = math.sqrt(d2)
                 distance[i, j] = d
-                if d <= gate:
+                if d <= reach[lo + j]:
                     cost[i, j] = d + weight * abs(t_force[i] - force[lo + j])
                 else:
                     cost[i, j] = far
@@ -800,7 +833,7 @@ def track_into(
                 continue
             best = -1
             for j in range(n_c):
-                if owner[j] >= 0 and distance[i, j] <= gate:
+                if owner[j] >= 0 and distance[i, j] <= reach[lo + j]:
                     if best < 0 or distance[i, j] < distance[i, best]:
                         best = j
             if best >= 0:
@@ -820,7 +853,7 @@ def track_into(
                 continue
             best = -1
             for i in range(n_t):
-                if match[i] >= 0 and distance[i, j] <= gate:
+                if match[i] >= 0 and distance[i, j] <= reach[lo + j]:
                     if best < 0 or distance[i, j] < distance[best, j]:
                         best = i
             parents[j] = t_id[best] if best >= 0 else -1

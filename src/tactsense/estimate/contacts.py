@@ -461,6 +461,7 @@ def _segment(signal, threshold, saddle, periodic, max_contacts, refine, floor=No
     taxels = np.empty((n, k), np.int64)
     converged = np.empty((n, k), np.bool_)
     root = np.empty((n, k), np.int64)
+    wide = np.zeros((n, k), np.bool_)
     labels = np.empty((n, rows, cols), np.int64)
     with deferred_interrupts():
         for lo in range(0, n, BLOCK):
@@ -472,7 +473,7 @@ def _segment(signal, threshold, saddle, periodic, max_contacts, refine, floor=No
                 out["rr"][lo:hi], out["cc"][lo:hi], out["rc"][lo:hi], taxels[lo:hi],
                 converged[lo:hi], root[lo:hi], labels[lo:hi],
                 float(threshold if floor is None else floor), float(ring),
-                float(WEAK_SHARE * threshold if ring > 0 else threshold),
+                float(WEAK_SHARE * threshold if ring > 0 else threshold), wide[lo:hi],
             )  # fmt: skip
     keep = np.arange(k)[np.newaxis, :] < count[:, np.newaxis]
     frame = np.broadcast_to(np.arange(n)[:, np.newaxis], (n, k))[keep]
@@ -486,6 +487,7 @@ def _segment(signal, threshold, saddle, periodic, max_contacts, refine, floor=No
         root=root[keep],
         peak_row=peak_row[keep],
         peak_col=peak_col[keep],
+        wide=wide[keep],
     )
     return rows_out, labels
 
@@ -535,6 +537,10 @@ def _grid_contacts(
         else:
             force = pad_contact_force(signal, labels, seg, sensor)
         pad_merged_force(signal, labels, seg, row, col, sensor, threshold, force)
+        if seg["wide"].any():
+            # an extended contact (a stamp's rim): no point load explains it; its summed
+            # signal over a point load's summed response per newton
+            force = np.where(seg["wide"], seg["total"] / _kernel_total(sensor), force)
         major, minor, angle = _extent(
             seg["rr"], seg["cc"], seg["rc"], g.row_pitch_mm, g.col_pitch_mm
         )
@@ -711,6 +717,15 @@ def signal_noise_variance(sensor) -> float:
     if transduction is not None and transduction.kind == "resistive":
         return counts / transduction.counts_per_strain**2
     return counts / sensor.electronics.nominal_counts**2
+
+
+@functools.lru_cache(maxsize=16)
+def _kernel_total(sensor) -> float:
+    """The summed signal of :func:`pad_force_kernel`'s window per newton, averaged over
+    the load's sub-taxel positions [-/N]: an extended contact's force is its summed
+    signal over this (``find_contacts``)."""
+    kernel, _, _ = pad_force_kernel(sensor)
+    return float(kernel.sum(axis=(2, 3)).mean())
 
 
 @functools.lru_cache(maxsize=16)
