@@ -158,7 +158,7 @@ def _find(uf, a):
 def _ridge_groups(
     s, above, active, parent, root_of, final, top, significant, edge_a, edge_b, edge_v,
     n_edges, ring, periodic, link, group_size, group_top, group_ring, reach, stack, extended,
-    weak,
+    weak, far, pair_share,
 ):  # fmt: skip
     """Merge (in ``final``) the regions of one frame that make one extended contact:
     those joined by ridges (saddles of at least ``ring`` of the lower maximum) into a
@@ -166,8 +166,10 @@ def _ridge_groups(
     around a hole (taxels below ``weak`` that the array's border does not reach through
     taxels below it: a stamp's or a punch's rim around its unstrained middle, taxels
     between ``weak`` and the threshold counting as rim).
-    The maximum a group is merged into is marked ``extended`` (its position is the
-    centre of its signal, not a peak)."""
+    Two maxima at least ``far`` taxels apart (beyond the reach of two point loads' tails)
+    joined by a ridge of at least ``pair_share`` of their summed heights are one contact
+    too (a cylinder's two ends). The maximum a group is merged into is marked
+    ``extended`` (its position is the centre of its signal, not a peak)."""
     rows, cols = s.shape
     n_regions = 0
     for t in range(above):
@@ -186,10 +188,19 @@ def _ridge_groups(
         b = _find(final, edge_b[t])
         if a == b or edge_v[t] < ring * min(top[a], top[b]):
             continue
+        ra = a // cols
+        rb = b // cols
+        dcol = abs((a - ra * cols) - (b - rb * cols))
+        if periodic and dcol > cols // 2:
+            dcol = cols - dcol
+        apart = math.hypot(ra - rb, dcol) >= far
+        pair = apart and edge_v[t] >= pair_share * (top[a] + top[b])
         a = _find(link, a)
         b = _find(link, b)
         if a != b:
             link[b] = a
+        if pair:
+            group_ring[a] = True
     # holes: flood the taxels below the threshold from the border (4-connected), once
     # through all of them and once through those below ``weak`` only (the others a rim)
     n = rows * cols
@@ -308,7 +319,7 @@ def _ridge_groups(
 def segment_into(
     signal, threshold, ratio, periodic, max_contacts, refine, tolerance, max_iterations,
     count, peak_row, peak_col, row, col, value, total, mrr, mcc, mrc, taxels, converged,
-    root, labels, dip_floor, ring, weak, wide,
+    root, labels, dip_floor, ring, weak, wide, far, pair_share,
 ):  # fmt: skip
     """Segment every frame into contacts and estimate each (see ``find_contacts``).
 
@@ -345,6 +356,7 @@ def segment_into(
     reach = np.empty(p_all, np.int64)
     stack = np.empty(p_all, np.int64)
     extended = np.zeros(p_all, np.bool_)
+    n_sig = np.zeros(p_all, np.int64)
     top = np.empty(p_all, np.float64)
     sums = np.empty((p_all, 7), np.float64)  # w, w dr, w dc, w dr2, w dc2, w dr dc, count
     final = np.empty(p_all, np.int64)
@@ -512,7 +524,7 @@ def segment_into(
                 _ridge_groups(
                     s, above, active, parent, root_of, final, top, significant, edge_a, edge_b,
                     edge_v, n_edges, ring, periodic, link, group_size, group_top, group_ring,
-                    reach, stack, extended, weak,
+                    reach, stack, extended, weak, far, pair_share,
                 )  # fmt: skip
         # 4. label each taxel with its merged maximum and accumulate its moments about
         # that maximum (columns unwrapped across the seam of a closed ring)
@@ -522,6 +534,20 @@ def segment_into(
             while final[m] != m:
                 m = final[m]
             root_of[p] = m
+        # a region holding two significant maxima or more (a shoulder besides its peak)
+        # is extended too: its peak may sit anywhere on it, its centre does not
+        for t in range(above):
+            p = active[t]
+            if parent[p] == p:
+                n_sig[root_of[p]] = 0
+        for t in range(above):
+            p = active[t]
+            if parent[p] == p and significant[p]:
+                n_sig[root_of[p]] += 1
+        for t in range(above):
+            p = active[t]
+            if parent[p] == p and final[p] == p and n_sig[p] >= 2 and ring > 0.0:
+                extended[p] = True
         n_regions = 0
         for t in range(above):
             p = active[t]

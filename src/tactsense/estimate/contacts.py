@@ -184,6 +184,12 @@ WEAK_SHARE = 0.4
 them for :data:`RING_RATIO`'s ridges (a rim broken by a low-gain taxel) [-]; they stay
 out of every contact's taxels."""
 
+PAIR_RIDGE = 0.25
+"""Two maxima farther apart than two point loads' tails reach (:func:`point_reach`) that
+are joined by a ridge of at least this share of their summed heights are one contact
+[-] (a cylinder lying across a pad reads its two ends highest; the tails of two loads
+that far apart make less than 0.1 of each one's peak at the midpoint)."""
+
 NOISE_THRESHOLD = 5.0
 """The default threshold is at least this many standard deviations of the read noise
 (:func:`default_threshold`) [-]."""
@@ -447,7 +453,31 @@ def dip_floor(sensor, threshold: float) -> float:
     return max(float(threshold), noise)
 
 
-def _segment(signal, threshold, saddle, periodic, max_contacts, refine, floor=None, ring=0.0):
+@functools.lru_cache(maxsize=16)
+def point_reach(sensor) -> float:
+    """Distance between two maxima beyond which two point loads cannot make a ridge
+    between them [taxel] (pads; inf otherwise): twice the farthest a 1.6-mm probe's
+    response reaches 0.1 of its peak (over its sub-taxel positions), plus twice the
+    farthest a load lies from its peak taxel (half a diagonal), plus one taxel."""
+    if getattr(sensor, "kind", None) != "pad":
+        return math.inf
+    kernel, step, half = pad_force_kernel(sensor)
+    reach = 0.0
+    n = kernel.shape[0]
+    offsets = np.arange(-half, half + 1, dtype=float)
+    for a in range(n):
+        for b in range(n):
+            k = kernel[a, b]
+            ii, jj = np.nonzero(k >= 0.1 * k.max())
+            d = np.hypot(offsets[ii] - a * step, offsets[jj] - b * step)
+            reach = max(reach, float(d.max()))
+    return 2.0 * reach + math.sqrt(2.0) + 1.0
+
+
+def _segment(
+    signal, threshold, saddle, periodic, max_contacts, refine, floor=None, ring=0.0,
+    far=math.inf,
+):  # fmt: skip
     """The compiled segmentation of (N, rows, cols) signal, block by block."""
     from tactsense.estimate._contacts_fast import segment_into
     from tactsense.estimate.localize import MAX_ITERATIONS, TOLERANCE
@@ -474,6 +504,7 @@ def _segment(signal, threshold, saddle, periodic, max_contacts, refine, floor=No
                 converged[lo:hi], root[lo:hi], labels[lo:hi],
                 float(threshold if floor is None else floor), float(ring),
                 float(WEAK_SHARE * threshold if ring > 0 else threshold), wide[lo:hi],
+                float(far), PAIR_RIDGE,
             )  # fmt: skip
     keep = np.arange(k)[np.newaxis, :] < count[:, np.newaxis]
     frame = np.broadcast_to(np.arange(n)[:, np.newaxis], (n, k))[keep]
@@ -518,7 +549,10 @@ def _grid_contacts(
     periodic = kind == "finger" and sensor.closes_circumference
     refine = method == "interpolate" and kind == "pad"
     floor = dip_floor(sensor, threshold)
-    seg, labels = _segment(signal, threshold, saddle, periodic, max_contacts, refine, floor, ring)
+    far = point_reach(sensor) if ring > 0 else math.inf
+    seg, labels = _segment(
+        signal, threshold, saddle, periodic, max_contacts, refine, floor, ring, far
+    )
     n = len(seg["frame"])
     rows, cols = sensor.shape
     flags = np.zeros(n, np.int64)
