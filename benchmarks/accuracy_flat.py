@@ -16,11 +16,11 @@ Indenters (``tactsense.physics.indenters``): rigid square stamps of 1-5 pitches 
 whose noise-free peak reads half the A/D range above the rest reading (a firm press
 well clear of the noise; stated in the table).
 
-Counted over every frame of every press: the share of frames with exactly one contact (``find_contacts``, default
-threshold: 5 sigma of the noise), and the ids per press (``ContactTracker`` over the
-whole recording; the distinct ids in a press's frames). Two columns: the saddle rule
-alone (``ring=0``: what ``find_contacts`` did before the ridge groups, with the same
-noise-aware threshold and dip) and now (default).
+Counted over every frame of every press: the share of frames with exactly one contact
+(``find_contacts``, default threshold: 5 sigma of the noise), and the ids per press
+(``ContactTracker`` over the whole recording; the distinct ids in a press's frames).
+Two columns: the saddle rule alone (``ring=0``: what ``find_contacts`` did before the
+ridge groups, with the same noise-aware threshold and dip) and now (default).
 
 Two probes: two equal 1.6-mm spheres 1.6, 1.8, 2 and 2.5 pitches apart, their midpoint
 at 24 sub-taxel phases over one pitch along the columns, on the preset with read noise

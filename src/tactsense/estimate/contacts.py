@@ -184,11 +184,12 @@ WEAK_SHARE = 0.4
 them for :data:`RING_RATIO`'s ridges (a rim broken by a low-gain taxel) [-]; they stay
 out of every contact's taxels."""
 
-PAIR_RIDGE = 0.25
+PAIR_RIDGE = 0.15
 """Two maxima farther apart than two point loads' tails reach (:func:`point_reach`) that
 are joined by a ridge of at least this share of their summed heights are one contact
 [-] (a cylinder lying across a pad reads its two ends highest; the tails of two loads
-that far apart make less than 0.1 of each one's peak at the midpoint)."""
+that far apart read less than 0.1 of each one's peak between them, 0.15 with a taxel's
+gain half as high again)."""
 
 NOISE_THRESHOLD = 5.0
 """The default threshold is at least this many standard deviations of the read noise
@@ -458,7 +459,8 @@ def point_reach(sensor) -> float:
     """Distance between two maxima beyond which two point loads cannot make a ridge
     between them [taxel] (pads; inf otherwise): twice the farthest a 1.6-mm probe's
     response reaches 0.1 of its peak (over its sub-taxel positions), plus twice the
-    farthest a load lies from its peak taxel (half a diagonal), plus one taxel."""
+    farthest a load lies from its peak taxel along a row or a column (half a taxel),
+    plus one taxel."""
     if getattr(sensor, "kind", None) != "pad":
         return math.inf
     kernel, step, half = pad_force_kernel(sensor)
@@ -471,7 +473,7 @@ def point_reach(sensor) -> float:
             ii, jj = np.nonzero(k >= 0.1 * k.max())
             d = np.hypot(offsets[ii] - a * step, offsets[jj] - b * step)
             reach = max(reach, float(d.max()))
-    return 2.0 * reach + math.sqrt(2.0) + 1.0
+    return 2.0 * reach + 2.0
 
 
 def _segment(
