@@ -158,7 +158,7 @@ def _find(uf, a):
 def _ridge_groups(
     s, above, active, parent, root_of, final, top, significant, edge_a, edge_b, edge_v,
     n_edges, ring, periodic, link, group_size, group_top, group_ring, reach, stack, extended,
-    weak, far, pair_share,
+    weak, far, pair_share, box,
 ):  # fmt: skip
     """Merge (in ``final``) the regions of one frame that make one extended contact:
     those joined by ridges (saddles of at least ``ring`` of the lower maximum) into a
@@ -313,13 +313,51 @@ def _ridge_groups(
             if (group_size[g] >= 3 or group_ring[g]) and group_top[g] != p:
                 final[p] = group_top[g]
                 extended[group_top[g]] = True
+    if periodic:
+        return
+    # a piece whose maximum lies within a taxel of an extended contact's bounding box is
+    # part of it (a corner of a stamp's rim cut off by a low-gain taxel)
+    any_extended = False
+    for t in range(above):
+        p = active[t]
+        if parent[p] == p and final[p] == p and extended[p]:
+            any_extended = True
+            box[p, 0] = rows
+            box[p, 1] = -1
+            box[p, 2] = cols
+            box[p, 3] = -1
+    if not any_extended:
+        return
+    for t in range(above):
+        p = active[t]
+        m = _find(final, root_of[p])
+        if extended[m]:
+            r = p // cols
+            c = p - r * cols
+            box[m, 0] = min(box[m, 0], r)
+            box[m, 1] = max(box[m, 1], r)
+            box[m, 2] = min(box[m, 2], c)
+            box[m, 3] = max(box[m, 3], c)
+    for t in range(above):
+        p = active[t]
+        if not (parent[p] == p and final[p] == p) or extended[p]:
+            continue
+        r = p // cols
+        c = p - r * cols
+        for t2 in range(above):
+            m = active[t2]
+            if not (parent[m] == m and final[m] == m and extended[m]):
+                continue
+            if box[m, 0] - 1 <= r <= box[m, 1] + 1 and box[m, 2] - 1 <= c <= box[m, 3] + 1:
+                final[p] = m
+                break
 
 
 @jit(nogil=True)
 def segment_into(
     signal, threshold, ratio, periodic, max_contacts, refine, tolerance, max_iterations,
     count, peak_row, peak_col, row, col, value, total, mrr, mcc, mrc, taxels, converged,
-    root, labels, dip_floor, ring, weak, wide, far, pair_share,
+    root, labels, dip_floor, ring, weak, wide, far, pair_share, point_taxels,
 ):  # fmt: skip
     """Segment every frame into contacts and estimate each (see ``find_contacts``).
 
@@ -357,6 +395,7 @@ def segment_into(
     stack = np.empty(p_all, np.int64)
     extended = np.zeros(p_all, np.bool_)
     n_sig = np.zeros(p_all, np.int64)
+    box = np.zeros((p_all, 4), np.int64)
     top = np.empty(p_all, np.float64)
     sums = np.empty((p_all, 7), np.float64)  # w, w dr, w dc, w dr2, w dc2, w dr dc, count
     final = np.empty(p_all, np.int64)
@@ -524,7 +563,7 @@ def segment_into(
                 _ridge_groups(
                     s, above, active, parent, root_of, final, top, significant, edge_a, edge_b,
                     edge_v, n_edges, ring, periodic, link, group_size, group_top, group_ring,
-                    reach, stack, extended, weak, far, pair_share,
+                    reach, stack, extended, weak, far, pair_share, box,
                 )  # fmt: skip
         # 4. label each taxel with its merged maximum and accumulate its moments about
         # that maximum (columns unwrapped across the seam of a closed ring)
@@ -534,8 +573,9 @@ def segment_into(
             while final[m] != m:
                 m = final[m]
             root_of[p] = m
-        # a region holding two significant maxima or more (a shoulder besides its peak)
-        # is extended too: its peak may sit anywhere on it, its centre does not
+        # a region holding two significant maxima or more (a shoulder besides its peak),
+        # or more taxels than two point loads cover, is placed at its centre: its peak
+        # may sit anywhere on it, its centre does not
         for t in range(above):
             p = active[t]
             if parent[p] == p:
@@ -544,10 +584,6 @@ def segment_into(
             p = active[t]
             if parent[p] == p and significant[p]:
                 n_sig[root_of[p]] += 1
-        for t in range(above):
-            p = active[t]
-            if parent[p] == p and final[p] == p and n_sig[p] >= 2 and ring > 0.0:
-                extended[p] = True
         n_regions = 0
         for t in range(above):
             p = active[t]
@@ -610,7 +646,8 @@ def segment_into(
             u = float(mr)
             v = float(mc)
             ok = False
-            if refine and not extended[m]:
+            centred = extended[m] or (ring > 0.0 and (n_sig[m] >= 2 or sums[m, 6] > point_taxels))
+            if refine and not centred:
                 # Newton on the interpolated surface of this contact, from its maximum
                 for _ in range(max_iterations):
                     f0, fu, fv, fuu, fvv, fuv = _surface(

@@ -455,6 +455,18 @@ def dip_floor(sensor, threshold: float) -> float:
 
 
 @functools.lru_cache(maxsize=16)
+def point_taxels(sensor) -> int:
+    """Most taxels two point loads cover on a pad (inf otherwise): twice the most taxels
+    reading 0.1 of a 1.6-mm probe's peak or more, over its sub-taxel positions [-]. A
+    contact over more is placed at the centre of its signal, not at its peak."""
+    if getattr(sensor, "kind", None) != "pad":
+        return 1 << 30
+    kernel, _, _ = pad_force_kernel(sensor)
+    peak = kernel.max(axis=(2, 3), keepdims=True)
+    return 2 * int((kernel >= 0.1 * peak).sum(axis=(2, 3)).max())
+
+
+@functools.lru_cache(maxsize=16)
 def point_reach(sensor) -> float:
     """Distance between two maxima beyond which two point loads cannot make a ridge
     between them [taxel] (pads; inf otherwise): twice the farthest a 1.6-mm probe's
@@ -478,7 +490,7 @@ def point_reach(sensor) -> float:
 
 def _segment(
     signal, threshold, saddle, periodic, max_contacts, refine, floor=None, ring=0.0,
-    far=math.inf,
+    far=math.inf, cover=1 << 30,
 ):  # fmt: skip
     """The compiled segmentation of (N, rows, cols) signal, block by block."""
     from tactsense.estimate._contacts_fast import segment_into
@@ -506,7 +518,7 @@ def _segment(
                 converged[lo:hi], root[lo:hi], labels[lo:hi],
                 float(threshold if floor is None else floor), float(ring),
                 float(WEAK_SHARE * threshold if ring > 0 else threshold), wide[lo:hi],
-                float(far), PAIR_RIDGE,
+                float(far), PAIR_RIDGE, int(cover),
             )  # fmt: skip
     keep = np.arange(k)[np.newaxis, :] < count[:, np.newaxis]
     frame = np.broadcast_to(np.arange(n)[:, np.newaxis], (n, k))[keep]
@@ -552,8 +564,9 @@ def _grid_contacts(
     refine = method == "interpolate" and kind == "pad"
     floor = dip_floor(sensor, threshold)
     far = point_reach(sensor) if ring > 0 else math.inf
+    cover = point_taxels(sensor) if ring > 0 else 1 << 30
     seg, labels = _segment(
-        signal, threshold, saddle, periodic, max_contacts, refine, floor, ring, far
+        signal, threshold, saddle, periodic, max_contacts, refine, floor, ring, far, cover
     )
     n = len(seg["frame"])
     rows, cols = sensor.shape
