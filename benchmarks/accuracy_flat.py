@@ -18,7 +18,9 @@ well clear of the noise; stated in the table).
 
 Counted over every frame of every press: the share of frames with exactly one contact
 (``find_contacts``, default threshold: 5 sigma of the noise), and the ids per press
-(``ContactTracker`` over the whole recording; the distinct ids in a press's frames).
+(``ContactTracker`` over the whole recording; the distinct ids in a press's frames),
+and the force read over the force applied (median over the frames of one contact;
+uncalibrated: an extended contact's summed signal over a point load's per newton).
 Two columns: the saddle rule alone (``ring=0``: what ``find_contacts`` did before the
 ridge groups, with the same noise-aware threshold and dip) and now (default).
 
@@ -131,7 +133,7 @@ def press_run(spec, make, force, rng):
     return rec.frames, press, n_base
 
 
-def measure(spec, frames, press, n_base, ring):
+def measure(spec, frames, press, n_base, ring, force):
     baseline = frames[:n_base].mean(axis=0)
     table = find_contacts(frames, spec, baseline=baseline, ring=ring)
     tracked, _ = ContactTracker(spec.scan_period_s).update(table)
@@ -144,7 +146,9 @@ def measure(spec, frames, press, n_base, ring):
         rows = np.isin(tracked.frame, frames_k)
         ids.append(len(np.unique(tracked.id[rows])))
     lifted = counts[(press < 0) & (np.arange(len(press)) >= n_base)] > 0
-    return int(one.sum()), int(pressed.sum()), ids, int(lifted.sum()), int(lifted.size)
+    alone = np.isin(table.frame, np.flatnonzero(pressed & (counts == 1)))
+    read = list(table.force_n[alone] / force)
+    return int(one.sum()), int(pressed.sum()), ids, int(lifted.sum()), int(lifted.size), read
 
 
 def flat_rows(name: str):
@@ -152,19 +156,22 @@ def flat_rows(name: str):
     probe_spec = flat_sensor(name, 0)
     for label, make in indenters(probe_spec):
         force = half_range_force(probe_spec, make)
-        tally = {ring: [0, 0, [], 0, 0] for ring in (0.0, None)}
+        tally = {ring: [0, 0, [], 0, 0, []] for ring in (0.0, None)}
         for seed in SEEDS:
             spec = flat_sensor(name, seed)
             rng = np.random.default_rng(100 + seed)
             frames, press, n_base = press_run(spec, make, force, rng)
             for ring in tally:
-                got = measure(spec, frames, press, n_base, RING_RATIO if ring is None else ring)
+                got = measure(
+                    spec, frames, press, n_base, RING_RATIO if ring is None else ring, force
+                )
                 t = tally[ring]
                 t[0] += got[0]
                 t[1] += got[1]
                 t[2] += got[2]
                 t[3] += got[3]
                 t[4] += got[4]
+                t[5] += got[5]
         rows.append((name, label, force, tally))
         print(
             f"{name} {label}: {force:.3g} N; one contact "
@@ -206,15 +213,16 @@ def block(flat, probes) -> str:
     lines.append(
         "| pad | indenter | force [N] | exactly one contact, saddle rule alone / now [%] "
         "| ids per press, saddle rule alone / now (mean, worst) | frames lifted with a "
-        "contact, now [%] |"
+        "contact, now [%] | force read / applied, now (median of one-contact frames) |"
     )
-    lines.append("|---|---|---|---|---|---|")
+    lines.append("|---|---|---|---|---|---|---|")
     for name, label, force, tally in flat:
         before, now = tally[0.0], tally[None]
         lines.append(
             f"| {name} | {label} | {force:.2f} | {100 * before[0] / before[1]:.1f} / "
             f"{100 * now[0] / now[1]:.1f} | {np.mean(before[2]):.2f} ({max(before[2])}) / "
-            f"{np.mean(now[2]):.2f} ({max(now[2])}) | {100 * now[3] / max(now[4], 1):.1f} |"
+            f"{np.mean(now[2]):.2f} ({max(now[2])}) | {100 * now[3] / max(now[4], 1):.1f} | "
+            f"{np.median(now[5]):.2f} |"
         )
     lines += ["", "| pad | two 50-g probes, apart [pitch] | seen as two, saddle rule alone / "
               "now [%] |", "|---|---|---|"]  # fmt: skip

@@ -92,7 +92,7 @@ def test_a_square_stamp_pressed_eight_times_is_eight_contacts_with_eight_ids(tmp
     19 ids. Simulated through the CLI from the array's description (every flaw of the
     twin), found against the untouched frames' median and tracked: one contact in every
     pressed frame, and 8 ids, one a press. (``locate`` takes the same frames through its
-    creep compensation and lift re-zero, which are not yet noise-aware: 67 % there, see
+    creep compensation and lift re-zero, which are not yet noise-aware, see
     docs/contacts.md.)"""
     sensor = _noisy_pad(tmp_path)
     rec = tmp_path / "stamp.h5"
