@@ -19,8 +19,9 @@ well clear of the noise; stated in the table).
 Counted over every frame of every press: the share of frames with exactly one contact
 (``find_contacts``, default threshold: 5 sigma of the noise), and the ids per press
 (``ContactTracker`` over the whole recording; the distinct ids in a press's frames),
-and the force read over the force applied (median over the frames of one contact;
-uncalibrated: an extended contact's summed signal over a point load's per newton).
+and the force read over the force applied (median over the frames of one contact,
+those with a saturated taxel, force NaN, left out; uncalibrated: an extended
+contact's summed signal over a point load's per newton).
 Two columns: the saddle rule alone (``ring=0``: what ``find_contacts`` did before the
 ridge groups, with the same noise-aware threshold and dip) and now (default).
 
@@ -222,7 +223,7 @@ def block(flat, probes) -> str:
             f"| {name} | {label} | {force:.2f} | {100 * before[0] / before[1]:.1f} / "
             f"{100 * now[0] / now[1]:.1f} | {np.mean(before[2]):.2f} ({max(before[2])}) / "
             f"{np.mean(now[2]):.2f} ({max(now[2])}) | {100 * now[3] / max(now[4], 1):.1f} | "
-            f"{np.median(now[5]):.2f} |"
+            f"{np.nanmedian(now[5]):.2f} |"
         )
     lines += ["", "| pad | two 50-g probes, apart [pitch] | seen as two, saddle rule alone / "
               "now [%] |", "|---|---|---|"]  # fmt: skip
