@@ -15,7 +15,15 @@ import numpy as np
 
 from tactsense._validation import TactsenseInputError, check_positive
 from tactsense.physics.contact import grams_force
-from tactsense.physics.indenters import INDENTERS, FlatPunch, Indenter, KnifeEdge, SphereProbe
+from tactsense.physics.indenters import (
+    INDENTERS,
+    CylinderProbe,
+    FlatPunch,
+    Indenter,
+    KnifeEdge,
+    SphereProbe,
+    SquareStamp,
+)
 from tactsense.simulate import Scenario, Step
 
 FIFTY_GRAMS = grams_force(50.0)
@@ -50,13 +58,29 @@ def _check_on(spec, x_mm: float, y_mm: float, what: str) -> None:
 def make_indenter(
     kind: str, x_mm: float, y_mm: float, force_n: float, size_mm: float, **extra
 ) -> Indenter:
-    """An indenter by kind: ``sphere`` (radius), ``disc`` (radius), ``punch`` (radius) or
-    ``knife`` (length; ``angle_deg`` in ``extra``)."""
+    """An indenter by kind: ``sphere`` (radius), ``disc`` (radius), ``punch`` (radius),
+    ``knife`` (length), ``square`` (a flat stamp's side) or ``cylinder`` (a cylinder
+    lying on the surface: its length; ``radius_mm`` in ``extra``, default 5); ``angle_deg``
+    in ``extra`` for the last three (their axis from the x axis [deg])."""
     if kind not in INDENTERS:
         raise TactsenseInputError(f"unknown indenter {kind!r}; expected {', '.join(INDENTERS)}")
+    if "angle_deg" in extra and kind not in ANGLED:
+        if extra["angle_deg"] != 0.0:
+            raise TactsenseInputError(
+                f"angle_deg applies to {', '.join(ANGLED)}; a {kind} has no axis"
+            )
+        extra = {k: v for k, v in extra.items() if k != "angle_deg"}
     if kind == "knife":
         return KnifeEdge(x_mm, y_mm, force_n, length_mm=size_mm, **extra)
+    if kind == "square":
+        return SquareStamp(x_mm, y_mm, force_n, side_mm=size_mm, **extra)
+    if kind == "cylinder":
+        return CylinderProbe(x_mm, y_mm, force_n, length_mm=size_mm, **extra)
     return INDENTERS[kind](x_mm, y_mm, force_n, radius_mm=size_mm, **extra)
+
+
+ANGLED = ("knife", "square", "cylinder")
+"""Indenters with an axis (``angle_deg``)."""
 
 
 def press(
@@ -72,8 +96,10 @@ def press(
     repeats: int = 1,
     settle_s: float = 0.2,
     at_taxel: int | None = None,
+    angle_deg: float = 0.0,
 ) -> Scenario:
-    """Press an indenter ``repeats`` times at one place, lifting between presses."""
+    """Press an indenter ``repeats`` times at one place, lifting between presses
+    (``angle_deg``: the axis of a knife, square stamp or cylinder, from x [deg])."""
     cx, cy = centre_mm(spec)
     x, y = (cx if x_mm is None else x_mm), (cy if y_mm is None else y_mm)
     _check_on(spec, x, y, indenter)
@@ -81,6 +107,8 @@ def press(
     if repeats < 1:
         raise TactsenseInputError(f"repeats must be at least 1; got {repeats}")
     extra = {"at_taxel": at_taxel} if at_taxel is not None else {}
+    if angle_deg != 0.0 or indenter in ANGLED:
+        extra["angle_deg"] = angle_deg
     contact = make_indenter(indenter, x, y, force_n, size_mm, **extra)
     steps = _settle(settle_s)
     for k in range(repeats):
@@ -93,7 +121,7 @@ def press(
         f"{indenter} of {size_mm:g} mm pressed {repeats}x with {force_n:g} N at "
         f"({x:g}, {y:g}) mm",
         {"x_mm": x, "y_mm": y, "force_n": force_n, "indenter": indenter, "size_mm": size_mm,
-         "repeats": repeats},
+         "repeats": repeats, **({"angle_deg": angle_deg} if indenter in ANGLED else {})},
     )  # fmt: skip
 
 

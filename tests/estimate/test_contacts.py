@@ -35,14 +35,14 @@ def _bumps(shape, centres, sigma=1.0, height=0.05):
 
 
 def test_regions_are_the_local_maxima_of_a_random_frame(pad16):
-    """With merging off (saddle 1, threshold tiny), each contact is one strict local
-    maximum (8-connected, as skimage finds them) and the regions cover every taxel
-    above the threshold."""
+    """With merging off (saddle 1, threshold tiny, no ridge groups: ring 0), each
+    contact is one strict local maximum (8-connected, as skimage finds them) and the
+    regions cover every taxel above the threshold."""
     rng = np.random.default_rng(3)
     for _ in range(20):
         frame = ndimage.gaussian_filter(rng.uniform(0, 1, (16, 16)), 1.0)
         table = find_contacts(frame, pad16, counts=False, threshold=1e-9, saddle=1.0,
-                              max_contacts=64, method="cop")  # fmt: skip
+                              max_contacts=64, method="cop", ring=0.0)  # fmt: skip
         maxima = local_maxima(frame, connectivity=2, allow_borders=True)
         assert len(table) == maxima.sum()
         assert table.taxels.sum() == 256
@@ -66,14 +66,30 @@ def test_two_bumps_split_or_merge_by_the_saddle_rule(pad16, separation, expected
 
 
 def test_a_shallow_dip_merges_and_a_deep_one_splits(pad16):
-    """Peaks 4 taxels apart, sigma 1.2: dip = 2 exp(-16/(8 1.44)) = 0.50 of a peak (< 0.8:
-    two); sigma 1.6: 2 exp(-16/(8 2.56)) = 0.92 (>= 0.8: one)."""
-    assert (
-        len(find_contacts(_bumps((16, 16), [(8, 6), (8, 10)], sigma=1.2), pad16, counts=False)) == 2
-    )
-    assert (
-        len(find_contacts(_bumps((16, 16), [(8, 6), (8, 10)], sigma=1.6), pad16, counts=False)) == 1
-    )
+    """The saddle rule alone (ring 0): peaks 4 taxels apart, sigma 1.2: dip =
+    2 exp(-16/(8 1.44)) = 0.50 of a peak (< 0.8: two); sigma 1.6: 2 exp(-16/(8 2.56)) =
+    0.92 (>= 0.8: one). (With the far-ends rule on, the sigma-1.2 pair is one contact on
+    pad16: two point loads 4 taxels apart on its layer leave no ridge at half their
+    height between them, ``test_far_ends_are_one_only_beyond_point_loads_reach``.)"""
+    frame = _bumps((16, 16), [(8, 6), (8, 10)], sigma=1.2)
+    assert len(find_contacts(frame, pad16, counts=False, ring=0.0)) == 2
+    frame = _bumps((16, 16), [(8, 6), (8, 10)], sigma=1.6)
+    assert len(find_contacts(frame, pad16, counts=False, ring=0.0)) == 1
+    assert len(find_contacts(frame, pad16, counts=False)) == 1
+
+
+def test_far_ends_are_one_only_beyond_point_loads_reach(pad16):
+    """Two narrow bumps (sigma 0.6 taxel, pad16's point-load width) joined by a ridge at
+    0.4 of their height: 3 taxels apart (under point_reach, 3.6 on pad16) they stay two;
+    5 apart (beyond it) they are one contact, a cylinder's two ends. The same bumps
+    without the ridge stay two at both distances."""
+    r, c = np.mgrid[0:16, 0:16].astype(float)
+    for apart, expected in ((3, 2), (5, 1)):
+        a, b = 8 - apart / 2, 8 + apart / 2
+        bumps = _bumps((16, 16), [(8, a), (8, b)], sigma=0.6)
+        ridge = 0.02 * ((np.abs(r - 8) < 0.5) & (c > a) & (c < b))
+        assert len(find_contacts(np.maximum(bumps, ridge), pad16, counts=False)) == expected
+        assert len(find_contacts(bumps, pad16, counts=False)) == 2
 
 
 def test_centre_of_pressure_equals_scipy_on_separate_blobs(pad16):

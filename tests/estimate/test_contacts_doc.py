@@ -77,5 +77,5 @@ def test_the_column_table_names_every_column(example):
     named = set()
     for row in table.splitlines():
         if row.startswith("| `"):
-            named |= set(re.findall(r"`([a-z_]+)`", row.split("|")[1]))
+            named |= set(re.findall(r"`([a-z_0-9]+)`", row.split("|")[1]))
     assert named == set(pd.read_parquet(example / "cols.parquet").columns)

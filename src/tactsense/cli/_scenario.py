@@ -80,13 +80,16 @@ SeparationOption = Annotated[
 IndenterOption = Annotated[
     str | None,
     typer.Option(help="'press' and 'hold': sphere (Hertz), disc (uniform), punch (rigid "
-                 "flat) or knife [default: sphere]."),
+                 "flat, round), knife, square (a rigid flat square stamp) or cylinder (a "
+                 "5-mm-radius cylinder lying on the surface, Hertz line contact) "
+                 "[default: sphere]."),
 ]  # fmt: skip
 SizeOption = Annotated[
     float | None,
     typer.Option("--size-mm", min=1e-3, max=1e3,
-                 help="Pads: the indenter's radius (sphere, disc, punch) or a knife edge's "
-                 "length [mm] [default: 1.6, the paper's 3.2-mm probe; punch 3; knife 10]."),
+                 help="Pads: the indenter's radius (sphere, disc, punch), a knife edge's or "
+                 "a cylinder's length, or a square stamp's side [mm] [default: 1.6, the "
+                 "paper's 3.2-mm probe; punch 3; knife and cylinder 10; square 5]."),
 ]  # fmt: skip
 SpeedOption = Annotated[
     float | None,
@@ -96,7 +99,8 @@ SpeedOption = Annotated[
 AngleOption = Annotated[
     float | None,
     typer.Option("--angle-deg", min=-360.0, max=360.0,
-                 help="'knife-edge' on a pad: the edge's angle from the x axis [deg] "
+                 help="'knife-edge' on a pad, and 'press'/'hold' with a knife, square or "
+                 "cylinder: its axis' angle from the x axis [deg] "
                  "[default: 0]; 'two-probes': the axis the pair is separated along, from "
                  "the x axis [deg] [default: 90, along y]."),
 ]  # fmt: skip
@@ -189,11 +193,21 @@ USES = {
         "force_g",
         "indenter",
         "size_mm",
+        "angle_deg",
         "dwell_s",
         "lift_s",
         "repeats",
     ),
-    ScenarioKind.hold: ("x_mm", "y_mm", "force_g", "indenter", "size_mm", "dwell_s", "lift_s"),
+    ScenarioKind.hold: (
+        "x_mm",
+        "y_mm",
+        "force_g",
+        "indenter",
+        "size_mm",
+        "angle_deg",
+        "dwell_s",
+        "lift_s",
+    ),
     ScenarioKind.two_probes: (
         "x_mm",
         "y_mm",
@@ -460,8 +474,10 @@ def _flat_scenario(spec, scenario: ScenarioKind, given: dict):
         options["hold_s"] = options.pop("dwell_s")
     if spec.kind == "points" and scenario in (ScenarioKind.press, ScenarioKind.hold):
         options.setdefault("at_taxel", 0)
-    if scenario in (ScenarioKind.press, ScenarioKind.hold) and options.get("indenter") == "knife":
-        options.setdefault("size_mm", 10.0)
+    if scenario in (ScenarioKind.press, ScenarioKind.hold):
+        default_size = {"knife": 10.0, "cylinder": 10.0, "square": 5.0}
+        if options.get("indenter") in default_size:
+            options.setdefault("size_mm", default_size[options["indenter"]])
     return SCENARIOS[scenario.value](spec, **options)
 
 

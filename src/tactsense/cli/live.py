@@ -718,7 +718,8 @@ def live(
 LIVE_CONTACT_COLUMNS = (
     "sequence", "device_time_s", "host_time_s", "n_contacts", "id", "x_mm", "y_mm", "z_mm",
     "row", "col", "force_n", "peak", "major_mm", "minor_mm", "orientation_deg", "taxels",
-    "vx_mm_s", "vy_mm_s", "vz_mm_s", "slip", "flags", "flag_names", "rezeroing", "latency_ms",
+    "area_mm2", "vx_mm_s", "vy_mm_s", "vz_mm_s", "slip", "flags", "flag_names", "rezeroing",
+    "latency_ms",
 )  # fmt: skip
 """Columns of ``live --format csv`` on a pad or a point set: one row per contact."""
 

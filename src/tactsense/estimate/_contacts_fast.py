@@ -149,13 +149,227 @@ def _surface(s, label, own, u, v, periodic, kr0, kr1, kr2, kc0, kc1, kc2):
     return f, fu, fv, fuu, fvv, fuv
 
 
+@jit(inline="always")
+def _find(uf, a):
+    while uf[a] != a:
+        a = uf[a]
+    return a
+
+
+@jit(nogil=True)
+def _ridge_groups(
+    s, above, active, parent, root_of, final, top, significant, edge_a, edge_b, edge_v,
+    n_edges, ring, periodic, link, group_size, group_top, group_ring, reach, stack, extended,
+    weak, far, pair_share, box,
+):  # fmt: skip
+    """Merge (in ``final``) the regions of one frame that make one extended contact:
+    those joined by ridges (saddles of at least ``ring`` of the lower maximum) into a
+    group holding three or more significant maxima (not bumps of the noise), and those
+    around a hole (taxels below ``weak`` that the array's border does not reach through
+    taxels below it: a stamp's or a punch's rim around its unstrained middle, taxels
+    between ``weak`` and the threshold counting as rim).
+    Two maxima at least ``far`` taxels apart (beyond the reach of two point loads' tails)
+    joined by a ridge of at least ``pair_share`` of their summed heights are one contact
+    too (a cylinder's two ends). The maximum a group is merged into is marked
+    ``extended`` (its position is the centre of its signal, not a peak)."""
+    rows, cols = s.shape
+    n_regions = 0
+    for t in range(above):
+        p = active[t]
+        if parent[p] == p:
+            link[p] = p
+            group_size[p] = 0
+            group_top[p] = -1
+            group_ring[p] = False
+            if final[p] == p:
+                n_regions += 1
+    if n_regions < 2:
+        return
+    for t in range(n_edges):
+        a = _find(final, edge_a[t])
+        b = _find(final, edge_b[t])
+        if a == b or edge_v[t] < ring * min(top[a], top[b]):
+            continue
+        ra = a // cols
+        rb = b // cols
+        dcol = abs((a - ra * cols) - (b - rb * cols))
+        if periodic and dcol > cols // 2:
+            dcol = cols - dcol
+        apart = math.hypot(ra - rb, dcol) >= far
+        pair = apart and edge_v[t] >= pair_share * (top[a] + top[b])
+        a = _find(link, a)
+        b = _find(link, b)
+        if a != b:
+            link[b] = a
+        if pair:
+            group_ring[a] = True
+    # holes: flood the taxels below the threshold from the border (4-connected), once
+    # through all of them and once through those below ``weak`` only (the others a rim)
+    n = rows * cols
+    for pass_ in range(2):
+        limit = np.inf if pass_ == 0 else weak
+        for p in range(n):
+            reach[p] = 0  # 0: not reached, 1: reached from the border, 2: a hole's, seen
+        top_ = 0
+        for p in range(n):
+            r = p // cols
+            c = p - r * cols
+            border = r == 0 or r == rows - 1 or (not periodic and (c == 0 or c == cols - 1))
+            if border and parent[p] < 0 and s[r, c] <= limit:
+                reach[p] = 1
+                stack[top_] = p
+                top_ += 1
+        while top_ > 0:
+            top_ -= 1
+            p = stack[top_]
+            r = p // cols
+            c = p - r * cols
+            for k in range(4):
+                rr = r + (1 if k == 0 else -1 if k == 1 else 0)
+                cc = c + (1 if k == 2 else -1 if k == 3 else 0)
+                if rr < 0 or rr >= rows:
+                    continue
+                if periodic:
+                    cc %= cols
+                elif cc < 0 or cc >= cols:
+                    continue
+                q = rr * cols + cc
+                if reach[q] == 0 and parent[q] < 0 and s[rr, cc] <= limit:
+                    reach[q] = 1
+                    stack[top_] = q
+                    top_ += 1
+        for p0 in range(n):
+            if reach[p0] != 0 or parent[p0] >= 0 or s[p0 // cols, p0 % cols] > limit:
+                continue
+            # a hole: every region that touches it is one contact
+            anchor = -1
+            reach[p0] = 2
+            stack[0] = p0
+            top_ = 1
+            while top_ > 0:
+                top_ -= 1
+                p = stack[top_]
+                r = p // cols
+                c = p - r * cols
+                for dr in range(-1, 2):
+                    rr = r + dr
+                    if rr < 0 or rr >= rows:
+                        continue
+                    for dc in range(-1, 2):
+                        cc = c + dc
+                        if periodic:
+                            cc %= cols
+                        elif cc < 0 or cc >= cols:
+                            continue
+                        q = rr * cols + cc
+                        if parent[q] >= 0:
+                            m = _find(link, _find(final, root_of[q]))
+                            if anchor < 0:
+                                anchor = m
+                            elif m != anchor:
+                                link[m] = anchor
+                        elif s[rr, cc] > limit:
+                            # a wall taxel below the threshold: the regions it touches
+                            for dr2 in range(-1, 2):
+                                r2 = rr + dr2
+                                if r2 < 0 or r2 >= rows:
+                                    continue
+                                for dc2 in range(-1, 2):
+                                    c2 = cc + dc2
+                                    if periodic:
+                                        c2 %= cols
+                                    elif c2 < 0 or c2 >= cols:
+                                        continue
+                                    q2 = r2 * cols + c2
+                                    if parent[q2] >= 0:
+                                        m = _find(link, _find(final, root_of[q2]))
+                                        if anchor < 0:
+                                            anchor = m
+                                        elif m != anchor:
+                                            link[m] = anchor
+                        elif reach[q] == 0 and (dr == 0 or dc == 0):
+                            reach[q] = 2
+                            stack[top_] = q
+                            top_ += 1
+            if anchor >= 0:
+                group_ring[anchor] = True
+    for t in range(above):
+        p = active[t]
+        if parent[p] != p:
+            continue
+        g = _find(link, _find(final, p))
+        if group_ring[p]:
+            group_ring[g] = True
+        if significant[p]:
+            group_size[g] += 1
+    for t in range(above):
+        p = active[t]
+        if parent[p] == p and final[p] == p:
+            g = _find(link, p)
+            if group_top[g] < 0 or top[p] > top[group_top[g]]:
+                group_top[g] = p
+    for t in range(above):
+        p = active[t]
+        if parent[p] == p and final[p] == p:
+            g = _find(link, p)
+            if (group_size[g] >= 3 or group_ring[g]) and group_top[g] != p:
+                final[p] = group_top[g]
+                extended[group_top[g]] = True
+    if periodic:
+        return
+    # a piece whose maximum lies within a taxel of an extended contact's bounding box is
+    # part of it (a corner of a stamp's rim cut off by a low-gain taxel)
+    any_extended = False
+    for t in range(above):
+        p = active[t]
+        if parent[p] == p and final[p] == p and extended[p]:
+            any_extended = True
+            box[p, 0] = rows
+            box[p, 1] = -1
+            box[p, 2] = cols
+            box[p, 3] = -1
+    if not any_extended:
+        return
+    for t in range(above):
+        p = active[t]
+        m = _find(final, root_of[p])
+        if extended[m]:
+            r = p // cols
+            c = p - r * cols
+            box[m, 0] = min(box[m, 0], r)
+            box[m, 1] = max(box[m, 1], r)
+            box[m, 2] = min(box[m, 2], c)
+            box[m, 3] = max(box[m, 3], c)
+    for t in range(above):
+        p = active[t]
+        if not (parent[p] == p and final[p] == p) or extended[p]:
+            continue
+        r = p // cols
+        c = p - r * cols
+        for t2 in range(above):
+            m = active[t2]
+            if not (parent[m] == m and final[m] == m and extended[m]):
+                continue
+            if box[m, 0] - 1 <= r <= box[m, 1] + 1 and box[m, 2] - 1 <= c <= box[m, 3] + 1:
+                final[p] = m
+                break
+
+
 @jit(nogil=True)
 def segment_into(
     signal, threshold, ratio, periodic, max_contacts, refine, tolerance, max_iterations,
     count, peak_row, peak_col, row, col, value, total, mrr, mcc, mrc, taxels, converged,
-    root, labels,
+    root, labels, dip_floor, ring, weak, wide, far, pair_share, point_taxels,
 ):  # fmt: skip
     """Segment every frame into contacts and estimate each (see ``find_contacts``).
+
+    Merging (``find_contacts``): two maxima are one contact when the saddle between them
+    is at least ``ratio`` of the lower or dips from it by less than ``dip_floor``; then
+    maxima joined by ridges (saddles of at least ``ring`` of the lower maximum; taxels
+    above ``weak`` but below ``threshold`` bridge regions they touch) into a group of
+    three or more are one contact (a flat stamp's corners and edges, a punch's rim), as
+    are regions around a hole; ``wide[f, k]``: the contact is such a group (its
+    position is the centre of its signal).
 
     Per frame ``f`` and contact ``k < count[f]`` (by decreasing summed signal): the peak
     taxel, the fractional peak (Newton on the interpolated surface when ``refine``,
@@ -168,9 +382,22 @@ def segment_into(
     p_all = rows * cols
     parent = np.empty(p_all, np.int64)
     root_of = np.empty(p_all, np.int64)
-    edge_a = np.empty(4 * p_all, np.int64)
-    edge_b = np.empty(4 * p_all, np.int64)
-    edge_v = np.empty(4 * p_all, np.float64)
+    n_cap = 4 * p_all + 28 * p_all  # 4 forward pairs a taxel, 28 pairs a bridge
+    edge_a = np.empty(n_cap, np.int64)
+    edge_b = np.empty(n_cap, np.int64)
+    edge_v = np.empty(n_cap, np.float64)
+    edge_weak = np.zeros(n_cap, np.bool_)  # a bridge: for the ridges of the groups only
+    link = np.empty(p_all, np.int64)
+    group_size = np.empty(p_all, np.int64)
+    group_top = np.empty(p_all, np.int64)
+    touched = np.empty(8, np.int64)
+    significant = np.empty(p_all, np.bool_)
+    group_ring = np.empty(p_all, np.bool_)
+    reach = np.empty(p_all, np.int64)
+    stack = np.empty(p_all, np.int64)
+    extended = np.zeros(p_all, np.bool_)
+    n_sig = np.zeros(p_all, np.int64)
+    box = np.zeros((p_all, 4), np.int64)
     top = np.empty(p_all, np.float64)
     sums = np.empty((p_all, 7), np.float64)  # w, w dr, w dc, w dr2, w dc2, w dr dc, count
     final = np.empty(p_all, np.int64)
@@ -182,7 +409,7 @@ def segment_into(
     kc1 = np.empty_like(kr0)
     kc2 = np.empty_like(kr0)
     active = np.empty(p_all, np.int64)
-    edge_order = np.empty(4 * p_all, np.int64)
+    edge_order = np.empty(n_cap, np.int64)
     ranked = np.empty(p_all, np.int64)
     for f in range(n):
         s = signal[f]
@@ -256,12 +483,50 @@ def segment_into(
                 edge_a[n_edges] = root_of[p]
                 edge_b[n_edges] = root_of[q]
                 edge_v[n_edges] = min(s[r, c], s[rr, cc])
+                edge_weak[n_edges] = False
                 n_edges += 1
+        # ... and taxels above ``weak`` but below the threshold that touch two regions
+        # bridge them (at their own value): a rim broken by a low-gain taxel
+        if weak < threshold:
+            for r in range(rows):
+                for c in range(cols):
+                    w = s[r, c]
+                    if not (w > weak and w <= threshold):
+                        continue
+                    n_touched = 0
+                    for dr in range(-1, 2):
+                        rr = r + dr
+                        if rr < 0 or rr >= rows:
+                            continue
+                        for dc in range(-1, 2):
+                            cc = _wrap(c + dc, cols, periodic)
+                            if cc < 0 or (dr == 0 and dc == 0):
+                                continue
+                            q = rr * cols + cc
+                            if parent[q] < 0:
+                                continue
+                            m = root_of[q]
+                            seen = False
+                            for u in range(n_touched):
+                                if touched[u] == m:
+                                    seen = True
+                            if not seen:
+                                touched[n_touched] = m
+                                n_touched += 1
+                    for u in range(n_touched):
+                        for u2 in range(u + 1, n_touched):
+                            edge_a[n_edges] = touched[u]
+                            edge_b[n_edges] = touched[u2]
+                            edge_v[n_edges] = w
+                            edge_weak[n_edges] = True
+                            n_edges += 1
         for t in range(above):
             p = active[t]
             if parent[p] == p:
                 final[p] = p  # union-find parent among maxima
                 top[p] = s[p // cols, p % cols]
+                significant[p] = True
+                extended[p] = False
         if n_edges > 0:
             # highest saddle first: an insertion sort (few edges), no allocation
             for t in range(n_edges):
@@ -275,6 +540,8 @@ def segment_into(
                 edge_order[q + 1] = e
             for t in range(n_edges):
                 e = edge_order[t]
+                if edge_weak[e]:
+                    continue
                 a = edge_a[e]
                 while final[a] != a:
                     a = final[a]
@@ -285,11 +552,21 @@ def segment_into(
                     continue
                 low = min(top[a], top[b])
                 saddle = edge_v[e]
-                if saddle >= ratio * low or low - saddle < threshold:
+                if saddle >= ratio * low or low - saddle < dip_floor:
+                    # the lower maximum is a bump of the noise, or a shoulder of the
+                    # higher one (it counts for the ridge groups, a noise bump does not)
+                    lower = b if top[a] >= top[b] else a
+                    significant[lower] = low - saddle >= dip_floor
                     if top[a] >= top[b]:
                         final[b] = a
                     else:
                         final[a] = b
+            if ring > 0.0:
+                _ridge_groups(
+                    s, above, active, parent, root_of, final, top, significant, edge_a, edge_b,
+                    edge_v, n_edges, ring, periodic, link, group_size, group_top, group_ring,
+                    reach, stack, extended, weak, far, pair_share, box,
+                )  # fmt: skip
         # 4. label each taxel with its merged maximum and accumulate its moments about
         # that maximum (columns unwrapped across the seam of a closed ring)
         for t in range(above):
@@ -298,6 +575,17 @@ def segment_into(
             while final[m] != m:
                 m = final[m]
             root_of[p] = m
+        # a region holding two significant maxima or more (a shoulder besides its peak),
+        # or more taxels than two point loads cover, is placed at its centre: its peak
+        # may sit anywhere on it, its centre does not
+        for t in range(above):
+            p = active[t]
+            if parent[p] == p:
+                n_sig[root_of[p]] = 0
+        for t in range(above):
+            p = active[t]
+            if parent[p] == p and significant[p]:
+                n_sig[root_of[p]] += 1
         n_regions = 0
         for t in range(above):
             p = active[t]
@@ -360,7 +648,8 @@ def segment_into(
             u = float(mr)
             v = float(mc)
             ok = False
-            if refine:
+            centred = extended[m] or (ring > 0.0 and (n_sig[m] >= 2 or sums[m, 6] > point_taxels))
+            if refine and not centred:
                 # Newton on the interpolated surface of this contact, from its maximum
                 for _ in range(max_iterations):
                     f0, fu, fv, fuu, fvv, fuv = _surface(
@@ -393,6 +682,7 @@ def segment_into(
             )
             value[f, k] = f0
             converged[f, k] = ok
+            wide[f, k] = extended[m]
             if periodic:
                 col[f, k] = col[f, k] % cols
 
@@ -523,7 +813,7 @@ def _move_track(i, to, t_pos, t_vel, t_force, t_dforce, t_last, t_id):
 @jit(nogil=True)
 def track_into(
     frame, pos, force, start, end, t_pos, t_vel, t_force, t_dforce, t_last, t_id, counters,
-    dt, gate, weight, max_missing, smoothing, slip_speed, slip_rate, far,
+    dt, gate, weight, max_missing, smoothing, slip_speed, slip_rate, far, reach,
     out_id, out_vel, out_slip, ev_frame, ev_kind, ev_id, ev_other,
 ):  # fmt: skip
     """The compiled :class:`~tactsense.estimate.track.ContactTracker` (same rules, same
@@ -532,7 +822,8 @@ def track_into(
     Tracks live in ``t_*[:counters[0]]``; ``counters`` = (tracks alive, next id,
     events written). Event kinds: 0 birth, 1 death, 2 merge, 3 split. Returns -1 when
     the track or event arrays are full (the caller grows them and runs again from its
-    saved state), else 0.
+    saved state), else 0. ``reach[k]``: the gate of row ``k``'s contact [mm] (the gate,
+    or more for a contact larger than it).
     """
     n = frame.shape[0]
     cap = t_id.shape[0]
@@ -574,7 +865,7 @@ def track_into(
                     d2 += diff * diff
                 d = math.sqrt(d2)
                 distance[i, j] = d
-                if d <= gate:
+                if d <= reach[lo + j]:
                     cost[i, j] = d + weight * abs(t_force[i] - force[lo + j])
                 else:
                     cost[i, j] = far
@@ -607,7 +898,7 @@ def track_into(
                 continue
             best = -1
             for j in range(n_c):
-                if owner[j] >= 0 and distance[i, j] <= gate:
+                if owner[j] >= 0 and distance[i, j] <= reach[lo + j]:
                     if best < 0 or distance[i, j] < distance[i, best]:
                         best = j
             if best >= 0:
@@ -627,7 +918,7 @@ def track_into(
                 continue
             best = -1
             for i in range(n_t):
-                if match[i] >= 0 and distance[i, j] <= gate:
+                if match[i] >= 0 and distance[i, j] <= reach[lo + j]:
                     if best < 0 or distance[i, j] < distance[best, j]:
                         best = i
             parents[j] = t_id[best] if best >= 0 else -1

@@ -79,6 +79,10 @@ class ContactTable:
     """[mm/s]"""
     slip: np.ndarray | None = None
     """True where the contact moves under a roughly constant force (tracker), bool."""
+    area_mm2: np.ndarray | None = None
+    """Area of the contact's taxels, each its cell of the grid (a pad's row pitch times
+    column pitch; a finger's axial step times its arc) [mm^2]; NaN on point sets (set
+    by :func:`find_contacts`; None in a table made otherwise)."""
     extra: dict = field(default_factory=dict)
     """Further per-row columns (name -> 1-D array), e.g. ``axial_mm`` on a finger."""
 
@@ -97,6 +101,7 @@ class ContactTable:
         "minor_mm": "mm",
         "orientation_deg": "deg",
         "taxels": "1",
+        "area_mm2": "mm2",
         "flags": "bits",
         "vx_mm_s": "mm/s",
         "vy_mm_s": "mm/s",
@@ -161,6 +166,30 @@ SADDLE_RATIO = 0.8
 """Two maxima of a frame are two contacts only if the signal between them dips below
 this share of the lower one (and by more than the contact threshold) [-]; otherwise the
 lower is a bump on the same contact and the two regions are merged."""
+
+NOISE_DIP = 3.0
+"""... and only if that dip exceeds this many standard deviations of the difference of
+two taxels' read noise (``NOISE_DIP * sqrt(2) * sigma``, sigma from the sensor's
+``read_noise_counts``; :func:`signal_noise_variance`) [-]: a noisy plateau's bumps are
+not contacts."""
+
+RING_RATIO = 0.1
+"""Maxima joined by ridges (saddles of at least this share of the lower one) into a
+group of three or more are one contact [-]: a flat stamp on a layer reads its rim
+(its corners highest), a punch its ring, each split into bumps by the taxels' gains;
+two probes make two maxima, and stay two. 0 switches the rule off."""
+
+WEAK_SHARE = 0.4
+"""Taxels above this share of the threshold (but below it) that touch two regions join
+them for :data:`RING_RATIO`'s ridges (a rim broken by a low-gain taxel) [-]; they stay
+out of every contact's taxels."""
+
+PAIR_RIDGE = 0.15
+"""Two maxima farther apart than two point loads' tails reach (:func:`point_reach`) that
+are joined by a ridge of at least this share of their summed heights are one contact
+[-] (a cylinder lying across a pad reads its two ends highest; the tails of two loads
+that far apart read less than 0.1 of each one's peak between them, 0.15 with a taxel's
+gain half as high again)."""
 
 METHODS = ("interpolate", "cop", "fit")
 """``interpolate``: the paper's method on the grid (Hann-windowed sinc over 3 taxels on
@@ -304,13 +333,16 @@ def find_contacts(
     saddle: float = SADDLE_RATIO,
     frame_period_s: float | None = None,
     compensator=None,
+    ring: float = RING_RATIO,
 ) -> ContactTable:
     """Every contact of every frame, on any kind of array.
 
     Each frame is segmented into contacts: the taxels above ``threshold`` are assigned
     to a local maximum by steepest ascent (a watershed on the taxel grid, or on the
     neighbour graph of a point set), and maxima separated by a shallow saddle (see
-    :data:`SADDLE_RATIO`) are merged into one contact. Each contact gets a position
+    :data:`SADDLE_RATIO`; or a dip within the read noise, :data:`NOISE_DIP`) are merged
+    into one contact, and on a grid so are maxima joined by ridges into a group of three
+    or more (a flat stamp's rim, :data:`RING_RATIO`). Each contact gets a position
     (``method``), the interpolated peak, its force, its extent (second moments of its
     taxels' signal) and its taxel count.
 
@@ -351,6 +383,8 @@ def find_contacts(
         Added to the ``frame`` column (pieces of a longer recording).
     saddle : float
         :data:`SADDLE_RATIO`, in (0, 1].
+    ring : float
+        :data:`RING_RATIO`, in [0, 1) (0: off; grids only).
 
     Returns
     -------
@@ -368,6 +402,8 @@ def find_contacts(
         raise TactsenseInputError(f"max_contacts must be an integer in 1-64; got {max_contacts!r}")
     if not (isinstance(saddle, float | int) and 0.0 < saddle <= 1.0):
         raise TactsenseInputError(f"saddle must be in (0, 1]; got {saddle!r}")
+    if not (isinstance(ring, float | int) and not isinstance(ring, bool) and 0.0 <= ring < 1.0):
+        raise TactsenseInputError(f"ring must be in [0, 1) (0: off); got {ring!r}")
     if threshold is None:  # a weight curve's own, else the default
         threshold = getattr(calibration, "contact_threshold", None) or default_threshold(sensor)
     if not (isinstance(threshold, float | int) and math.isfinite(threshold) and threshold > 0):
@@ -380,7 +416,7 @@ def find_contacts(
         # creep state runs through the whole batch, so it is applied in one piece)
         options = dict(baseline=baseline, counts=counts, dead=dead, threshold=threshold,
                        max_contacts=max_contacts, method=method, saddle=saddle,
-                       calibration=calibration)  # fmt: skip
+                       calibration=calibration, ring=ring)  # fmt: skip
         return ContactTable.concatenate(
             find_contacts(frames[lo : lo + BLOCK], sensor, first_frame=first_frame + lo, **options)
             for lo in range(0, len(frames), BLOCK)
@@ -430,7 +466,7 @@ def find_contacts(
     if kind == "points":
         table = _points_contacts(signal, sensor, threshold, saddle, max_contacts, method)
     else:
-        table = _grid_contacts(signal, sensor, threshold, saddle, max_contacts, method)
+        table = _grid_contacts(signal, sensor, threshold, saddle, max_contacts, method, ring)
     table.flags |= flags[table.frame]
     if array_calibration:
         table.force_n, beyond = calibration.contact_force(table)
@@ -457,7 +493,54 @@ def _mark_saturated(table: ContactTable, saturated: np.ndarray, sensor) -> None:
             table.flags[k] &= ~int(Flag.SATURATED)
 
 
-def _segment(signal, threshold, saddle, periodic, max_contacts, refine):
+def dip_floor(sensor, threshold: float) -> float:
+    """Smallest dip from the lower maximum to the saddle that keeps two maxima apart
+    [-]: the threshold, or :data:`NOISE_DIP` standard deviations of two taxels' read
+    noise difference when that is more (pads and point sets)."""
+    if getattr(sensor, "kind", None) not in ("pad", "points"):
+        return float(threshold)
+    noise = NOISE_DIP * math.sqrt(2.0 * signal_noise_variance(sensor))
+    return max(float(threshold), noise)
+
+
+@functools.lru_cache(maxsize=16)
+def point_taxels(sensor) -> int:
+    """Most taxels two point loads cover on a pad (inf otherwise): twice the most taxels
+    reading 0.1 of a 1.6-mm probe's peak or more, over its sub-taxel positions [-]. A
+    contact over more is placed at the centre of its signal, not at its peak."""
+    if getattr(sensor, "kind", None) != "pad":
+        return 1 << 30
+    kernel, _, _ = pad_force_kernel(sensor)
+    peak = kernel.max(axis=(2, 3), keepdims=True)
+    return 2 * int((kernel >= 0.1 * peak).sum(axis=(2, 3)).max())
+
+
+@functools.lru_cache(maxsize=16)
+def point_reach(sensor) -> float:
+    """Distance between two maxima beyond which two point loads cannot make a ridge
+    between them [taxel] (pads; inf otherwise): twice the farthest a 1.6-mm probe's
+    response reaches 0.1 of its peak (over its sub-taxel positions), plus twice the
+    farthest a load lies from its peak taxel along a row or a column (half a taxel),
+    plus one taxel."""
+    if getattr(sensor, "kind", None) != "pad":
+        return math.inf
+    kernel, step, half = pad_force_kernel(sensor)
+    reach = 0.0
+    n = kernel.shape[0]
+    offsets = np.arange(-half, half + 1, dtype=float)
+    for a in range(n):
+        for b in range(n):
+            k = kernel[a, b]
+            ii, jj = np.nonzero(k >= 0.1 * k.max())
+            d = np.hypot(offsets[ii] - a * step, offsets[jj] - b * step)
+            reach = max(reach, float(d.max()))
+    return 2.0 * reach + 2.0
+
+
+def _segment(
+    signal, threshold, saddle, periodic, max_contacts, refine, floor=None, ring=0.0,
+    far=math.inf, cover=1 << 30,
+):  # fmt: skip
     """The compiled segmentation of (N, rows, cols) signal, block by block."""
     from tactsense.estimate._contacts_fast import segment_into
     from tactsense.estimate.localize import MAX_ITERATIONS, TOLERANCE
@@ -471,6 +554,7 @@ def _segment(signal, threshold, saddle, periodic, max_contacts, refine):
     taxels = np.empty((n, k), np.int64)
     converged = np.empty((n, k), np.bool_)
     root = np.empty((n, k), np.int64)
+    wide = np.zeros((n, k), np.bool_)
     labels = np.empty((n, rows, cols), np.int64)
     with deferred_interrupts():
         for lo in range(0, n, BLOCK):
@@ -481,6 +565,9 @@ def _segment(signal, threshold, saddle, periodic, max_contacts, refine):
                 out["row"][lo:hi], out["col"][lo:hi], out["value"][lo:hi], out["total"][lo:hi],
                 out["rr"][lo:hi], out["cc"][lo:hi], out["rc"][lo:hi], taxels[lo:hi],
                 converged[lo:hi], root[lo:hi], labels[lo:hi],
+                float(threshold if floor is None else floor), float(ring),
+                float(WEAK_SHARE * threshold if ring > 0 else threshold), wide[lo:hi],
+                float(far), PAIR_RIDGE, int(cover),
             )  # fmt: skip
     keep = np.arange(k)[np.newaxis, :] < count[:, np.newaxis]
     frame = np.broadcast_to(np.arange(n)[:, np.newaxis], (n, k))[keep]
@@ -494,6 +581,7 @@ def _segment(signal, threshold, saddle, periodic, max_contacts, refine):
         root=root[keep],
         peak_row=peak_row[keep],
         peak_col=peak_col[keep],
+        wide=wide[keep],
     )
     return rows_out, labels
 
@@ -513,7 +601,9 @@ def _extent(rr, cc, rc, scale_r: float, scale_c: float):
     return major, minor, angle
 
 
-def _grid_contacts(signal, sensor, threshold, saddle, max_contacts, method) -> ContactTable:
+def _grid_contacts(
+    signal, sensor, threshold, saddle, max_contacts, method, ring=RING_RATIO
+) -> ContactTable:
     kind = sensor.kind
     if method == "fit" and kind != "pad":
         raise TactsenseInputError(
@@ -521,7 +611,12 @@ def _grid_contacts(signal, sensor, threshold, saddle, max_contacts, method) -> C
         )
     periodic = kind == "finger" and sensor.closes_circumference
     refine = method == "interpolate" and kind == "pad"
-    seg, labels = _segment(signal, threshold, saddle, periodic, max_contacts, refine)
+    floor = dip_floor(sensor, threshold)
+    far = point_reach(sensor) if ring > 0 else math.inf
+    cover = point_taxels(sensor) if ring > 0 else 1 << 30
+    seg, labels = _segment(
+        signal, threshold, saddle, periodic, max_contacts, refine, floor, ring, far, cover
+    )
     n = len(seg["frame"])
     rows, cols = sensor.shape
     flags = np.zeros(n, np.int64)
@@ -540,9 +635,14 @@ def _grid_contacts(signal, sensor, threshold, saddle, max_contacts, method) -> C
         else:
             force = pad_contact_force(signal, labels, seg, sensor)
         pad_merged_force(signal, labels, seg, row, col, sensor, threshold, force)
+        if seg["wide"].any():
+            # an extended contact (a stamp's rim): no point load explains it; its summed
+            # signal over a point load's summed response per newton
+            force = np.where(seg["wide"], seg["total"] / _kernel_total(sensor), force)
         major, minor, angle = _extent(
             seg["rr"], seg["cc"], seg["rc"], g.row_pitch_mm, g.col_pitch_mm
         )
+        cell_mm2 = g.row_pitch_mm * g.col_pitch_mm
         flags[(method == "interpolate") & ~seg["converged"]] |= int(Flag.NOT_CONVERGED)
         with np.errstate(invalid="ignore"):
             edge = (row < 0.5) | (row > rows - 1.5) | (col < 0.5) | (col > cols - 1.5)
@@ -559,6 +659,7 @@ def _grid_contacts(signal, sensor, threshold, saddle, max_contacts, method) -> C
         step_axial = float(np.diff(tactel_to_surface(sensor, np.array([1.0, 2.0]), 0.0)[0])[0])
         step_arc = sensor.radius_mm * math.radians(sensor.array.spacing_angle_deg)
         major, minor, angle = _extent(seg["rr"], seg["cc"], seg["rc"], abs(step_axial), step_arc)
+        cell_mm2 = abs(step_axial) * step_arc
         extra = {"axial_mm": axial, "angle_deg": angle_deg}
     extra["_root"] = seg["root"]
     extra["_labels"] = labels
@@ -566,7 +667,8 @@ def _grid_contacts(signal, sensor, threshold, saddle, max_contacts, method) -> C
     table = ContactTable(
         frame=seg["frame"], contact=seg["contact"], x_mm=x, y_mm=y, z_mm=z, row=row, col=col,
         force_n=force, peak=peak, major_mm=major, minor_mm=minor, orientation_deg=angle,
-        taxels=seg["taxels"], flags=flags, n_frames=len(signal), extra=extra,
+        taxels=seg["taxels"], area_mm2=seg["taxels"] * cell_mm2, flags=flags,
+        n_frames=len(signal), extra=extra,
     )  # fmt: skip
     return table
 
@@ -717,6 +819,15 @@ def signal_noise_variance(sensor) -> float:
 
 
 @functools.lru_cache(maxsize=16)
+def _kernel_total(sensor) -> float:
+    """The summed signal of :func:`pad_force_kernel`'s window per newton, averaged over
+    the load's sub-taxel positions [-/N]: an extended contact's force is its summed
+    signal over this (``find_contacts``)."""
+    kernel, _, _ = pad_force_kernel(sensor)
+    return float(kernel.sum(axis=(2, 3)).mean())
+
+
+@functools.lru_cache(maxsize=16)
 def _kernel_max(sensor) -> np.ndarray:
     """The largest response of each taxel of :func:`pad_force_kernel`'s signed window
     over every tabulated load position [-/N] (for :func:`pad_merged_force`'s skip)."""
@@ -793,8 +904,10 @@ def points_force_kernel(sensor):
     return kernel
 
 
-def _points_segment(s, threshold, saddle, neighbours):
-    """Labels (the maximum each taxel climbs to, -1 below the threshold) of one frame."""
+def _points_segment(s, threshold, saddle, neighbours, floor=None):
+    """Labels (the maximum each taxel climbs to, -1 below the threshold) of one frame
+    (``floor``: the smallest dip that keeps two maxima apart, :func:`dip_floor`)."""
+    floor = threshold if floor is None else floor
     n = len(s)
     parent = np.full(n, -1)
     for i in range(n):
@@ -828,7 +941,7 @@ def _points_segment(s, threshold, saddle, neighbours):
         if a == b:
             continue
         low = min(s[a], s[b])
-        if value >= saddle * low or low - value < threshold:
+        if value >= saddle * low or low - value < floor:
             if s[a] >= s[b]:
                 final[b] = a
             else:
@@ -877,11 +990,12 @@ def _points_peak(s, own, peak, positions, normals, neighbours):
 def _points_contacts(signal, sensor, threshold, saddle, max_contacts, method) -> ContactTable:
     positions, normals, neighbours = _points_geometry(sensor)
     kernel = points_force_kernel(sensor)
+    floor = dip_floor(sensor, threshold)
     rows = []
     labels = np.full(signal.shape, -1, dtype=np.int64)
     for f in range(len(signal)):
         s = signal[f, 0]
-        label = _points_segment(s, threshold, saddle, neighbours)
+        label = _points_segment(s, threshold, saddle, neighbours, floor)
         labels[f, 0] = label
         found = []
         for r in np.unique(label[label >= 0]):
@@ -928,7 +1042,7 @@ def _points_contacts(signal, sensor, threshold, saddle, max_contacts, method) ->
         y_mm=point[:, 1], z_mm=point[:, 2], row=nan, col=nan.copy(), force_n=np.array(force),
         peak=np.array(peak), major_mm=np.array(major, float), minor_mm=np.array(minor, float),
         orientation_deg=np.array(angle, float), taxels=np.array(taxels, np.int64),
-        flags=np.array(flag, np.int64), n_frames=len(signal),
+        area_mm2=np.full(len(rows), np.nan), flags=np.array(flag, np.int64), n_frames=len(signal),
         extra={"_root": np.array(root, np.int64), "_labels": labels,
                "_total": np.array(total, float)},
     )  # fmt: skip

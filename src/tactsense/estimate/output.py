@@ -204,7 +204,7 @@ class ContactsWriter(EstimatesWriter):
 
     Columns: ``frame``, ``time_s``, ``id`` (the tracked identity; -1 when not tracked),
     the table's columns (``x_mm``, ``y_mm``, ``z_mm``, ``row``, ``col``, ``force_n``,
-    ``peak``, ``major_mm``, ``minor_mm``, ``orientation_deg``, ``taxels``, ``flags``,
+    ``peak``, ``major_mm``, ``minor_mm``, ``orientation_deg``, ``taxels``, ``area_mm2``, ``flags``,
     ``contact``, the velocities and ``slip`` when tracked, and any extra columns such as
     a finger's ``axial_mm`` and ``angle_deg``), and ``event``: ``birth`` on the row where
     an id is born, ``split:P`` where it splits off id P, empty otherwise. Deaths and

@@ -26,6 +26,10 @@ Events (:class:`TrackEvent`):
   contact matched to another track (``others = (survivor,)``); a merge ends the track
   at once.
 
+A contact larger than the gate (a flat stamp) has a gate of :data:`EXTENT_GATE` times
+its extent along its major axis instead (``major_mm``): its centre jumps when its rim
+first reads in part, and it keeps its id.
+
 Velocity: the displacement since the track was last seen over the time elapsed,
 smoothed exponentially (``smoothing`` is the weight of the new value). Slip: a contact
 moving faster than ``slip_speed_mm_s`` while its force changes by less than
@@ -92,6 +96,14 @@ def assign(cost: np.ndarray, limit: float) -> list[tuple[int, int]]:
     return [(i, int(j)) for i, j in enumerate(match) if j >= 0]
 
 
+EXTENT_GATE = 3.0
+"""A contact larger than the gate is matched within this many of its extents along its
+major axis (``major_mm``, a standard deviation) [-]: a flat stamp's centre (or the peak
+of a rim that reaches the array's edge) moves by more than the gate from frame to
+frame, and keeps its id. Three standard deviations of a uniform footprint are 0.87 of
+its side."""
+
+
 def _columns(table: ContactTable):
     """What both trackers read and write: positions (contiguous) [mm], forces (NaN as 0)
     [N], and the id, velocity and slip columns to fill."""
@@ -99,6 +111,12 @@ def _columns(table: ContactTable):
     pos = np.ascontiguousarray(np.column_stack([table.x_mm, table.y_mm, table.z_mm]), float)
     force = np.nan_to_num(np.asarray(table.force_n, dtype=float))
     return pos, force, np.full(n, -1, np.int64), np.zeros((n, 3)), np.zeros(n, bool)
+
+
+def _reach(table: ContactTable, gate_mm: float) -> np.ndarray:
+    """Each row's gate [mm]: ``gate_mm``, or :data:`EXTENT_GATE` times its extent."""
+    major = np.nan_to_num(np.asarray(table.major_mm, dtype=float))
+    return np.ascontiguousarray(np.maximum(gate_mm, EXTENT_GATE * major))
 
 
 def _tracked(table: ContactTable, ids, vel, slip) -> ContactTable:
@@ -193,6 +211,7 @@ class ReferenceTracker:
         """
         start, end, frames = self._check(table, first_frame)
         pos, force, ids, vel, slip = _columns(table)
+        reach = _reach(table, self.gate_mm)
         events: list[TrackEvent] = []
         bounds = np.searchsorted(frames, np.arange(start, end + 1))
         # frames without contacts only age the tracks: jump over runs of them
@@ -200,7 +219,7 @@ class ReferenceTracker:
         for f in busy:
             lo, hi = bounds[f - start], bounds[f - start + 1]
             self._frame(int(f), pos[lo:hi], force[lo:hi], ids[lo:hi], vel[lo:hi], slip[lo:hi],
-                        events)  # fmt: skip
+                        events, reach[lo:hi])  # fmt: skip
         self._age_until(end, events)
         self.next_frame = end
         return _tracked(table, ids, vel, slip), events
@@ -238,18 +257,19 @@ class ReferenceTracker:
                 alive.append(track)
         self.tracks = alive
 
-    def _frame(self, f, pos, force, ids, vel, slip, events) -> None:
+    def _frame(self, f, pos, force, ids, vel, slip, events, reach=None) -> None:
         self._age_until(f, events)
         tracks = self.tracks
         dt = self.frame_period_s
         n_t, n_c = len(tracks), len(pos)
+        gate = np.full(n_c, self.gate_mm) if reach is None else reach
         if n_t:
             predicted = np.array([t.pos + t.vel * dt * (f - t.last) for t in tracks])
             distance = np.linalg.norm(predicted[:, None, :] - pos[None, :, :], axis=-1)
             cost = distance + self.force_weight * np.abs(
                 np.array([t.force for t in tracks])[:, None] - force[None, :]
             )
-            cost = np.where(distance <= self.gate_mm, cost, _FAR)
+            cost = np.where(distance <= gate[None, :], cost, _FAR)
             from scipy.optimize import linear_sum_assignment
 
             rows, cols = linear_sum_assignment(cost)
@@ -279,7 +299,7 @@ class ReferenceTracker:
             if i in matched_t:
                 survivors.append(track)
                 continue
-            into = [j for j in matched_c if distance[i, j] <= self.gate_mm]
+            into = [j for j in matched_c if distance[i, j] <= gate[j]]
             if into:
                 j = min(into, key=lambda j: distance[i, j])
                 events.append(TrackEvent(f, "merge", track.id, (owner[j].id,)))
@@ -292,7 +312,7 @@ class ReferenceTracker:
                 continue
             track = _Track(self.next_id, pos[j], force[j], f)
             self.next_id += 1
-            near = [i for i in matched_t if distance[i, j] <= self.gate_mm]
+            near = [i for i in matched_t if distance[i, j] <= gate[j]]
             if near:
                 parent = tracks[min(near, key=lambda i: distance[i, j])]
                 events.append(TrackEvent(f, "split", track.id, (parent.id,)))
@@ -374,7 +394,8 @@ class ContactTracker(ReferenceTracker):
                 frames, pos, force, start, end, self._t_pos, self._t_vel, self._t_force,
                 self._t_dforce, self._t_last, self._t_id, counters, self.frame_period_s,
                 self.gate_mm, self.force_weight, self.max_missing, self.smoothing,
-                self.slip_speed, self.slip_force_rate, _FAR, ids, vel, slip, *ev,
+                self.slip_speed, self.slip_force_rate, _FAR, _reach(table, self.gate_mm), ids,
+                vel, slip, *ev,
             )  # fmt: skip
         if status != 0:  # pragma: no cover - the capacities above are upper bounds
             raise RuntimeError("tracker capacity exceeded")

@@ -17,6 +17,16 @@ Pressure laws:
   (Boussinesq's punch; Johnson 1985, eq. 3.35), its edge singularity cell-averaged.
 * :class:`KnifeEdge`: a line load of a given length, angle and width (elliptical across
   the edge, as a 2-D Hertz contact).
+* :class:`SquareStamp`: a rigid flat rectangular (by default square) stamp turned by an
+  angle. Its exact pressure has no closed form; it is approximated by the product of
+  two plane-strain flat-punch profiles (Sneddon; Johnson 1985, eq. 2.64),
+  ``p = F / (pi^2 sqrt((a^2 - u^2) (b^2 - v^2)))`` over ``|u| < a``, ``|v| < b``: it
+  carries the load exactly, is singular as ``1/sqrt`` along every edge (as the exact
+  one is) and concentrates at the corners; each axis' singularity is band-averaged.
+* :class:`CylinderProbe`: a rigid cylinder of a given radius and length lying on the
+  surface: Hertz's line contact (Johnson 1985, eqs. 4.43-4.45), half-width
+  ``b = sqrt(4 F R / (pi L E*))`` and ``p = (2 F / (pi b L)) sqrt(1 - u^2/b^2)`` across,
+  uniform along its length (the ends' concentration left out).
 """
 
 from __future__ import annotations
@@ -240,8 +250,135 @@ class KnifeEdge(Indenter):
         return profile * (np.abs(along) <= self.length_mm / 2.0)
 
 
+def _punch_band(u, half_width, half_step):
+    """Mean of ``1 / sqrt(1 - (u / a)^2)`` over ``[u - h, u + h]`` (its integral is
+    ``a arcsin(u / a)``): the plane-strain punch profile, bounded at the edge [-]."""
+    low = np.clip((u - half_step) / half_width, -1.0, 1.0)
+    high = np.clip((u + half_step) / half_width, -1.0, 1.0)
+    return half_width * (np.arcsin(high) - np.arcsin(low)) / (2.0 * half_step)
+
+
+def _ellipse_band(u, half_width, half_step):
+    """Mean of ``sqrt(1 - (u / b)^2)`` over ``[u - h, u + h]`` (Hertz's profile; its
+    integral is ``b (t sqrt(1 - t^2) + arcsin t) / 2``, ``t = u / b``): exact however
+    narrow the contact against the step [-]."""
+
+    def primitive(t):
+        t = np.clip(t, -1.0, 1.0)
+        return 0.5 * (t * np.sqrt(1.0 - t * t) + np.arcsin(t))
+
+    return (
+        half_width
+        * (primitive((u + half_step) / half_width) - primitive((u - half_step) / half_width))
+        / (2.0 * half_step)
+    )
+
+
+def _local_axes(dx, dy, angle_deg):
+    angle = math.radians(angle_deg)
+    along = dx * math.cos(angle) + dy * math.sin(angle)
+    across = -dx * math.sin(angle) + dy * math.cos(angle)
+    return along, across
+
+
+def _finite_angle(value) -> None:
+    if not (isinstance(value, int | float) and math.isfinite(value)):
+        raise TactsenseInputError(f"angle_deg must be a finite angle [deg]; got {value!r}")
+
+
+@dataclass(frozen=True)
+class SquareStamp(Indenter):
+    """A rigid flat stamp ``side_mm`` long (along ``angle_deg`` from the x axis) and
+    ``width_mm`` wide (None: square), pressed flat with ``force_n``.
+
+    Pressure: the product of two plane-strain flat-punch profiles (module docstring),
+    ``F / (pi^2 sqrt((a^2 - u^2) (b^2 - v^2)))`` with ``a = side / 2``, ``b = width / 2``.
+    """
+
+    side_mm: float = 5.0
+    width_mm: float | None = None
+    angle_deg: float = 0.0
+    kind: ClassVar[str] = "square"
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        _finite_positive("side_mm", self.side_mm)
+        if self.width_mm is not None:
+            _finite_positive("width_mm", self.width_mm)
+        _finite_angle(self.angle_deg)
+
+    @property
+    def half_sides_mm(self) -> tuple[float, float]:
+        """Half the side along and across the stamp's axis [mm]."""
+        width = self.side_mm if self.width_mm is None else self.width_mm
+        return 0.5 * self.side_mm, 0.5 * width
+
+    def area_mm2(self) -> float:
+        """The stamp's face [mm^2]."""
+        a, b = self.half_sides_mm
+        return 4.0 * a * b
+
+    def reach_mm(self, modulus_star_pa):
+        return math.hypot(*self.half_sides_mm)
+
+    def _integral_mm2(self, modulus_star_pa):
+        # each axis' profile 1/sqrt(1 - (u/a)^2) integrates to pi a
+        a, b = self.half_sides_mm
+        return math.pi**2 * a * b
+
+    def _shape(self, dx, dy, modulus_star_pa, step_mm):
+        a, b = self.half_sides_mm
+        along, across = _local_axes(dx, dy, self.angle_deg)
+        half = 0.5 * step_mm
+        return _punch_band(along, a, half) * _punch_band(across, b, half)
+
+
+@dataclass(frozen=True)
+class CylinderProbe(Indenter):
+    """A rigid cylinder of ``radius_mm`` and ``length_mm`` lying on the surface along
+    ``angle_deg`` from the x axis, pressed with ``force_n``: Hertz's line contact."""
+
+    length_mm: float = 10.0
+    radius_mm: float = 5.0
+    angle_deg: float = 0.0
+    kind: ClassVar[str] = "cylinder"
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        _finite_positive("length_mm", self.length_mm)
+        _finite_positive("radius_mm", self.radius_mm)
+        _finite_angle(self.angle_deg)
+
+    def half_width_mm(self, modulus_star_pa: float) -> float:
+        """Hertz's half-width of the line contact, ``b = sqrt(4 F R / (pi L E*))`` [mm]
+        (Johnson 1985, eq. 4.43, load per unit length ``F / L``), at most the radius."""
+        per_length = self.force_n / (self.length_mm * 1e-3)  # [N/m]
+        b = math.sqrt(4.0 * per_length * self.radius_mm * 1e-3 / (math.pi * modulus_star_pa))
+        return min(1e3 * b, self.radius_mm)
+
+    def reach_mm(self, modulus_star_pa):
+        return math.hypot(0.5 * self.length_mm, self.half_width_mm(modulus_star_pa))
+
+    def _integral_mm2(self, modulus_star_pa):
+        return 0.5 * math.pi * self.half_width_mm(modulus_star_pa) * self.length_mm
+
+    def _shape(self, dx, dy, modulus_star_pa, step_mm):
+        b = self.half_width_mm(modulus_star_pa)
+        if b <= 0:
+            return np.zeros(np.broadcast(dx, dy).shape)
+        along, across = _local_axes(dx, dy, self.angle_deg)
+        half = 0.5 * step_mm
+        inside = np.clip(
+            (np.minimum(along + half, 0.5 * self.length_mm)
+             - np.maximum(along - half, -0.5 * self.length_mm)) / step_mm,
+            0.0, 1.0,
+        )  # fmt: skip
+        return _ellipse_band(across, b, half) * inside
+
+
 INDENTERS: dict[str, type] = {
-    cls.kind: cls for cls in (SphereProbe, DiscProbe, FlatPunch, KnifeEdge)
+    cls.kind: cls
+    for cls in (SphereProbe, DiscProbe, FlatPunch, KnifeEdge, SquareStamp, CylinderProbe)
 }
 
 

@@ -237,6 +237,7 @@ CONTACT_FIELDS = (
     "minor_mm",
     "orientation_deg",
     "taxels",
+    "area_mm2",
     "vx_mm_s",
     "vy_mm_s",
     "vz_mm_s",
