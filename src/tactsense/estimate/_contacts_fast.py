@@ -822,8 +822,9 @@ def track_into(
     Tracks live in ``t_*[:counters[0]]``; ``counters`` = (tracks alive, next id,
     events written). Event kinds: 0 birth, 1 death, 2 merge, 3 split. Returns -1 when
     the track or event arrays are full (the caller grows them and runs again from its
-    saved state), else 0. ``reach[k]``: the gate of row ``k``'s contact [mm] (the gate,
-    or more for a contact larger than it).
+    saved state), else 0. ``reach[k]``: the gate of row ``k``'s contact for matching
+    [mm] (the gate, or more for a contact larger than it); merges and splits are told
+    within the gate.
     """
     n = frame.shape[0]
     cap = t_id.shape[0]
@@ -898,7 +899,7 @@ def track_into(
                 continue
             best = -1
             for j in range(n_c):
-                if owner[j] >= 0 and distance[i, j] <= reach[lo + j]:
+                if owner[j] >= 0 and distance[i, j] <= gate:
                     if best < 0 or distance[i, j] < distance[i, best]:
                         best = j
             if best >= 0:
@@ -918,7 +919,7 @@ def track_into(
                 continue
             best = -1
             for i in range(n_t):
-                if match[i] >= 0 and distance[i, j] <= reach[lo + j]:
+                if match[i] >= 0 and distance[i, j] <= gate:
                     if best < 0 or distance[i, j] < distance[best, j]:
                         best = i
             parents[j] = t_id[best] if best >= 0 else -1

@@ -26,9 +26,10 @@ Events (:class:`TrackEvent`):
   contact matched to another track (``others = (survivor,)``); a merge ends the track
   at once.
 
-A contact larger than the gate (a flat stamp) has a gate of :data:`EXTENT_GATE` times
-its extent along its major axis instead (``major_mm``): its centre jumps when its rim
-first reads in part, and it keeps its id.
+A contact larger than the gate (a flat stamp) is matched within :data:`EXTENT_GATE`
+times its extent along its major axis instead (``major_mm``): its centre jumps when its
+rim first reads in part, and it keeps its id. Merges and splits are told within the
+gate.
 
 Velocity: the displacement since the track was last seen over the time elapsed,
 smoothed exponentially (``smoothing`` is the weight of the new value). Slip: a contact
@@ -299,7 +300,7 @@ class ReferenceTracker:
             if i in matched_t:
                 survivors.append(track)
                 continue
-            into = [j for j in matched_c if distance[i, j] <= gate[j]]
+            into = [j for j in matched_c if distance[i, j] <= self.gate_mm]
             if into:
                 j = min(into, key=lambda j: distance[i, j])
                 events.append(TrackEvent(f, "merge", track.id, (owner[j].id,)))
@@ -312,7 +313,7 @@ class ReferenceTracker:
                 continue
             track = _Track(self.next_id, pos[j], force[j], f)
             self.next_id += 1
-            near = [i for i in matched_t if distance[i, j] <= gate[j]]
+            near = [i for i in matched_t if distance[i, j] <= self.gate_mm]
             if near:
                 parent = tracks[min(near, key=lambda i: distance[i, j])]
                 events.append(TrackEvent(f, "split", track.id, (parent.id,)))
