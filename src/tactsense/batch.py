@@ -252,9 +252,12 @@ class iter_contacts:
             if self.health["excluded"].any() and not array_calibration:
                 self.dead = self.health["excluded"]
             creep, stiffening, self.creep = creep_applied(sensor, reader.attrs)
+            if threshold is None:  # the sensor's, over the noise the creep
+                # compensation leaves (the same for the baseline and the contacts)
+                threshold = default_threshold(sensor, creep=creep)
             self.baseline = DriftBaseline(
                 start, sensor, frame_period_s=sensor.scan_period_s,
-                threshold=default_threshold(sensor) if threshold is None else threshold,
+                threshold=threshold,
                 time_constant_s=math.inf if drift_s is None else drift_s,
                 creep=creep, stiffening=stiffening,
             )  # fmt: skip

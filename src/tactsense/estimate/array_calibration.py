@@ -1134,10 +1134,10 @@ def contact_totals(frames, sensor, calibration, *, baseline_frames=5, threshold=
     from tactsense.estimate.creep import creep_applied
     from tactsense.estimate.deflection import Flag
 
-    threshold = default_threshold(sensor) if threshold is None else float(threshold)
     frames = np.asarray(frames)
     start = np.nanmedian(frames[:baseline_frames].astype(float), axis=0)
     creep, stiffening, label = creep_applied(sensor, attrs or {"source": "measured"})
+    threshold = default_threshold(sensor, creep=creep) if threshold is None else float(threshold)
     drift = DriftBaseline(
         start, sensor, frame_period_s=sensor.scan_period_s, threshold=threshold,
         time_constant_s=math.inf if not drift_s else drift_s, creep=creep,
@@ -1193,7 +1193,12 @@ def _add_weight_curve(calibration, sensor, loads, weights, baseline_frames, thre
         )
     if weights.time_s is not None and time_s is None:
         raise ArrayCalibrationError("a timed weights log needs the recording's frame times")
-    threshold = default_threshold(sensor) if threshold is None else float(threshold)
+    if threshold is None:  # over the noise the creep compensation leaves, as locate's
+        from tactsense.estimate.creep import creep_applied
+
+        applied = creep_applied(sensor, attrs or {"source": "measured"})[0]
+        threshold = default_threshold(sensor, creep=applied)
+    threshold = float(threshold)
     totals, saturated, creep = contact_totals(
         load_frames, sensor, calibration, baseline_frames=baseline_frames,
         threshold=threshold, attrs=attrs,

@@ -313,7 +313,12 @@ class LiveContacts:
         self.sensor = sensor
         if threshold is None:  # a weight curve's own threshold, else the sensor's
             threshold = getattr(calibration, "contact_threshold", None)
-        self.threshold = default_threshold(sensor) if threshold is None else float(threshold)
+        if threshold is None:  # over the noise the creep compensation leaves
+            from tactsense.estimate.creep import described_compensation
+
+            creep = described_compensation(sensor)[0]
+            threshold = default_threshold(sensor, creep=creep, frame_period_s=frame_period_s)
+        self.threshold = float(threshold)
         self.frame_period_s = float(frame_period_s or sensor.scan_period_s)
         self._baseline_frames = max(1, int(baseline_frames))
         self._drift_s = drift_s
