@@ -119,6 +119,8 @@ class ContactTable:
             if f.name in ("n_frames", "extra"):
                 continue
             value = getattr(self, f.name)
+            if value is None and f.name == "area_mm2":  # a table made without it
+                value = np.full(len(self.frame), np.nan)
             if value is not None:
                 out[f.name] = np.asarray(value)
         out.update({k: np.asarray(v) for k, v in self.extra.items()})
