@@ -150,8 +150,12 @@ def test_bad_pad_descriptions_say_what_is_wrong(change, message):
 
 
 def test_kind_and_extends_must_agree():
-    with pytest.raises(SensorSpecError, match="is not a preset; available: pad4, pad16"):
+    with pytest.raises(SensorSpecError, match="'initial' is a finger preset, and this desc"):
         sensor_from_dict({"kind": "pad", "extends": "initial"})
+    with pytest.raises(SensorSpecError, match=r"available: initial \(finger\),.* fsr16 \(pad\)"):
+        sensor_from_dict({"kind": "pad", "extends": "fsr-16"})
+    with pytest.raises(SensorSpecError, match='kind = "pad" or kind = "points"'):
+        sensor_from_dict({"grid": {"rows": 4}})
     with pytest.raises(SensorSpecError, match="kind = 'sphere' is not a sensor kind"):
         sensor_from_dict({"kind": "sphere"})
 

@@ -24,6 +24,10 @@ VACUUM_PERMITTIVITY = 8.8541878128e-12  # [F/m]
 STANDARD_GRAVITY = 9.80665  # [m/s^2]
 
 
+_KIND_WORDS = {"finger": "finger", "pad": "pad", "points": "point set"}
+"""How a message names each kind of sensor."""
+
+
 class SensorSpecError(TactsenseInputError):
     """Raised when a sensor description is invalid."""
 
@@ -313,11 +317,17 @@ class SpecBase:
         if "extends" in data:
             extends = data["extends"]
             key = extends.removeprefix("fearing1990_") if isinstance(extends, str) else None
-            if key not in PRESETS or PRESETS[key]().kind != cls.kind:
-                same = [name for name, make in PRESETS.items() if make().kind == cls.kind]
+            if key in PRESETS and PRESETS[key]().kind != cls.kind:
+                other = PRESETS[key]().kind
                 raise SensorSpecError(
-                    f"{source}: extends = {extends!r} is not a preset; "
-                    f"available: {', '.join(same)} ({cls.kind} presets)"
+                    f"{source}: extends = {extends!r} is a {_KIND_WORDS.get(other, other)} "
+                    f"preset, and this description is a {_KIND_WORDS.get(cls.kind, cls.kind)}"
+                    f"'s: add kind = {other!r} at the top"
+                )
+            if key not in PRESETS:
+                every = ", ".join(f"{name} ({make().kind})" for name, make in PRESETS.items())
+                raise SensorSpecError(
+                    f"{source}: extends = {extends!r} is not a preset; available: {every}"
                 )
             base = preset(key).to_dict()
         elif not any(section in data for section in cls.SECTIONS):
@@ -325,6 +335,11 @@ class SpecBase:
                 f"{source}: no sections ({', '.join(f'[{s}]' for s in cls.SECTIONS)}); "
                 'describe every section, or start from a preset with extends = "NAME" '
                 "(tactsense sensor show prints a complete description to edit)"
+                + (
+                    '; a pad or a point set says so first: kind = "pad" or kind = "points"'
+                    if cls.kind == "finger"
+                    else ""
+                )
             )
         sections: dict[str, Any] = {}
         for section, section_type in cls.SECTIONS.items():
