@@ -119,7 +119,10 @@ def test_validation_says_what_is_wrong(text, message):
         ('name = "x"\n', "no sections"),
         ("[array]\nspacing_axial_mm = 3.0\n", r"\[array\] is missing cylinder_rows, cols"),
         ("[array]\nspacing_axial_mm = 3.0\n", r"\[elastic\] is missing"),
-        ('extends = "bogus"\n', "not a preset; available: initial \\(finger\\), improved \\(finger\\)"),
+        (
+            'extends = "bogus"\n',
+            r"not a preset; available: initial \(finger\), improved \(finger\)",
+        ),
         ("extends = 3\n", "not a preset"),
     ],
 )
