@@ -88,3 +88,64 @@ def test_a_noisy_stamp_through_locate_with_creep_compensation(tmp_path):
     assert (per_frame[loaded] == 1).mean() >= 0.98
     assert (per_frame[~loaded] == 0).all()
     assert table["id"].nunique() <= 8 + 3
+
+
+@pytest.fixture(scope="module")
+def tip_weights(tmp_path_factory):
+    """An iCub-like fingertip's weights series (20-160 g), as a lab's logger gives it:
+    simulated, exported to CSV, imported."""
+    folder = tmp_path_factory.mktemp("tip")
+    toml = folder / "tip.toml"
+    toml.write_text('extends = "icub_fingertip"\nname = "lab_tip"\n')
+    sim, frames, rec = folder / "sim.h5", folder / "frames.csv", folder / "w.h5"
+    for args in (
+        ["simulate", "--sensor", str(toml), "--scenario", "loads", "--forces-g",
+         "20,40,60,80,100,120,140,160", "--dwell-s", "2", "--lift-s", "2", "--seed", "1",
+         "-o", str(sim)],
+        ["export", str(sim), "--format", "csv", "-o", str(frames)],
+        ["import", str(frames), "--sensor", str(toml), "-o", str(rec)],
+    ):  # fmt: skip
+        result = runner.invoke(app, args)
+        assert result.exit_code == 0, result.output
+    return folder, rec
+
+
+def _weights(folder, name, header, masses):
+    path = folder / name
+    path.write_text(f"press,{header}\n" + "".join(f"{k + 1},{m}\n" for k, m in enumerate(masses)))
+    return path
+
+
+def test_weights_logged_out_of_order_are_said_so(tip_weights):
+    """Two rows of the log swapped (80 g logged before 60 g): the totals fall from one
+    load to the next, which the monotone fit pools; it said "add weights there, where
+    the curve bends" (a leave-one-out error of 50 %), never that the log is out of
+    order."""
+    folder, rec = tip_weights
+    log = _weights(folder, "swapped.csv", "mass_g", [20, 40, 80, 60, 100, 120, 140, 160])
+    result = runner.invoke(
+        app, ["calibrate", str(rec), "--force-log", str(log), "-o", str(folder / "c1.json")]
+    )
+    said = " ".join(result.output.replace("│", " ").split())
+    assert "the totals fall from" in said, said
+    assert "is the log in the order the weights were placed" in said, said
+
+
+def test_grams_under_a_kilogram_header_are_questioned(tip_weights):
+    """Grams written under ``mass_kg``: the curve went to 1569 N on a 144-mm^2 fingertip
+    (10.9 MPa) without a word. A weight above 1 MPa over the whole array asks for the
+    unit; a log in the right unit gets no such warning."""
+    folder, rec = tip_weights
+    masses = [20, 40, 60, 80, 100, 120, 140, 160]
+    wrong = _weights(folder, "kg.csv", "mass_kg", masses)
+    result = runner.invoke(
+        app, ["calibrate", str(rec), "--force-log", str(wrong), "-o", str(folder / "c2.json")]
+    )
+    said = " ".join(result.output.split())
+    assert "is 'mass_kg' the unit of the numbers" in said, said
+    right = _weights(folder, "g.csv", "mass_g", masses)
+    result = runner.invoke(
+        app, ["calibrate", str(rec), "--force-log", str(right), "-o", str(folder / "c3.json")]
+    )
+    assert result.exit_code == 0 and "the unit of the numbers" not in result.output
+    assert "holds for" in result.output

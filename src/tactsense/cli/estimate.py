@@ -521,6 +521,23 @@ def _calibrate_array(recording, out, *, press, force_log, loads, baseline_frames
 LOO_GOAL_PERCENT = 5.0
 """A held-out weight predicted further off than this [%] gets a hint to add weights."""
 
+PLAUSIBLE_PRESSURE_PA = 1.0e6
+"""A weight heavier than this pressure over the whole array's area [Pa] is taken for a
+unit mistake (1 MPa: four times the Young's modulus of the presets' rubber, a strain
+that tears a skin; grams under ``mass_kg`` read 1000 times heavier)."""
+
+
+def _array_area_mm2(sensor) -> float | None:
+    """The area the array's taxels cover [mm^2]: a pad's rows x cols cells, a point
+    set's taxel areas; None on a finger."""
+    grid = getattr(sensor, "grid", None)
+    if grid is not None:
+        return float(grid.rows * grid.cols * grid.row_pitch_mm * grid.col_pitch_mm)
+    areas = getattr(sensor, "areas_mm2", None)  # a point set's, one per taxel
+    if areas is None:
+        return None
+    return float(np.sum(areas() if callable(areas) else areas))
+
 
 def _print_weight_curve(calibration, table, console) -> None:
     """The weight curve's summary and its leave-one-out table, as kept in the notes."""
@@ -548,14 +565,38 @@ def _print_weight_curve(calibration, table, console) -> None:
     said = [] if loo is None else [f"largest error {loo:.1f} % (weights between two others)"]
     if lightest is not None:
         said.append(f"the lightest {lightest:+.1f} % (from the origin)")
-    bends = [w["force_n"] for w in weights if w.get("loo_between") and
-             abs(w["loo_error_percent"]) > LOO_GOAL_PERCENT]  # fmt: skip
+    disorder = notes.get("out_of_order") or []
+    pooled = {f for pair in disorder for f in pair}
+    bends = [w["force_n"] for w in weights if w.get("loo_between") and w["force_n"] not in pooled
+             and abs(w["loo_error_percent"]) > LOO_GOAL_PERCENT]  # fmt: skip
+    if disorder:
+        said.append(
+            "[bold]the totals fall from "
+            + ", ".join(f"{a:.3g} N to {b:.3g} N" for a, b in disorder)
+            + ": is the log in the order the weights were placed, one row per placing?[/]"
+        )
     if bends:
         said.append(
             f"[bold]above {LOO_GOAL_PERCENT:g} % at {', '.join(f'{f:.3g}' for f in bends)} N: "
             "add weights there, where the curve bends[/]"
         )
     table.add_row("leave-one-out", "; ".join(said) or "no weight could be held out")
+    table.add_row(
+        "holds for",
+        "loads placed and shaped as the weights were: a cell whose reading is not linear "
+        "in its load (an FSR's divider) sums otherwise when a load is shared between "
+        "taxels, and a sparse array reads less between taxels; place each weight at "
+        "several spots (one row each) to take their median (docs/calibration.md)",
+    )
+    area_mm2 = _array_area_mm2(calibration.sensor)
+    heaviest = max(w["force_n"] for w in weights)
+    if area_mm2 and heaviest / (area_mm2 * 1e-6) > PLAUSIBLE_PRESSURE_PA:
+        console.print(
+            f"warning: the heaviest weight, {heaviest:.4g} N, over the whole array "
+            f"({area_mm2:.4g} mm^2) is {heaviest / area_mm2:.3g} MPa, more than a rubber "
+            f"skin bears: is {notes['weights_column']!r} the unit of the numbers in "
+            f"{notes['weights_log']} (grams written under mass_kg or force_n)?"
+        )
     hysteresis = notes["hysteresis"]
     table.add_row(
         "hysteresis",

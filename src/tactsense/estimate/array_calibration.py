@@ -778,7 +778,8 @@ def weight_curve(presses: Presses) -> dict:
         ``saturation`` (the lightest saturated weight [N] and why, or None),
         ``loo_max_error_percent`` (the largest error [%] of the weights held out between
         two others), ``loo_lightest_error_percent`` (the lightest's, read between the
-        origin and the next weight, where a response bends most).
+        origin and the next weight, where a response bends most), ``out_of_order``
+        (pairs of neighbouring loads [N] whose totals fall as the load rises).
     """
     loads = presses.force_n
     if np.max(loads) < 1.5 * np.min(loads):
@@ -855,6 +856,10 @@ def weight_curve(presses: Presses) -> dict:
                 entry.update(loo_n=None, loo_error_percent=None,
                              loo_note="beyond the others' range: not extrapolated")  # fmt: skip
         weights.append(entry)
+    # neighbours whose totals fall as the load rises: pooled by the monotone fit, and a
+    # sign of a log out of the placing order more than of a bend
+    disorder = [[float(force[k]), float(force[k + 1])] for k in range(end - 1)
+                if total[k + 1] < total[k]]  # fmt: skip
     errors = [abs(w["loo_error_percent"]) for w in weights if w.get("loo_between")]
     lightest = [w["loo_error_percent"] for w in weights
                 if w.get("loo_error_percent") is not None and not w["loo_between"]]  # fmt: skip
@@ -867,6 +872,7 @@ def weight_curve(presses: Presses) -> dict:
                                                        "reason": reason},
         "loo_max_error_percent": float(max(errors)) if errors else None,
         "loo_lightest_error_percent": float(lightest[0]) if lightest else None,
+        "out_of_order": disorder,
     }  # fmt: skip
 
 
@@ -1238,6 +1244,7 @@ def _add_weight_curve(calibration, sensor, loads, weights, baseline_frames, thre
         saturation=curve["saturation"],
         loo_max_error_percent=curve["loo_max_error_percent"],
         loo_lightest_error_percent=curve["loo_lightest_error_percent"],
+        out_of_order=curve["out_of_order"],
         hysteresis=hysteresis(presses, curve),
         temperature=temperature_coefficient(presses, curve),
     )  # fmt: skip
