@@ -86,9 +86,13 @@ ContactThresholdOption = Annotated[
         "--threshold",
         callback=_threshold,
         help="Smallest signal that counts as contact, as a fraction [default: 10 counts' "
-        "worth (3 on an 8-bit converter): for capacitive taxels the fractional deflection "
-        "of 10 counts from the rest reading, at least 0.005 (0.5 %, 10 counts at 2000); "
-        "for resistive ones 10 / counts_per_strain of strain].",
+        "worth on 12 bits or more (the same share of the range on fewer, at least 3 "
+        "counts), or 5 standard deviations of the description's read_noise_counts when "
+        "that is more (times the creep compensation's noise gain where creep is taken "
+        "out); for capacitive taxels the fractional deflection of that change from the "
+        "rest reading, at least 0.005 (0.5 %, 10 counts at 2000); for resistive and "
+        "piezoresistive ones that change / counts_per_strain of strain; a weights "
+        "calibration's own threshold when one is given].",
     ),
 ]
 

@@ -229,8 +229,10 @@ def calibrate(
     sweep: Annotated[
         Path,
         typer.Argument(
-            help="Recording of a probe swept along every column (section 3.1), "
-            "starting with untouched frames."
+            help="Recording starting with untouched frames: a finger's probe swept along "
+            "every column (section 3.1); a pad's or point set's sweep over every taxel, a "
+            "uniform press (--press), or the weights placed one at a time (with "
+            "--force-log WEIGHTS.csv and no sweep)."
         ),
     ],
     out: Annotated[
