@@ -149,3 +149,24 @@ def test_grams_under_a_kilogram_header_are_questioned(tip_weights):
     )
     assert result.exit_code == 0 and "the unit of the numbers" not in result.output
     assert "holds for" in result.output
+
+
+def test_weights_on_a_fingertip_described_with_the_wrong_polarity(tip_weights):
+    """The fingertip's frames (falling under load) imported with a description that
+    says rising: calibrate said only "found 6 presses ... lists 8 weights", phantom
+    presses and no hint; now the message names the polarity to set (exit 2, no file)."""
+    folder, _ = tip_weights
+    toml = folder / "rising.toml"
+    toml.write_text(
+        'extends = "icub_fingertip"\nname = "lab_tip"\n[transduction]\npolarity = "rising"\n'
+    )
+    rec, out = folder / "rising.h5", folder / "rising.json"
+    result = runner.invoke(
+        app, ["import", str(folder / "frames.csv"), "--sensor", str(toml), "-o", str(rec)]
+    )
+    assert result.exit_code == 0, result.output
+    log = _weights(folder, "g8.csv", "mass_g", [20, 40, 60, 80, 100, 120, 140, 160])
+    result = runner.invoke(app, ["calibrate", str(rec), "--force-log", str(log), "-o", str(out)])
+    said = " ".join(result.output.split())
+    assert result.exit_code == 2 and not out.exists()
+    assert "set [transduction] polarity = 'falling'" in said, said

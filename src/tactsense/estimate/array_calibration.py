@@ -1218,9 +1218,22 @@ def _add_weight_curve(calibration, sensor, loads, weights, baseline_frames, thre
     )  # fmt: skip
     signal = own.signal(load_frames, sensor)[0].reshape(len(load_frames), -1)
     timing = np.where(signal > threshold, signal, 0.0).sum(axis=1)
+    against = np.where(signal < -threshold, -signal, 0.0).sum(axis=1)
     del signal
-    presses = weight_presses(totals, saturated, weights, time_s=time_s,
-                             rest_frames=baseline_frames, timing=timing)  # fmt: skip
+    try:
+        presses = weight_presses(totals, saturated, weights, time_s=time_s,
+                                 rest_frames=baseline_frames, timing=timing)  # fmt: skip
+    except ArrayCalibrationError as error:
+        if against.max(initial=0.0) > 2.0 * timing.max(initial=0.0):  # the other way
+            polarity = getattr(getattr(sensor, "transduction", None), "polarity", "rising")
+            other = "falling" if polarity == "rising" else "rising"
+            raise ArrayCalibrationError(
+                f"{error}; the readings moved against the description's polarity "
+                f"({polarity!r}: up to {against.max():.3g} of summed signal the other way, "
+                f"{timing.max():.3g} with it): if they are {other} under load, set "
+                f"[transduction] polarity = {other!r} in the sensor's description"
+            ) from None
+        raise
     try:
         curve = weight_curve(presses)
     except ArrayCalibrationError as error:
