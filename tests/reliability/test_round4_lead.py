@@ -170,3 +170,33 @@ def test_weights_on_a_fingertip_described_with_the_wrong_polarity(tip_weights):
     said = " ".join(result.output.split())
     assert result.exit_code == 2 and not out.exists()
     assert "set [transduction] polarity = 'falling'" in said, said
+
+
+def test_csv_times_in_milliseconds_are_questioned(tip_weights):
+    """A logger's CSV with times in ms was imported silently (``info`` then showed a
+    recording of 20180 s at 50 Hz); frames 1000 times the sensor's scan period apart now
+    get a warning, and the same rows in seconds get none."""
+    import csv
+
+    folder, _ = tip_weights
+    with open(folder / "frames.csv", newline="") as stream:
+        rows = list(csv.reader(stream))
+    column = rows[0].index("time")
+    for name, scale in (("ms.csv", 1000.0), ("s.csv", 1.0)):
+        with open(folder / name, "w", newline="") as stream:
+            writer = csv.writer(stream)
+            writer.writerow(rows[0])
+            for row in rows[1:60]:
+                writer.writerow([*row[:column], repr(float(row[column]) * scale),
+                                 *row[column + 1:]])  # fmt: skip
+    toml = folder / "tip.toml"
+    said = {}
+    for name in ("ms.csv", "s.csv"):
+        result = runner.invoke(
+            app, ["import", str(folder / name), "--sensor", str(toml),
+                  "-o", str(folder / f"{name}.h5")],
+        )  # fmt: skip
+        assert result.exit_code == 0, result.output
+        said[name] = " ".join(result.output.split())
+    assert "are the times in seconds (not ms or us)?" in said["ms.csv"], said["ms.csv"]
+    assert "warning" not in said["s.csv"]

@@ -5,11 +5,17 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Annotated
 
+import numpy as np
 import typer
 
 from tactsense.cli._common import atomic_output, check_output, console, new_group, sensor_file
 
 app = new_group("Other tools' files into tactsense recordings.")
+
+
+RATE_MISMATCH = 20.0
+"""Imported frames further apart (or closer) than this many times the sensor's scan period
+get a warning: a time column in milliseconds reads 1000 times too slow."""
 
 
 @app.command("import")
@@ -90,7 +96,19 @@ def import_(
         f"wrote {out}: {len(recording)} frames of {recording.sensor.name} "
         f"({recording.sensor.shape[0]} x {recording.sensor.shape[1]})"
     )
-    if "the file carries no times" in recording.scenario.get("description", ""):
+    times = np.asarray(recording.time_s, dtype=float)
+    no_times = "the file carries no times" in recording.scenario.get("description", "")
+    if len(times) > 2 and not no_times:
+        step = float(np.median(np.diff(times)))
+        period = recording.sensor.scan_period_s
+        if step > RATE_MISMATCH * period or step < period / RATE_MISMATCH:
+            console.print(
+                f"warning: the frames are {step:.4g} s apart (median), "
+                f"{step / period:.3g} times the period of {recording.sensor.name!r} "
+                f"({period:.4g} s, its scan_rate_hz): are the times in seconds (not ms or "
+                "us)? Otherwise set \\[electronics] scan_rate_hz in the sensor's description"
+            )
+    if no_times:
         console.print(
             "note: the iCub grasp trial carries no times; frame times are slice numbers "
             "(1 s apart): give --period S if the slices' period is known"
