@@ -355,6 +355,17 @@ def sensor_check(
     warnings = []
     if spec.kind != "pad" and probe_g is not None:
         fail(f"--probe-g maps the blind spots of a pad; {spec.name!r} is a {spec.kind_label}")
+    if spec.kind != "finger":
+        from tactsense.estimate.contacts import default_threshold, threshold_counts
+
+        noise = float(spec.flaws.read_noise_counts)
+        table.add_row(
+            "contact threshold",
+            f"{threshold_counts(spec):.3g} counts from the rest, signal "
+            f"{default_threshold(spec):.3g} (locate's default: the larger of 10 counts, the "
+            f"same share of a range of fewer than 12 bits but at least 3, and 5 x the read "
+            f"noise of {noise:.3g} counts; raised where creep is taken out)",
+        )
     if spec.kind == "pad":
         label, value, warnings = _blind_spot_report(spec, 50.0 if probe_g is None else probe_g)
         table.add_row(label, value)
