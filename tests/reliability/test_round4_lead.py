@@ -205,12 +205,14 @@ def test_csv_times_in_milliseconds_are_questioned(tip_weights):
 @pytest.mark.parametrize(
     "preset, counts", [("fsr16", "205 counts"), ("icub_fingertip", "3 counts")]
 )
-def test_sensor_check_prints_the_contact_threshold(preset, counts):
+def test_sensor_check_prints_the_contact_threshold(tmp_path, preset, counts):
     """``sensor check`` printed the blind-spot map's threshold (3 x the noise) and never
     the contact threshold ``locate`` uses (5 x the noise on a noisy array, 3 counts on an
     8-bit one), so a lab could not see why a light press found nothing. 205 = 5 x 41
     counts (1 % of 4095); 3 counts: the floor below 12 bits."""
-    result = runner.invoke(app, ["sensor", "check", preset])
+    toml = tmp_path / "mine.toml"
+    toml.write_text(f'extends = "{preset}"\nname = "mine"\n')
+    result = runner.invoke(app, ["sensor", "check", str(toml)])
     assert result.exit_code == 0, result.output
     said = " ".join(result.output.replace("│", " ").split())
     assert f"contact threshold {counts} from the rest" in said, said
