@@ -156,6 +156,18 @@ def _find(uf, a):
     return a
 
 
+@jit(inline="always")
+def _join(link, final, root_of, q, anchor):
+    """Link the region of taxel ``q`` to ``anchor`` (the first region met, if none yet);
+    the anchor after."""
+    m = _find(link, _find(final, root_of[q]))
+    if anchor < 0:
+        return m
+    if m != anchor:
+        link[m] = anchor
+    return anchor
+
+
 @jit(nogil=True)
 def _ridge_groups(
     s, above, active, parent, root_of, final, top, significant, edge_a, edge_b, edge_v,
@@ -263,11 +275,7 @@ def _ridge_groups(
                             continue
                         q = rr * cols + cc
                         if parent[q] >= 0:
-                            m = _find(link, _find(final, root_of[q]))
-                            if anchor < 0:
-                                anchor = m
-                            elif m != anchor:
-                                link[m] = anchor
+                            anchor = _join(link, final, root_of, q, anchor)
                         elif s[rr, cc] > limit:
                             # a wall taxel below the threshold: the regions it touches
                             for dr2 in range(-1, 2):
@@ -282,11 +290,7 @@ def _ridge_groups(
                                         continue
                                     q2 = r2 * cols + c2
                                     if parent[q2] >= 0:
-                                        m = _find(link, _find(final, root_of[q2]))
-                                        if anchor < 0:
-                                            anchor = m
-                                        elif m != anchor:
-                                            link[m] = anchor
+                                        anchor = _join(link, final, root_of, q2, anchor)
                         elif reach[q] == 0 and (dr == 0 or dc == 0):
                             reach[q] = 2
                             stack[top_] = q
