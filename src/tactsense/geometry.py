@@ -24,12 +24,18 @@ import numpy as np
 
 from tactsense._validation import TactsenseInputError, as_float_array
 from tactsense.sensor import SensorSpec
+from tactsense.sensor.cylinder import surface_to_xyz, tactel_centers, wrap_angle_deg
 
-
-def wrap_angle_deg(angle_deg):
-    """Wrap angles to (-180, 180] [deg]."""
-    wrapped = np.mod(np.asarray(angle_deg, dtype=float) + 180.0, 360.0) - 180.0
-    return np.where(wrapped == -180.0, 180.0, wrapped)
+__all__ = [
+    "surface_to_tactel",
+    "surface_to_unwrapped",
+    "surface_to_xyz",
+    "tactel_centers",
+    "tactel_to_surface",
+    "unwrapped_to_surface",
+    "wrap_angle_deg",
+    "xyz_to_surface",
+]
 
 
 def _row_knots(spec: SensorSpec) -> tuple[np.ndarray, np.ndarray]:
@@ -104,33 +110,6 @@ def unwrapped_to_surface(spec: SensorSpec, u_mm, v_mm):
     return u_mm + 0.0 * v_mm, wrap_angle_deg(np.rad2deg(v_mm / spec.radius_mm)) + 0.0 * u_mm
 
 
-def surface_to_xyz(spec: SensorSpec, axial_mm, angle_deg, depth_mm=0.0):
-    """3-D point of a surface position, optionally ``depth_mm`` below the skin.
-
-    Returns
-    -------
-    ndarray, shape (..., 3)
-        ``(x, y, z)`` [mm].
-    """
-    axial_mm, angle_deg, depth_mm = np.broadcast_arrays(
-        as_float_array(axial_mm, "axial_mm"),
-        as_float_array(angle_deg, "angle_deg"),
-        as_float_array(depth_mm, "depth_mm"),
-    )
-    radius = spec.radius_mm
-    if np.any(axial_mm < -np.pi * radius / 2 - 1e-9):
-        raise TactsenseInputError(
-            f"axial_mm below the apex of the tip (-{np.pi * radius / 2:.3f} mm)"
-        )
-    angle = np.deg2rad(angle_deg)
-    latitude = np.clip(-axial_mm / radius, 0.0, None)
-    on_cylinder = axial_mm >= 0
-    r = radius - depth_mm
-    x = np.where(on_cylinder, axial_mm, -r * np.sin(latitude))
-    ring = np.where(on_cylinder, r, r * np.cos(latitude))
-    return np.stack([x, ring * np.cos(angle), ring * np.sin(angle)], axis=-1)
-
-
 def xyz_to_surface(spec: SensorSpec, points):
     """Surface position of the skin point radially above 3-D points.
 
@@ -157,18 +136,6 @@ def xyz_to_surface(spec: SensorSpec, points):
     axial_mm = np.where(on_cylinder, x, -radius * latitude)
     depth_mm = np.where(on_cylinder, radius - rho, radius - np.hypot(x, rho))
     return axial_mm, angle_deg, depth_mm
-
-
-def tactel_centers(spec: SensorSpec):
-    """Surface positions of all wired tactels.
-
-    Returns
-    -------
-    axial_mm, angle_deg : ndarray, shape (rows, cols)
-    """
-    axial = np.broadcast_to(spec.row_axial_mm[:, None], spec.shape)
-    angle = np.broadcast_to(spec.col_angle_deg[None, :], spec.shape)
-    return axial.copy(), angle.copy()
 
 
 def _piecewise_linear(value: np.ndarray, knots: np.ndarray, targets: np.ndarray) -> np.ndarray:

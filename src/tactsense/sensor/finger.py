@@ -26,13 +26,15 @@ from typing import ClassVar
 
 import numpy as np
 
+from tactsense.sensor.checks import (
+    check_electronics,
+    check_flaws,
+)
 from tactsense.sensor.common import (
     VACUUM_PERMITTIVITY,
     Electronics,
     Flaws,
     SpecBase,
-    check_electronics,
-    check_flaws,
 )
 
 
@@ -183,7 +185,7 @@ class SensorSpec(SpecBase):
 
         3-D axes of :mod:`tactsense.geometry`: x along the axis toward the base.
         """
-        from tactsense.geometry import surface_to_xyz, tactel_centers
+        from tactsense.sensor.cylinder import surface_to_xyz, tactel_centers
 
         axial, angle = tactel_centers(self)
         return surface_to_xyz(self, axial, angle).reshape(-1, 3)

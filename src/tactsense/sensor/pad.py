@@ -17,6 +17,14 @@ from typing import ClassVar
 
 import numpy as np
 
+from tactsense.sensor.checks import (
+    check_electronics,
+    check_flaws,
+    check_layer,
+    check_transduction,
+    habit_rows,
+    positive,
+)
 from tactsense.sensor.common import (
     Electronics,
     Flaws,
@@ -24,12 +32,6 @@ from tactsense.sensor.common import (
     SpecBase,
     Transduction,
     capacitance_f,
-    check_electronics,
-    check_flaws,
-    check_layer,
-    check_transduction,
-    habit_rows,
-    positive,
 )
 
 

@@ -17,6 +17,12 @@ from typing import ClassVar
 
 import numpy as np
 
+from tactsense.sensor.checks import (
+    check_electronics,
+    check_flaws,
+    check_layer,
+    check_transduction,
+)
 from tactsense.sensor.common import (
     Electronics,
     Flaws,
@@ -25,10 +31,6 @@ from tactsense.sensor.common import (
     SpecBase,
     Transduction,
     capacitance_f,
-    check_electronics,
-    check_flaws,
-    check_layer,
-    check_transduction,
 )
 
 

@@ -1,12 +1,18 @@
-"""The kinds of sensor and the built-in presets, by name.
+"""The kinds of sensor and the presets, by name: the built-in ones and those other
+packages register.
 
-Adding a kind: a module in this package with a :class:`~tactsense.sensor.common.SpecBase`
-dataclass, one line in :data:`KINDS`, and its physics; nothing in ``cli/`` changes.
+Adding a kind: a :class:`~tactsense.sensor.common.SpecBase` dataclass and a
+:class:`tactsense.kinds.Kind` registered through the ``tactsense.kinds`` entry-point group
+(``docs/kinds.md``); :data:`KINDS` and :data:`PRESETS` then find its description class
+(the kind's ``spec_class``) and its presets (its ``presets``) without this package
+importing :mod:`tactsense.kinds`. Nothing in ``cli/`` changes.
 """
 
 from __future__ import annotations
 
+import importlib.metadata
 import math
+from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -20,13 +26,93 @@ from tactsense.sensor.common import (
     SpecBase,
     Transduction,
     read_toml,
+    use_registry,
 )
 from tactsense.sensor.finger import SensorSpec, fearing1990_improved, fearing1990_initial
 from tactsense.sensor.pad import Grid, PadSpec
 from tactsense.sensor.points import PointsSpec, Taxels
 
-KINDS: dict[str, type] = {"finger": SensorSpec, "pad": PadSpec, "points": PointsSpec}
-"""TOML ``kind`` -> the class that describes it (a TOML without ``kind`` is a finger)."""
+GROUP = "tactsense.kinds"
+"""The entry-point group other packages register their kinds in (as :mod:`tactsense.kinds`
+reads it)."""
+
+
+def _plugin_entry_points(name: str | None = None) -> list:
+    """The ``tactsense.kinds`` entry points that are not built-in kinds (only ``name``'s)."""
+    found = importlib.metadata.entry_points(group=GROUP)
+    return [
+        ep for ep in found if ep.name not in _BUILTIN_KINDS and (name is None or ep.name == name)
+    ]
+
+
+def _load_plugin(ep) -> Any:
+    """The object an entry point names (a kind, or its class), or a one-line error."""
+    try:
+        kind = ep.load()
+    except Exception as err:  # a broken plug-in: one line, not a traceback
+        raise SensorSpecError(
+            f"the sensor kind {ep.name!r} registered by {ep.value!r} failed to load: {err}"
+        ) from None
+    spec_class = getattr(kind, "spec_class", None)
+    if not isinstance(spec_class, type) or not isinstance(getattr(spec_class, "kind", None), str):
+        raise SensorSpecError(
+            f"the sensor kind {ep.name!r} registered by {ep.value!r} has no spec_class (a "
+            "SpecBase dataclass with a kind name); expected a tactsense.kinds.Kind"
+        )
+    return kind
+
+
+class _Registered(Mapping):
+    """Built-in entries first, then those the ``tactsense.kinds`` entry points add, read
+    lazily: looking up a built-in name loads no plug-in; an unknown kind's name loads the
+    plug-in of that name only; listing loads them all."""
+
+    def __init__(self, builtin: dict[str, Any], read: Callable[[Any], dict[str, Any]]):
+        self._builtin = builtin
+        self._read = read
+
+    def _plugins(self, name: str | None = None) -> dict[str, Any]:
+        found: dict[str, Any] = {}
+        for ep in _plugin_entry_points(name):
+            for key, value in self._read(_load_plugin(ep)).items():
+                if key not in self._builtin:
+                    found.setdefault(key, value)
+        return found
+
+    def __getitem__(self, key: str) -> Any:
+        if key in self._builtin:
+            return self._builtin[key]
+        if not isinstance(key, str):
+            raise KeyError(key)
+        found = self._plugins(key)  # a kind's entry point is named for it
+        if key not in found:
+            found = self._plugins()
+        return found[key]
+
+    def __contains__(self, key: object) -> bool:
+        try:
+            self[key]  # type: ignore[index]
+        except KeyError:
+            return False
+        return True
+
+    def __iter__(self) -> Iterator[str]:
+        return iter({**self._builtin, **self._plugins()})
+
+    def __len__(self) -> int:
+        return len({**self._builtin, **self._plugins()})
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({dict(self)!r})"
+
+
+_BUILTIN_KINDS: dict[str, type] = {"finger": SensorSpec, "pad": PadSpec, "points": PointsSpec}
+
+KINDS: Mapping[str, type] = _Registered(
+    _BUILTIN_KINDS, lambda kind: {kind.spec_class.kind: kind.spec_class}
+)
+"""TOML ``kind`` -> the class that describes it (a TOML without ``kind`` is a finger): the
+built-in kinds and those registered through the ``tactsense.kinds`` entry points."""
 
 _PAPER = "Fearing (1990)"
 _PROVENANCE = (
@@ -310,7 +396,7 @@ def dsa9205() -> PadSpec:
     )
 
 
-PRESETS = {
+_BUILTIN_PRESETS: dict[str, Callable[[], SpecBase]] = {
     "initial": fearing1990_initial,
     "improved": fearing1990_improved,
     "pad4": pad4,
@@ -321,11 +407,18 @@ PRESETS = {
     "fsr16": fsr16,
     "dsa9205": dsa9205,
 }
-"""Built-in sensors by short name (the fingers also answer to ``fearing1990_...``)."""
+
+PRESETS: Mapping[str, Callable[[], SpecBase]] = _Registered(
+    _BUILTIN_PRESETS, lambda kind: dict(getattr(kind, "presets", None) or {})
+)
+"""Sensors by short name (the fingers also answer to ``fearing1990_...``): the built-in
+ones, then the ``presets`` of the kinds registered through the ``tactsense.kinds`` entry
+points."""
 
 
 def preset(name: str = "initial") -> SpecBase:
-    """A built-in sensor by short name (``tactsense sensor show NAME`` prints it)."""
+    """A sensor by short name, built-in or a registered kind's (``tactsense sensor show
+    NAME`` prints it)."""
     key = name.removeprefix("fearing1990_")
     if key not in PRESETS:
         raise SensorSpecError(f"unknown preset {name!r}; available: {', '.join(PRESETS)}")
@@ -352,11 +445,15 @@ def sensor_from_dict(
             f"{source}: kind = {kind!r} is not a sensor kind; expected one of {', '.join(KINDS)}"
         )
     cls = KINDS[kind]
-    if expected is not None and expected is not cls and expected in KINDS.values():
+    named = getattr(expected, "kind", None)
+    if expected is not None and expected is not cls and KINDS.get(named) is expected:
         raise SensorSpecError(
             f"{source} describes a {kind} sensor; expected a {expected.kind} sensor"
         )
     return cls.from_dict(data, source=source)
+
+
+use_registry(PRESETS, sensor_from_dict)
 
 
 def load_sensor(source: str | Path | SpecBase | None = None) -> SpecBase:
@@ -366,8 +463,10 @@ def load_sensor(source: str | Path | SpecBase | None = None) -> SpecBase:
     if isinstance(source, SpecBase):
         return source
     text = str(source)
-    if text.removeprefix("fearing1990_") in PRESETS:
+    if text.removeprefix("fearing1990_") in _BUILTIN_PRESETS:
         return preset(text)
+    if not Path(text).exists() and text.removeprefix("fearing1990_") in PRESETS:
+        return preset(text)  # a plug-in's (a file of that name would come first)
     if not Path(text).exists():
         raise SensorSpecError(
             f"no preset or sensor file named {text!r}; presets: {', '.join(PRESETS)}, "
