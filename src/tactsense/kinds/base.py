@@ -81,6 +81,23 @@ class Kind:
     def __repr__(self) -> str:
         return f"<{type(self).__name__} {self.name!r}>"
 
+    # ---- the view and the commands (r5-cliview) ----
+    view_drawing: ClassVar[str] = "dots"
+    """How the browser view draws a sensor of this kind: ``"unwrapped"`` (the paper's
+    finger cut open along its seam: rows along it, columns around it, the tip row apart),
+    ``"grid"`` (a flat grid in mm with the interpolated surface) or ``"dots"`` (dots at
+    the taxels' positions [mm] projected onto the plane normal to their mean normal; asks
+    only ``taxel_positions_mm`` and ``taxel_normals``, so any kind can use it)."""
+    contact_estimation: ClassVar[bool] = True
+    """Whether contacts are estimated frame by frame (by the live estimator
+    :attr:`multi_contact` picks); False: the view shows the deflection only and says
+    ``contact estimation: not yet for <plural>``."""
+    array_calibration: ClassVar[bool] = True
+    """Whether the kind takes an array's calibration (``tactsense calibrate``: a probe
+    on every taxel, a uniform press or known weights; per-taxel gains and a force curve);
+    False: the paper's finger calibration (a probe swept along every column, section 3.1,
+    with creep steps and a knife edge)."""
+
 
 def positions_of(spec: Any) -> np.ndarray:
     """Surface positions [mm] of every taxel, frame order, (N, 3)."""

@@ -26,5 +26,9 @@ class FingerKind(Kind):
         """Along the finger [mm] and around it [deg]."""
         return first_mm, math.degrees(second_mm / spec.radius_mm)
 
+    # ---- the view and the commands (r5-cliview) ----
+    view_drawing = "unwrapped"
+    array_calibration = False
+
 
 KIND: Any = FingerKind()

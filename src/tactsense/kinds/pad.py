@@ -14,5 +14,8 @@ class PadKind(Kind):
     image_grid = True
     multi_contact = True
 
+    # ---- the view and the commands (r5-cliview) ----
+    view_drawing = "grid"
+
 
 KIND: Any = PadKind()

@@ -6,13 +6,9 @@ a finger unwrapped, a pad as a flat grid in millimetres, a point set as dots.
 :class:`ViewServer` serves them (Starlette on uvicorn, websocket push).
 """
 
-from tactsense.view.feed import (
-    DeflectionOnly,
-    LiveFeed,
-    RecordingFeed,
-    layout_message,
-    view_locator,
-)
+from tactsense.view.feed import LiveFeed, RecordingFeed
+from tactsense.view.layout import layout_message
+from tactsense.view.locators import DeflectionOnly, view_locator
 from tactsense.view.server import ViewServer, create_app
 
 __all__ = [

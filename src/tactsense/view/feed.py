@@ -3,12 +3,8 @@
 A *feed* runs in a thread of its own. It reads frames (from a live stream or from a
 recording), estimates the contact of each, and hands every frame's message (JSON
 text) to a ``publish`` callable. The server (:mod:`tactsense.view.server`) passes the
-messages on to the pages. Nothing here knows about HTTP.
-
-The page draws the interpolated surface itself from weights sent once in the layout:
-``surface = W_rows @ deflection[cylinder rows] @ W_cols.T`` is the windowed-sinc
-reconstruction of eq. 48 (:func:`tactsense.estimate.interpolate.surface`) on a grid
-``SURFACE_STEPS`` times finer than the tactels, periodic around a closed finger.
+messages on to the pages. Nothing here knows about HTTP. The layout message is
+:mod:`tactsense.view.layout`'s; what runs on each frame, :mod:`tactsense.view.locators`'.
 """
 
 from __future__ import annotations
@@ -22,29 +18,33 @@ from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
-from matplotlib import colormaps
 
-from tactsense._validation import TactsenseInputError
-from tactsense.estimate import Flag
-from tactsense.estimate.deflection import deflection_from_counts
-from tactsense.estimate.interpolate import col_weights, row_weights
 from tactsense.io.recording import RecordingReader
-from tactsense.sensor import SensorSpec, SpecBase
-from tactsense.stream.live import LiveContacts, LiveLocator
+from tactsense.sensor import SensorSpec
+from tactsense.stream.live import LiveLocator
 from tactsense.stream.reader import LOSS_KINDS, StreamError, StreamFrame, StreamReader
-
-SURFACE_STEPS = 9
-"""Points of the interpolated surface per tactel spacing, along and around: the centres
-of bands 1/9 of a tactel wide (odd, so that one band is centred on each tactel)."""
+from tactsense.view.layout import (  # noqa: F401 - re-exported: their home was here
+    COLORMAP,
+    MAX_FINE,
+    SURFACE_STEPS,
+    flat_steps,
+    layout_message,
+    not_estimated_note,
+    project_points,
+)
+from tactsense.view.locators import (  # noqa: F401 - re-exported: their home was here
+    DEFLECTION,
+    DeflectionOnly,
+    estimates,
+    multi_contact,
+    view_locator,
+)
 
 HISTORY_S = 20.0
 """Seconds of recent frames a page receives when it connects (for its time traces)."""
 
 MAX_HISTORY = 2000
 """At most this many recent frames are kept for new pages, whatever the frame rate."""
-
-COLORMAP = "viridis"
-"""Matplotlib colour map of the heat map: its lightness rises monotonically."""
 
 Publish = Callable[[str], None]
 
@@ -59,365 +59,6 @@ def _finite(value):
     if isinstance(value, dict):
         return {k: _finite(v) for k, v in value.items()}
     return value
-
-
-def _finger_geometry(sensor: SensorSpec) -> dict:
-    """The finger unwrapped: rows along it (the tip row apart), columns around it."""
-    rows, cols = sensor.shape
-    first = 1 if sensor.array.tip_row else 0
-    cylinder = rows - first
-    periodic = bool(sensor.closes_circumference)
-    # fine rows over the cylinder rows' span, fine columns over the tactels' span (one
-    # whole turn, seam included, when the finger closes)
-    # (beyond the first and last rows the surface is held flat, not extrapolated)
-    fine_rows = (np.arange(cylinder * SURFACE_STEPS) + 0.5) / SURFACE_STEPS - 0.5
-    fine_rows = np.clip(fine_rows, 0.0, cylinder - 1.0)
-    fine_cols = (np.arange(cols * SURFACE_STEPS) + 0.5) / SURFACE_STEPS - 0.5
-    w_rows = row_weights(fine_rows, cylinder, derivatives=0)
-    w_cols = col_weights(fine_cols, cols, periodic, derivatives=0)
-    return {
-        "geometry": "finger",
-        "first_row": first,
-        "tip_row": bool(sensor.array.tip_row),
-        "closes": periodic,
-        "row_axial_mm": [float(v) for v in sensor.row_axial_mm],
-        "col_angle_deg": [float(v) for v in sensor.col_angle_deg],
-        "spacing_mm": float(sensor.array.spacing_axial_mm),
-        "spacing_deg": float(sensor.array.spacing_angle_deg),
-        "surface": {
-            "row": fine_rows.tolist(),
-            "col": fine_cols.tolist(),
-            "w_rows": np.round(w_rows, 6).tolist(),
-            "w_cols": np.round(w_cols, 6).tolist(),
-        },
-    }
-
-
-MAX_FINE = 288
-"""At most this many surface points along an axis of a pad (32 taxels at
-:data:`SURFACE_STEPS`); a larger pad gets fewer points per pitch (an odd number, at least
-one), so the page's work per frame stays bounded."""
-
-
-def flat_steps(n: int) -> int:
-    """Surface points per pitch along a pad's axis of ``n`` taxels (odd, 1 to 9)."""
-    steps = min(SURFACE_STEPS, max(1, MAX_FINE // max(n, 1)))
-    return steps if steps % 2 else steps - 1
-
-
-def _flat_weights(n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Fine positions [taxel] over ``n`` taxels' span and the windowed-sinc weights (eq. 48's
-    kernel, not periodic: the edges are not wrapped) at them, held flat beyond the outer
-    taxels; an axis of one taxel is constant."""
-    steps = flat_steps(n)
-    fine = (np.arange(n * steps) + 0.5) / steps - 0.5
-    if n < 2:
-        return np.zeros_like(fine), np.ones((fine.size, 1))
-    fine = np.clip(fine, 0.0, n - 1.0)
-    return fine, row_weights(fine, n, derivatives=0)
-
-
-def _transduction(sensor) -> dict:
-    """How a reading follows from the deflection (the page's counts mode needs it)."""
-    t = sensor.transduction
-    return {
-        "kind": t.kind,
-        "counts_per_strain": float(t.counts_per_strain),
-        "falling": t.polarity == "falling",
-    }
-
-
-def _pad_geometry(sensor) -> dict:
-    """A pad: a flat grid in millimetres, x with the row, y with the column
-    (``docs/nomenclature.md``), and the separable interpolated surface."""
-    rows, cols = sensor.shape
-    g = sensor.grid
-    positions = sensor.taxel_positions_mm()
-    fine_x, w_x = _flat_weights(rows)
-    fine_y, w_y = _flat_weights(cols)
-    return {
-        "geometry": "plane",
-        "u_mm": positions[:, 0].tolist(),
-        "v_mm": positions[:, 1].tolist(),
-        "u_label": f"x [mm] (rows, {g.row_pitch_mm:g} mm apart)",
-        "v_label": f"y [mm] (columns, {g.col_pitch_mm:g} mm apart)",
-        "bounds_mm": [
-            -0.5 * g.row_pitch_mm,
-            (rows - 0.5) * g.row_pitch_mm,
-            -0.5 * g.col_pitch_mm,
-            (cols - 0.5) * g.col_pitch_mm,
-        ],
-        "spacing_mm": float(min(g.row_pitch_mm, g.col_pitch_mm)),
-        "dot_mm": 0.32 * float(min(g.row_pitch_mm, g.col_pitch_mm)),
-        "projection": "the pad seen from outside (its normal +z toward you)",
-        "transduction": _transduction(sensor),
-        "surface": {
-            "row": fine_x.tolist(),
-            "col": fine_y.tolist(),
-            "w_rows": np.round(w_x, 6).tolist(),
-            "w_cols": np.round(w_y, 6).tolist(),
-        },
-    }
-
-
-def project_points(positions_mm: np.ndarray, normals: np.ndarray) -> dict:
-    """Taxels projected onto the plane normal to their mean normal, seen from outside.
-
-    An orthographic projection along the mean outward normal ``m`` (``+z`` when the
-    normals cancel out): ``u = p . e_u``, ``v = p . e_v`` with ``e_u`` the direction of
-    ``+x`` in that plane (``+y`` when ``m`` is along ``x``) and ``e_v = m x e_u``. When
-    ``m`` is ``+z`` this is simply ``(x, y)``. Distances within the plane are true [mm];
-    distances along a curved surface shrink by the cosine of its slope.
-
-    Parameters
-    ----------
-    positions_mm : ndarray, shape (N, 3)
-        Taxel surface points [mm].
-    normals : ndarray, shape (N, 3)
-        Outward unit normals [-].
-
-    Returns
-    -------
-    dict
-        ``u_mm``, ``v_mm`` (N,) [mm], the unit vectors ``normal``, ``e_u``, ``e_v`` [-].
-    """
-    positions = np.asarray(positions_mm, dtype=float).reshape(-1, 3)
-    mean = np.asarray(normals, dtype=float).reshape(-1, 3).sum(axis=0)
-    size = float(np.linalg.norm(mean))
-    m = mean / size if size > 1e-6 * len(positions) else np.array([0.0, 0.0, 1.0])
-    e_u = np.array([1.0, 0.0, 0.0]) - m[0] * m
-    if np.linalg.norm(e_u) < 1e-6:
-        e_u = np.array([0.0, 1.0, 0.0]) - m[1] * m
-    e_u /= np.linalg.norm(e_u)
-    e_v = np.cross(m, e_u)
-    return {
-        "u_mm": positions @ e_u,
-        "v_mm": positions @ e_v,
-        "normal": m,
-        "e_u": e_u,
-        "e_v": e_v,
-    }
-
-
-def _points_geometry(sensor) -> dict:
-    """Any taxel set: dots at their positions projected onto the plane normal to the mean
-    normal (:func:`project_points`); no surface between scattered points. Asks the sensor
-    only where its taxels are, so a kind without a drawing of its own shows this way."""
-    plane = project_points(sensor.taxel_positions_mm(), sensor.taxel_normals())
-    u, v = plane["u_mm"], plane["v_mm"]
-    points = np.column_stack([u, v])
-    if len(points) > 1:
-        gaps = np.linalg.norm(points[:, None] - points[None, :], axis=-1)
-        np.fill_diagonal(gaps, np.inf)
-        spacing = float(np.median(gaps.min(axis=1)))
-    else:
-        spacing = 1.0
-    if not spacing > 0:
-        spacing = 1.0
-    areas = getattr(sensor, "areas_mm2", None)
-    dot = 0.32 * spacing
-    if areas is not None:  # the electrode's own size where it is smaller than that
-        dot = min(dot, float(np.sqrt(np.median(areas) / np.pi)))
-    margin = max(spacing, 2.0 * dot)
-    m = plane["normal"]
-    along_z = bool(m[2] > 1.0 - 1e-9)
-    return {
-        "geometry": "plane",
-        "u_mm": u.tolist(),
-        "v_mm": v.tolist(),
-        "u_label": "x [mm]" if along_z else "u [mm] (in the plane normal to the mean normal)",
-        "v_label": "y [mm]" if along_z else "v [mm]",
-        "bounds_mm": [
-            float(u.min() - margin),
-            float(u.max() + margin),
-            float(v.min() - margin),
-            float(v.max() + margin),
-        ],
-        "spacing_mm": spacing,
-        "dot_mm": dot,
-        "projection": (
-            "x-y, seen from +z (the mean normal)"
-            if along_z
-            else "projected along the mean normal "
-            f"({m[0]:.2f}, {m[1]:.2f}, {m[2]:.2f}), seen from outside"
-        ),
-        "transduction": _transduction(sensor),
-        "surface": None,
-    }
-
-
-GEOMETRY: dict[str, Callable[[SpecBase], dict]] = {
-    "finger": _finger_geometry,
-    "pad": _pad_geometry,
-    "points": _points_geometry,
-}
-"""How the page draws each kind; a kind not listed is drawn as dots at its taxels'
-positions (:func:`_points_geometry` asks only ``taxel_positions_mm`` and ``taxel_normals``)."""
-
-PLURAL = {"finger": "fingers", "pad": "pads", "points": "point sets"}
-
-
-def estimates(sensor: SpecBase) -> bool:
-    """Whether contacts on this kind of sensor are estimated (:data:`LOCATORS`: fingers,
-    pads and point sets)."""
-    return sensor.kind in LOCATORS
-
-
-def not_estimated_note(sensor: SpecBase) -> str | None:
-    """The page's one line where there is no contact estimate for the sensor's kind."""
-    if estimates(sensor):
-        return None
-    return f"contact estimation: not yet for {PLURAL.get(sensor.kind, sensor.kind)}"
-
-
-def layout_message(sensor: SpecBase, source: dict) -> dict:
-    """Everything a page needs once: geometry, surface weights, colour map, source."""
-    rows, cols = sensor.shape
-    lut = (colormaps[COLORMAP](np.linspace(0.0, 1.0, 256))[:, :3] * 255).round().astype(int)
-    message = {
-        "type": "layout",
-        "sensor": sensor.name,
-        "kind": sensor.kind,
-        "rows": rows,
-        "cols": cols,
-        "estimation": not_estimated_note(sensor),
-        # several tracked contacts a frame (pads, point sets), or the finger's one
-        "multi_contact": LOCATORS.get(sensor.kind) is LiveContacts,
-    }
-    message.update(GEOMETRY.get(sensor.kind, _points_geometry)(sensor))
-    message.update(
-        {
-            "full_scale": int(2**sensor.electronics.adc_bits - 1),
-            "colormap": {"name": COLORMAP, "lut": lut.tolist()},
-            "loss_kinds": list(LOSS_KINDS),
-            "flags": {flag.name: int(flag) for flag in Flag if flag},
-            "source": source,
-        }
-    )
-    return message
-
-
-def _capacitive_deflection(counts, baseline, sensor) -> np.ndarray:
-    # eq. 4, (counts - baseline) / counts; 0 where a taxel reads nothing usable
-    if sensor.transduction.polarity == "falling":  # the mirrored reading's eq. 4
-        from tactsense.estimate.contacts import signal_from_counts
-
-        counts = np.asarray(counts, dtype=float)
-        return signal_from_counts(counts, baseline, sensor)[0].reshape(counts.shape)
-    return deflection_from_counts(counts, baseline, sensor)[0]
-
-
-def _resistive_deflection(counts, baseline, sensor) -> np.ndarray:
-    # the compressive strain: the reading moves by counts_per_strain per unit strain
-    strain = (np.asarray(counts, dtype=float) - baseline) / sensor.transduction.counts_per_strain
-    if sensor.transduction.polarity == "falling":
-        strain = -strain
-    return np.where(np.isfinite(strain), strain, 0.0)
-
-
-DEFLECTION = {
-    "capacitive": _capacitive_deflection,
-    "resistive": _resistive_deflection,
-    "piezoresistive": _resistive_deflection,
-}
-"""Transduction kind -> the deflection [-] of a frame from its counts and the baseline."""
-
-
-class DeflectionOnly:
-    """The deflection of every frame of a sensor whose contacts are not estimated yet.
-
-    The same interface as :class:`~tactsense.stream.live.LiveLocator` for a feed: called
-    with a frame it returns no estimate (None) and keeps the frame's deflection in
-    :attr:`last_deflection` once the baseline is known. The baseline is the median of the
-    first ``baseline_frames`` frames (untouched), or given. The deflection follows the
-    sensor's transduction (:data:`DEFLECTION`): a capacitive taxel's is eq. 4,
-    ``(counts - baseline) / counts``; a resistive taxel's ``(counts - baseline) /
-    counts_per_strain``.
-    """
-
-    calibration = None
-
-    def __init__(self, sensor: SpecBase, *, baseline_frames: int = 5, baseline=None):
-        self.sensor = sensor
-        self._deflection = DEFLECTION[sensor.transduction.kind]
-        self._baseline_frames = max(1, int(baseline_frames))
-        self._collected: list[np.ndarray] = []
-        self._baseline = None if baseline is None else np.asarray(baseline, dtype=float)
-        self.last_deflection: np.ndarray | None = None
-        """Deflection of the last frame [-] (None until the baseline is known)."""
-
-    @property
-    def ready(self) -> bool:
-        return self._baseline is not None
-
-    def reset(self) -> None:
-        """Nothing to forget (no creep compensation)."""
-
-    def __call__(self, frame: StreamFrame) -> None:
-        counts = np.asarray(frame.counts, dtype=float)
-        if self._baseline is None:
-            self._collected.append(counts)
-            if len(self._collected) >= self._baseline_frames:
-                self._baseline = np.median(np.stack(self._collected), axis=0)
-                self._collected = []
-            return None
-        self.last_deflection = self._deflection(counts, self._baseline, self.sensor)
-        return None
-
-
-LOCATORS = {"finger": LiveLocator, "pad": LiveContacts, "points": LiveContacts}
-"""Sensor kind -> what estimates its contacts frame by frame: the paper's finger its one
-contact (:class:`LiveLocator`), pads and point sets every contact, tracked
-(:class:`LiveContacts`); a kind not listed gets :class:`DeflectionOnly`."""
-
-
-def view_locator(
-    sensor: SpecBase,
-    *,
-    calibration=None,
-    baseline_frames: int = 5,
-    threshold: float | None = None,
-    frame_period_s: float | None = None,
-    baseline=None,
-):
-    """What the view runs on each frame of ``sensor``: a contact locator where one exists
-    for its kind, else :class:`DeflectionOnly` (which takes no calibration yet).
-    ``threshold`` None: the sensor's default (0.005 on the finger)."""
-    locator = LOCATORS.get(sensor.kind)
-    if locator is LiveContacts:
-        return LiveContacts(
-            sensor,
-            baseline_frames=baseline_frames,
-            threshold=threshold,
-            frame_period_s=frame_period_s,
-            baseline=baseline,
-            keep_deflection=True,
-            calibration=calibration,
-        )
-    if locator is not None and calibration is not None and not hasattr(calibration, "apply"):
-        raise TactsenseInputError(
-            f"an array's calibration does not apply to {sensor.name!r}, a finger: "
-            "calibrate it with 'tactsense calibrate' on a probe sweep of the finger"
-        )
-    if locator is not None:
-        if threshold is None:
-            threshold = 0.005
-        return locator(
-            sensor,
-            calibration=calibration,
-            baseline_frames=baseline_frames,
-            threshold=threshold,
-            frame_period_s=frame_period_s,
-            baseline=baseline,
-            keep_deflection=True,
-        )
-    if calibration is not None:
-        raise TactsenseInputError(
-            f"--calibration applies to fingers, not to {PLURAL.get(sensor.kind, sensor.kind)} "
-            f"(sensor {sensor.name!r}), whose calibration does not exist yet: leave "
-            "--calibration out"
-        )
-    return DeflectionOnly(sensor, baseline_frames=baseline_frames, baseline=baseline)
 
 
 class _Rate:
@@ -456,7 +97,7 @@ class Feed:
         self._rate = _Rate()
         self._lock = threading.Lock()
         self._plane = None
-        if LOCATORS.get(sensor.kind) is LiveContacts:  # contacts drawn on the plane
+        if multi_contact(sensor):  # contacts drawn on the plane
             plane = project_points(sensor.taxel_positions_mm(), sensor.taxel_normals())
             self._plane = (plane["e_u"], plane["e_v"])
 
@@ -793,3 +434,13 @@ class RecordingFeed(Feed):
         health = super().health()
         health["playback"] = self._playback()
         return health
+
+
+def __getattr__(name: str):
+    """``LOCATORS`` and ``PLURAL``: :mod:`tactsense.view.locators` reads them from the
+    registered kinds."""
+    if name in ("LOCATORS", "PLURAL"):
+        from tactsense.view import locators
+
+        return getattr(locators, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
