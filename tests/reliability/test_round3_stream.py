@@ -343,7 +343,7 @@ def test_the_first_contact_compiles_and_loads_nothing(name, options):
 def test_live_warms_the_locator_before_opening_a_format_device(monkeypatch):
     """A device of another format streams once its line opens: the locator is made
     first (its frames queued 5 s behind the compilation on a cold cache)."""
-    from tactsense.cli import live as cli_live
+    from tactsense.cli import _live_sources as cli_live
 
     calls = []
     real_locator, real_open = cli_live._locator_for, cli_live._open_reader

@@ -22,6 +22,7 @@ from tactsense.cli._common import (
     remove_stale_partials,
 )
 from tactsense.estimate.array_calibration import load_calibration
+from tactsense.kinds import kind_of
 
 app = new_group("Other tools' formats: MCAP (ROS 2, Foxglove) and Rerun.")
 
@@ -32,6 +33,10 @@ class ExportFormat(StrEnum):
     lerobot = "lerobot"
     csv = "csv"
 
+
+DEFAULT_FRAME_ID = "finger"
+"""``--frame-id``'s default: the URDF link 'tactsense sensor export --urdf' names (a link's
+name, not a sensor kind's)."""
 
 SUFFIXES = {ExportFormat.mcap: ".mcap", ExportFormat.rerun: ".rrd", ExportFormat.csv: ".csv"}
 
@@ -75,7 +80,7 @@ def export(
             help="mcap: the frame_id of every header, the URDF link the sensor is mounted on "
             "(the link 'tactsense sensor export --urdf --link' wrote; default finger).",
         ),
-    ] = "finger",
+    ] = DEFAULT_FRAME_ID,
     start_time: Annotated[
         float | None,
         typer.Option(
@@ -126,11 +131,13 @@ def export(
     if export_format is ExportFormat.csv:
         if calibration is not None or threshold is not None:
             fail("--calibration and --threshold apply to contacts; a CSV export holds the frames")
-        if frame_id != "finger" or start_time is not None:
+        if frame_id != DEFAULT_FRAME_ID or start_time is not None:
             fail("--frame-id and --start-time apply to --format mcap only")
         _export_csv(recording, out, force, quiet)
         return
-    if export_format is not ExportFormat.mcap and (frame_id != "finger" or start_time is not None):
+    if export_format is not ExportFormat.mcap and (
+        frame_id != DEFAULT_FRAME_ID or start_time is not None
+    ):
         fail("--frame-id and --start-time apply to --format mcap only")
     if not frame_id.strip() or any(c.isspace() for c in frame_id):
         fail(f"--frame-id {frame_id!r}: give a link name without spaces")
@@ -166,7 +173,7 @@ def export(
     except (TactsenseInputError, FileExistsError) as error:
         fail(str(error))
     clock = f", {counts['clock']} clock" if "clock" in counts else ""
-    if counts.get("kind", "finger") != "finger":  # every contact of every frame
+    if kind_of(counts.get("kind", "finger")).multi_contact:  # every contact of every frame
         what = (
             "one TactileContact per contact per frame, named <sensor>/<id>; "
             if export_format is ExportFormat.mcap
@@ -226,7 +233,7 @@ def _export_lerobot(recording, out, calibration, baseline_frames, threshold, epi
     )  # fmt: skip
     contacts = (
         f"{counts['contacts']} with a contact"
-        if counts.get("kind", "finger") == "finger"
+        if not kind_of(counts.get("kind", "finger")).multi_contact
         else f"{counts['contacts']} contacts"
     )
     console.print(
