@@ -162,12 +162,16 @@ def _stream_and_locator(
 def _locator_for(
     spec, calibration, baseline_frames, threshold, *, keep_deflection, contact_options
 ):
-    """The compiled, warmed locator of a sensor: :class:`LiveLocator` for a finger,
-    :class:`LiveContacts` (every contact, tracked) for a pad or a point set."""
+    """The compiled, warmed locator of a sensor, as its kind says: :class:`LiveContacts`
+    (every contact, tracked) where it has many a frame (a pad, a point set), else
+    :class:`LiveLocator` (the finger's one contact)."""
     from tactsense.stream import LiveLocator
     from tactsense.stream.live import LiveContacts
 
-    if kind_of(spec).multi_contact:
+    kind = kind_of(spec)
+    if not kind.contact_estimation:
+        raise kind.unsupported(spec, "live contact estimation")
+    if kind.multi_contact:
         return LiveContacts(
             spec,
             baseline_frames=baseline_frames,
