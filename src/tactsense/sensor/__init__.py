@@ -10,6 +10,8 @@ Three kinds share one schema (TOML sections, one validator each, TOML in and out
   areas under a locally flat layer; preset ``dome12``.
 
 A TOML without a ``kind`` key is a finger, so every existing description still loads.
+Kinds and presets other packages register through the ``tactsense.kinds`` entry points
+are found too (:data:`KINDS`, :data:`PRESETS`, :func:`load_sensor`; ``docs/kinds.md``).
 """
 
 from tactsense.sensor.common import (
