@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from tactsense._validation import TactsenseInputError, check_positive
+from tactsense.kinds import kind_of
 from tactsense.physics.contact import grams_force
 from tactsense.physics.indenters import (
     INDENTERS,
@@ -35,23 +36,26 @@ def _settle(settle_s: float) -> list[Step]:
 
 
 def centre_mm(spec) -> tuple[float, float]:
-    """The middle of a pad, or of a point set's first taxel's tangent plane [mm]."""
-    if spec.kind == "pad":
-        g = spec.grid
-        return (0.5 * (g.rows - 1) * g.row_pitch_mm, 0.5 * (g.cols - 1) * g.col_pitch_mm)
+    """The middle of a pad's grid, or of a point set's first taxel's tangent plane [mm]."""
+    grid = kind_of(spec).surface_grid(spec)
+    if grid is not None:
+        (row_pitch, rows), (col_pitch, cols) = grid
+        return (0.5 * (rows - 1) * row_pitch, 0.5 * (cols - 1) * col_pitch)
     return (0.0, 0.0)
 
 
 def _check_on(spec, x_mm: float, y_mm: float, what: str) -> None:
-    if spec.kind != "pad":
+    kind = kind_of(spec)
+    grid = kind.surface_grid(spec)
+    if grid is None:  # no grid to fall off: a place in a taxel's tangent plane
         return
-    g = spec.grid
-    low_x, high_x = -0.5 * g.row_pitch_mm, (g.rows - 0.5) * g.row_pitch_mm
-    low_y, high_y = -0.5 * g.col_pitch_mm, (g.cols - 0.5) * g.col_pitch_mm
+    (row_pitch, rows), (col_pitch, cols) = grid
+    low_x, high_x = -0.5 * row_pitch, (rows - 0.5) * row_pitch
+    low_y, high_y = -0.5 * col_pitch, (cols - 0.5) * col_pitch
     if not (low_x <= x_mm <= high_x and low_y <= y_mm <= high_y):
         raise TactsenseInputError(
-            f"{what} at ({x_mm:g}, {y_mm:g}) mm is off the {g.rows}x{g.cols} pad {spec.name!r} "
-            f"(x in [{low_x:g}, {high_x:g}], y in [{low_y:g}, {high_y:g}] mm)"
+            f"{what} at ({x_mm:g}, {y_mm:g}) mm is off the {rows}x{cols} {kind.label} "
+            f"{spec.name!r} (x in [{low_x:g}, {high_x:g}], y in [{low_y:g}, {high_y:g}] mm)"
         )
 
 
@@ -184,9 +188,10 @@ def slide(
     check_positive(speed_mm_s, "speed_mm_s")
     check_positive(increment_mm, "increment_mm")
     cx, _ = centre_mm(spec)
-    if spec.kind == "pad":
-        margin = spec.grid.col_pitch_mm
-        span = (spec.grid.cols - 1) * spec.grid.col_pitch_mm
+    grid = kind_of(spec).surface_grid(spec)
+    if grid is not None:
+        margin, cols = grid[1]
+        span = (cols - 1) * margin
         default_start, default_end = (cx, margin), (cx, span - margin)
     else:
         default_start, default_end = (0.0, -2.0), (0.0, 2.0)
@@ -227,8 +232,10 @@ def sweep(
     check_positive(increment_mm, "increment_mm")
     cx, _ = centre_mm(spec)
     x = cx if x_mm is None else x_mm
-    if spec.kind == "pad":
-        ys = np.arange(0.0, (spec.grid.cols - 1) * spec.grid.col_pitch_mm + 1e-9, increment_mm)
+    grid = kind_of(spec).surface_grid(spec)
+    if grid is not None:
+        col_pitch, cols = grid[1]
+        ys = np.arange(0.0, (cols - 1) * col_pitch + 1e-9, increment_mm)
     else:
         ys = np.arange(-3.0, 3.0 + 1e-9, increment_mm)
     steps = _settle(settle_s)
@@ -284,11 +291,12 @@ def raster(
     calibrate``; the finger's 'calibration' sweep on an array)."""
     check_positive(dwell_s, "dwell_s")
     steps = _settle(settle_s)
-    if spec.kind == "pad":
-        g = spec.grid
-        for r in range(g.rows):
-            for c in range(g.cols):
-                x, y = r * g.row_pitch_mm, c * g.col_pitch_mm
+    grid = kind_of(spec).surface_grid(spec)
+    if grid is not None:
+        (row_pitch, rows), (col_pitch, cols) = grid
+        for r in range(rows):
+            for c in range(cols):
+                x, y = r * row_pitch, c * col_pitch
                 probe = SphereProbe(x, y, force_n, radius_mm=size_mm)
                 steps += [Step((probe,), dwell_s, f"taxel ({r}, {c})"), Step((), dwell_s, "lifted")]
     else:
@@ -347,9 +355,10 @@ def loads(
     if repeats < 1:
         raise TactsenseInputError(f"repeats must be at least 1; got {repeats}")
     cx = cy = 0.0
-    if spec.kind == "pad":
-        g = spec.grid
-        cx, cy = (g.rows - 1) // 2 * g.row_pitch_mm, (g.cols - 1) // 2 * g.col_pitch_mm
+    grid = kind_of(spec).surface_grid(spec)
+    if grid is not None:
+        (row_pitch, rows), (col_pitch, cols) = grid
+        cx, cy = (rows - 1) // 2 * row_pitch, (cols - 1) // 2 * col_pitch
     if places is None:
         places = [((cx if x_mm is None else x_mm), (cy if y_mm is None else y_mm))]
     elif x_mm is not None or y_mm is not None:
@@ -359,7 +368,7 @@ def loads(
         raise TactsenseInputError("places is empty; give at least one (x, y) [mm]")
     for x, y in places:
         _check_on(spec, x, y, "a press")
-    extra = {"at_taxel": 0} if spec.kind == "points" else {}
+    extra = {"at_taxel": 0} if grid is None else {}  # in the tangent plane of taxel 0
     steps = _settle(settle_s)
     k = 0
     for _ in range(repeats):

@@ -23,6 +23,7 @@ import math
 import numpy as np
 
 from tactsense._validation import TactsenseInputError, check_positive
+from tactsense.kinds import kind_of
 from tactsense.physics.indenters import SphereProbe, pressure_map
 from tactsense.physics.pad_response import modulus_star_pa, pad_strain, strain_map
 from tactsense.physics.transduction import amplifier_gain, divider_voltage, voltage_to_counts
@@ -69,8 +70,17 @@ def expected_counts(spec, x_mm: float, y_mm: float, force_n: float, radius_mm: f
     return counts_from_strain(spec, pad_strain(spec, [probe]))
 
 
+def _on_layer_grid(spec) -> bool:
+    """Whether ``spec`` is a grid of taxels under an elastic layer (``Kind.design_model``
+    ``"layer"``), what this bound and the blind-spot map are computed for."""
+    try:
+        return kind_of(spec).design_model == "layer"
+    except TactsenseInputError:  # not a sensor description
+        return False
+
+
 def _check_pad(spec, x_mm: float, y_mm: float) -> None:
-    if getattr(spec, "kind", None) != "pad":
+    if not _on_layer_grid(spec):
         raise TactsenseInputError(
             f"this bound is for pads; {spec.name!r} is a {getattr(spec, 'kind_label', '?')}"
         )
@@ -299,7 +309,7 @@ def blind_spots(
         grid ``step_mm``; and ``weakest_change_counts`` (the smallest, over the pad, of
         the largest change).
     """
-    if getattr(spec, "kind", None) != "pad":
+    if not _on_layer_grid(spec):
         raise TactsenseInputError(
             f"blind spots are mapped on pads; {spec.name!r} is a {getattr(spec, 'kind_label', '?')}"
         )

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from tactsense.kinds import kind_of
 from tactsense.physics.contact import grams_force
 from tactsense.physics.indenters import SphereProbe
 from tactsense.physics.pad_response import pad_strain, strain_transfer
@@ -211,7 +212,8 @@ def designs_on_map(
     marked = {sensor.name: map_point(sensor)}
     left_out = {}
     for pad in pads:
-        if pad.kind != "pad" or pad.name == sensor.name:
+        same_model = kind_of(pad).design_model == kind_of(sensor).design_model
+        if not same_model or pad.name == sensor.name:
             continue
         differences = map_differences(sensor, pad, poisson_ratio)
         if differences:

@@ -20,12 +20,14 @@ on a Dask client (``client=``) as well as here.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
 from tactsense._validation import TactsenseInputError
 from tactsense.analysis.aliasing import interpolation_errors, reconstruction_error
 from tactsense.analysis.bound import cramer_rao_bound
+from tactsense.kinds import kind_of, kinds
 from tactsense.physics.array_response import tactel_deflection
 from tactsense.physics.contact import Probe, grams_force
 from tactsense.physics.transduction import deflection_to_counts
@@ -75,27 +77,72 @@ def design_point(
     }
 
 
+@dataclass(frozen=True)
+class DesignMap:
+    """How one design model (``Kind.design_model``) maps designs: its variables (name ->
+    (unit, long name)), ``point(sensor, depth [mm], pitch [mm], poisson [-], grams [g])``
+    giving them for one design, the command's default grid (``--depth``, ``--spacing``,
+    ``--poisson`` as START:STOP:COUNT) and ``marks(sensor, poisson)``: the designs to mark
+    on the plot (name -> (depth, pitch) [mm]) and a note naming those left out."""
+
+    variables: dict
+    point: Callable
+    grid: dict
+    marks: Callable
+
+
+def _paper_marks(sensor, poisson_ratio: float):
+    """The paper's two fingers (Table 1)."""
+    from tactsense.sensor import load_sensor
+
+    improved = load_sensor("improved")
+    designs = {
+        "initial": (3.8, 3.8),
+        "improved": (improved.elastic.effective_depth_mm, improved.array.spacing_axial_mm),
+    }
+    return designs, None
+
+
+def _layer_marks(sensor, poisson_ratio: float):
+    """The pads the map describes (same layer and transduction), and a note on the rest."""
+    from tactsense.analysis.pad_design import designs_on_map, left_out_note
+    from tactsense.sensor import PRESETS
+
+    pads = [make() for make in PRESETS.values()]
+    designs, left_out = designs_on_map(sensor, pads, poisson_ratio)
+    return designs, left_out_note(left_out, sensor.name)
+
+
+def design_map(sensor) -> DesignMap:
+    """The design map of a sensor's kind (``Kind.design_model``): the paper's finger
+    (here), or a grid of taxels under an elastic layer
+    (:mod:`tactsense.analysis.pad_design`); another kind has none (a one-line error)."""
+    kind = kind_of(sensor)
+    if kind.design_model == "paper":
+        grid = {"depth": "2:6:9", "spacing": "2:3.8:7", "poisson": "0.4"}
+        return DesignMap(VARIABLES, design_point, grid, _paper_marks)
+    if kind.design_model == "layer":
+        from tactsense.analysis import pad_design
+
+        grid = {"depth": "0.5:4:8", "spacing": "1.5:5:8", "poisson": "0.5"}
+        return DesignMap(pad_design.VARIABLES, pad_design.design_point, grid, _layer_marks)
+    mapped = " and ".join(k.plural for k in kinds().values() if k.design_model)
+    raise TactsenseInputError(
+        f"design maps are made for {mapped}; {sensor.name!r} is a {kind.label}"
+    )
+
+
 def variables_of(sensor) -> dict[str, tuple[str, str]]:
     """The map's variables for a sensor's kind: a finger's, or a pad's
     (:mod:`tactsense.analysis.pad_design`)."""
-    if sensor.kind == "pad":
-        from tactsense.analysis import pad_design
-
-        return pad_design.VARIABLES
-    if sensor.kind != "finger":
-        raise TactsenseInputError(
-            f"design maps are made for fingers and pads; {sensor.name!r} is a {sensor.kind_label}"
-        )
-    return VARIABLES
+    return design_map(sensor).variables
 
 
 def _depth_slice(sensor_toml: str, depth, spacings, poissons, grams) -> np.ndarray:
     """All designs of one depth: array (spacing, poisson, grams, variable)."""
     sensor = SensorSpec.from_toml_string(sensor_toml)
-    variables = variables_of(sensor)
-    point_of = design_point
-    if sensor.kind == "pad":
-        from tactsense.analysis.pad_design import design_point as point_of
+    mapped = design_map(sensor)
+    variables, point_of = mapped.variables, mapped.point
     out = np.full((len(spacings), len(poissons), len(grams), len(variables)), np.nan)
     for i, spacing in enumerate(spacings):
         for j, nu in enumerate(poissons):

@@ -11,6 +11,7 @@ import typer
 
 from tactsense._validation import TactsenseInputError
 from tactsense.cli._common import progress_bar
+from tactsense.kinds import kind_of, kinds
 from tactsense.physics.contact import grams_force
 from tactsense.physics.flaws import FLAW_NAMES
 from tactsense.sensor import SensorSpec
@@ -30,11 +31,6 @@ class ScenarioKind(StrEnum):
     punch = "punch"
     loads = "loads"
 
-
-FINGER_SCENARIOS = ("sweep-axial", "sweep-around", "repeated", "calibration", "knife-edge")
-FLAT_SCENARIOS = ("press", "hold", "two-probes", "slide", "sweep", "knife-edge", "punch",
-                  "calibration", "loads")  # fmt: skip
-"""The scenarios of a finger, and of a pad or a point set (``tactsense.flat_scenarios``)."""
 
 ScenarioOption = Annotated[
     ScenarioKind | None,
@@ -227,27 +223,19 @@ USES = {
     ScenarioKind.calibration: ("force_g", "increment"),
     ScenarioKind.knife: ("row", "col", "increment"),
 }
-"""The options each scenario reads; any other scenario option given is an error."""
+"""The options each scenario reads (where a kind's differ: ``Kind.scenario_options``, e.g.
+'knife-edge' and 'calibration' on a pad or a point set); any other scenario option given
+is an error. Which scenarios a kind takes: ``Kind.scenarios``."""
 
 
 def _flag(name: str) -> str:
     return "--" + name.replace("_", "-")
 
 
-FLAT_KNIFE_USES = ("force_g", "size_mm", "angle_deg", "dwell_s")
-"""'knife-edge' on a pad or a point set (on a finger it is section 4.1's sweep)."""
-
-
-FLAT_CALIBRATION_USES = ("force_g", "size_mm", "dwell_s")
-"""'calibration' on a pad or a point set: a sphere on every taxel in turn."""
-
-
 def _uses(scenario: ScenarioKind, kind: str) -> tuple[str, ...]:
-    if scenario is ScenarioKind.knife and kind != "finger":
-        return FLAT_KNIFE_USES
-    if scenario is ScenarioKind.calibration and kind != "finger":
-        return FLAT_CALIBRATION_USES
-    return USES[scenario]
+    """The options ``scenario`` reads on a sensor of ``kind`` (its name): the kind's own
+    where it has them (``Kind.scenario_options``), else :data:`USES`."""
+    return kind_of(kind).scenario_options.get(scenario.value, USES[scenario])
 
 
 def check_scenario_options(scenario: ScenarioKind, given: dict, kind: str = "finger") -> dict:
@@ -266,14 +254,15 @@ def check_scenario_options(scenario: ScenarioKind, given: dict, kind: str = "fin
 def resolve_scenario(spec, scenario: ScenarioKind | None) -> ScenarioKind:
     """The scenario asked for, or the sensor's default; one the sensor cannot run is an
     error naming those it can."""
-    finger = spec.kind == "finger"
+    kind = kind_of(spec)
+    allowed = kind.scenarios
     if scenario is None:
-        return ScenarioKind.sweep_axial if finger else ScenarioKind.press
-    allowed = FINGER_SCENARIOS if finger else FLAT_SCENARIOS
+        return ScenarioKind(allowed[0])
     if scenario.value not in allowed:
+        others = [k.plural for k in kinds().values() if scenario.value in k.scenarios]
         raise TactsenseInputError(
-            f"--scenario {scenario.value} is for {'pads and point sets' if finger else 'fingers'}; "
-            f"{spec.name!r} is a {spec.kind_label}, which takes {', '.join(allowed)}"
+            f"--scenario {scenario.value} is for {' and '.join(others)}; "
+            f"{spec.name!r} is a {kind.label}, which takes {', '.join(allowed)}"
         )
     return scenario
 
@@ -346,7 +335,7 @@ def build_scenario(
     not use it (:data:`USES`) is a :class:`TactsenseInputError`.
     """
     scenario = resolve_scenario(spec, scenario)
-    if spec.kind != "finger":
+    if kind_of(spec).surface_scenarios:
         given = dict(
             row=row, col=col, force_g=force_g, increment=increment, dwell_s=dwell_s,
             lift_s=lift_s, repeats=repeats, x_mm=x_mm, y_mm=y_mm,
@@ -431,17 +420,19 @@ def parse_forces_g(text: str) -> list[float]:
 
 def _check_place(spec, x_mm: float | None, y_mm: float | None) -> None:
     """Refuse a ``--x-mm`` or ``--y-mm`` off a pad, naming the option and the pad's range."""
-    if spec.kind != "pad":
+    kind = kind_of(spec)
+    grid = kind.surface_grid(spec)
+    if grid is None:  # no grid to fall off: a place in a taxel's tangent plane
         return
-    g = spec.grid
+    (row_pitch, rows), (col_pitch, cols) = grid
     for flag, value, pitch, n, axis in (
-        ("--x-mm", x_mm, g.row_pitch_mm, g.rows, "x"),
-        ("--y-mm", y_mm, g.col_pitch_mm, g.cols, "y"),
+        ("--x-mm", x_mm, row_pitch, rows, "x"),
+        ("--y-mm", y_mm, col_pitch, cols, "y"),
     ):
         low, high = -0.5 * pitch, (n - 0.5) * pitch
         if value is not None and not low <= value <= high:
             raise TactsenseInputError(
-                f"{flag} {value:g} is off the {g.rows}x{g.cols} pad {spec.name!r}: "
+                f"{flag} {value:g} is off the {rows}x{cols} {kind.label} {spec.name!r}: "
                 f"{axis} runs from {low:g} to {high:g} mm (taxel centres 0 to "
                 f"{(n - 1) * pitch:g} mm)"
             )
@@ -472,8 +463,9 @@ def _flat_scenario(spec, scenario: ScenarioKind, given: dict):
         options[key] = given["size_mm"]
     if scenario is ScenarioKind.hold and "dwell_s" in options:
         options["hold_s"] = options.pop("dwell_s")
-    if spec.kind == "points" and scenario in (ScenarioKind.press, ScenarioKind.hold):
-        options.setdefault("at_taxel", 0)
+    no_grid = kind_of(spec).surface_grid(spec) is None
+    if no_grid and scenario in (ScenarioKind.press, ScenarioKind.hold):
+        options.setdefault("at_taxel", 0)  # in the tangent plane of taxel 0
     if scenario in (ScenarioKind.press, ScenarioKind.hold):
         default_size = {"knife": 10.0, "cylinder": 10.0, "square": 5.0}
         if options.get("indenter") in default_size:

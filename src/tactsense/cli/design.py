@@ -19,6 +19,7 @@ from tactsense.cli._common import (
     progress_bar,
     same_file,
 )
+from tactsense.kinds import KindNotSupported, kind_of, kinds
 from tactsense.physics.contact import grams_force
 from tactsense.sensor import load_sensor
 
@@ -139,17 +140,22 @@ def design_bound(
     (a finger, or a pad: a sphere at --x-mm, --y-mm)."""
     try:
         spec = load_sensor(sensor)
-        if spec.kind == "pad":
+        kind = kind_of(spec)
+        if kind.design_model == "layer":  # the layer model's bound: a sphere at (x, y)
             for flag, value in (("--axial", axial), ("--angle", angle)):
                 if value is not None:
-                    fail(f"{flag} is for fingers; {spec.name!r} is a pad: give --x-mm, --y-mm")
+                    fail(f"{flag} is for fingers; {spec.name!r} is a {kind.label}: give "
+                         "--x-mm, --y-mm")  # fmt: skip
             _pad_bound(spec, x_mm, y_mm, force_g, 3.2 if diameter is None else diameter,
                        as_json)  # fmt: skip
             return
-        spec.require_kind("finger", "pad", what="design bound")
+        if kind.design_model != "paper":
+            bounded = " and ".join(f"{k.name} sensors" for k in kinds().values() if k.design_model)
+            raise KindNotSupported(f"design bound works on {bounded}; {spec.name!r} is a "
+                                   f"{kind.label}")  # fmt: skip
         for flag, value in (("--x-mm", x_mm), ("--y-mm", y_mm)):
             if value is not None:
-                fail(f"{flag} is for pads; {spec.name!r} is a finger: give --axial, --angle")
+                fail(f"{flag} is for pads; {spec.name!r} is a {kind.label}: give --axial, --angle")
     except TactsenseInputError as error:
         fail(str(error))
     _finger_bound(
@@ -219,18 +225,19 @@ def _pad_bound(spec, x_mm, y_mm, force_g, diameter, as_json) -> None:
     from tactsense.analysis.pad_bound import cramer_rao_bound, noise_variance
     from tactsense.flat_scenarios import centre_mm
 
-    g = spec.grid
+    kind = kind_of(spec)
+    (row_pitch, rows), (col_pitch, cols) = kind.surface_grid(spec)
     cx, cy = centre_mm(spec)
     x = cx if x_mm is None else x_mm
     y = cy if y_mm is None else y_mm
     for flag, value, pitch, n, axis in (
-        ("--x-mm", x, g.row_pitch_mm, g.rows, "x"),
-        ("--y-mm", y, g.col_pitch_mm, g.cols, "y"),
+        ("--x-mm", x, row_pitch, rows, "x"),
+        ("--y-mm", y, col_pitch, cols, "y"),
     ):
         low, high = -0.5 * pitch, (n - 0.5) * pitch
         if not low <= value <= high:
-            fail(f"{flag} {value:g} is off the {g.rows}x{g.cols} pad {spec.name!r}: {axis} "
-                 f"runs from {low:g} to {high:g} mm")  # fmt: skip
+            fail(f"{flag} {value:g} is off the {rows}x{cols} {kind.label} {spec.name!r}: "
+                 f"{axis} runs from {low:g} to {high:g} mm")  # fmt: skip
     force = grams_force(force_g)
     try:
         bound = cramer_rao_bound(spec, x, y, force, radius_mm=0.5 * diameter)
@@ -440,7 +447,7 @@ def design_sweep_command(
     two fingers are marked on the plot; for a pad (--sensor pad16), sensing depth x pitch
     with the pad presets marked."""
 
-    from tactsense.analysis.sweep import design_sweep, plot_map
+    from tactsense.analysis.sweep import design_map, design_sweep, plot_map
     from tactsense.cli._common import atomic_output, check_output, console, sensor_file
 
     check_output(out, force, inputs=sensor_file(sensor))
@@ -452,12 +459,14 @@ def design_sweep_command(
             fail(f"--plot {plot} and --out {out} are the same file; choose two names")
         check_plot_format(plot)
     spec = load_sensor(sensor)
-    pad = spec.kind == "pad"
-    if spec.kind not in ("finger", "pad"):
-        fail(f"design maps are made for fingers and pads; {spec.name!r} is a {spec.kind_label}")
-    depths = _grid(depth or ("0.5:4:8" if pad else "2:6:9"), "--depth", low=0.5, high=20.0)
-    spacings = _grid(spacing or ("1.5:5:8" if pad else "2:3.8:7"), "--spacing", low=0.5, high=20.0)
-    ratios = _grid(poisson or ("0.5" if pad else "0.4"), "--poisson", low=0.0, high=0.5)
+    try:
+        mapped = design_map(spec)  # the kind's map; another kind has none
+    except TactsenseInputError as error:
+        fail(str(error))
+    grid = mapped.grid
+    depths = _grid(depth or grid["depth"], "--depth", low=0.5, high=20.0)
+    spacings = _grid(spacing or grid["spacing"], "--spacing", low=0.5, high=20.0)
+    ratios = _grid(poisson or grid["poisson"], "--poisson", low=0.0, high=0.5)
     loads = _grid(force_g, "--force-g", low=0.1, high=10_000.0)
     client = cluster = None
     if workers > 0:
@@ -492,24 +501,11 @@ def design_sweep_command(
     with atomic_output(out) as temporary:
         dataset.to_netcdf(temporary, engine="scipy")
     if plot is not None:
-        note = None
-        if spec.kind == "pad":  # the pad and the presets the map describes (same layer...)
-            from tactsense.analysis.pad_design import designs_on_map, left_out_note
-            from tactsense.sensor import PRESETS
-
-            pads = [make() for make in PRESETS.values()]
-            designs, left_out = designs_on_map(spec, pads, ratios[0])
-            note = left_out_note(left_out, spec.name)
-        else:
-            designs = {
-                "initial": (3.8, 3.8),
-                "improved": (
-                    load_sensor("improved").elastic.effective_depth_mm,
-                    load_sensor("improved").array.spacing_axial_mm,
-                ),
-            }
+        designs, note = mapped.marks(spec, ratios[0])
         with atomic_output(plot) as temporary:
             plot_map(dataset, temporary, designs=designs, note=note)
     n = len(depths) * len(spacings) * len(ratios) * len(loads)
     fits = int(np.isfinite(dataset["xi"].values).sum())
-    console.print(f"wrote {out}: {n} designs ({n - fits} do not fit the {spec.kind}: NaN)")
+    console.print(
+        f"wrote {out}: {n} designs ({n - fits} do not fit the {kind_of(spec).label}: NaN)"
+    )

@@ -46,6 +46,7 @@ from tactsense.cli._scenario import (
     run_scenario,
 )
 from tactsense.io.recording import read_recording
+from tactsense.kinds import kind_of
 from tactsense.sensor import SensorSpec, load_sensor
 
 app = new_group("Simulate the finger and describe recordings.")
@@ -130,9 +131,7 @@ def simulate(
                      "extension .csv")  # fmt: skip
         if plot is not None:
             check_plot_format(plot)
-        from tactsense.physics.finger3d_table import check_forward
-
-        check_forward(forward, spec)
+        kind_of(spec).check_forward(spec, forward)
         scenario = resolve_scenario(spec, scenario)
         if plot is not None and scenario not in (
             ScenarioKind.sweep_axial,
@@ -297,20 +296,7 @@ def sensor_show(
 
 def _preset_row(name: str, spec) -> tuple[str, str, str, str, str]:
     """(name, kind, size, pitch, one-line description) of a preset, for ``sensor list``."""
-    if spec.kind == "finger":
-        a = spec.array
-        size = f"{spec.shape[0]} x {spec.shape[1]} tactels"
-        pitch = f"{a.spacing_axial_mm:g} mm x {a.spacing_angle_deg:g} deg"
-    elif spec.kind == "pad":
-        g = spec.grid
-        size = f"{g.rows} x {g.cols} taxels"
-        pitch = f"{g.row_pitch_mm:g} x {g.col_pitch_mm:g} mm"
-    else:  # a point set: the median distance from each taxel to its nearest
-        positions = spec.taxel_positions_mm()
-        gaps = np.linalg.norm(positions[:, None] - positions[None], axis=-1)
-        np.fill_diagonal(gaps, np.inf)
-        size = f"{spec.n_taxels} taxels"
-        pitch = f"{np.median(gaps.min(axis=1)):.3g} mm (nearest, median)"
+    size, pitch = kind_of(spec).size_text(spec)
     first = spec.description.split(". ")[0].rstrip(".")
     return name, spec.kind, size, pitch, first
 
@@ -353,9 +339,11 @@ def sensor_check(
     for label, value in spec.summary():
         table.add_row(label, value)
     warnings = []
-    if spec.kind != "pad" and probe_g is not None:
-        fail(f"--probe-g maps the blind spots of a pad; {spec.name!r} is a {spec.kind_label}")
-    if spec.kind != "finger":
+    kind = kind_of(spec)
+    layer = kind.design_model == "layer"  # blind spots are mapped with the layer model
+    if not layer and probe_g is not None:
+        fail(f"--probe-g maps the blind spots of a pad; {spec.name!r} is a {kind.label}")
+    if kind.multi_contact:  # locate's contact threshold
         from tactsense.estimate.contacts import default_threshold, threshold_counts
 
         noise = float(spec.flaws.read_noise_counts)
@@ -366,7 +354,7 @@ def sensor_check(
             f"same share of a range of fewer than 12 bits but at least 3, and 5 x the read "
             f"noise of {noise:.3g} counts; raised where creep is taken out)",
         )
-    if spec.kind == "pad":
+    if layer:
         label, value, warnings = _blind_spot_report(spec, 50.0 if probe_g is None else probe_g)
         table.add_row(label, value)
     print_table(table)
@@ -476,9 +464,10 @@ def sensor_import(
             fail(f"--extends {extends!r} is not a preset; available: {', '.join(PRESETS)}")
         if path.suffix.lower() == ".json":
             base = preset(extends or "dome12")
-            if base.kind != "points":
+            if "taxels" not in base.SECTIONS:  # a kind described taxel by taxel
                 fail(
-                    f"--extends {extends} is a {base.kind_label}; a JSON taxel list is a point set"
+                    f"--extends {extends} is a {kind_of(base).label}; a JSON taxel list is a "
+                    "point set"
                 )
             data = base.to_dict()
             taxels = taxels_from_json(path)

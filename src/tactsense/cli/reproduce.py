@@ -22,6 +22,7 @@ from tactsense.cli._common import (
     remove_stale_partials,
     sensor_file,
 )
+from tactsense.kinds import KindNotSupported, kind_of, kinds
 from tactsense.sensor import load_sensor
 
 app = new_group("The paper's experiments on the twin.")
@@ -58,7 +59,12 @@ def reproduce(
 
     try:
         spec = load_sensor(sensor)
-        spec.require_kind("finger", what="reproduce (the paper's experiments)")
+        kind = kind_of(spec)
+        if kind.design_model != "paper":  # the paper's experiments need the paper's model
+            paper = " and ".join(f"{k.name} sensors" for k in kinds().values()
+                                 if k.design_model == "paper")  # fmt: skip
+            raise KindNotSupported(f"reproduce (the paper's experiments) works on {paper}; "
+                                   f"{spec.name!r} is a {kind.label}")  # fmt: skip
         if out.exists() and not out.is_dir():
             fail(f"{out} is a file; expected a directory for the report")
         for source in sensor_file(sensor):

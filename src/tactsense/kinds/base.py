@@ -97,6 +97,92 @@ class Kind:
     on every taxel, a uniform press or known weights; per-taxel gains and a force curve);
     False: the paper's finger calibration (a probe swept along every column, section 3.1,
     with creep steps and a knife edge)."""
+    # ---- simulation, scenarios and design (r5-sim) ----
+    forwards: ClassVar[tuple[str, ...]] = ("twin",)
+    """The elastic models ``simulate --forward`` takes for this kind; ``"twin"`` is the
+    kind's own (for a layer kind, its three-dimensional layer model)."""
+    frame_axes: ClassVar[str] = "time, row, col"
+    """What the axes of a recording's frames are (the ``axes`` attribute of ``frames``)."""
+    scenarios: ClassVar[tuple[str, ...]] = (
+        "press", "hold", "two-probes", "slide", "sweep", "knife-edge", "punch",
+        "calibration", "loads",
+    )  # fmt: skip
+    """The ``--scenario`` names the kind takes, the first its default."""
+    scenario_options: ClassVar[Mapping[str, tuple[str, ...]]] = MappingProxyType(
+        {
+            "knife-edge": ("force_g", "size_mm", "angle_deg", "dwell_s"),
+            "calibration": ("force_g", "size_mm", "dwell_s"),
+        }
+    )
+    """The options a scenario reads on this kind where they differ from the command's
+    table (``tactsense.cli._scenario.USES``): scenario name -> option names."""
+    surface_scenarios: ClassVar[bool] = True
+    """Whether its scenarios are the indenters of :mod:`tactsense.flat_scenarios`, placed
+    on the surface in mm; False: the paper's probe sweeps over (row, col) tactels
+    (:mod:`tactsense.simulate`)."""
+    design_model: ClassVar[str | None] = None
+    """The elastic model the design analyses use for this kind: ``"paper"`` (the finger's
+    strip and half-plane, Fearing 1990: ``design bound``, ``design sweep``,
+    ``reproduce``), ``"layer"`` (a grid of taxels under an elastic layer: ``design
+    bound``, ``design sweep``, ``sensor check``'s blind spots), or None (none of them)."""
+
+    def check_forward(self, spec: Any, forward: str) -> str:
+        """``forward`` checked: a known model, and one this kind has (a one-line error
+        otherwise)."""
+        from tactsense.physics.finger3d_table import check_forward
+
+        check_forward(forward)
+        if forward not in self.forwards:
+            raise KindNotSupported(
+                f"--forward {forward} is the paper's finger in 3-D; {spec.name!r} is "
+                f"a {self.label} (its layer model is already three-dimensional)"
+            )
+        return forward
+
+    def layer_strain(self, spec: Any, indenters: Any) -> np.ndarray:
+        """Compressive strain [-] of every taxel, (rows, cols), under ``indenters`` pressed
+        together (the layer model of :mod:`tactsense.physics.pad_response`)."""
+        from tactsense.physics.pad_response import points_strain
+
+        return points_strain(spec, indenters)
+
+    def elastic_batch(
+        self, spec: Any, states: Any, *, forward: str = "twin", alone: bool = True
+    ) -> np.ndarray:
+        """Fractional deflection [-] of every taxel for each state (a tuple of contacts
+        held together), shape (S, rows, cols), before gains and the transducer.
+
+        ``alone``: whether ``states`` are the whole scenario's states or a window of them
+        whose path (where a kind has several) the whole scenario chose (see
+        :meth:`elastic_window_alone`).
+        """
+        from tactsense.physics.pad_response import deflection_batch_flat
+
+        return deflection_batch_flat(spec, states, self.layer_strain)
+
+    def elastic_window_alone(self, applied: Any) -> bool:
+        """Whether a window of ``applied``'s states takes the path the whole would
+        (``elastic_batch``'s ``alone``); a kind with one path: True."""
+        return True
+
+    def reads_capacitive(self, spec: Any) -> bool:
+        """Whether the sensor reads through the paper's capacitive chain (eqs. 1-4)."""
+        return spec.transduction.kind == "capacitive"
+
+    def surface_grid(self, spec: Any) -> tuple[tuple[float, int], tuple[float, int]] | None:
+        """The grid of taxels a surface scenario places indenters on: along x and along y
+        the pitch [mm] and the number of taxels; None: no grid, an indenter is placed in
+        the tangent plane of a taxel (``at_taxel``, by default the first)."""
+        return None
+
+    def size_text(self, spec: Any) -> tuple[str, str]:
+        """(size, pitch) of a sensor in words, for ``sensor list``: the taxel count and
+        the median distance from each taxel to its nearest [mm]."""
+        positions = spec.taxel_positions_mm()
+        gaps = np.linalg.norm(positions[:, None] - positions[None], axis=-1)
+        np.fill_diagonal(gaps, np.inf)
+        size = f"{spec.n_taxels} taxels"
+        return size, f"{np.median(gaps.min(axis=1)):.3g} mm (nearest, median)"
 
 
 def positions_of(spec: Any) -> np.ndarray:

@@ -29,6 +29,42 @@ class FingerKind(Kind):
     # ---- the view and the commands (r5-cliview) ----
     view_drawing = "unwrapped"
     array_calibration = False
+    # ---- simulation, scenarios and design (r5-sim) ----
+    forwards = ("twin", "finger3d", "finger3d-foam")
+    frame_axes = "time, row (along the finger, 0 = tip), col (around)"
+    scenarios = ("sweep-axial", "sweep-around", "repeated", "calibration", "knife-edge")
+    scenario_options = MappingProxyType({})
+    surface_scenarios = False
+    design_model = "paper"
+
+    def elastic_batch(self, spec, states, *, forward="twin", alone=True):
+        """The 2-D twin (:func:`~tactsense.physics.array_response.deflection_batch`) or
+        the 3-D skin's tabulated response (:mod:`tactsense.physics.finger3d_table`)."""
+        if forward != "twin":
+            from tactsense.physics.finger3d_table import deflection_batch_3d
+
+            return deflection_batch_3d(spec, states, forward)
+        from tactsense.physics.array_response import deflection_batch
+
+        if alone:
+            return deflection_batch(spec, states)
+        # an empty state keeps a window of probes alone on the path of the whole
+        return deflection_batch(spec, [*states, ()])[:-1]
+
+    def elastic_window_alone(self, applied):
+        """The compiled path (single probes of one diameter) when the whole is on it."""
+        from tactsense.physics.contact import Probe
+
+        probes = [s[0] for s in applied if len(s) == 1 and type(s[0]) is Probe]
+        return len(probes) == len(applied) and len({p.contact_diameter_mm for p in probes}) == 1
+
+    def reads_capacitive(self, spec):
+        return True
+
+    def size_text(self, spec):
+        a = spec.array
+        size = f"{spec.shape[0]} x {spec.shape[1]} tactels"
+        return size, f"{a.spacing_axial_mm:g} mm x {a.spacing_angle_deg:g} deg"
 
 
 KIND: Any = FingerKind()

@@ -288,14 +288,9 @@ def _tabulated(contact) -> str:
     )
 
 
-def check_forward(forward: str, spec) -> str:
-    """The forward model's name, checked against the sensor's kind."""
+def check_forward(forward: str, spec=None) -> str:
+    """The forward model's name, checked (whether the sensor's kind has it is the kind's
+    question: ``Kind.check_forward``)."""
     if forward not in FORWARDS:
         raise TactsenseInputError(f"forward {forward!r}: expected one of {', '.join(FORWARDS)}")
-    if forward != "twin" and getattr(spec, "kind", "finger") != "finger":
-        raise TactsenseInputError(
-            f"--forward {forward} is the paper's finger in 3-D; {spec.name!r} is "
-            f"{ {'pad': 'a pad', 'points': 'a point set'}.get(spec.kind, spec.kind) } "
-            "(its layer model is already three-dimensional)"
-        )
     return forward

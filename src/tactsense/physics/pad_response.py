@@ -250,12 +250,13 @@ def surface_point(spec: PointsSpec, indenter: Indenter) -> tuple[np.ndarray, np.
     return positions[index] + indenter.x_mm * t1 + indenter.y_mm * t2, normals[index]
 
 
-def strain_batch(spec: PadSpec | PointsSpec, applied) -> np.ndarray:
+def strain_batch(spec: PadSpec | PointsSpec, applied, response) -> np.ndarray:
     """Compressive strain of every taxel for each step's indenters, (S, rows, cols) [-].
 
-    Steps with the same indenters are computed once.
+    ``response(spec, indenters)`` is the sensor's strain under one step's indenters, the
+    kind's (:func:`pad_strain`, :func:`points_strain`; ``Kind.layer_strain``). Steps with
+    the same indenters are computed once.
     """
-    response = pad_strain if spec.kind == "pad" else points_strain
     out = np.zeros((len(applied), *spec.shape))
     seen: dict[tuple, np.ndarray] = {}
     for k, indenters in enumerate(applied):
@@ -274,14 +275,15 @@ def strain_batch(spec: PadSpec | PointsSpec, applied) -> np.ndarray:
     return out
 
 
-def deflection_batch_flat(spec: PadSpec | PointsSpec, applied) -> np.ndarray:
-    """Fractional deflection of every taxel per step, (S, rows, cols) [-].
+def deflection_batch_flat(spec: PadSpec | PointsSpec, applied, response) -> np.ndarray:
+    """Fractional deflection of every taxel per step, (S, rows, cols) [-], from the
+    kind's strain ``response`` (:func:`strain_batch`).
 
     Capacitive: ``strain_gain`` times the compressive strain (eq. 3 when 1); resistive: the
     compressive strain itself (the transducer's gain is applied by
     :func:`deflection_to_counts`).
     """
-    strain = strain_batch(spec, applied)
+    strain = strain_batch(spec, applied, response)
     if spec.transduction.kind == "capacitive":
         return spec.transduction.strain_gain * strain
     return strain
