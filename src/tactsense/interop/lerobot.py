@@ -438,7 +438,7 @@ def import_lerobot(folder: str | Path, *, sensor=None):
     ``sensor`` (its shape must be the feature's). Times: ``frame_time`` where the dataset
     has it, else ``timestamp`` (made continuous across episodes from ``fps``).
     """
-    from tactsense.interop.importers import build_recording
+    from tactsense.interop._build import build_recording
     from tactsense.sensor import SensorSpecError, load_sensor, sensor_from_dict
 
     pa, pq = _pyarrow()
