@@ -20,6 +20,7 @@ from dataclasses import fields
 from pathlib import Path
 
 from tactsense._validation import TactsenseInputError
+from tactsense.kinds import kind_of
 from tactsense.stream.reader import LOSS_KINDS
 
 LOSS_COLUMNS = tuple(f"{kind}_frames" if kind == "lost" else kind for kind in LOSS_KINDS)
@@ -95,15 +96,15 @@ def process_recording(
     events = None if sidecar is None else temporary.with_name(temporary.name + ".events.csv")
     try:
         cal = _calibration(recording, calibration)
-        if _kind_of(recording) == "finger":
-            threshold = CONTACT_THRESHOLD if threshold is None else threshold
-            summary = locate_file(recording, temporary, calibration=cal, threshold=threshold)
-        else:
+        if _multi_contact(recording):  # every contact, tracked
             found = contacts_file(recording, temporary, calibration=cal, threshold=threshold,
                                   drift_s=2.0, events_path=events)  # fmt: skip
             summary = {key: found[key] for key in ("frames", "saturated", "force_mean_n",
                                                    "force_max_n")}  # fmt: skip
             summary["contacts"] = found["rows"]
+        else:  # the one contact of each frame
+            threshold = CONTACT_THRESHOLD if threshold is None else threshold
+            summary = locate_file(recording, temporary, calibration=cal, threshold=threshold)
         if events is not None and events.exists():
             os.replace(events, sidecar)
         os.replace(temporary, output)
@@ -115,11 +116,12 @@ def process_recording(
     return summary
 
 
-def _kind_of(recording: str) -> str:
+def _multi_contact(recording: str) -> bool:
+    """Whether the recording's sensor finds and tracks many contacts a frame."""
     from tactsense.io.recording import RecordingReader
 
     with RecordingReader(recording) as reader:
-        return reader.sensor.kind
+        return kind_of(reader.sensor).multi_contact
 
 
 def _calibration(recording: str, calibration: str | None):
@@ -262,7 +264,7 @@ def _frames_of(recording: Path) -> int | None:
 
     try:
         with RecordingReader(recording) as reader:
-            return reader.n_frames if reader.sensor.kind == "finger" else None
+            return None if kind_of(reader.sensor).multi_contact else reader.n_frames
     except TactsenseInputError:
         return None  # the task itself will fail and say why
 

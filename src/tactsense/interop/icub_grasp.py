@@ -210,7 +210,7 @@ def trial_recording(trial: GraspTrial, finger: str, *, sensor=None, period_s=Non
         Time between slices [s]; the files carry none, so by default
         :data:`DEFAULT_PERIOD_S` (the frame times are the slice numbers).
     """
-    from tactsense.interop.importers import ImportError_, build_recording
+    from tactsense.interop._build import ImportError_, build_recording
     from tactsense.sensor import SensorSpecError, load_sensor
 
     k = finger_index(finger)

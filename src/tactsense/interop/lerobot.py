@@ -46,6 +46,7 @@ from pathlib import Path
 import numpy as np
 
 from tactsense._validation import TactsenseInputError
+from tactsense.kinds import kind_of
 
 CODEBASE_VERSION = "v3.0"
 CHUNKS_SIZE = 1000
@@ -379,16 +380,7 @@ def export_lerobot(
     with RecordingReader(recording) as reader:
         sensor = reader.sensor
         losses = reader.losses
-        if sensor.kind == "finger":
-            state_names = STATE_NAMES
-            pieces = (
-                (start, len(time_s), time_s, _state(est, len(time_s)))
-                for start, time_s, est in iter_locate(
-                    reader, baseline_frames=baseline_frames, calibration=calibration,
-                    threshold=CONTACT_THRESHOLD if threshold is None else threshold,
-                )
-            )  # fmt: skip
-        else:  # every contact, tracked, as locate's long table has them
+        if kind_of(sensor).multi_contact:  # every contact, tracked, as locate's long table
             from tactsense.batch import iter_contacts
 
             state_names = contact_state_names()
@@ -397,6 +389,15 @@ def export_lerobot(
                 for start, n, time_s, table, _ in iter_contacts(
                     reader, baseline_frames=baseline_frames, calibration=calibration,
                     threshold=threshold, max_contacts=MAX_CONTACTS, drift_s=drift_s,
+                )
+            )  # fmt: skip
+        else:  # the one contact of each frame
+            state_names = STATE_NAMES
+            pieces = (
+                (start, len(time_s), time_s, _state(est, len(time_s)))
+                for start, time_s, est in iter_locate(
+                    reader, baseline_frames=baseline_frames, calibration=calibration,
+                    threshold=CONTACT_THRESHOLD if threshold is None else threshold,
                 )
             )  # fmt: skip
         for start, n, time_s, state in pieces:
@@ -438,7 +439,7 @@ def import_lerobot(folder: str | Path, *, sensor=None):
     ``sensor`` (its shape must be the feature's). Times: ``frame_time`` where the dataset
     has it, else ``timestamp`` (made continuous across episodes from ``fps``).
     """
-    from tactsense.interop.importers import build_recording
+    from tactsense.interop._build import build_recording
     from tactsense.sensor import SensorSpecError, load_sensor, sensor_from_dict
 
     pa, pq = _pyarrow()

@@ -43,6 +43,7 @@ from pathlib import Path
 import numpy as np
 
 from tactsense._validation import TactsenseInputError
+from tactsense.kinds import kind_of
 from tactsense.sensor import SensorSpec, SensorSpecError
 from tactsense.stream.reader import LossCounters, StreamError, StreamFrame
 
@@ -147,9 +148,7 @@ def frames_info(sensor: SensorSpec, identity: dict, rate_hz: float):
     _acquisition(desc, identity)
     channels = desc.append_child("channels")
     positions = sensor.taxel_positions_mm()
-    finger = sensor.kind == "finger"
-    if finger:
-        axial, angle = sensor.row_axial_mm, sensor.col_angle_deg
+    fields = kind_of(sensor).lsl_taxel_fields(sensor)  # a finger: axial_mm, angle_deg
     for r in range(rows):
         for c in range(cols):
             channel = channels.append_child("channel")
@@ -161,9 +160,8 @@ def frames_info(sensor: SensorSpec, identity: dict, rate_hz: float):
                 location.append_child_value(axis, f"{value:.6g}")
             channel.append_child_value("row", str(r))
             channel.append_child_value("col", str(c))
-            if finger:
-                channel.append_child_value("axial_mm", f"{axial[r]:.6g}")
-                channel.append_child_value("angle_deg", f"{angle[c]:.6g}")
+            for field, values in fields.items():
+                channel.append_child_value(field, f"{values[r * cols + c]:.6g}")
     meta = desc.append_child("tactsense")
     meta.append_child_value("sensor_toml", sensor.to_toml_string())
     meta.append_child_value("layout", "row-major: channel = row * cols + col")
@@ -183,10 +181,11 @@ def contacts_info(sensor: SensorSpec, identity: dict, rate_hz: float):
     """The ``StreamInfo`` of the contacts outlet: the finger's one contact, or the slots
     of a pad's or point set's contacts."""
     pylsl = _pylsl()
-    if sensor.kind == "finger":
-        described = list(zip(CONTACT_CHANNELS, CONTACT_UNITS, CONTACT_TYPES, strict=True))
-    else:
+    slots = kind_of(sensor).multi_contact  # several contacts a frame, tracked: slots
+    if slots:
         described = _slot_channels()
+    else:
+        described = list(zip(CONTACT_CHANNELS, CONTACT_UNITS, CONTACT_TYPES, strict=True))
     info = pylsl.StreamInfo(
         f"{sensor.name}-contacts",
         "TactileContact",
@@ -197,7 +196,7 @@ def contacts_info(sensor: SensorSpec, identity: dict, rate_hz: float):
     )
     desc = info.desc()
     _acquisition(desc, identity)
-    if sensor.kind != "finger":
+    if slots:
         meta = desc.append_child("tactsense")
         meta.append_child_value("slots", str(SLOTS))
         meta.append_child_value(

@@ -30,6 +30,7 @@ from tactsense.interop.ros import (
     tactile_contact,
     tactile_state,
 )
+from tactsense.kinds import kind_of
 from tactsense.sensor import SensorSpec
 
 STATES_TOPIC = "/tactile_states"
@@ -443,7 +444,7 @@ def export_mcap(
         )
         if reader.losses:
             writer.losses(reader.losses)
-        if reader.sensor.kind != "finger":  # every contact, tracked: one message each
+        if kind_of(reader.sensor).multi_contact:  # every contact, tracked: one message each
             from tactsense.batch import iter_contacts
 
             sensor = reader.sensor

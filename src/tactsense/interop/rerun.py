@@ -47,6 +47,7 @@ from pathlib import Path
 import numpy as np
 
 from tactsense._validation import TactsenseInputError
+from tactsense.kinds import kind_of
 
 
 def _rerun():
@@ -104,7 +105,7 @@ def export_rerun(
     frames_written = contacts = 0
     with RecordingReader(recording) as reader:
         sensor = reader.sensor
-        if sensor.kind != "finger":
+        if kind_of(sensor).multi_contact:  # every contact, tracked
             return _export_array(
                 rr, reader, recording, out, calibration=calibration,
                 baseline_frames=baseline_frames, threshold=threshold,
@@ -200,7 +201,8 @@ def _export_array(
     from tactsense.physics.contact import newtons_to_grams
 
     sensor = reader.sensor
-    root = sensor.kind
+    root = sensor.kind  # the entity path's root: pad/..., points/...
+    picture = kind_of(sensor).image_grid  # a grid of taxels: a heat map to picture
     viridis = colormaps["viridis"]
     pieces = iter_contacts(reader, baseline_frames=baseline_frames, calibration=calibration,
                            threshold=threshold, drift_s=drift_s)  # fmt: skip
@@ -231,13 +233,13 @@ def _export_array(
     for start_frame, n, time_s, table, _ in pieces:
         values = signal(reader.frames(start_frame, start_frame + n))
         scaled = np.clip((np.nan_to_num(values) - low) / (high - low), 0.0, 1.0)
-        colours = (viridis(scaled)[..., :3] * 255).round().astype(np.uint8)  # pads only
+        colours = (viridis(scaled)[..., :3] * 255).round().astype(np.uint8)  # pictures only
         bounds = np.searchsorted(table.frame, np.arange(start_frame, start_frame + n + 1))
         force_g = newtons_to_grams(np.asarray(table.force_n, dtype=float))
         for k, t in enumerate(time_s):
             stream.set_time("time", duration=float(t))
             frame = np.ascontiguousarray(values[k], dtype=np.float32)
-            if sensor.kind == "pad":
+            if picture:
                 stream.log(f"{root}/signal", rr.Image(colours[k], color_model="RGB"))
                 tensor = rr.Tensor(frame, dim_names=("row", "col"), value_range=(low, high))
             else:  # a point set: no grid to picture; its taxels in order
@@ -248,7 +250,7 @@ def _export_array(
             if ids:
                 xyz = np.column_stack([table.x_mm[rows], table.y_mm[rows], table.z_mm[rows]])
                 stream.log(f"{root}/contacts", rr.Points3D(xyz, labels=ids, radii=0.5))
-                if sensor.kind == "pad":
+                if picture:
                     pixels = np.column_stack([table.col[rows] + 0.5, table.row[rows] + 0.5])
                     stream.log(f"{root}/signal/contacts",
                                rr.Points2D(pixels, labels=ids, radii=0.15))  # fmt: skip
@@ -258,7 +260,7 @@ def _export_array(
                 contacts += len(ids)
             else:
                 stream.log(f"{root}/contacts", rr.Clear(recursive=False))
-                if sensor.kind == "pad":
+                if picture:
                     stream.log(f"{root}/signal/contacts", rr.Clear(recursive=False))
             finite = force_g[rows][np.isfinite(force_g[rows])]
             stream.log(f"{root}/force_g", rr.Scalars([float(finite.sum())]))

@@ -28,30 +28,24 @@ from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass
 from pathlib import Path
 
-from tactsense._validation import TactsenseInputError
-from tactsense.sensor import SensorSpec, SensorSpecError, preset
+from tactsense.kinds import kind_of
+from tactsense.kinds.urdf import TactileArray, TactileTaxels, UrdfError
+from tactsense.kinds.urdf import rpy_to_matrix as _rpy_to_matrix  # noqa: F401 (tests)
+from tactsense.sensor import SensorSpec, preset
 
-
-@dataclass(frozen=True)
-class TactileArray:
-    """One ``<sensor>`` with a ``<tactile><array>`` element, in SI units as written."""
-
-    name: str
-    rows: int
-    cols: int
-    order: str
-    size_m: tuple[float, float]
-    spacing_m: tuple[float, float]
-    offset_m: tuple[float, float]
-    update_rate_hz: float | None
-    parent_link: str | None
-
-
-class UrdfError(TactsenseInputError):
-    """A URDF file that is not XML or has no usable tactile array."""
+__all__ = [
+    "TactileArray",
+    "TactileTaxels",
+    "UrdfError",
+    "finger_array_to_urdf",
+    "read_tactile_arrays",
+    "read_tactile_taxels",
+    "sensor_from_urdf",
+    "sensor_from_urdf_any",
+    "sensor_to_urdf",
+]
 
 
 def _pair(element, attribute: str, default, source: str) -> tuple[float, float]:
@@ -181,42 +175,10 @@ def sensor_from_urdf(
             raise UrdfError(f"{path}: no tactile array named {name!r}; it has {names}")
         array = matches[0]
     base = preset(extends)
-    data = base.to_dict()
-    radius_mm = base.body.diameter_mm / 2.0
-    spacing_along_mm = abs(array.spacing_m[0]) * 1e3
-    spacing_around_mm = abs(array.spacing_m[1]) * 1e3
-    tip = bool(base.array.tip_row)
-    if tip and array.rows < 2:
-        raise UrdfError(
-            f"{path}: sensor {array.name!r} has {array.rows} row; the {extends!r} finger has "
-            "a tip row (row 0) and needs at least one more"
-        )
-    cylinder_rows = array.rows - int(tip)
-    data["name"] = array.name
-    data["description"] = f"imported from {Path(path).name} (URDF tactile array), on {base.name}"
-    layout = data["array"]
-    layout.update(
-        cylinder_rows=cylinder_rows,
-        cols=array.cols,
-        wired_rows=array.rows,
-        wired_cols=array.cols,
-        wired_col_offset=0,
-        spacing_axial_mm=spacing_along_mm,
-        spacing_angle_deg=math.degrees(spacing_around_mm / radius_mm),
-    )
-    data["rings"].update(
-        ring_width_mm=abs(array.size_m[0]) * 1e3, strip_width_mm=abs(array.size_m[1]) * 1e3
-    )
-    if array.update_rate_hz is not None:
-        data["electronics"]["scan_rate_hz"] = array.update_rate_hz
-    try:
-        return SensorSpec.from_dict(data, source=str(path))
-    except SensorSpecError as error:
-        first = str(error).splitlines()[1].strip(" -") if "\n" in str(error) else str(error)
-        raise UrdfError(
-            f"{path}: the array does not fit the {extends!r} finger ({first}); a flat pad? "
-            "give --extends pad16 (or another pad preset)"
-        ) from None
+    found = kind_of(base).from_urdf_array(array, base, path=path, preset=extends)
+    if found is None:
+        raise UrdfError(f"{path}: sensor {array.name!r} is an <array>; extend a finger or a pad")
+    return found
 
 
 def finger_array_to_urdf(
@@ -267,19 +229,6 @@ def finger_array_to_urdf(
 
 
 # ---- pads and point sets ---------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class TactileTaxels:
-    """One ``<sensor>`` with a ``<tactile>`` list of ``<taxel idx xyz rpy>`` elements [m]."""
-
-    name: str
-    idx: tuple[int, ...]
-    xyz_m: tuple[tuple[float, float, float], ...]
-    rpy: tuple[tuple[float, float, float], ...]
-    area_m2: tuple[float | None, ...]
-    box_m: tuple[tuple[float, float] | None, ...]
-    update_rate_hz: float | None
 
 
 def _triple(element, attribute: str, source: str) -> tuple[float, float, float]:
@@ -354,23 +303,6 @@ def read_tactile_taxels(path: str | Path) -> list[TactileTaxels]:
     return found
 
 
-def _rpy_to_matrix(roll: float, pitch: float, yaw: float):
-    """URDF's fixed-axis roll-pitch-yaw: R = Rz(yaw) Ry(pitch) Rx(roll)."""
-    import numpy as np
-
-    cr, sr, cp, sp, cy, sy = (
-        math.cos(roll), math.sin(roll), math.cos(pitch),
-        math.sin(pitch), math.cos(yaw), math.sin(yaw),
-    )  # fmt: skip
-    return np.array(
-        [
-            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-            [-sp, cp * sr, cp * cr],
-        ]
-    )
-
-
 def _taxel_rpy(normal) -> tuple[float, float, float]:
     """Roll-pitch-yaw of a taxel frame: z along ``normal``, x along the part of +x (the
     finger's axis toward the base) tangent to the surface (+y where +x is normal)."""
@@ -390,77 +322,6 @@ def _taxel_rpy(normal) -> tuple[float, float, float]:
     return roll, pitch, yaw
 
 
-def _finger_from_taxels(path, taxels: TactileTaxels, base):
-    """A finger whose rows and columns are read back from its taxels' skin positions."""
-    import numpy as np
-
-    from tactsense.geometry import wrap_angle_deg, xyz_to_surface
-    from tactsense.sensor import sensor_from_dict
-
-    source = f"{path}: sensor {taxels.name!r}"
-    order = np.argsort(taxels.idx)
-    points = np.asarray(taxels.xyz_m, dtype=float)[order] * 1e3
-    on_cylinder = points[:, 0] >= 0
-    if not on_cylinder.any():
-        raise UrdfError(f"{source}: no taxel on the cylinder (x >= 0); not a finger")
-    radius = float(np.median(np.hypot(points[on_cylinder, 1], points[on_cylinder, 2])))
-    data = base.to_dict()
-    data["body"]["diameter_mm"] = 2.0 * radius
-    try:
-        spec0 = sensor_from_dict(data, source=source)
-    except TactsenseInputError as error:
-        raise UrdfError(
-            f"{source}: radius {radius:g} mm does not fit {base.name!r}: {error}"
-        ) from None
-    axial, angle, _ = xyz_to_surface(spec0, points)
-    distinct = np.unique(np.round(axial, 6))
-    rows = distinct.size
-    if len(points) % rows:
-        raise UrdfError(f"{source}: {len(points)} taxels on {rows} rows is not a grid")
-    cols = len(points) // rows
-    axial = axial.reshape(rows, cols)
-    angle = angle.reshape(rows, cols)
-    if not np.allclose(axial, axial[:, :1], atol=1e-6):
-        raise UrdfError(f"{source}: the taxels are not in row-major order of rings")
-    tip = bool(base.array.tip_row)
-    ring_axial = axial[int(tip) :, 0]
-    spacing_axial = (
-        float(np.mean(np.diff(ring_axial))) if ring_axial.size > 1 else base.array.spacing_axial_mm
-    )
-    spacing_angle = (
-        float(wrap_angle_deg(angle[-1, 1] - angle[-1, 0]))
-        if cols > 1
-        else base.array.spacing_angle_deg
-    )
-    layout = data["array"]
-    layout.update(
-        cylinder_rows=rows - int(tip),
-        cols=cols,
-        wired_rows=rows,
-        wired_cols=cols,
-        wired_col_offset=0,
-        spacing_axial_mm=spacing_axial,
-        spacing_angle_deg=spacing_angle,
-        first_row_axial_mm=float(ring_axial[0]),
-        first_col_angle_deg=float(angle[-1, 0]),
-    )
-    if tip:
-        layout["tip_row_axial_mm"] = float(axial[0, 0])
-    sizes = [taxels.box_m[k] for k in order if taxels.box_m[k] is not None]
-    if sizes:
-        data["rings"].update(ring_width_mm=sizes[0][0] * 1e3, strip_width_mm=sizes[0][1] * 1e3)
-    if taxels.update_rate_hz is not None:
-        data["electronics"]["scan_rate_hz"] = taxels.update_rate_hz
-    data["name"] = taxels.name
-    data["description"] = f"imported from {Path(path).name} (URDF taxel list), on {base.name}"
-    try:
-        return sensor_from_dict(data, source=str(path))
-    except TactsenseInputError as error:
-        raise UrdfError(
-            f"{path}: the taxels do not fit the {base.name!r} finger: {error}"
-        ) from None
-
-
 def sensor_from_urdf_any(path: str | Path, *, name: str | None = None, extends: str | None = None):
     """A sensor of any kind from a URDF tactile sensor.
 
@@ -471,8 +332,6 @@ def sensor_from_urdf_any(path: str | Path, *, name: str | None = None, extends: 
     them; the taxel area comes from a ``<box>`` (x * y) or ``<cylinder>`` geometry, else
     from the preset.
     """
-    from tactsense.sensor import PadSpec, PointsSpec, preset, sensor_from_dict
-
     lists = read_tactile_taxels(path)
     arrays = read_tactile_arrays(path)
     names = [t.name for t in lists] + [a.name for a in arrays]
@@ -488,66 +347,19 @@ def sensor_from_urdf_any(path: str | Path, *, name: str | None = None, extends: 
     taxels = next((t for t in lists if t.name == wanted), None)
     if taxels is None:
         base = preset(extends or "initial")
-        if base.kind == "finger":
-            return sensor_from_urdf(path, name=wanted, extends=extends or "initial")
-        if not isinstance(base, PadSpec):
-            raise UrdfError(f"{path}: sensor {wanted!r} is an <array>; extend a finger or a pad")
         array = next(a for a in arrays if a.name == wanted)
-        data = base.to_dict()
-        data["name"] = array.name
-        data["description"] = (
-            f"imported from {Path(path).name} (URDF tactile array), on {base.name}"
-        )
-        data["grid"].update(
-            rows=array.rows,
-            cols=array.cols,
-            row_pitch_mm=abs(array.spacing_m[0]) * 1e3,
-            col_pitch_mm=abs(array.spacing_m[1]) * 1e3,
-            electrode_x_mm=abs(array.size_m[0]) * 1e3,
-            electrode_y_mm=abs(array.size_m[1]) * 1e3,
-        )
-        if array.update_rate_hz is not None:
-            data["electronics"]["scan_rate_hz"] = array.update_rate_hz
-        try:
-            return sensor_from_dict(data, source=str(path))
-        except TactsenseInputError as error:
-            raise UrdfError(f"{path}: the array does not fit {base.name!r}: {error}") from None
+        found = kind_of(base).from_urdf_array(array, base, path=path, preset=extends or "initial")
+        if found is None:
+            raise UrdfError(f"{path}: sensor {wanted!r} is an <array>; extend a finger or a pad")
+        return found
     base = preset(extends or "dome12")
-    if base.kind == "finger":
-        return _finger_from_taxels(path, taxels, base)
-    if not isinstance(base, PointsSpec):
+    found = kind_of(base).from_urdf_taxels(taxels, base, path=path)
+    if found is None:
         raise UrdfError(
             f"{path}: sensor {wanted!r} is a <taxel> list, a point set; --extends must name a "
             "point-set preset (dome12) or a finger preset (initial, improved)"
         )
-    order = sorted(range(len(taxels.idx)), key=lambda k: taxels.idx[k])
-    if sorted(taxels.idx) != list(range(len(taxels.idx))):
-        raise UrdfError(
-            f"{path}: sensor {wanted!r}: taxel idx must be 0..{len(taxels.idx) - 1}, each once; "
-            f"got {sorted(taxels.idx)[:8]}..."
-        )
-    default_area = float(base.areas_mm2[0])
-    positions, normals, areas = [], [], []
-    for k in order:
-        positions.append(tuple(v * 1e3 for v in taxels.xyz_m[k]))
-        normal = _rpy_to_matrix(*taxels.rpy[k])[:, 2]
-        normals.append(tuple(float(v) for v in normal))
-        area = taxels.area_m2[k]
-        areas.append(area * 1e6 if area else default_area)
-    data = base.to_dict()
-    data["name"] = taxels.name
-    data["description"] = f"imported from {Path(path).name} (URDF taxel list), on {base.name}"
-    data["taxels"] = {
-        "positions_mm": [list(p) for p in positions],
-        "normals": [list(n) for n in normals],
-        "area_mm2": areas,
-    }
-    if taxels.update_rate_hz is not None:
-        data["electronics"]["scan_rate_hz"] = taxels.update_rate_hz
-    try:
-        return sensor_from_dict(data, source=str(path))
-    except TactsenseInputError as error:
-        raise UrdfError(f"{path}: the taxels do not fit {base.name!r}: {error}") from None
+    return found
 
 
 def sensor_to_urdf(spec, *, link: str = "finger", robot: str | None = None) -> str:
@@ -571,32 +383,26 @@ def sensor_to_urdf(spec, *, link: str = "finger", robot: str | None = None) -> s
     ET.SubElement(sensor, "parent", link=link)
     ET.SubElement(sensor, "origin", xyz="0 0 0", rpy="0 0 0")
     tactile = ET.SubElement(sensor, "tactile", channel=spec.name)
-    if spec.kind == "pad":
-        g = spec.grid
+    kind = kind_of(spec)
+    array = kind.urdf_array(spec)
+    if array is not None:
+        (size_x, size_y), (spacing_x, spacing_y) = array["size_mm"], array["spacing_mm"]
         ET.SubElement(
             tactile,
             "array",
-            rows=str(g.rows),
-            cols=str(g.cols),
+            rows=str(array["rows"]),
+            cols=str(array["cols"]),
             order="row-major",
-            size=f"{m(g.electrode_x_mm)} {m(g.electrode_y_mm)}",
-            spacing=f"{m(g.row_pitch_mm)} {m(g.col_pitch_mm)}",
+            size=f"{m(size_x)} {m(size_y)}",
+            spacing=f"{m(spacing_x)} {m(spacing_y)}",
             offset="0 0",
         )
     else:
         positions, normals = spec.taxel_positions_mm(), spec.taxel_normals()
-        if spec.kind == "finger":  # ring width along the axis, strip width around it
-            boxes = [(spec.rings.ring_width_mm, spec.rings.strip_width_mm)] * len(positions)
-        else:
-            boxes = [(math.sqrt(a), math.sqrt(a)) for a in spec.areas_mm2]
-        if spec.kind == "finger" and spec.array.tip_row:
-            tactile.append(
-                ET.Comment(
-                    f" tactsense: {spec.name}, row 0 under the hemispherical tip at "
-                    f"{spec.array.tip_row_axial_mm:g} mm along the skin; each taxel on the "
-                    "skin at its real position, z its outward normal, x along the finger "
-                )
-            )
+        boxes = kind.urdf_taxels(spec)
+        note = kind.urdf_note(spec)
+        if note is not None:
+            tactile.append(ET.Comment(note))
         rows = zip(positions, normals, boxes, strict=True)
         for index, (position, normal, (size_x, size_y)) in enumerate(rows):
             rpy = _taxel_rpy(normal)

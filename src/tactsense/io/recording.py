@@ -42,233 +42,40 @@ around it (``docs/nomenclature.md``).
 
 from __future__ import annotations
 
-import datetime as _dt
 import json
 import os
 import subprocess
 import sys
-import time
 from contextlib import contextmanager
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import h5py
 import numpy as np
 
 from tactsense._validation import TactsenseInputError
-from tactsense._version import __version__
+from tactsense.io._layout import (
+    FORMAT,
+    FORMAT_VERSION,
+    Recording,
+    RecordingError,
+    write_recording,
+)
+from tactsense.io._writer import RecordingWriter
 from tactsense.sensor import SensorSpec, SensorSpecError
 
-FORMAT = "tactsense-recording"
-FORMAT_VERSION = 2
-
-
-class RecordingError(TactsenseInputError):
-    """Raised when a recording file is missing, malformed or of the wrong kind."""
-
-
-@dataclass
-class Recording:
-    """Frames recorded from (or simulated for) one finger.
-
-    Attributes
-    ----------
-    frames : ndarray, shape (T, rows, cols)
-        A/D readings [counts].
-    time_s : ndarray, shape (T,)
-        Start of each frame's scan [s].
-    sample_offset_s : ndarray, shape (rows, cols)
-        When within a frame each tactel is sampled [s].
-    sensor : SensorSpec
-    scenario : dict
-        What was applied (simulated) or a description (measured).
-    flaws : tuple of str
-        Flaws switched on in the simulation.
-    truth : dict of arrays
-        Ground truth of a simulated recording; empty for a measured one.
-    gains : ndarray, shape (rows, cols), optional
-        Per-tactel gains used by the simulator.
-    sequence : ndarray of uint16, shape (T,), optional
-        Sequence number of each frame on the wire (recorded streams).
-    host_time_s : ndarray, shape (T,), optional
-        Arrival of each frame on the host, Unix time [s] (recorded streams).
-    device_time_us : ndarray of int64, shape (T,), optional
-        Start of each frame's scan on the device clock, exactly as the wire carried it
-        [us] (recorded streams; ``time_s`` holds it as float seconds).
-    losses : dict
-        Loss counters of the stream it was recorded from (``tactsense.stream``).
-    source : str
-        Where the frames came from (the stream's URL), empty for a simulation.
-    closed_cleanly : bool
-        False when the writer did not close the file (it was killed): the frames are
-        those up to its last flush.
-    """
-
-    frames: np.ndarray
-    time_s: np.ndarray
-    sample_offset_s: np.ndarray
-    sensor: SensorSpec
-    scenario: dict = field(default_factory=dict)
-    flaws: tuple[str, ...] = ()
-    truth: dict = field(default_factory=dict)
-    gains: np.ndarray | None = None
-    sequence: np.ndarray | None = None
-    host_time_s: np.ndarray | None = None
-    device_time_us: np.ndarray | None = None
-    losses: dict = field(default_factory=dict)
-    source: str = ""
-    closed_cleanly: bool = True
-
-    def __post_init__(self) -> None:
-        frames = np.asarray(self.frames)
-        shape = self.sensor.shape
-        if frames.ndim != 3 or frames.shape[1:] != shape:
-            raise RecordingError(
-                f"frames have shape {frames.shape}; expected (T, {shape[0]}, {shape[1]}) "
-                f"for sensor {self.sensor.name!r}"
-            )
-        if np.asarray(self.time_s).shape != (frames.shape[0],):
-            raise RecordingError(
-                f"time has shape {np.asarray(self.time_s).shape}; expected ({frames.shape[0]},)"
-            )
-        if np.asarray(self.sample_offset_s).shape != shape:
-            raise RecordingError(
-                f"sample_offset has shape {np.asarray(self.sample_offset_s).shape}; "
-                f"expected {shape}"
-            )
-
-    def __len__(self) -> int:
-        return int(self.frames.shape[0])
-
-    def sample_step(self, row: int, col: int) -> np.ndarray:
-        """Scenario step in force when tactel (row, col) was sampled, per frame (simulated only).
-
-        ``truth["frame_step"]`` is the step at the middle of each frame's scan; a
-        tactel sampled early or late in the scan may see the step before or after.
-        """
-        steps = self.scenario.get("steps")
-        if not steps:
-            raise RecordingError("this recording carries no scenario steps")
-        bounds = np.cumsum([0.0] + [float(step["duration_s"]) for step in steps])
-        instants = np.asarray(self.time_s) + float(self.sample_offset_s[row, col])
-        return np.clip(np.searchsorted(bounds, instants, side="right") - 1, 0, len(steps) - 1)
-
-    def last_loaded_frames(self, row: int, col: int) -> tuple[np.ndarray, np.ndarray]:
-        """The last frame of every step that loads the finger, as tactel (row, col) saw it.
-
-        Returns
-        -------
-        frames : ndarray of int
-            Frame indices, one per loaded step (simulated recordings only).
-        steps : ndarray of int
-            The step each of those frames belongs to.
-        """
-        step = self.sample_step(row, col)
-        loaded = np.asarray(self.truth["step_n_contacts"])[step] > 0
-        last = np.flatnonzero(loaded & np.r_[step[1:] != step[:-1], True])
-        return last, step[last]
-
-    @property
-    def baseline_frames(self) -> np.ndarray:
-        """Indices of frames during which nothing touched (simulated recordings only)."""
-        if "frame_step" not in self.truth:
-            raise RecordingError("this recording carries no truth; find untouched frames yourself")
-        counts = np.asarray(self.truth["step_n_contacts"])[np.asarray(self.truth["frame_step"])]
-        return np.flatnonzero(counts == 0)
-
-
-def write_recording(path: str | Path, recording: Recording, *, overwrite: bool = False) -> Path:
-    """Write a recording to an HDF5 file.
-
-    An existing file is never replaced unless ``overwrite`` is true; the
-    new file is written next to it first and moved in place only when
-    complete, so an interrupted write loses nothing.
-    """
-    path = Path(path)
-    if path.exists() and not overwrite:
-        raise FileExistsError(f"{path} exists; pass overwrite=True (--force) to replace it")
-    if not path.parent.exists():
-        raise RecordingError(f"folder {path.parent} does not exist")
-    partial = path.with_name(path.name + ".partial")
-    try:
-        _write_file(partial, recording)
-    except BaseException:
-        partial.unlink(missing_ok=True)  # interrupted: leave nothing behind
-        raise
-    partial.replace(path)
-    return path
-
-
-def _checked_dataset(group, name: str, data, **options):
-    """A chunked dataset with HDF5's Fletcher-32 checksum: damage is an error, not numbers."""
-    data = np.asarray(data)
-    if data.ndim == 0:  # a scalar cannot be chunked (none is written today)
-        return group.create_dataset(name, data=data)
-    if "chunks" not in options:
-        row = int(np.prod(data.shape[1:], dtype=np.int64))
-        options["chunks"] = (max(1, min(data.shape[0], 65_536 // max(row, 1))), *data.shape[1:])
-    if data.shape[0] == 0 or 0 in data.shape[1:]:
-        options["maxshape"] = (None, *data.shape[1:])
-        options["chunks"] = tuple(max(1, n) for n in options["chunks"])
-    return group.create_dataset(name, data=data, fletcher32=True, **options)
-
-
-def _write_file(partial: Path, recording: Recording) -> None:
-    # format v110: object headers, B-trees and the superblock carry checksums too
-    with h5py.File(partial, "w", libver=("v110", "v110")) as h5:
-        h5.attrs["format"] = FORMAT
-        h5.attrs["format_version"] = FORMAT_VERSION
-        h5.attrs["tactsense_version"] = __version__
-        h5.attrs["created"] = _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds")
-        h5.attrs["sensor_toml"] = recording.sensor.to_toml_string()
-        h5.attrs["scenario_json"] = json.dumps(recording.scenario)
-        h5.attrs["flaws"] = ",".join(recording.flaws)
-        h5.attrs["scan_rate_hz"] = recording.sensor.electronics.scan_rate_hz
-        frames = _checked_dataset(
-            h5,
-            "frames",
-            recording.frames,
-            compression="gzip",
-            chunks=(max(1, min(len(recording), 1024)), *recording.sensor.shape),
-            maxshape=(None, *recording.sensor.shape),
-        )
-        frames.attrs["units"] = "counts"
-        frames.attrs["axes"] = "time, row (along the finger, 0 = tip), col (around)"
-        time_s = _checked_dataset(h5, "time", np.asarray(recording.time_s, float))
-        time_s.attrs["units"] = "s"
-        offset = _checked_dataset(h5, "sample_offset", recording.sample_offset_s)
-        offset.attrs["units"] = "s"
-        if recording.gains is not None:
-            _checked_dataset(h5, "gains", recording.gains).attrs["units"] = "1"
-        h5.attrs["source"] = recording.source
-        if recording.sequence is not None:
-            _checked_dataset(h5, "sequence", np.asarray(recording.sequence, np.uint16))
-        if recording.host_time_s is not None:
-            host = _checked_dataset(h5, "host_time", np.asarray(recording.host_time_s, float))
-            host.attrs["units"] = "s"
-        if recording.device_time_us is not None:
-            device = _checked_dataset(
-                h5, "device_time_us", np.asarray(recording.device_time_us, np.int64)
-            )
-            device.attrs["units"] = "us"
-        if recording.losses:
-            losses = _checked_dataset(h5, "losses", np.array(list(recording.losses.values())))
-            losses.attrs["kinds"] = ",".join(recording.losses)
-        if recording.truth:
-            group = h5.create_group("truth")
-            units = {
-                "step_axial_mm": "mm",
-                "step_angle_deg": "deg",
-                "step_x_mm": "mm",
-                "step_y_mm": "mm",
-                "step_force_n": "N",
-            }
-            for key, value in recording.truth.items():
-                if isinstance(value, str):
-                    group.attrs[key] = value
-                else:
-                    dataset = _checked_dataset(group, key, value)
-                    dataset.attrs["units"] = units.get(key, "1")
+__all__ = [
+    "CHECK_TIMEOUT_S",
+    "FORMAT",
+    "FORMAT_VERSION",
+    "Recording",
+    "RecordingError",
+    "RecordingReader",
+    "RecordingWriter",
+    "check_structure",
+    "read_losses",
+    "read_recording",
+    "write_recording",
+]
 
 
 # The structure check, run in a child process so that a loop inside libhdf5 (a damaged
@@ -660,174 +467,3 @@ def read_losses(path: str | Path) -> dict[str, int]:
     """A recording's loss counters alone, without reading its frames."""
     with RecordingReader(path) as reader:
         return reader.losses
-
-
-class RecordingWriter:
-    """Append frames to a new recording as they arrive; crash-safe.
-
-    The file is created at once at its final name, in HDF5's single-writer /
-    multiple-reader mode, with resizable chunked datasets; :meth:`append` buffers and
-    :meth:`flush` (called at least every ``flush_interval_s``) writes and flushes, so a
-    writer killed at any moment leaves a file holding every frame up to its last flush,
-    which :func:`read_recording` and ``tactsense info`` read. :meth:`close` ends it
-    cleanly. Use it as a context manager.
-
-    Parameters
-    ----------
-    path : path
-        The new recording; an existing file is refused unless ``overwrite``.
-    sensor : SensorSpec
-    sample_offset_s : array_like, shape (rows, cols)
-        When within a frame each tactel is sampled [s].
-    source : str
-        Where the frames come from (a stream's URL).
-    loss_kinds : sequence of str
-        Names of the loss counters kept with the recording.
-    losses : callable() -> dict, optional
-        Returns the current loss counters (by kind); read at every flush.
-    flush_interval_s : float
-        Longest time between flushes [s].
-    """
-
-    def __init__(
-        self,
-        path: str | Path,
-        sensor: SensorSpec,
-        sample_offset_s,
-        *,
-        source: str = "",
-        loss_kinds=(),
-        losses=None,
-        overwrite: bool = False,
-        flush_interval_s: float = 1.0,
-        chunk_frames: int = 1024,
-    ):
-        path = Path(path)
-        if path.exists() and not overwrite:
-            raise FileExistsError(f"{path} exists; pass --force to replace it")
-        if np.shape(sample_offset_s) != sensor.shape:
-            raise RecordingError(
-                f"sample_offset_s has shape {np.shape(sample_offset_s)}; expected {sensor.shape}"
-            )
-        if not path.parent.is_dir():
-            raise RecordingError(f"folder {path.parent} does not exist")
-        self.path = path
-        self.sensor = sensor
-        self._interval = float(flush_interval_s)
-        self._last_flush = time.monotonic()
-        self._loss_source = losses
-        self._buffer: list[tuple] = []
-        self._count = 0
-        rows, cols = sensor.shape
-        h5 = h5py.File(path, "w", libver="latest")
-        try:
-            h5.attrs["format"] = FORMAT
-            h5.attrs["format_version"] = FORMAT_VERSION
-            h5.attrs["tactsense_version"] = __version__
-            h5.attrs["created"] = _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds")
-            h5.attrs["sensor_toml"] = sensor.to_toml_string()
-            h5.attrs["scenario_json"] = json.dumps({"description": f"recorded from {source}"})
-            h5.attrs["flaws"] = ""
-            h5.attrs["scan_rate_hz"] = sensor.electronics.scan_rate_hz
-            h5.attrs["source"] = source
-            chunk = max(1, int(chunk_frames))
-            self._frames = h5.create_dataset(
-                "frames",
-                (0, rows, cols),
-                np.uint16,
-                maxshape=(None, rows, cols),
-                chunks=(chunk, rows, cols),
-                compression="gzip",
-                compression_opts=1,
-                fletcher32=True,
-            )
-            self._frames.attrs["units"] = "counts"
-            self._frames.attrs["axes"] = "time, row (along the finger, 0 = tip), col (around)"
-            self._time = h5.create_dataset(
-                "time", (0,), float, maxshape=(None,), chunks=(chunk,), fletcher32=True
-            )
-            self._time.attrs["units"] = "s"
-            self._sequence = h5.create_dataset(
-                "sequence", (0,), np.uint16, maxshape=(None,), chunks=(chunk,), fletcher32=True
-            )
-            self._host = h5.create_dataset(
-                "host_time", (0,), float, maxshape=(None,), chunks=(chunk,), fletcher32=True
-            )
-            self._host.attrs["units"] = "s"
-            self._device_us = h5.create_dataset(
-                "device_time_us", (0,), np.int64, maxshape=(None,), chunks=(chunk,),
-                fletcher32=True,
-            )  # fmt: skip
-            self._device_us.attrs["units"] = "us"
-            self._device_us.attrs["meaning"] = (
-                "start of each frame's scan on the device clock, exactly as sent (-1: not known)"
-            )
-            offset = _checked_dataset(h5, "sample_offset", np.asarray(sample_offset_s, float))
-            offset.attrs["units"] = "s"
-            self._kinds = list(loss_kinds)
-            self._losses = _checked_dataset(
-                h5, "losses", np.zeros(max(len(self._kinds), 1), np.int64)
-            )
-            self._losses.attrs["kinds"] = ",".join(self._kinds)
-            h5.swmr_mode = True
-            h5.flush()
-        except BaseException:
-            h5.close()
-            path.unlink(missing_ok=True)
-            raise
-        self._h5 = h5
-
-    def __len__(self) -> int:
-        return self._count + len(self._buffer)
-
-    def append(
-        self,
-        counts,
-        device_time_s: float,
-        sequence: int,
-        host_time_s: float,
-        *,
-        device_time_us: int = -1,
-    ) -> None:
-        """Add one frame; flushes when ``flush_interval_s`` has passed since the last.
-
-        ``device_time_us`` is the device clock exactly as the frame carried it [us]
-        (``/device_time_us``; ``/time`` holds it in seconds, a float).
-        """
-        self._buffer.append((counts, device_time_s, sequence, host_time_s, int(device_time_us)))
-        if time.monotonic() - self._last_flush >= self._interval:
-            self.flush()
-
-    def flush(self) -> None:
-        """Write the buffered frames and the loss counters, and flush the file."""
-        if self._buffer:
-            n, k = self._count, len(self._buffer)
-            counts, times, seqs, hosts, device_us = zip(*self._buffer, strict=True)
-            for dataset in (
-                self._frames, self._time, self._sequence, self._host, self._device_us
-            ):  # fmt: skip
-                dataset.resize(n + k, axis=0)
-            self._frames[n:] = np.stack(counts)
-            self._time[n:] = times
-            self._sequence[n:] = seqs
-            self._host[n:] = hosts
-            self._device_us[n:] = device_us
-            self._count += k
-            self._buffer.clear()
-        if self._loss_source is not None and self._kinds:
-            counters = self._loss_source()
-            self._losses[:] = [int(counters.get(kind, 0)) for kind in self._kinds]
-        self._h5.flush()
-        self._last_flush = time.monotonic()
-
-    def close(self) -> None:
-        """Flush and close the file (idempotent)."""
-        if self._h5.id.valid:
-            self.flush()
-            self._h5.close()
-
-    def __enter__(self) -> RecordingWriter:
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.close()

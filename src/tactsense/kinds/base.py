@@ -183,6 +183,48 @@ class Kind:
         np.fill_diagonal(gaps, np.inf)
         size = f"{spec.n_taxels} taxels"
         return size, f"{np.median(gaps.min(axis=1)):.3g} mm (nearest, median)"
+    # ---- forms for other tools: LSL, URDF (r5-interop) -------------------------
+    def lsl_taxel_fields(self, spec: Any) -> dict[str, np.ndarray]:
+        """Extra metadata of each channel of the LSL frames outlet, beside its label,
+        unit, type, location [mm], row and column: field name (units in the name, e.g.
+        ``axial_mm``) -> one number per taxel in frame order (row-major), shape (N,).
+        Default: none."""
+        return {}
+
+    def urdf_array(self, spec: Any) -> dict | None:
+        """The sensor as the ROS tactile toolbox's flat ``<array>``: ``rows``, ``cols``,
+        ``size_mm`` (x, y) [mm] of a taxel and ``spacing_mm`` (x, y) [mm] between taxels
+        (row (row, col) at (row * spacing x, col * spacing y)); None (the default) to be
+        written as a ``<taxel>`` list at the taxels' real positions and normals."""
+        return None
+
+    def urdf_taxels(self, spec: Any) -> list[tuple[float, float]]:
+        """The ``<box>`` (x, y) [mm] of each taxel of a ``<taxel>`` list, frame order (x
+        along the tangent the URDF writer picks: +x, the finger's axis, where it can).
+        Default: a square of each taxel's area (``spec.areas_mm2``)."""
+        areas = getattr(spec, "areas_mm2", None)
+        if areas is None:
+            raise self.unsupported(spec, "a URDF <taxel> list (no taxel areas)")
+        return [(float(np.sqrt(a)), float(np.sqrt(a))) for a in areas]
+
+    def urdf_note(self, spec: Any) -> str | None:
+        """A comment written before the ``<taxel>`` list (what the list cannot say);
+        default none."""
+        return None
+
+    def from_urdf_array(self, array: Any, base: Any, *, path: Any, preset: str) -> Any:
+        """A sensor of this kind from a URDF ``<array>`` (a
+        :class:`~tactsense.kinds.urdf.TactileArray`), the rest from ``base`` (the preset
+        named ``preset``); a :class:`~tactsense.kinds.urdf.UrdfError` naming ``path`` if it
+        does not fit. None (the default): this kind is not read from an ``<array>``."""
+        return None
+
+    def from_urdf_taxels(self, taxels: Any, base: Any, *, path: Any) -> Any:
+        """A sensor of this kind from a URDF ``<taxel>`` list (a
+        :class:`~tactsense.kinds.urdf.TactileTaxels`), the rest from ``base``; a
+        :class:`~tactsense.kinds.urdf.UrdfError` naming ``path`` if it does not fit. None
+        (the default): this kind is not read from a ``<taxel>`` list."""
+        return None
 
 
 def positions_of(spec: Any) -> np.ndarray:

@@ -65,6 +65,42 @@ class FingerKind(Kind):
         a = spec.array
         size = f"{spec.shape[0]} x {spec.shape[1]} tactels"
         return size, f"{a.spacing_axial_mm:g} mm x {a.spacing_angle_deg:g} deg"
+    # ---- forms for other tools: LSL, URDF (r5-interop) -------------------------
+    def lsl_taxel_fields(self, spec: SensorSpec) -> dict:
+        """Each channel's position along the finger [mm] and around it [deg]."""
+        import numpy as np
+
+        rows, cols = spec.shape
+        return {
+            "axial_mm": np.repeat(spec.row_axial_mm, cols),
+            "angle_deg": np.tile(spec.col_angle_deg, rows),
+        }
+
+    def urdf_taxels(self, spec: SensorSpec) -> list[tuple[float, float]]:
+        """The ring width along the axis by the strip width around it [mm]."""
+        return [(spec.rings.ring_width_mm, spec.rings.strip_width_mm)] * spec.n_taxels
+
+    def urdf_note(self, spec: SensorSpec) -> str | None:
+        """Where the tip row is, and which way the taxel frames point."""
+        if not spec.array.tip_row:
+            return None
+        return (
+            f" tactsense: {spec.name}, row 0 under the hemispherical tip at "
+            f"{spec.array.tip_row_axial_mm:g} mm along the skin; each taxel on the "
+            "skin at its real position, z its outward normal, x along the finger "
+        )
+
+    def from_urdf_array(self, array, base: SensorSpec, *, path, preset: str) -> SensorSpec:
+        """The unwrapped cylinder: rows along the finger, columns around it."""
+        from tactsense.kinds._finger_urdf import finger_from_array
+
+        return finger_from_array(array, base, path, preset)
+
+    def from_urdf_taxels(self, taxels, base: SensorSpec, *, path) -> SensorSpec:
+        """Rows and columns read back from the taxels' positions on the skin."""
+        from tactsense.kinds._finger_urdf import finger_from_taxels
+
+        return finger_from_taxels(taxels, base, path)
 
 
 KIND: Any = FingerKind()

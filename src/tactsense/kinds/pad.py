@@ -31,6 +31,44 @@ class PadKind(Kind):
     def size_text(self, spec):
         g = spec.grid
         return f"{g.rows} x {g.cols} taxels", f"{g.row_pitch_mm:g} x {g.col_pitch_mm:g} mm"
+    # ---- forms for other tools: LSL, URDF (r5-interop) -------------------------
+    def urdf_array(self, spec: PadSpec) -> dict:
+        """Rows along x, columns along y: the electrode's size and the pitches [mm]."""
+        g = spec.grid
+        return {
+            "rows": g.rows,
+            "cols": g.cols,
+            "size_mm": (g.electrode_x_mm, g.electrode_y_mm),
+            "spacing_mm": (g.row_pitch_mm, g.col_pitch_mm),
+        }
+
+    def from_urdf_array(self, array, base: PadSpec, *, path, preset: str) -> PadSpec:
+        """Rows, columns, pitches (``spacing``) and electrode size (``size``) [m]."""
+        from pathlib import Path
+
+        from tactsense._validation import TactsenseInputError
+        from tactsense.kinds.urdf import UrdfError
+        from tactsense.sensor import sensor_from_dict
+
+        data = base.to_dict()
+        data["name"] = array.name
+        data["description"] = (
+            f"imported from {Path(path).name} (URDF tactile array), on {base.name}"
+        )
+        data["grid"].update(
+            rows=array.rows,
+            cols=array.cols,
+            row_pitch_mm=abs(array.spacing_m[0]) * 1e3,
+            col_pitch_mm=abs(array.spacing_m[1]) * 1e3,
+            electrode_x_mm=abs(array.size_m[0]) * 1e3,
+            electrode_y_mm=abs(array.size_m[1]) * 1e3,
+        )
+        if array.update_rate_hz is not None:
+            data["electronics"]["scan_rate_hz"] = array.update_rate_hz
+        try:
+            return sensor_from_dict(data, source=str(path))
+        except TactsenseInputError as error:
+            raise UrdfError(f"{path}: the array does not fit {base.name!r}: {error}") from None
 
 
 KIND: Any = PadKind()

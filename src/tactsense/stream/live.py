@@ -13,6 +13,7 @@ from tactsense.estimate.creep import CreepCompensator
 from tactsense.estimate.deflection import deflection_from_counts
 from tactsense.estimate.locate import CONTACT_THRESHOLD
 from tactsense.estimate.realtime import RealTimeLocator
+from tactsense.kinds import kind_of
 from tactsense.physics.contact import newtons_to_grams
 from tactsense.sensor import SensorSpec
 from tactsense.stream.reader import StreamFrame
@@ -303,9 +304,9 @@ class LiveContacts:
 
         if calibration is not None:
             if not isinstance(calibration, ArrayCalibration):
-                what = "a point set" if sensor.kind == "points" else f"a {sensor.kind}"
                 raise TactsenseInputError(
-                    f"a finger's calibration does not apply to {sensor.name!r}, {what}: "
+                    f"a finger's calibration does not apply to {sensor.name!r}, "
+                    f"a {kind_of(sensor).label}: "
                     "calibrate it with 'tactsense calibrate' on its own recording"
                 )
             calibration.check_sensor(sensor)
