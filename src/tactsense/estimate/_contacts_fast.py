@@ -15,7 +15,7 @@ import math
 import numpy as np
 
 from tactsense._jit import jit
-from tactsense.estimate._fast import taxel_signal
+from tactsense.estimate.finger._fast import taxel_signal
 
 HALF_WINDOW = 3
 """Taxels on each side of the peak that the interpolation uses [taxel]."""

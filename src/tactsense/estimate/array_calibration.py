@@ -44,7 +44,7 @@ from pathlib import Path
 import numpy as np
 
 from tactsense._validation import TactsenseInputError, check_frames
-from tactsense.estimate.calibrate import save_json
+from tactsense.estimate.finger.calibrate import save_json
 
 FORMAT = "tactsense-array-calibration"
 
@@ -88,7 +88,7 @@ class ArrayCalibration:
 
     @property
     def sensor(self):
-        from tactsense.estimate.calibrate import sensor_of
+        from tactsense.estimate.finger.calibrate import sensor_of
 
         return sensor_of(self.sensor_toml)
 
@@ -210,7 +210,7 @@ class ArrayCalibration:
             )
             sensor = calibration.sensor
         except (KeyError, TypeError, ValueError, AttributeError) as error:
-            from tactsense.estimate.calibrate import damaged
+            from tactsense.estimate.finger.calibrate import damaged
 
             keys = ("format", "sensor_toml", "baseline_counts", "gains", "dead", "force_curve")
             raise ArrayCalibrationError(damaged(source, error, "array calibration", keys)) from None
@@ -219,7 +219,7 @@ class ArrayCalibration:
                 raise ArrayCalibrationError(
                     f"{source}: {name} has the wrong shape, expected {tuple(sensor.shape)}"
                 )
-        from tactsense.estimate.calibrate import check_in_use
+        from tactsense.estimate.finger.calibrate import check_in_use
 
         check_in_use(source, ~calibration.dead, calibration, ArrayCalibrationError, "taxel",
                      sensor=sensor)  # fmt: skip
@@ -1138,7 +1138,7 @@ def contact_totals(frames, sensor, calibration, *, baseline_frames=5, threshold=
     from tactsense.estimate.baseline import DriftBaseline
     from tactsense.estimate.contacts import default_threshold, find_contacts
     from tactsense.estimate.creep import creep_applied
-    from tactsense.estimate.deflection import Flag
+    from tactsense.estimate.finger.deflection import Flag
 
     frames = np.asarray(frames)
     start = np.nanmedian(frames[:baseline_frames].astype(float), axis=0)
@@ -1330,7 +1330,7 @@ def load_calibration(path: str | Path, sensor=None):
     """A calibration file of either kind: a finger's
     (:class:`~tactsense.estimate.calibrate.Calibration`) or an array's
     (:class:`ArrayCalibration`), checked against ``sensor`` when given."""
-    from tactsense.estimate.calibrate import Calibration
+    from tactsense.estimate.finger.calibrate import Calibration
 
     path = Path(path)
     try:

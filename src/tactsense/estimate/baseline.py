@@ -47,9 +47,9 @@ import numpy as np
 from tactsense._jit import jit
 from tactsense._signals import deferred_interrupts
 from tactsense._validation import TactsenseInputError, check_frames
-from tactsense.estimate._fast import taxel_signal
+from tactsense.estimate.finger._fast import taxel_signal
 from tactsense.estimate.creep import CreepCompensator
-from tactsense.estimate.deflection import Flag
+from tactsense.estimate.finger.deflection import Flag
 
 TIME_CONSTANT_S = 2.0
 """Default time constant of the drift-following average [s]. Measured on the paper's

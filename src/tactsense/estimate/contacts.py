@@ -23,7 +23,7 @@ import numpy as np
 
 from tactsense._signals import deferred_interrupts
 from tactsense._validation import TactsenseInputError, check_frames
-from tactsense.estimate.deflection import Flag
+from tactsense.estimate.finger.deflection import Flag
 from tactsense.geometry import tactel_to_surface
 
 _INT_COLUMNS = ("frame", "contact", "id", "taxels", "flags")
@@ -559,7 +559,7 @@ def _segment(
 ):  # fmt: skip
     """The compiled segmentation of (N, rows, cols) signal, block by block."""
     from tactsense.estimate._contacts_fast import segment_into
-    from tactsense.estimate.localize import MAX_ITERATIONS, TOLERANCE
+    from tactsense.estimate.finger.localize import MAX_ITERATIONS, TOLERANCE
 
     n, rows, cols = signal.shape
     k = max_contacts
@@ -693,8 +693,8 @@ def _finger_positions(signal, labels, seg, sensor, threshold, method):
     """Each contact of a finger frame located by :func:`~tactsense.estimate.locate` on
     the frame with the other contacts' taxels zeroed (one contact: the frame as read,
     so that the numbers are locate's own)."""
-    from tactsense.estimate.force import force_per_deflection
-    from tactsense.estimate.locate import locate
+    from tactsense.estimate.finger.force import force_per_deflection
+    from tactsense.estimate.finger.locate import locate
 
     frame, root = seg["frame"], seg["root"]
     n = len(frame)

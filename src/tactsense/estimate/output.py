@@ -12,8 +12,8 @@ import pyarrow.csv as pa_csv
 import pyarrow.parquet as pq
 
 from tactsense._validation import TactsenseInputError
-from tactsense.estimate.deflection import Flag
-from tactsense.estimate.locate import Estimates
+from tactsense.estimate.finger.deflection import Flag
+from tactsense.estimate.finger.locate import Estimates
 
 FORMATS = {".csv": "csv", ".parquet": "parquet", ".h5": "h5", ".hdf5": "h5"}
 """Output formats by file extension."""
