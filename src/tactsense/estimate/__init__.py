@@ -10,11 +10,12 @@ any array (:mod:`tactsense.estimate.contacts`); their result types and flags are
 from tactsense.estimate import locate as _locate_module  # noqa: F401
 from tactsense.estimate.finger.angle import angle_from_skew, even_odd, inverse_filter, skew_index
 from tactsense.estimate.finger.calibrate import Calibration, CalibrationError, calibrate_sweep
-from tactsense.estimate.finger.deflection import Flag, baseline_from, deflection_from_counts
+from tactsense.estimate.finger.deflection import baseline_from, deflection_from_counts
 from tactsense.estimate.finger.force import force_per_deflection, total_force
 from tactsense.estimate.finger.interpolate import kernel, reconstruct_row, surface
 from tactsense.estimate.finger.localize import locate_contacts, newton_peak
-from tactsense.estimate.finger.locate import Estimates, locate, write_estimates_csv
+from tactsense.estimate.finger.locate import locate, write_estimates_csv
+from tactsense.estimate.results import Estimates, Flag
 
 __all__ = [
     "Calibration",

@@ -428,7 +428,7 @@ def check_in_use(source, used, calibration, error, word: str, sensor=None) -> No
     for name, values in (("gains", calibration.gains), ("baseline_counts", calibration.baseline)):
         bad = used & ~(np.isfinite(values) & (values > 0))
         if name == "baseline_counts" and sensor is not None:
-            from tactsense.estimate.contacts import unusable_baseline
+            from tactsense.estimate.reading import unusable_baseline
 
             bad = used & unusable_baseline(values, sensor)
         if bad.any():

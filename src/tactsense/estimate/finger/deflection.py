@@ -2,55 +2,12 @@
 
 from __future__ import annotations
 
-from enum import IntFlag
-
 import numpy as np
 
 from tactsense._validation import TactsenseInputError, check_frames
+from tactsense.estimate.results import Flag
 from tactsense.physics.transduction import fractional_deflection
 from tactsense.sensor import SensorSpec
-
-
-class Flag(IntFlag):
-    """Quality flags of an estimate; several may be set at once."""
-
-    NONE = 0
-    NO_CONTACT = 1
-    """No tactel deflects more than the contact threshold: nothing is reported."""
-    NAN_INPUT = 2
-    """The frame held NaN or infinite readings; those tactels were ignored."""
-    SATURATED = 4
-    """A tactel read the converter's full scale: the load there is unknown."""
-    DEAD_TACTEL = 8
-    """A tactel read zero counts (open junction) or was marked dead; it was ignored."""
-    NOT_CONVERGED = 16
-    """Newton's method did not reach 0.01 tactel within its iteration limit."""
-    EDGE = 32
-    """The peak lies within half a tactel of an open edge of the array: biased inward."""
-    TIP = 64
-    """The peak lies toward the tip row, where the half-plane model does not hold."""
-    MULTIPLE = 128
-    """A second, separate contact was seen; the fields describe the largest one."""
-    BELOW_BASELINE = 256
-    """A taxel read below its baseline by more than the contact threshold where no
-    tension beside a contact explains it (a resistive taxel, a frame without contact, or
-    deeper than the frame's largest compression:
-    :func:`~tactsense.estimate.baseline.below_baseline`): the baseline was taken under
-    load, or has drifted (:class:`~tactsense.estimate.baseline.DriftBaseline`)."""
-    NEGATIVE_FORCE = 512
-    """A tactel is above the contact threshold but the deflections sum to zero or less:
-    the skin reads as much tension as compression around the contact (as the solid 3-D
-    skin can, whose tensile side lobes cancel its compression, ``docs/model.md``
-    sections 3a-3b), so the sum is no measure of the load; the force is NaN."""
-    BEYOND_CALIBRATION = 1024
-    """The contact's total signal lies beyond the range its array calibration's weights
-    covered (above the heaviest unsaturated weight): its force would be an extrapolation,
-    so it is NaN (:mod:`~tactsense.estimate.array_calibration`)."""
-
-    @classmethod
-    def describe(cls, value: int) -> str:
-        """Names of the flags set in ``value``, joined by '|' ('' for none)."""
-        return "|".join(flag.name for flag in cls if flag and value & flag)
 
 
 def baseline_from(frames, n_frames: int = 5) -> np.ndarray:

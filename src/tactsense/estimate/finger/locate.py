@@ -2,71 +2,22 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import fields
 from pathlib import Path
-from typing import ClassVar
 
 import numpy as np
 
 from tactsense._signals import deferred_interrupts
 from tactsense._validation import TactsenseInputError, check_frames
 from tactsense.estimate.finger._fast import locate_into, place_tip_gap, prepare_frames
-from tactsense.estimate.finger.deflection import Flag
 from tactsense.estimate.finger.force import force_per_deflection
 from tactsense.estimate.finger.localize import MAX_ITERATIONS, MAX_STEP, TOLERANCE
+from tactsense.estimate.output import EstimatesWriter
+from tactsense.estimate.results import Estimates, Flag
 from tactsense.geometry import tactel_to_surface
 from tactsense.sensor import SensorSpec
 
 CONTACT_THRESHOLD = 0.005  # fractional deflection: 10 counts at 2000, about 5 g on the probe
-
-
-@dataclass
-class Estimates:
-    """Per-frame estimates; every field has the batch shape of the frames."""
-
-    row: np.ndarray
-    """Fractional row of the peak [tactel]; NaN without contact."""
-    col: np.ndarray
-    """Fractional column of the peak [tactel]."""
-    axial_mm: np.ndarray
-    """Surface position along the finger [mm]."""
-    angle_deg: np.ndarray
-    """Surface position around the finger [deg]."""
-    peak_deflection: np.ndarray
-    """Interpolated fractional deflection at the peak [-]."""
-    force_n: np.ndarray
-    """Total normal force from the integral of the deflection [N]; NaN in frames flagged
-    SATURATED (a clipped reading makes the integral a lower bound only)."""
-    skew: np.ndarray
-    """Skew index along the finger (eq. 63) [-]."""
-    iterations: np.ndarray
-    """Newton steps."""
-    converged: np.ndarray
-    """Newton reached 0.01 tactel."""
-    flags: np.ndarray
-    """:class:`~tactsense.estimate.deflection.Flag` bits."""
-
-    UNITS: ClassVar[dict[str, str]] = {
-        "row": "tactel",
-        "col": "tactel",
-        "axial_mm": "mm",
-        "angle_deg": "deg",
-        "peak_deflection": "1",
-        "force_n": "N",
-        "skew": "1",
-        "iterations": "1",
-        "converged": "bool",
-        "flags": "names",
-    }
-
-    def __len__(self) -> int:
-        return int(np.size(self.row))
-
-    def _asdict_rows(self) -> list[dict]:
-        """One dict per frame (flattened batch), for tests and quick looks."""
-        names = [f.name for f in fields(self)]
-        columns = {name: np.ravel(getattr(self, name)) for name in names}
-        return [{name: columns[name][k] for name in names} for k in range(len(self))]
 
 
 def locate(
@@ -294,7 +245,6 @@ def write_estimates_csv(
     path: str | Path, estimates: Estimates, time_s=None, *, overwrite: bool = False
 ) -> Path:
     """Write one row per frame, units in the column names (full precision)."""
-    from tactsense.estimate.output import EstimatesWriter
 
     path = Path(path)
     if path.exists() and not overwrite:

@@ -10,10 +10,10 @@ from tactsense import _signals
 from tactsense._signals import deliver, gate_ready
 from tactsense._validation import TactsenseInputError, check_frames
 from tactsense.estimate.finger._fast import locate_deflection_one, locate_one
-from tactsense.estimate.finger.deflection import Flag
 from tactsense.estimate.finger.force import force_per_deflection
 from tactsense.estimate.finger.localize import MAX_ITERATIONS, MAX_STEP, TOLERANCE
 from tactsense.estimate.finger.locate import CONTACT_THRESHOLD
+from tactsense.estimate.results import Flag
 from tactsense.sensor import SensorSpec
 
 _NO_CONTACT = int(Flag.NO_CONTACT)
