@@ -144,7 +144,7 @@ def find_contacts(
             find_contacts(frames[lo : lo + BLOCK], sensor, first_frame=first_frame + lo, **options)
             for lo in range(0, len(frames), BLOCK)
         )
-    from tactsense.estimate.contacts.array_calibration import ArrayCalibration
+    from tactsense.estimate.contacts.calibration import ArrayCalibration
 
     array_calibration = isinstance(calibration, ArrayCalibration)
     if calibration is not None and not counts:
