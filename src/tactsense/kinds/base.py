@@ -81,6 +81,47 @@ class Kind:
     def __repr__(self) -> str:
         return f"<{type(self).__name__} {self.name!r}>"
 
+    # ---- estimation (r5-estimate) ----------------------------------------------
+    own_calibration: ClassVar[bool] = False
+    """Whether the kind is calibrated by its own procedure (the paper's finger:
+    ``tactsense calibrate``'s :class:`~tactsense.estimate.calibrate.Calibration`, which
+    holds its creep compensation too) rather than by an array calibration
+    (:class:`~tactsense.estimate.contacts.calibration.ArrayCalibration`: gains, dead
+    taxels and a force curve from a lab's own data)."""
+    response_fit: ClassVar[bool] = False
+    """Whether the kind tabulates its layer's response on a grid
+    (:meth:`contact_response` with a window ``half``), so that ``find_contacts`` can fit
+    it: the ``fit`` method, the sub-taxel refinement of ``interpolate``, a contact's
+    force as the response's amplitude, and the reach of two point loads (pads)."""
+
+    def contact_response(
+        self, spec: Any, *, half: int = 0, n_sub: int = 8, signed: bool = False
+    ) -> np.ndarray:
+        """The response an estimator fits: the signal of the taxels per newton of the
+        scenarios' probe (a 1.6-mm sphere) [-/N], from the kind's own forward model.
+
+        Parameters
+        ----------
+        spec : the sensor's description
+        half : int
+            Half width of the window of taxels [taxel] (grid kinds).
+        n_sub : int
+            Sub-taxel positions of the probe per taxel along each axis (grid kinds).
+        signed : bool
+            A resistive taxel's strain before it is clipped at zero (grid kinds), so
+            that the responses to several loads add up.
+
+        Returns
+        -------
+        ndarray
+            On a grid kind (:attr:`response_fit`), shape ``(n_sub + 1, n_sub + 1,
+            2 half + 1, 2 half + 1)``: ``[a, b, i, j]`` the taxel at offset ``(i - half,
+            j - half)`` from the taxel nearest below the probe, for the probe ``(a, b) /
+            n_sub`` taxels from that taxel. On a kind without a grid, shape ``(N, N)``:
+            row ``i`` for the probe centred on taxel ``i`` (``half``, ``n_sub`` unused).
+        """
+        raise self.unsupported(spec, "a contact response")
+
 
 def positions_of(spec: Any) -> np.ndarray:
     """Surface positions [mm] of every taxel, frame order, (N, 3)."""

@@ -26,5 +26,8 @@ class FingerKind(Kind):
         """Along the finger [mm] and around it [deg]."""
         return first_mm, math.degrees(second_mm / spec.radius_mm)
 
+    # ---- estimation (r5-estimate) ----------------------------------------------
+    own_calibration = True
+
 
 KIND: Any = FingerKind()

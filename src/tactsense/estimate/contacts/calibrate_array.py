@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tactsense._validation import check_frames
+from tactsense.estimate._kind import kind_or_none
 from tactsense.estimate.contacts.calibration import ArrayCalibration, ArrayCalibrationError
 from tactsense.estimate.contacts.find import find_contacts
 from tactsense.estimate.contacts.lab_logs import WeightsLog
@@ -163,7 +164,8 @@ def calibrate_array(
 
     if method not in METHODS:
         raise ArrayCalibrationError(f"method {method!r}: expected one of {', '.join(METHODS)}")
-    if getattr(sensor, "kind", None) not in ("pad", "points"):
+    kind = kind_or_none(sensor)
+    if kind is None or kind.own_calibration:
         raise ArrayCalibrationError(
             f"an array calibration is for pads and point sets; {sensor.name!r} is a "
             f"{getattr(sensor, 'kind', type(sensor).__name__)}"

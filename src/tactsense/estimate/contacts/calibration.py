@@ -43,6 +43,7 @@ from pathlib import Path
 import numpy as np
 
 from tactsense._validation import TactsenseInputError
+from tactsense.estimate._kind import kind_or_none
 from tactsense.estimate.finger.calibrate import save_json
 
 FORMAT = "tactsense-array-calibration"
@@ -256,9 +257,10 @@ def load_calibration(path: str | Path, sensor=None):
         if sensor is not None:
             calibration.check_sensor(sensor)
         return calibration
-    if sensor is not None and getattr(sensor, "kind", "finger") != "finger":
+    kind = kind_or_none(sensor)
+    if kind is not None and not kind.own_calibration:
         calibration = Calibration.load(path)  # a finger's: named as such below
         raise ArrayCalibrationError(
-            f"{path} is a finger's calibration; {sensor.name!r} is a {sensor.kind_label}: "
+            f"{path} is a finger's calibration; {sensor.name!r} is a {kind.label}: "
             "calibrate it with 'tactsense calibrate' on its own recording"
         )

@@ -18,6 +18,7 @@ import math
 import numpy as np
 
 from tactsense._validation import TactsenseInputError, check_frames
+from tactsense.estimate._kind import kind_or_none
 from tactsense.estimate.contacts.pad import (
     _kernel_total,
     pad_contact_force,
@@ -39,6 +40,7 @@ from tactsense.estimate.contacts.segment import (
 from tactsense.estimate.reading import at_rail, default_threshold, signal_from_counts
 from tactsense.estimate.results import ContactTable, Flag
 from tactsense.geometry import tactel_to_surface
+from tactsense.kinds import kind_of
 
 
 def find_contacts(
@@ -114,8 +116,8 @@ def find_contacts(
     ContactTable
         One row per contact per frame; frames without contact have no row.
     """
-    kind = getattr(sensor, "kind", None)
-    if kind not in ("finger", "pad", "points"):
+    kind = kind_or_none(sensor)
+    if kind is None:
         raise TactsenseInputError(
             f"sensor must be a finger, pad or point set; got {type(sensor).__name__}"
         )
@@ -150,17 +152,17 @@ def find_contacts(
     if calibration is not None and not counts:
         raise TactsenseInputError("a calibration applies to counts, not to the signal")
     if array_calibration:
-        if kind == "finger":
+        if kind.own_calibration:
             raise TactsenseInputError(
-                f"{sensor.name!r} is a finger: calibrate it with 'tactsense calibrate' (a "
+                f"{sensor.name!r} is a {kind.label}: calibrate it with 'tactsense calibrate' (a "
                 "finger's calibration), not with an array calibration"
             )
         calibration.check_sensor(sensor)
         signal, flags = calibration.signal(frames, sensor, baseline=baseline)
     elif calibration is not None:
-        if kind != "finger":
+        if not kind.own_calibration:
             raise TactsenseInputError(
-                f"a finger's calibration does not apply to {sensor.name!r}, a {kind}: "
+                f"a finger's calibration does not apply to {sensor.name!r}, a {kind.name}: "
                 "calibrate it with 'tactsense calibrate' on the array's own recording"
             )
         signal, flags = calibration.apply(
@@ -186,7 +188,7 @@ def find_contacts(
     saturated = None
     if counts and (flags & int(Flag.SATURATED)).any():
         saturated = at_rail(frames, sensor)
-    if kind == "points":
+    if not kind.image_grid:
         table = _points_contacts(signal, sensor, threshold, saddle, max_contacts, method)
     else:
         table = _grid_contacts(signal, sensor, threshold, saddle, max_contacts, method, ring)
@@ -219,13 +221,11 @@ def _mark_saturated(table: ContactTable, saturated: np.ndarray, sensor) -> None:
 def _grid_contacts(
     signal, sensor, threshold, saddle, max_contacts, method, ring=RING_RATIO
 ) -> ContactTable:
-    kind = sensor.kind
-    if method == "fit" and kind != "pad":
-        raise TactsenseInputError(
-            f"method 'fit' works on pads; {sensor.name!r} is a {sensor.kind_label}"
-        )
-    periodic = kind == "finger" and sensor.closes_circumference
-    refine = method == "interpolate" and kind == "pad"
+    kind = kind_of(sensor)
+    if method == "fit" and not kind.response_fit:
+        raise TactsenseInputError(f"method 'fit' works on pads; {sensor.name!r} is a {kind.label}")
+    periodic = kind.periodic(sensor)
+    refine = method == "interpolate" and kind.response_fit
     floor = dip_floor(sensor, threshold)
     far = point_reach(sensor) if ring > 0 else math.inf
     cover = point_taxels(sensor) if ring > 0 else 1 << 30
@@ -236,7 +236,7 @@ def _grid_contacts(
     rows, cols = sensor.shape
     flags = np.zeros(n, np.int64)
     extra = {}
-    if kind == "pad":
+    if kind.multi_contact:  # an array's grid: positions from its pitches
         g = sensor.grid
         row, col = seg["row"], seg["col"]
         x = row * g.row_pitch_mm
@@ -262,7 +262,7 @@ def _grid_contacts(
         with np.errstate(invalid="ignore"):
             edge = (row < 0.5) | (row > rows - 1.5) | (col < 0.5) | (col > cols - 1.5)
         flags[edge] |= int(Flag.EDGE)
-    else:
+    else:  # one contact per frame by its kind's estimator: the paper's locate, per contact
         row, col, axial, angle_deg, peak, force, finger_flags = _finger_positions(
             signal, labels, seg, sensor, threshold, method
         )

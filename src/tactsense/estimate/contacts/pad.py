@@ -3,14 +3,15 @@ probe, which the pad's kind tabulates (:meth:`~tactsense.kinds.Kind.contact_resp
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 import math
 
 import numpy as np
 
 from tactsense._signals import deferred_interrupts
+from tactsense.estimate._kind import kind_or_none
 from tactsense.estimate.reading import signal_noise_variance
+from tactsense.kinds import kind_of
 
 
 @functools.lru_cache(maxsize=16)
@@ -18,7 +19,8 @@ def point_taxels(sensor) -> int:
     """Most taxels two point loads cover on a pad (inf otherwise): twice the most taxels
     reading 0.1 of a 1.6-mm probe's peak or more, over its sub-taxel positions [-]. A
     contact over more is placed at the centre of its signal, not at its peak."""
-    if getattr(sensor, "kind", None) != "pad":
+    kind = kind_or_none(sensor)
+    if kind is None or not kind.response_fit:
         return 1 << 30
     kernel, _, _ = pad_force_kernel(sensor)
     peak = kernel.max(axis=(2, 3), keepdims=True)
@@ -32,7 +34,8 @@ def point_reach(sensor) -> float:
     response reaches 0.1 of its peak (over its sub-taxel positions), plus twice the
     farthest a load lies from its peak taxel along a row or a column (half a taxel),
     plus one taxel."""
-    if getattr(sensor, "kind", None) != "pad":
+    kind = kind_or_none(sensor)
+    if kind is None or not kind.response_fit:
         return math.inf
     kernel, step, half = pad_force_kernel(sensor)
     reach = 0.0
@@ -60,33 +63,14 @@ def pad_force_kernel(sensor, n_sub: int = 8, signed: bool = False):
     taxel at offset ``(i - half, j - half)`` from the taxel nearest below the probe, for
     the probe at ``(a, b) * step`` taxels from that taxel. Computed on a pad of the same
     pitch, electrodes, layer and transduction large enough for the window (the layer's
-    response does not depend on where it is applied).
+    response does not depend on where it is applied): the kind's
+    :meth:`~tactsense.kinds.Kind.contact_response`.
     """
     from tactsense.estimate.contacts._fast import HALF_WINDOW
-    from tactsense.physics.indenters import SphereProbe
-    from tactsense.physics.pad_response import pad_strain
 
     half = HALF_WINDOW
-    size = 2 * half + 2
-    grid = dataclasses.replace(sensor.grid, rows=size, cols=size)
-    from tactsense.sensor.common import Flaws
-
-    big = dataclasses.replace(sensor, grid=grid, flaws=Flaws())
-    g = big.grid
-    newtons = 0.49
-    kernel = np.empty((n_sub + 1, n_sub + 1, 2 * half + 1, 2 * half + 1))
-    step = 1.0 / n_sub
-    for a in range(n_sub + 1):
-        for b in range(n_sub + 1):
-            probe = SphereProbe(
-                (half + a * step) * g.row_pitch_mm, (half + b * step) * g.col_pitch_mm, newtons
-            )
-            strain = pad_strain(big, [probe])[: 2 * half + 1, : 2 * half + 1] / newtons
-            if sensor.transduction.kind != "capacitive":
-                kernel[a, b] = strain if signed else np.maximum(strain, 0.0)
-            else:
-                kernel[a, b] = sensor.transduction.strain_gain * strain
-    return kernel, step, half
+    kernel = kind_of(sensor).contact_response(sensor, half=half, n_sub=n_sub, signed=signed)
+    return kernel, 1.0 / n_sub, half
 
 
 FIT_STEPS = 32

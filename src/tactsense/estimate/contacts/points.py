@@ -9,6 +9,7 @@ import numpy as np
 
 from tactsense.estimate.contacts.segment import _extent, dip_floor
 from tactsense.estimate.results import ContactTable, Flag
+from tactsense.kinds import kind_of
 
 
 @functools.lru_cache(maxsize=16)
@@ -37,20 +38,9 @@ def _points_geometry(sensor):
 @functools.lru_cache(maxsize=16)
 def points_force_kernel(sensor):
     """The signal of every taxel per newton of the scenarios' probe (1.6-mm sphere)
-    centred on each taxel, shape (N, N) [-/N]: row i for the probe on taxel i."""
-    from tactsense.physics.indenters import SphereProbe
-    from tactsense.physics.pad_response import points_strain
-
-    newtons = 0.49
-    n = sensor.shape[1]
-    kernel = np.empty((n, n))
-    for i in range(n):
-        strain = points_strain(sensor, [SphereProbe(0.0, 0.0, newtons, at_taxel=i)])[0] / newtons
-        if sensor.transduction.kind != "capacitive":
-            kernel[i] = np.maximum(strain, 0.0)
-        else:
-            kernel[i] = sensor.transduction.strain_gain * strain
-    return kernel
+    centred on each taxel, shape (N, N) [-/N]: row i for the probe on taxel i (the
+    kind's :meth:`~tactsense.kinds.Kind.contact_response`)."""
+    return kind_of(sensor).contact_response(sensor)
 
 
 def _points_segment(s, threshold, saddle, neighbours, floor=None):

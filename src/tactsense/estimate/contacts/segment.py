@@ -8,6 +8,7 @@ import math
 import numpy as np
 
 from tactsense._signals import deferred_interrupts
+from tactsense.estimate._kind import kind_or_none
 from tactsense.estimate.reading import signal_noise_variance
 
 # ---- finding the contacts of a batch of frames ---------------------------------------
@@ -55,8 +56,10 @@ BLOCK = 4096
 def dip_floor(sensor, threshold: float) -> float:
     """Smallest dip from the lower maximum to the saddle that keeps two maxima apart
     [-]: the threshold, or :data:`NOISE_DIP` standard deviations of two taxels' read
-    noise difference when that is more (pads and point sets)."""
-    if getattr(sensor, "kind", None) not in ("pad", "points"):
+    noise difference when that is more (the kinds whose contacts are many: pads and
+    point sets; the finger keeps the paper's threshold)."""
+    kind = kind_or_none(sensor)
+    if kind is None or not kind.multi_contact:
         return float(threshold)
     noise = NOISE_DIP * math.sqrt(2.0 * signal_noise_variance(sensor))
     return max(float(threshold), noise)

@@ -9,6 +9,7 @@ import numpy as np
 
 from tactsense._signals import deferred_interrupts
 from tactsense._validation import TactsenseInputError, check_frames
+from tactsense.estimate._kind import kind_or_none
 from tactsense.estimate.finger._fast import locate_into, place_tip_gap, prepare_frames
 from tactsense.estimate.finger.force import force_per_deflection
 from tactsense.estimate.finger.localize import MAX_ITERATIONS, MAX_STEP, TOLERANCE
@@ -71,14 +72,14 @@ def locate(
         tactel passes the threshold. Frames with unusable tactels are
         processed with those tactels ignored, and flagged.
     """
-    if getattr(sensor, "kind", None) in ("pad", "points"):
-        what = "a point set" if sensor.kind == "points" else f"a {sensor.kind}"
+    kind = kind_or_none(sensor)
+    if kind is not None and kind.multi_contact:
         raise TactsenseInputError(
-            f"this works on fingers; {sensor.name!r} is {what}: its contacts come from "
+            f"this works on fingers; {sensor.name!r} is a {kind.label}: its contacts come from "
             "'tactsense locate' (the long table), 'live', 'view' and the export to MCAP "
             "(tactsense.estimate.find_contacts)"
         )
-    if not isinstance(sensor, SensorSpec):
+    if kind is None or not kind.describes(sensor):  # the finger's description
         raise TactsenseInputError(f"sensor must be a SensorSpec; got {type(sensor).__name__}")
     frames = check_frames(frames, sensor.shape)
     if calibration is not None and not counts:
