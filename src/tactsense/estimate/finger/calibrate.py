@@ -22,25 +22,43 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from tactsense._validation import CalibrationError, check_frames
 from tactsense.estimate.creep import (
     CreepCompensator,
     Viscoelastic,
     compensate_viscoelastic,
-    creep_bounds,
     fit_viscoelastic,
     fit_viscoelastic_recording,
     load_schedule,
 )
 from tactsense.estimate.finger.deflection import deflection_from_counts
+from tactsense.estimate.finger.fit_checks import (
+    DEPTH_BOUNDS,
+    MAX_FIT_RMS_PERCENT,
+    NU_BOUNDS,
+    ModelFit,
+    array_health,
+    check_model_fit,
+    check_viscoelastic_fit,
+    fit_plane_stress,
+    jitter_statistics,
+)
+from tactsense.estimate.finger.tables import (
+    apply_nonlinearity,
+    gain_table,
+    gains_from_peak,
+    nonlinearity_table,
+    track_baseline,
+)
 from tactsense.physics.array_response import deflection_batch
 from tactsense.physics.contact import Probe
-from tactsense.physics.halfplane import impulse_response
 from tactsense.sensor import STANDARD_GRAVITY, SensorSpec
 
 __all__ = [
+    "DEPTH_BOUNDS",
+    "MAX_FIT_RMS_PERCENT",
+    "NU_BOUNDS",
     "Calibration",
     "CalibrationError",
     "ModelFit",
@@ -61,359 +79,6 @@ __all__ = [
 ]
 
 FORMAT = "tactsense-calibration"
-
-
-# ---- gains -------------------------------------------------------------------------
-
-
-def gain_table(deflection, *, min_response: float = 0.01, reference: float | None = None):
-    """Per-tactel gain from a recording of a probe swept over every tactel (section 3.1).
-
-    The gain parameter of the paper is each tactel's largest fractional
-    deflection during the sweep; divided by a reference it becomes the gain
-    that normalizes frames (Fig. 7 after calibration). The reference is the
-    deflection the model predicts for the calibration probe centred on a
-    tactel (absolute gains), or, without it, the median over the array
-    (relative gains, as in the paper).
-
-    Parameters
-    ----------
-    deflection : ndarray, shape (T, rows, cols)
-        Fractional deflection of the sweep [-].
-    min_response : float
-        A tactel whose largest deflection stays below this is left uncalibrated
-        (gain 1, reported in ``uncalibrated``) [-].
-
-    Returns
-    -------
-    gains : ndarray, shape (rows, cols)
-        Relative gain [-].
-    peak : ndarray, shape (rows, cols)
-        Largest deflection of each tactel [-].
-    uncalibrated : ndarray of bool, shape (rows, cols)
-    """
-    deflection = np.asarray(deflection, dtype=float)
-    if deflection.ndim != 3 or deflection.shape[0] < 2:
-        raise CalibrationError(
-            f"a gain calibration needs a sweep of frames (T, rows, cols); got {deflection.shape}"
-        )
-    return gains_from_peak(deflection.max(axis=0), min_response=min_response, reference=reference)
-
-
-def gains_from_peak(peak, *, min_response: float = 0.01, reference=None):
-    """:func:`gain_table` from each tactel's largest deflection (for sweeps read in pieces)."""
-    peak = np.asarray(peak, dtype=float)
-    calibrated = peak >= min_response
-    if not calibrated.any():
-        raise CalibrationError(
-            f"no tactel deflected more than {min_response:.3g}: the recording has no contact"
-        )
-    if reference is None:
-        reference = np.median(peak[calibrated])
-    gains = np.where(calibrated, peak / reference, 1.0)
-    return gains, peak, ~calibrated
-
-
-# ---- baseline, drift and re-zero ---------------------------------------------------
-
-
-def track_baseline(
-    frames,
-    initial_baseline,
-    sensor: SensorSpec,
-    *,
-    touch: float = 0.005,
-    release: float = 0.003,
-    rate: float = 0.2,
-    settle_frames: int = 2,
-):
-    """Follow the zero of every tactel while nothing touches, and re-zero after contact.
-
-    A frame is *touched* when its largest deflection against the current
-    baseline exceeds ``touch``; contact is *broken* when it falls below
-    ``release``. While untouched, the baseline follows the readings with an
-    exponential average (``rate`` per frame), which absorbs slow drift; once
-    contact has been broken for ``settle_frames`` frames, the baseline is reset
-    to the current reading (the paper's "new zero deflection point after
-    contact is broken"), so that residual strain is not read as force.
-
-    Parameters
-    ----------
-    frames : ndarray, shape (T, rows, cols)
-        Readings [counts].
-    initial_baseline : ndarray, shape (rows, cols)
-        Zero before the first frame [counts].
-
-    Returns
-    -------
-    baselines : ndarray, shape (T, rows, cols)
-        Baseline to use for each frame [counts].
-    touched : ndarray of bool, shape (T,)
-    """
-    frames = check_frames(frames, sensor.shape).astype(float)
-    if frames.ndim != 3:
-        raise CalibrationError(f"frames has shape {frames.shape}; expected (T, rows, cols)")
-    baseline = np.array(initial_baseline, dtype=float)
-    baselines = np.empty_like(frames)
-    touched = np.zeros(frames.shape[0], dtype=bool)
-    in_contact, quiet = False, 0
-    for k, frame in enumerate(frames):
-        level = np.nanmax((frame - baseline) / np.where(frame > 0, frame, np.inf))
-        if in_contact:
-            if level < release:
-                quiet += 1
-                if quiet >= settle_frames:
-                    in_contact, quiet = False, 0
-                    baseline = frame.copy()
-        elif level > touch:
-            in_contact, quiet = True, 0
-        touched[k] = in_contact
-        if not in_contact:
-            baseline = np.where(np.isfinite(frame), (1 - rate) * baseline + rate * frame, baseline)
-        baselines[k] = baseline
-    return baselines, touched
-
-
-# ---- nonlinearity -----------------------------------------------------------------
-
-
-def nonlinearity_table(loads, deflections, *, linear_below: float | None = None):
-    """Lookup table from measured deflection to the deflection of a linear sensor (Fig. 6).
-
-    The linear reference is the straight line through the origin and the
-    response to the loads up to ``linear_below`` (default: the smallest half
-    of the series), as the paper compares the 1-N response with "the straight
-    line from the origin through the strain for a 0.5-N load".
-
-    Parameters
-    ----------
-    loads : array_like, shape (n,)
-        Applied forces [N], increasing.
-    deflections : array_like, shape (n,)
-        Measured fractional deflection of one cell at each load [-].
-
-    Returns
-    -------
-    measured, linear : ndarray, shape (n + 1,)
-        Table knots, starting at (0, 0); apply with :func:`apply_nonlinearity`.
-    """
-    loads = np.asarray(loads, dtype=float)
-    deflections = np.asarray(deflections, dtype=float)
-    if loads.shape != deflections.shape or loads.ndim != 1 or loads.size < 2:
-        raise CalibrationError("loads and deflections must be 1-D arrays of the same length >= 2")
-    order = np.argsort(loads)
-    loads, deflections = loads[order], deflections[order]
-    if np.any(np.diff(deflections) <= 0):
-        raise CalibrationError("the deflection must grow with the load to build a lookup table")
-    limit = np.median(loads) if linear_below is None else linear_below
-    low = loads <= limit
-    slope = np.sum(deflections[low] * loads[low]) / np.sum(loads[low] ** 2)
-    return np.r_[0.0, deflections], np.r_[0.0, slope * loads]
-
-
-def apply_nonlinearity(deflection, measured, linear):
-    """Map measured deflection to linear deflection; the end slopes extrapolate."""
-    deflection = np.asarray(deflection, dtype=float)
-    result = np.interp(deflection, measured, linear)
-    high = (linear[-1] - linear[-2]) / (measured[-1] - measured[-2])
-    low = (linear[1] - linear[0]) / (measured[1] - measured[0])
-    result = np.where(
-        deflection > measured[-1], linear[-1] + high * (deflection - measured[-1]), result
-    )
-    return np.where(deflection < measured[0], linear[0] + low * (deflection - measured[0]), result)
-
-
-# ---- the plane-stress fit of section 4.1 --------------------------------------------
-
-
-@dataclass(frozen=True)
-class ModelFit:
-    """Depth and Poisson's ratio fitted to a knife-edge sweep (section 4.1)."""
-
-    depth_mm: float
-    poisson_ratio: float
-    centre_mm: float
-    amplitude: float
-    rms_percent: float
-    """RMS residual as a percentage of full scale (the largest reading)."""
-
-
-def fit_plane_stress(positions_mm, response, *, youngs_modulus: float = 2.5e5) -> ModelFit:
-    """Least-squares fit of eq. 7's depth and nu to one tactel's knife-edge sweep.
-
-    After amplitude normalization (a free amplitude) and a free centre, the
-    shape of the plane-stress line-load response fixes the depth and nu.
-
-    Parameters
-    ----------
-    positions_mm : ndarray, shape (n,)
-        Knife-edge positions along the finger [mm].
-    response : ndarray, shape (n,)
-        Fractional deflection of the tactel [-].
-    """
-    x = np.asarray(positions_mm, dtype=float)
-    r = np.asarray(response, dtype=float)
-    if x.shape != r.shape or x.size < 6:
-        raise CalibrationError("a model fit needs at least 6 positions with one response each")
-    if r.max() <= 0:
-        raise CalibrationError("the tactel never responded: no contact in the sweep")
-
-    def shape(p):
-        depth, nu, centre, amplitude = p
-        h = -impulse_response(
-            (x - centre) * 1e-3, depth * 1e-3, youngs_modulus=youngs_modulus, poisson_ratio=nu
-        )
-        return amplitude * h / h.max() if h.max() > 0 else amplitude * h
-
-    start = [3.0, 0.3, float(x[np.argmax(r)]), float(r.max())]
-    fit = least_squares(
-        lambda p: shape(p) - r,
-        start,
-        bounds=(
-            [DEPTH_BOUNDS[0], NU_BOUNDS[0], x.min(), 0],
-            [DEPTH_BOUNDS[1], NU_BOUNDS[1], x.max(), np.inf],
-        ),
-    )
-    depth, nu, centre, amplitude = fit.x
-    rms = 100 * float(np.sqrt(np.mean(fit.fun**2)) / r.max())
-    return ModelFit(float(depth), float(nu), float(centre), float(amplitude), rms)
-
-
-DEPTH_BOUNDS = (0.2, 30.0)
-"""Depths a knife-edge fit may return [mm]."""
-NU_BOUNDS = (0.0, 0.5)
-"""Poisson's ratios a knife-edge fit may return [-]: rubber is 0 to 0.5."""
-MAX_FIT_RMS_PERCENT = 10.0
-"""A fit whose RMS residual exceeds this share of full scale describes another tactel,
-another load, or no contact at all [%]."""
-
-
-def _at(value: float, bound: float) -> bool:
-    return abs(value - bound) <= 1e-3 * max(1.0, abs(bound))
-
-
-def check_model_fit(fit: ModelFit) -> list[str]:
-    """Why a knife-edge fit cannot be trusted (empty if it can)."""
-    problems = []
-    for name, value, bounds, unit in (
-        ("depth", fit.depth_mm, DEPTH_BOUNDS, " mm"),
-        ("Poisson's ratio", fit.poisson_ratio, NU_BOUNDS, ""),
-    ):
-        for bound in bounds:
-            if _at(value, bound):
-                problems.append(f"{name} stopped at its bound {bound:g}{unit}")
-    if fit.rms_percent > MAX_FIT_RMS_PERCENT:
-        problems.append(
-            f"the residual is {fit.rms_percent:.1f} % of full scale (at most "
-            f"{MAX_FIT_RMS_PERCENT:g} % expected)"
-        )
-    return problems
-
-
-def check_viscoelastic_fit(model: Viscoelastic, rms: float, dt: float, fine: int = 16) -> list[str]:
-    """Why a creep fit cannot be trusted (empty if it can); ``rms`` as a share [-].
-
-    A fraction at its upper bound, or a time constant at a bound while its fraction is
-    more than 1 %, means the data did not hold the steps the model describes (a sweep
-    given as --steps, a tactel the load never reached). A fraction of 0 is allowed: a
-    finger may well show no creep.
-    """
-    problems = []
-    lower, upper = creep_bounds(dt, fine)
-    fractions = (
-        ("delayed fraction", model.delayed_fraction, upper[1]),
-        ("creep fraction", model.creep_fraction, upper[3]),
-    )
-    for name, value, bound in fractions:
-        if _at(value, bound):
-            problems.append(f"{name} stopped at its bound {bound:g}")
-    taus = (
-        ("delayed time constant", model.delayed_time_constant_s, model.delayed_fraction, 2),
-        ("creep time constant", model.creep_time_constant_s, model.creep_fraction, 4),
-    )
-    for name, tau, fraction, k in taus:
-        if fraction > 0.01:
-            for bound in (np.exp(lower[k]), np.exp(upper[k])):
-                if _at(np.log(tau), np.log(bound)):
-                    problems.append(f"{name} stopped at its bound {bound:.3g} s")
-    if 100 * rms > MAX_FIT_RMS_PERCENT:
-        problems.append(
-            f"the residual is {100 * rms:.1f} % of full scale "
-            f"(at most {MAX_FIT_RMS_PERCENT:g} % expected)"
-        )
-    return problems
-
-
-# ---- health of the array ------------------------------------------------------------
-
-
-def array_health(
-    peak_deflection,
-    baseline_frames,
-    *,
-    probe_grams: float = 50.0,
-    nominal_counts: float = 2000.0,
-    weak: float = 0.5,
-    noisy: float = 4.0,
-    expected=None,
-):
-    """Sensitivity of every tactel and detection of dead, weak and noisy ones (Figs. 8-11).
-
-    Parameters
-    ----------
-    peak_deflection : ndarray, shape (rows, cols)
-        Largest deflection of each tactel under the calibration probe [-].
-    baseline_frames : ndarray, shape (T, rows, cols)
-        Untouched readings [counts].
-    probe_grams : float
-        Load of the calibration probe [g].
-    weak : float
-        A tactel below this share of the median sensitivity is weak [-].
-    noisy : float
-        A tactel whose untouched noise exceeds this many times the median is noisy [-].
-    expected : ndarray, shape (rows, cols), optional
-        The model's peak deflection of each tactel (:func:`expected_peaks`); with it,
-        weakness is judged on measured over expected, not on the raw peak.
-
-    Returns
-    -------
-    dict
-        ``threshold_g`` (grams per A/D unit, Fig. 8), ``noise_counts`` (standard
-        deviation untouched), and boolean masks ``dead``, ``weak``, ``noisy``.
-    """
-    peak = np.asarray(peak_deflection, dtype=float)
-    base = np.asarray(baseline_frames, dtype=float)
-    counts_change = nominal_counts * peak / np.maximum(1.0 - peak, 1e-9)
-    with np.errstate(divide="ignore"):
-        threshold = np.where(counts_change > 0, probe_grams / counts_change, np.inf)
-    dead = (base.mean(axis=0) <= 0) | (peak <= 0)
-    alive = ~dead
-    relative = peak if expected is None else peak / np.asarray(expected, dtype=float)
-    median_peak = np.median(relative[alive]) if alive.any() else 0.0
-    noise = base.std(axis=0)
-    # quantization alone gives 1/sqrt(12) counts; do not call a quiet array noisy
-    floor = max(np.median(noise[alive]) if alive.any() else 0.0, 1 / np.sqrt(12))
-    return {
-        "threshold_g": threshold,
-        "noise_counts": noise,
-        "dead": dead,
-        "weak": alive & (relative < weak * median_peak),
-        "noisy": alive & (noise > noisy * floor),
-    }
-
-
-def jitter_statistics(readings, counts_per_gram):
-    """Jitter of repeated loads (Figs. 10-11): standard deviation in counts and grams."""
-    readings = np.asarray(readings, dtype=float)
-    if readings.size < 3:
-        raise CalibrationError("jitter needs at least 3 repeated applications")
-    std = float(readings.std(ddof=1))
-    return {
-        "mean_counts": float(readings.mean()),
-        "std_counts": std,
-        "std_grams": std / counts_per_gram,
-        "applications": int(readings.size),
-    }
 
 
 # ---- the calibration object ---------------------------------------------------------
