@@ -94,7 +94,7 @@ def creep_applied(sensor, attrs) -> tuple[Viscoelastic | None, float, str]:
         ``"described (simulation)"``, ``"described (sensor file)"`` or ``"none"``.
     """
     kind = kind_or_none(sensor)
-    if kind is not None and kind.own_calibration:  # its calibration's compensation
+    if kind is not None and not kind.array_calibration:  # its calibration's compensation
         return None, 0.0, "none"
     on = None  # the flaws a simulation switched on (None: a measured recording)
     if not str(attrs.get("source", "")):
@@ -130,7 +130,7 @@ def described_compensation(sensor) -> tuple[Viscoelastic | None, float]:
         [-]; 0 for none.
     """
     kind = kind_or_none(sensor)
-    if kind is not None and kind.own_calibration:
+    if kind is not None and not kind.array_calibration:
         return None, 0.0
     flaws = getattr(sensor, "flaws", None)
     if flaws is None or not getattr(flaws, "creep_known", False):

@@ -82,12 +82,11 @@ class Kind:
         return f"<{type(self).__name__} {self.name!r}>"
 
     # ---- estimation (r5-estimate) ----------------------------------------------
-    own_calibration: ClassVar[bool] = False
-    """Whether the kind is calibrated by its own procedure (the paper's finger:
-    ``tactsense calibrate``'s :class:`~tactsense.estimate.calibrate.Calibration`, which
-    holds its creep compensation too) rather than by an array calibration
-    (:class:`~tactsense.estimate.contacts.calibration.ArrayCalibration`: gains, dead
-    taxels and a force curve from a lab's own data)."""
+    array_calibration: ClassVar[bool] = True
+    """Whether the kind takes an array's calibration (``tactsense calibrate``: a probe
+    on every taxel, a uniform press or known weights; per-taxel gains and a force curve);
+    False: the paper's finger calibration (a probe swept along every column, section 3.1,
+    with creep steps and a knife edge)."""
     response_fit: ClassVar[bool] = False
     """Whether the kind tabulates its layer's response on a grid
     (:meth:`contact_response` with a window ``half``), so that ``find_contacts`` can fit

@@ -27,7 +27,7 @@ class FingerKind(Kind):
         return first_mm, math.degrees(second_mm / spec.radius_mm)
 
     # ---- estimation (r5-estimate) ----------------------------------------------
-    own_calibration = True
+    array_calibration = False
 
 
 KIND: Any = FingerKind()

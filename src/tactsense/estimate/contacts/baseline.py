@@ -409,7 +409,7 @@ class DriftBaseline:
         """The creep model's two memories (delayed, creep) per taxel [-], carried from
         frame to frame; zero after a re-zero."""
         if release is None:  # a finger's creep is its calibration's (calibrate --steps)
-            release = creep is None and kind is not None and not kind.own_calibration
+            release = creep is None and kind is not None and kind.array_calibration
         self.release = bool(release)
         """Whether a lift's creep is re-zeroed (``release``)."""
         self._release_alpha = -math.expm1(-self.frame_period_s / RELEASE_TIME_CONSTANT_S)

@@ -165,7 +165,7 @@ def calibrate_array(
     if method not in METHODS:
         raise ArrayCalibrationError(f"method {method!r}: expected one of {', '.join(METHODS)}")
     kind = kind_or_none(sensor)
-    if kind is None or kind.own_calibration:
+    if kind is None or not kind.array_calibration:
         raise ArrayCalibrationError(
             f"an array calibration is for pads and point sets; {sensor.name!r} is a "
             f"{getattr(sensor, 'kind', type(sensor).__name__)}"

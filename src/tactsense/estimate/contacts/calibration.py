@@ -258,7 +258,7 @@ def load_calibration(path: str | Path, sensor=None):
             calibration.check_sensor(sensor)
         return calibration
     kind = kind_or_none(sensor)
-    if kind is not None and not kind.own_calibration:
+    if kind is not None and kind.array_calibration:
         calibration = Calibration.load(path)  # a finger's: named as such below
         raise ArrayCalibrationError(
             f"{path} is a finger's calibration; {sensor.name!r} is a {kind.label}: "

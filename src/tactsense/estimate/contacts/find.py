@@ -152,7 +152,7 @@ def find_contacts(
     if calibration is not None and not counts:
         raise TactsenseInputError("a calibration applies to counts, not to the signal")
     if array_calibration:
-        if kind.own_calibration:
+        if not kind.array_calibration:
             raise TactsenseInputError(
                 f"{sensor.name!r} is a {kind.label}: calibrate it with 'tactsense calibrate' (a "
                 "finger's calibration), not with an array calibration"
@@ -160,7 +160,7 @@ def find_contacts(
         calibration.check_sensor(sensor)
         signal, flags = calibration.signal(frames, sensor, baseline=baseline)
     elif calibration is not None:
-        if not kind.own_calibration:
+        if kind.array_calibration:
             raise TactsenseInputError(
                 f"a finger's calibration does not apply to {sensor.name!r}, a {kind.name}: "
                 "calibrate it with 'tactsense calibrate' on the array's own recording"
