@@ -2,7 +2,10 @@
 
 Two jobs: the paper's finger pipeline (:mod:`tactsense.estimate.finger`) and contacts on
 any array (:mod:`tactsense.estimate.contacts`); their result types and flags are
-:mod:`tactsense.estimate.results`, the writers :mod:`tactsense.estimate.output`.
+:mod:`tactsense.estimate.results`, the writers :mod:`tactsense.estimate.output`. The
+modules beside them with the old names (``deflection``, ``locate``, ``calibrate``,
+``baseline``, ``track``, ``array_calibration``, ``_contacts_fast``, ...) are the old import
+paths of the moved modules: each is the moved module itself.
 """
 
 # the old module path first: importing it later would rebind the name ``locate`` (the
