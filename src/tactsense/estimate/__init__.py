@@ -1,12 +1,24 @@
-"""The inverse: from frames to contacts. Never imports the simulator."""
+"""The inverse: from frames to contacts. Never imports the simulator.
 
-from tactsense.estimate.angle import angle_from_skew, even_odd, inverse_filter, skew_index
-from tactsense.estimate.calibrate import Calibration, CalibrationError, calibrate_sweep
-from tactsense.estimate.deflection import Flag, baseline_from, deflection_from_counts
-from tactsense.estimate.force import force_per_deflection, total_force
-from tactsense.estimate.interpolate import kernel, reconstruct_row, surface
-from tactsense.estimate.localize import locate_contacts, newton_peak
-from tactsense.estimate.locate import Estimates, locate, write_estimates_csv
+Two jobs: the paper's finger pipeline (:mod:`tactsense.estimate.finger`) and contacts on
+any array (:mod:`tactsense.estimate.contacts`); their result types and flags are
+:mod:`tactsense.estimate.results`, the writers :mod:`tactsense.estimate.output`. The
+modules beside them with the old names (``deflection``, ``locate``, ``calibrate``,
+``baseline``, ``track``, ``array_calibration``, ``_contacts_fast``, ...) are the old import
+paths of the moved modules: each is the moved module itself.
+"""
+
+# the old module path first: importing it later would rebind the name ``locate`` (the
+# function below) to the module
+from tactsense.estimate import locate as _locate_module  # noqa: F401
+from tactsense.estimate.finger.angle import angle_from_skew, even_odd, inverse_filter, skew_index
+from tactsense.estimate.finger.calibrate import Calibration, CalibrationError, calibrate_sweep
+from tactsense.estimate.finger.deflection import baseline_from, deflection_from_counts
+from tactsense.estimate.finger.force import force_per_deflection, total_force
+from tactsense.estimate.finger.interpolate import kernel, reconstruct_row, surface
+from tactsense.estimate.finger.localize import locate_contacts, newton_peak
+from tactsense.estimate.finger.locate import locate, write_estimates_csv
+from tactsense.estimate.results import Estimates, Flag
 
 __all__ = [
     "Calibration",

@@ -11,6 +11,7 @@ from scipy.optimize import least_squares
 from scipy.signal import lfilter
 
 from tactsense._validation import CalibrationError, TactsenseInputError
+from tactsense.estimate._kind import kind_or_none
 
 
 @dataclass(frozen=True)
@@ -92,7 +93,8 @@ def creep_applied(sensor, attrs) -> tuple[Viscoelastic | None, float, str]:
     label : str
         ``"described (simulation)"``, ``"described (sensor file)"`` or ``"none"``.
     """
-    if getattr(sensor, "kind", None) == "finger":
+    kind = kind_or_none(sensor)
+    if kind is not None and not kind.array_calibration:  # its calibration's compensation
         return None, 0.0, "none"
     on = None  # the flaws a simulation switched on (None: a measured recording)
     if not str(attrs.get("source", "")):
@@ -127,7 +129,8 @@ def described_compensation(sensor) -> tuple[Viscoelastic | None, float]:
     stiffening : float
         [-]; 0 for none.
     """
-    if getattr(sensor, "kind", None) == "finger":
+    kind = kind_or_none(sensor)
+    if kind is not None and not kind.array_calibration:
         return None, 0.0
     flaws = getattr(sensor, "flaws", None)
     if flaws is None or not getattr(flaws, "creep_known", False):

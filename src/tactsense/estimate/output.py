@@ -12,8 +12,7 @@ import pyarrow.csv as pa_csv
 import pyarrow.parquet as pq
 
 from tactsense._validation import TactsenseInputError
-from tactsense.estimate.deflection import Flag
-from tactsense.estimate.locate import Estimates
+from tactsense.estimate.results import ContactTable, Estimates, Flag
 
 FORMATS = {".csv": "csv", ".parquet": "parquet", ".h5": "h5", ".hdf5": "h5"}
 """Output formats by file extension."""
@@ -291,8 +290,6 @@ def events_sidecar(path: str | Path) -> Path:
 
 
 def _contact_units() -> dict:
-    from tactsense.estimate.contacts import ContactTable
-
     return dict(ContactTable.UNITS)
 
 

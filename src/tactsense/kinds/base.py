@@ -64,7 +64,8 @@ class Kind:
 
     def describes(self, spec: Any) -> bool:
         """Whether ``spec`` is a sensor of this kind."""
-        return isinstance(spec, self.spec_class)
+        # a subclass of this kind's description may be another kind (``kind`` names it)
+        return isinstance(spec, self.spec_class) and getattr(spec, "kind", None) == self.name
 
     def periodic(self, spec: Any) -> bool:
         """Whether the columns wrap around (the last column neighbours the first)."""
@@ -183,6 +184,7 @@ class Kind:
         np.fill_diagonal(gaps, np.inf)
         size = f"{spec.n_taxels} taxels"
         return size, f"{np.median(gaps.min(axis=1)):.3g} mm (nearest, median)"
+
     # ---- forms for other tools: LSL, URDF (r5-interop) -------------------------
     def lsl_taxel_fields(self, spec: Any) -> dict[str, np.ndarray]:
         """Extra metadata of each channel of the LSL frames outlet, beside its label,
@@ -225,6 +227,41 @@ class Kind:
         :class:`~tactsense.kinds.urdf.UrdfError` naming ``path`` if it does not fit. None
         (the default): this kind is not read from a ``<taxel>`` list."""
         return None
+
+    # ---- estimation (r5-estimate) ----------------------------------------------
+    response_fit: ClassVar[bool] = False
+    """Whether the kind tabulates its layer's response on a grid
+    (:meth:`contact_response` with a window ``half``), so that ``find_contacts`` can fit
+    it: the ``fit`` method, the sub-taxel refinement of ``interpolate``, a contact's
+    force as the response's amplitude, and the reach of two point loads (pads)."""
+
+    def contact_response(
+        self, spec: Any, *, half: int = 0, n_sub: int = 8, signed: bool = False
+    ) -> np.ndarray:
+        """The response an estimator fits: the signal of the taxels per newton of the
+        scenarios' probe (a 1.6-mm sphere) [-/N], from the kind's own forward model.
+
+        Parameters
+        ----------
+        spec : the sensor's description
+        half : int
+            Half width of the window of taxels [taxel] (grid kinds).
+        n_sub : int
+            Sub-taxel positions of the probe per taxel along each axis (grid kinds).
+        signed : bool
+            A resistive taxel's strain before it is clipped at zero (grid kinds), so
+            that the responses to several loads add up.
+
+        Returns
+        -------
+        ndarray
+            On a grid kind (:attr:`response_fit`), shape ``(n_sub + 1, n_sub + 1,
+            2 half + 1, 2 half + 1)``: ``[a, b, i, j]`` the taxel at offset ``(i - half,
+            j - half)`` from the taxel nearest below the probe, for the probe ``(a, b) /
+            n_sub`` taxels from that taxel. On a kind without a grid, shape ``(N, N)``:
+            row ``i`` for the probe centred on taxel ``i`` (``half``, ``n_sub`` unused).
+        """
+        raise self.unsupported(spec, "a contact response")
 
 
 def positions_of(spec: Any) -> np.ndarray:

@@ -65,6 +65,7 @@ class FingerKind(Kind):
         a = spec.array
         size = f"{spec.shape[0]} x {spec.shape[1]} tactels"
         return size, f"{a.spacing_axial_mm:g} mm x {a.spacing_angle_deg:g} deg"
+
     # ---- forms for other tools: LSL, URDF (r5-interop) -------------------------
     def lsl_taxel_fields(self, spec: SensorSpec) -> dict:
         """Each channel's position along the finger [mm] and around it [deg]."""
@@ -101,6 +102,8 @@ class FingerKind(Kind):
         from tactsense.kinds._finger_urdf import finger_from_taxels
 
         return finger_from_taxels(taxels, base, path)
+
+    # ---- estimation (r5-estimate) ----------------------------------------------
 
 
 KIND: Any = FingerKind()
