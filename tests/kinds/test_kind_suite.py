@@ -124,6 +124,24 @@ def read(path: Path):
 # ---- what the kind is -------------------------------------------------------------
 
 
+def test_the_toy_kind_comes_through_its_entry_point(cli_env):
+    """Not through an import of tests/kinds/toy_kind.py: importlib.metadata finds the
+    toy_kind-0.0.dist-info, in this process and in a command's."""
+    from importlib.metadata import entry_points
+
+    from tactsense.kinds import GROUP
+
+    (point,) = [ep for ep in entry_points(group=GROUP) if ep.name == "hexpatch"]
+    assert point.value == "toy_kind:KIND"
+    assert point.dist.name == "toy-kind"
+    assert kinds()["hexpatch"] is point.load()
+    listed = subprocess.run(
+        [sys.executable, "-c", "from tactsense.kinds import kinds; print(*kinds())"],
+        env=cli_env, capture_output=True, text=True, timeout=TIMEOUT_S, check=True,
+    ).stdout.split()  # fmt: skip
+    assert listed[:3] == ["finger", "pad", "points"] and "hexpatch" in listed
+
+
 def test_the_kind_is_registered_and_describes_its_preset(case):
     kind, spec = case.kind, case.spec
     assert kind_of(kind.name) is kind
