@@ -111,6 +111,21 @@ def test_import_contracts_are_the_stated_ones():
     }
 
 
+def test_every_package_has_a_layer():
+    """A new package or module of tactsense is placed in the layers (pyproject.toml), so
+    that no part of the house escapes the contract unnoticed."""
+    layered = set()
+    for layer in contracts()["contracts"][0]["layers"]:
+        layered |= {part.strip(" ()") for part in layer.split(":")}
+    top = {
+        path.stem if path.is_file() else path.name
+        for path in PACKAGE.iterdir()
+        if (path.suffix == ".py" or (path / "__init__.py").is_file())
+    }
+    missing = sorted(top - layered - {"__init__", "__main__"})
+    assert not missing, f"not in any layer of [tool.importlinter] (pyproject.toml): {missing}"
+
+
 def _plant_package(root: Path, violations: dict[str, str]) -> None:
     """A skeleton ``tactsense`` under ``root``: one empty package per layer (and the two
     physics modules estimation may not import), plus ``violations`` (package -> source of
