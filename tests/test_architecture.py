@@ -498,18 +498,20 @@ def test_kind_comparison_check_catches_planted_comparisons(tmp_path):
 def test_kind_names_come_from_the_registry(tmp_path, monkeypatch):
     from tactsense.kinds import base
 
-    class Hex(base.Kind):
-        name = "hexpatch"
-        spec_class = type("HexSpec", (), {})
+    class Hex(base.Kind):  # a kind nobody registers (the toy kind may be registered)
+        name = "planted_hexagon"
+        spec_class = type("PlantedHexSpec", (), {})
 
     names, classes = kind_vocabulary()
     assert {"finger", "pad", "points"} <= names
     assert {"SensorSpec", "PadSpec", "PointsSpec"} <= classes
     extended = names | {Hex.name}
     path = tmp_path / "m.py"
-    path.write_text('def f(s):\n    return s.kind == "hexpatch" or isinstance(s, HexSpec)\n')
+    path.write_text(
+        'def f(s):\n    return s.kind == "planted_hexagon" or isinstance(s, PlantedHexSpec)\n'
+    )
     assert kind_comparisons(path, "m.py", names, classes) == []
-    assert len(kind_comparisons(path, "m.py", extended, classes | {"HexSpec"})) == 2
+    assert len(kind_comparisons(path, "m.py", extended, classes | {"PlantedHexSpec"})) == 2
 
 
 # ---- 4. no long source file ---------------------------------------------------------

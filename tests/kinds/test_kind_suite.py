@@ -7,7 +7,7 @@ among them the toy hexagonal patch of ``tests/kinds/toy_kind.py`` (registered by
 ``conftest.py`` through a real ``toy_kind-0.0.dist-info``). For a preset of each kind
 (the first of ``Kind.presets``), every step is a command (``python -m tactsense``):
 
-* ``sensor show`` and ``sensor check`` on the preset's TOML;
+* ``sensor show`` and ``sensor check`` on the preset's TOML, ``sensor show`` by preset name;
 * ``simulate`` (the kind's default scenario: a press, or the finger's probe sweep);
 * ``emulate`` the device and ``record`` from it: the frames the simulation wrote;
 * ``locate``: the contacts lie near the pressed spots (:data:`TOLERANCE`);
@@ -180,6 +180,13 @@ def test_sensor_show_and_check(case):
     assert type(case.spec).from_dict(tomllib.loads(shown)) == case.spec
     checked = case.run("sensor", "check", case.toml)
     assert case.spec.name in checked.stdout
+
+
+def test_its_presets_are_known_by_name(case):
+    """``--sensor NAME`` finds the kind's presets, as it finds the built-in ones."""
+    for name, make in case.kind.presets.items():
+        shown = case.run("sensor", "show", "--sensor", name).stdout
+        assert type(case.spec).from_dict(tomllib.loads(shown)) == make(), name
 
 
 def test_simulate_writes_frames_of_the_sensor_and_the_truth(case, simulated):
