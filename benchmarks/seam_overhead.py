@@ -1,9 +1,11 @@
 """What the sensor-kind seam costs: finger and pad throughput of this tree against a
 reference commit, measured in the same run (issue 33: within 5 % of before).
 
-    python benchmarks/seam_overhead.py [--ref bb4ab76] [--repeats 5] [--frames 20000]
+    python benchmarks/seam_overhead.py [--ref bb4ab76] [--current REF] [--repeats 5]
+                                       [--frames 20000] [--live-frames 2000]
 
-The reference commit is extracted with ``git archive`` into a temporary directory; each
+The reference commit (and ``--current``, a commit measured instead of the work tree) is
+extracted with ``git archive`` into a temporary directory; each
 measurement runs in its own subprocess (``python -c``, ``PYTHONPATH`` pointing at one tree's
 ``src``), the two trees alternating (current, reference, reference, current, ...) so that
 a change in the machine's load touches both alike. The frames are the same for both: two
@@ -97,9 +99,22 @@ def run(src: Path, args: list[str]) -> dict[str, float]:
     return json.loads(line.removeprefix("RATES "))
 
 
+def extract(ref: str, where: Path) -> Path:
+    """The ``src`` of commit ``ref``, written under ``where`` (``git archive``)."""
+    where.mkdir()
+    archive = subprocess.run(
+        ["git", "-C", str(ROOT), "archive", ref, "src"], capture_output=True, check=True
+    )
+    subprocess.run(["tar", "-x", "-C", str(where)], input=archive.stdout, check=True)
+    return where
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--ref", default="bb4ab76", help="reference commit [bb4ab76]")
+    parser.add_argument(
+        "--current", default=None, help="measure this commit instead of the work tree"
+    )
     parser.add_argument("--repeats", type=int, default=5, help="runs of each tree [5]")
     parser.add_argument("--frames", type=int, default=20_000, help="batch frames [20000]")
     parser.add_argument("--live-frames", type=int, default=2_000, help="per-frame [2000]")
@@ -107,18 +122,14 @@ def main(argv: list[str] | None = None) -> None:
     current = ROOT / "src"
     with tempfile.TemporaryDirectory(prefix="seam_overhead_") as tmp:
         tmp = Path(tmp)
-        reference = tmp / "ref"
-        reference.mkdir()
-        archive = subprocess.run(
-            ["git", "-C", str(ROOT), "archive", options.ref, "src"],
-            capture_output=True,
-            check=True,
-        )
-        subprocess.run(["tar", "-x", "-C", str(reference)], input=archive.stdout, check=True)
+        reference = extract(options.ref, tmp / "ref")
+        if options.current is not None:
+            current = extract(options.current, tmp / "current") / "src"
         commit = subprocess.run(
-            ["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"],
+            ["git", "-C", str(ROOT), "rev-parse", "--short", options.current or "HEAD"],
             capture_output=True, text=True, check=True,
         ).stdout.strip()  # fmt: skip
+        what = commit if options.current else f"HEAD {commit} + work tree"
         env = dict(os.environ, PYTHONPATH=str(current))
         recordings = {"finger": ("initial", "sweep-axial"), "pad": ("pad16", "slide")}
         for name, (sensor, scenario) in recordings.items():
@@ -141,7 +152,7 @@ def main(argv: list[str] | None = None) -> None:
                       file=sys.stderr, flush=True)  # fmt: skip
         load = os.getloadavg()[0]
     print(
-        f"current tree (HEAD {commit} + work tree) against {options.ref}, "
+        f"current tree ({what}) against {options.ref}, "
         f"{options.repeats} alternating runs each, {options.frames:,} frames a batch, "
         f"{options.live_frames:,} one at a time; best rate of each tree "
         f"({time.perf_counter() - start:.0f} s; load average {load:.1f} at the end)\n"
