@@ -18,7 +18,7 @@ import numpy as np
 
 import tactsense as ts
 from tactsense.analysis.bound import cramer_rao_bound
-from tactsense.estimate.model_fit import fit_frames
+from tactsense.estimate.finger.model_fit import fit_frames
 from tactsense.geometry import wrap_angle_deg
 
 REPEATS = 60

@@ -44,7 +44,7 @@ from pathlib import Path
 import numpy as np
 
 from tactsense.estimate.contacts import RING_RATIO, find_contacts
-from tactsense.estimate.track import ContactTracker
+from tactsense.estimate.contacts.track import ContactTracker
 from tactsense.physics.indenters import CylinderProbe, FlatPunch, SphereProbe, SquareStamp
 from tactsense.sensor.registry import load_sensor
 from tactsense.simulate import Scenario, Step, simulate

@@ -21,7 +21,7 @@ import numpy as np
 from scipy import ndimage
 
 from tactsense.estimate.contacts import find_contacts, pad_force_kernel
-from tactsense.estimate.track import ContactTracker, ReferenceTracker
+from tactsense.estimate.contacts.track import ContactTracker, ReferenceTracker
 from tactsense.sensor.registry import load_sensor
 
 

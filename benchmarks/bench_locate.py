@@ -20,8 +20,8 @@ import numpy as np
 from scipy.optimize import minimize
 
 import tactsense as ts
-from tactsense.estimate._fast import locate_frames
-from tactsense.estimate.realtime import RealTimeLocator
+from tactsense.estimate.finger._fast import locate_frames
+from tactsense.estimate.finger.realtime import RealTimeLocator
 from tactsense.physics.array_response import deflection_batch
 from tactsense.physics.transduction import deflection_to_counts, fractional_deflection
 

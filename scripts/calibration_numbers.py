@@ -32,7 +32,7 @@ def run(folder: Path) -> dict:
     from typer.testing import CliRunner
 
     from tactsense.cli import app
-    from tactsense.estimate.calibrate import Calibration
+    from tactsense.estimate.finger.calibrate import Calibration
 
     runner = CliRunner()
     here = os.getcwd()

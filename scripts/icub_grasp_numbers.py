@@ -46,7 +46,7 @@ def calibrations(report, folder: Path) -> list[Path]:
     """One array calibration per fingertip: the baseline of all the grasps of nothing."""
     import numpy as np
 
-    from tactsense.estimate.array_calibration import ArrayCalibration
+    from tactsense.estimate.contacts.array_calibration import ArrayCalibration
     from tactsense.interop.icub_grasp import FINGERS
     from tactsense.sensor import load_sensor
 

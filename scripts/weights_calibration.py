@@ -119,7 +119,7 @@ def run(sensor: str, folder: Path) -> dict:
 
     import tactsense as ts
     from tactsense.cli import app
-    from tactsense.estimate.array_calibration import load_calibration
+    from tactsense.estimate.contacts.array_calibration import load_calibration
 
     toml, threshold = describe(sensor, folder)
     weights, check, updown = SERIES_G[ts.load_sensor(sensor).name]
@@ -156,8 +156,8 @@ def _check(rec, table, cal) -> list[dict]:
     """Each press of the second series: its load, and what ``locate`` gave over its
     settled part (the median of the frames' summed force; the share of those frames
     flagged beyond the calibration or saturated)."""
-    from tactsense.estimate.array_calibration import _plateau
-    from tactsense.estimate.deflection import Flag
+    from tactsense.estimate.contacts.array_calibration import _plateau
+    from tactsense.estimate.finger.deflection import Flag
 
     step = np.asarray(rec.truth["frame_step"])
     force = np.asarray(rec.truth["step_force_n"])

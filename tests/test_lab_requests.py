@@ -10,7 +10,7 @@ from typer.testing import CliRunner
 import tactsense as ts
 from tactsense import flat_scenarios as fs
 from tactsense.cli import app
-from tactsense.estimate.array_calibration import read_force_log
+from tactsense.estimate.contacts.array_calibration import read_force_log
 from tactsense.physics.contact import grams_force
 
 runner = CliRunner()

@@ -23,8 +23,8 @@ from pathlib import Path
 import numpy as np
 
 from tactsense._validation import TactsenseInputError
-from tactsense.estimate.deflection import Flag
-from tactsense.estimate.locate import CONTACT_THRESHOLD, Estimates, locate
+from tactsense.estimate.finger.deflection import Flag
+from tactsense.estimate.finger.locate import CONTACT_THRESHOLD, Estimates, locate
 from tactsense.estimate.output import FORMATS, EstimatesWriter, output_format
 from tactsense.io.recording import RecordingReader
 
@@ -43,7 +43,7 @@ def iter_locate(
 ) -> Iterator[tuple[int, np.ndarray, Estimates]]:
     """Estimates of a recording, one piece at a time: ``(first frame, time_s, estimates)``.
 
-    The same numbers as :func:`~tactsense.estimate.locate` on the whole recording: the
+    The same numbers as :func:`~tactsense.estimate.finger.locate` on the whole recording: the
     baseline is the median of the first ``baseline_frames`` frames (or given), and a
     calibration's creep compensation carries its state from piece to piece.
     """
@@ -131,7 +131,7 @@ def locate_file(
         ``frames``, ``contacts`` (frames with a contact), ``saturated`` (frames flagged
         SATURATED), ``force_mean_n`` and ``force_max_n`` over the contacts [N], and
         ``movement``: when no frame has a contact although the readings moved by more
-        than the threshold, why (:func:`~tactsense.estimate.baseline.movement_warning`);
+        than the threshold, why (:func:`~tactsense.estimate.contacts.baseline.movement_warning`);
         else None.
     """
     output_format(out)
@@ -158,7 +158,7 @@ def locate_file(
             writer.rows = 0
         movement = None
         if tally.contacts == 0 and total >= baseline_frames:  # why none: from the readings
-            from tactsense.estimate.baseline import ReadingRange, movement_warning
+            from tactsense.estimate.contacts.baseline import ReadingRange, movement_warning
 
             extremes = ReadingRange(reader.sensor.shape)
             for _, frames, _ in reader.chunks(chunk_frames):
@@ -184,7 +184,7 @@ class iter_contacts:
     caller. Unless a finger's calibration says which taxels are dead, the recording is
     read once first for every taxel's range of readings (:attr:`extremes`), from which
     the taxels that give no signal are found (:attr:`health`,
-    :func:`~tactsense.estimate.baseline.taxel_health`: no finite reading, stuck at the
+    :func:`~tactsense.estimate.contacts.baseline.taxel_health`: no finite reading, stuck at the
     rail, or never changing while the others do); the first two are left out (flag
     ``DEAD_TACTEL``; with an array calibration, its own dead taxels are left out
     instead).
@@ -203,11 +203,11 @@ class iter_contacts:
         tracker_options: dict | None = None,
         drift_s: float | None = None,
     ):
-        from tactsense.estimate.array_calibration import ArrayCalibration
-        from tactsense.estimate.baseline import DriftBaseline, ReadingRange, taxel_health
+        from tactsense.estimate.contacts.array_calibration import ArrayCalibration
+        from tactsense.estimate.contacts.baseline import DriftBaseline, ReadingRange, taxel_health
         from tactsense.estimate.contacts import default_threshold
         from tactsense.estimate.creep import creep_applied
-        from tactsense.estimate.track import ContactTracker
+        from tactsense.estimate.contacts.track import ContactTracker
 
         sensor = reader.sensor
         self.reader = reader
@@ -218,10 +218,10 @@ class iter_contacts:
         calibration)."""
         self.extremes = None
         """Every taxel's smallest and largest reading over the recording
-        (:class:`~tactsense.estimate.baseline.ReadingRange`; None with a finger's
+        (:class:`~tactsense.estimate.contacts.baseline.ReadingRange`; None with a finger's
         calibration)."""
         self.health = None
-        """:func:`~tactsense.estimate.baseline.taxel_health` of the recording."""
+        """:func:`~tactsense.estimate.contacts.baseline.taxel_health` of the recording."""
         self.dead = None
         self.creep = "none"
         """Where the creep taken out came from (:func:`~tactsense.estimate.creep.creep_applied`)."""
@@ -300,10 +300,10 @@ def contacts_file(
 
     Without a calibration the baseline is the median of the first ``baseline_frames``
     frames; with ``drift_s`` [s] it then follows slow drift of untouched taxels with that
-    time constant (:class:`~tactsense.estimate.baseline.DriftBaseline`).
+    time constant (:class:`~tactsense.estimate.contacts.baseline.DriftBaseline`).
 
     :func:`~tactsense.estimate.contacts.find_contacts` and
-    :class:`~tactsense.estimate.track.ContactTracker` piece by piece (bounded memory;
+    :class:`~tactsense.estimate.contacts.track.ContactTracker` piece by piece (bounded memory;
     the tracker's state carries across pieces), written by
     :class:`~tactsense.estimate.output.ContactsWriter` (``events_path``: where a CSV's
     events go, by default beside it).
@@ -322,12 +322,12 @@ def contacts_file(
         taken out: ``"none"`` or ``"described (...)"``,
         :func:`~tactsense.estimate.creep.creep_applied`), ``unusable`` (a sentence
         naming the taxels found to give no signal,
-        :func:`~tactsense.estimate.baseline.health_warning`, or None) and
+        :func:`~tactsense.estimate.contacts.baseline.health_warning`, or None) and
         ``movement`` (what the way the readings moved says is wrong: against the
         polarity, or no contact although they moved by more than the threshold,
-        :func:`~tactsense.estimate.baseline.movement_warning`; else None).
+        :func:`~tactsense.estimate.contacts.baseline.movement_warning`; else None).
     """
-    from tactsense.estimate.baseline import health_warning, movement_warning
+    from tactsense.estimate.contacts.baseline import health_warning, movement_warning
     from tactsense.estimate.contacts import default_threshold, find_contacts
     from tactsense.estimate.output import ContactsWriter
 

@@ -86,7 +86,7 @@ def process_recording(
     ``<name>.events.csv`` beside it); ``contacts`` then counts contacts, not frames.
     """
     from tactsense.batch import contacts_file, locate_file
-    from tactsense.estimate.locate import CONTACT_THRESHOLD
+    from tactsense.estimate.finger.locate import CONTACT_THRESHOLD
     from tactsense.estimate.output import events_sidecar
 
     start = time.perf_counter()
@@ -128,7 +128,7 @@ def _calibration(recording: str, calibration: str | None):
     """The calibration file checked against the recording's sensor (None without one)."""
     if calibration is None:
         return None
-    from tactsense.estimate.array_calibration import load_calibration
+    from tactsense.estimate.contacts.array_calibration import load_calibration
     from tactsense.io.recording import RecordingReader
 
     with RecordingReader(recording) as reader:
@@ -208,7 +208,7 @@ def combine_parts(parts: list[dict], recording: str, output: str) -> dict:
     recording's summary. Reads one part at a time."""
     import pyarrow.parquet as pq
 
-    from tactsense.estimate.locate import Estimates
+    from tactsense.estimate.finger.locate import Estimates
     from tactsense.estimate.output import EstimatesWriter
 
     start_time = time.perf_counter()

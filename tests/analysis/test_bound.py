@@ -5,7 +5,7 @@ import pytest
 
 import tactsense as ts
 from tactsense.analysis.bound import cramer_rao_bound, expected_counts, fisher_information
-from tactsense.estimate.model_fit import fit_frames
+from tactsense.estimate.finger.model_fit import fit_frames
 from tactsense.physics.array_response import deflection_batch, probe_response
 
 

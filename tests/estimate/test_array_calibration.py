@@ -12,7 +12,7 @@ from typer.testing import CliRunner
 import tactsense as ts
 from tactsense import flat_scenarios as fs
 from tactsense.cli import app
-from tactsense.estimate.array_calibration import (
+from tactsense.estimate.contacts.array_calibration import (
     ArrayCalibration,
     ArrayCalibrationError,
     calibrate_array,

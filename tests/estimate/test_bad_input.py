@@ -38,7 +38,7 @@ def test_saturated_and_dead_tactels_are_flagged(initial, frames):
     # a saturated frame gives no force (a lower bound only), but still a position
     assert np.isnan(est.force_n[0]) and np.isfinite(est.force_n[1])
     assert np.isfinite(est.row[0]) and np.isfinite(est.axial_mm[0])
-    from tactsense.estimate.realtime import RealTimeLocator
+    from tactsense.estimate.finger.realtime import RealTimeLocator
 
     locator = RealTimeLocator(initial, baseline)
     contact = locator(bad[0])

@@ -3,8 +3,8 @@ import pytest
 from contourpy import contour_generator
 
 import tactsense as ts
-from tactsense.estimate.contours import track_contour
-from tactsense.estimate.interpolate import surface
+from tactsense.estimate.finger.contours import track_contour
+from tactsense.estimate.finger.interpolate import surface
 
 
 @pytest.mark.parametrize("share", [0.3, 0.6])

@@ -5,10 +5,10 @@ import pytest
 
 import tactsense as ts
 from tactsense.estimate import Flag, deflection_from_counts
-from tactsense.estimate.angle import skew_along_finger
-from tactsense.estimate.force import total_force
-from tactsense.estimate.localize import newton_peak
-from tactsense.estimate.realtime import RealTimeLocator
+from tactsense.estimate.finger.angle import skew_along_finger
+from tactsense.estimate.finger.force import total_force
+from tactsense.estimate.finger.localize import newton_peak
+from tactsense.estimate.finger.realtime import RealTimeLocator
 from tactsense.physics.array_response import deflection_batch
 from tactsense.physics.transduction import deflection_to_counts
 

@@ -11,7 +11,7 @@ import pytest
 
 from tactsense.estimate.contacts import find_contacts
 from tactsense.estimate.output import ContactsWriter
-from tactsense.estimate.track import ContactTracker
+from tactsense.estimate.contacts.track import ContactTracker
 from tactsense.physics.indenters import CylinderProbe, SphereProbe, SquareStamp
 from tactsense.sensor.registry import load_sensor
 from tactsense.simulate import Scenario, Step, simulate

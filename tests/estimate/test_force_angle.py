@@ -3,7 +3,7 @@ import pytest
 
 import tactsense as ts
 from tactsense.estimate import angle as ang
-from tactsense.estimate.force import force_per_deflection, ideal_force_per_deflection
+from tactsense.estimate.finger.force import force_per_deflection, ideal_force_per_deflection
 from tactsense.physics import halfplane as hp
 
 E, D = 2.5e5, 3.8e-3

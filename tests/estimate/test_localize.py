@@ -3,7 +3,7 @@ import pytest
 
 import tactsense as ts
 from tactsense.estimate import interpolate as ip
-from tactsense.estimate.localize import locate_contacts, newton_peak
+from tactsense.estimate.finger.localize import locate_contacts, newton_peak
 
 
 def bump(row0, col0, width=1.0):

@@ -29,7 +29,7 @@ import tactsense as ts
 from tactsense import flat_scenarios as fs
 from tactsense.batch import iter_contacts
 from tactsense.estimate.contacts import default_threshold, signal_from_counts
-from tactsense.estimate.deflection import Flag
+from tactsense.estimate.finger.deflection import Flag
 from tactsense.io.recording import RecordingReader
 from tactsense.physics.transduction import deflection_to_counts
 from tactsense.sensor.registry import load_sensor

@@ -21,7 +21,7 @@ import os, signal, sys, threading, time
 import numpy as np
 import tactsense as ts
 from tactsense import _signals
-from tactsense.estimate.realtime import RealTimeLocator
+from tactsense.estimate.finger.realtime import RealTimeLocator
 
 spec = ts.fearing1990_initial()
 frames = ts.simulate(spec, ts.probe_sweep(spec), rng=0).frames

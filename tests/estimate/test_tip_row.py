@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 import tactsense as ts
-from tactsense.estimate.interpolate import surface
-from tactsense.estimate.localize import newton_peak
+from tactsense.estimate.finger.interpolate import surface
+from tactsense.estimate.finger.localize import newton_peak
 from tactsense.geometry import tactel_to_surface
 
 DOCS = Path(__file__).resolve().parents[2] / "docs" / "estimation.md"
@@ -120,7 +120,7 @@ def test_a_contact_whose_deflections_sum_below_zero_has_no_force():
     NEGATIVE_FORCE with a NaN force, in locate and in the real-time locator alike; the
     position is still estimated."""
     from tactsense.estimate import Flag
-    from tactsense.estimate.realtime import RealTimeLocator
+    from tactsense.estimate.finger.realtime import RealTimeLocator
 
     spec = ts.fearing1990_initial()
     frame = np.full(spec.shape, -0.004)

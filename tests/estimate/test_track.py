@@ -11,7 +11,7 @@ import tactsense as ts
 from tactsense import flat_scenarios as fs
 from tactsense._validation import TactsenseInputError
 from tactsense.estimate.contacts import ContactTable, find_contacts
-from tactsense.estimate.track import _FAR, ContactTracker, ReferenceTracker, assign, track
+from tactsense.estimate.contacts.track import _FAR, ContactTracker, ReferenceTracker, assign, track
 from tactsense.sensor.registry import load_sensor
 
 PERIOD = 0.01

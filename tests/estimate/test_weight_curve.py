@@ -7,7 +7,7 @@ import pytest
 
 import tactsense as ts
 from tactsense import flat_scenarios as fs
-from tactsense.estimate.array_calibration import (
+from tactsense.estimate.contacts.array_calibration import (
     ArrayCalibration,
     ArrayCalibrationError,
     Presses,
@@ -18,7 +18,7 @@ from tactsense.estimate.array_calibration import (
     weight_curve,
 )
 from tactsense.estimate.contacts import find_contacts, signal_from_counts
-from tactsense.estimate.deflection import Flag
+from tactsense.estimate.finger.deflection import Flag
 
 G = 9.80665e-3  # N per gram-force
 
@@ -206,7 +206,7 @@ def test_find_contacts_reads_the_curve_at_the_contact_total():
 
 
 def test_the_weight_curve_survives_its_json(tmp_path):
-    from tactsense.estimate.array_calibration import load_calibration
+    from tactsense.estimate.contacts.array_calibration import load_calibration
 
     pad = ts.preset("pad16")
     cal = ArrayCalibration(pad.to_toml_string(), np.full(pad.shape, 100.0), np.ones(pad.shape),

@@ -8,7 +8,7 @@ from typer.testing import CliRunner
 import tactsense as ts
 from tactsense.cli import app
 from tactsense.estimate import Flag
-from tactsense.estimate.deflection import deflection_from_counts
+from tactsense.estimate.finger.deflection import deflection_from_counts
 from tactsense.io.recording import write_recording
 from tactsense.physics.contact import newtons_to_grams
 

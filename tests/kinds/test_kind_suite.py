@@ -277,7 +277,7 @@ def test_calibrate_or_say_there_is_none(case, simulated):
 VIEW = textwrap.dedent(
     """
     import json, sys, time
-    from tactsense.estimate.deflection import baseline_from
+    from tactsense.estimate.finger.deflection import baseline_from
     from tactsense.view.feed import RecordingFeed, view_locator
 
     def locator_for(spec, file):

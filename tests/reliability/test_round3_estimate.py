@@ -179,7 +179,7 @@ def test_a_calibrated_force_is_never_negative():
     """Issue 31 item 5: the force curve extended below its first knot went negative (26
     of 100 rows of a calibrated pad). Knots (0.1, 0.05) and (0.2, 0.5) extend to -0.175 N
     at 0.05 N estimated; the force is clamped at zero, NaN stays NaN."""
-    from tactsense.estimate.array_calibration import ArrayCalibration
+    from tactsense.estimate.contacts.array_calibration import ArrayCalibration
 
     pad = ts.preset("pad4")
     ones = np.ones(pad.shape)
@@ -269,7 +269,7 @@ def test_the_force_log_checks_are_reported(bench):
 def test_a_blank_cell_in_a_log_names_its_line(tmp_path, reader):
     """Issue 31 item 13: a blank cell in a knife (stage) log or a force log said
     "could not convert string to float: ''", no line. Now: the line and the column."""
-    from tactsense.estimate import array_calibration
+    from tactsense.estimate.contacts import array_calibration
 
     path = tmp_path / "log.csv"
     path.write_text("time_s,position_mm,force_n\n0.0,1.0,0.0\n0.1,1.0,0.5\n0.2,1.0,\n0.3,1.0,0.0\n")
@@ -301,7 +301,7 @@ def test_a_damaged_array_calibration_names_the_missing_key(bench):
 def test_a_damaged_finger_calibration_names_the_missing_key(tmp_path):
     import json
 
-    from tactsense.estimate.calibrate import FORMAT, Calibration, CalibrationError
+    from tactsense.estimate.finger.calibrate import FORMAT, Calibration, CalibrationError
 
     path = tmp_path / "badcal.json"
     path.write_text(json.dumps({"format": FORMAT, "version": 1}))

@@ -103,7 +103,7 @@ def test_the_compiled_compensation_is_the_creep_compensator():
     """DriftBaseline's compiled creep compensation (fixed baseline) against
     CreepCompensator written out in NumPy, with stiffening undone and redone: equal to
     rounding (1e-12)."""
-    from tactsense.estimate.baseline import DriftBaseline
+    from tactsense.estimate.contacts.baseline import DriftBaseline
     from tactsense.estimate.creep import CreepCompensator, described_creep
 
     pad = load_sensor("pad16")  # resistive: the signal is (counts - base) / 20000
@@ -420,7 +420,7 @@ def test_the_release_share_parts_a_lift_from_a_load_that_stays(unknown, name, k,
     before, on the taxel that carries the load that stays (or the lifted one's peak):
     under RELEASE_SHARE after a lift (10-s and 70-s presses), above it by a margin of
     0.05 where a load stays (half the force, the other probe lifting)."""
-    from tactsense.estimate.baseline import RELEASE_SHARE, DriftBaseline
+    from tactsense.estimate.contacts.baseline import RELEASE_SHARE, DriftBaseline
 
     with RecordingReader(unknown[name]) as reader:
         frames, sensor = reader.frames(0, reader.n_frames), reader.sensor

@@ -17,7 +17,7 @@ import tactsense as ts
 from tactsense._validation import TactsenseInputError
 from tactsense.cli import app
 from tactsense.estimate.contacts import find_contacts
-from tactsense.estimate.track import ContactTracker
+from tactsense.estimate.contacts.track import ContactTracker
 from tactsense.flat_scenarios import make_indenter, press
 from tactsense.physics.indenters import CylinderProbe, SquareStamp
 from tactsense.sensor.registry import load_sensor

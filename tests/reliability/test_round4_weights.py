@@ -121,7 +121,7 @@ def test_threshold_is_for_arrays(tmp_path):
 
 def test_every_press_saturated_is_said_with_its_load(bench):
     """The lightest weight's load is named (1.96 N = 200 g)."""
-    from tactsense.estimate.array_calibration import ArrayCalibrationError, Presses, weight_curve
+    from tactsense.estimate.contacts.array_calibration import ArrayCalibrationError, Presses, weight_curve
 
     with pytest.raises(ArrayCalibrationError, match=r"the lightest, 1\.96 N"):
         weight_curve(Presses(np.arange(3), np.arange(3) + 1, np.ones(3),
@@ -138,8 +138,8 @@ def test_locate_gives_newtons_and_flags_what_lies_beyond(bench, tmp_path):
     (NaN, flagged BEYOND_CALIBRATION or SATURATED), with the warning."""
     import pandas as pd
 
-    from tactsense.estimate.array_calibration import _plateau
-    from tactsense.estimate.deflection import Flag
+    from tactsense.estimate.contacts.array_calibration import _plateau
+    from tactsense.estimate.finger.deflection import Flag
 
     cal = tmp_path / "cal.json"
     runner.invoke(app, ["calibrate", str(bench / "w.h5"), "--force-log", str(bench / "good.csv"),
@@ -181,7 +181,7 @@ def test_gains_from_a_sweep_on_top_of_the_weights(tmp_path):
     gains 2.0 times apart)."""
     import pandas as pd
 
-    from tactsense.estimate.array_calibration import _plateau
+    from tactsense.estimate.contacts.array_calibration import _plateau
 
     pad = ts.preset("pad4")
     g = pad.grid

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import tactsense as ts
-from tactsense.estimate.deflection import baseline_from, deflection_from_counts
+from tactsense.estimate.finger.deflection import baseline_from, deflection_from_counts
 from tactsense.io.recording import write_recording
 from tactsense.stream import Emulator, FaultRates, LiveLocator, StreamReader
 from tactsense.view import LiveFeed, RecordingFeed, ViewServer

@@ -9,8 +9,8 @@ import pytest
 from websockets.sync.client import connect
 
 import tactsense as ts
-from tactsense.estimate.deflection import baseline_from
-from tactsense.estimate.interpolate import reconstruct_row
+from tactsense.estimate.finger.deflection import baseline_from
+from tactsense.estimate.finger.interpolate import reconstruct_row
 from tactsense.io.recording import write_recording
 from tactsense.stream import Emulator, LiveLocator, StreamReader
 from tactsense.view import LiveFeed, RecordingFeed, ViewServer, layout_message
@@ -48,7 +48,7 @@ def test_surface_weights_pass_through_the_tactels(name):
 
 def test_surface_weights_along_match_the_one_dimensional_reconstruction():
     """Along one column the 2-D weights reduce to eq. 46's row reconstruction (a separate
-    implementation in tactsense.estimate.interpolate)."""
+    implementation in tactsense.estimate.finger.interpolate)."""
     spec = ts.fearing1990_initial()
     layout = layout_message(spec, {"kind": "test", "name": "x"})
     first = layout["first_row"]

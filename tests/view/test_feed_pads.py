@@ -10,7 +10,7 @@ import pytest
 
 import tactsense as ts
 from tactsense._validation import TactsenseInputError
-from tactsense.estimate.interpolate import reconstruct_row
+from tactsense.estimate.finger.interpolate import reconstruct_row
 from tactsense.io.recording import Recording, write_recording
 from tactsense.sensor import Electronics, Grid, PadSpec, PointsSpec, Taxels, Transduction
 from tactsense.stream.live import LiveContacts

@@ -9,7 +9,7 @@ import time
 import pytest
 
 import tactsense as ts
-from tactsense.estimate.deflection import baseline_from
+from tactsense.estimate.finger.deflection import baseline_from
 from tactsense.io.recording import write_recording
 from tactsense.stream import LiveLocator
 from tactsense.view import RecordingFeed, ViewServer

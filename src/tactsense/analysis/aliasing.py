@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from tactsense._validation import as_float_array, check_poisson_ratio, check_positive
-from tactsense.estimate.interpolate import kernel
+from tactsense.estimate.finger.interpolate import kernel
 from tactsense.physics.halfplane import frequency_response, impulse_response
 
 

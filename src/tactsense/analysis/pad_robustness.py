@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tactsense.estimate.contacts import find_contacts
-from tactsense.estimate.deflection import baseline_from
+from tactsense.estimate.finger.deflection import baseline_from
 from tactsense.physics.indenters import SphereProbe
 from tactsense.sensor import PadSpec
 from tactsense.simulate import Scenario, Step, simulate

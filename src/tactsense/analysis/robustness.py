@@ -8,7 +8,7 @@ real finger differs from its drawing (10-20 %, and an uncalibrated gain spread).
 estimators are compared, each without and with the calibration step:
 
 * ``interpolation``: :func:`tactsense.locate` (the paper's eqs. 48 and 54);
-* ``model``: :func:`tactsense.estimate.model_fit.fit_frames` (maximum likelihood on the
+* ``model``: :func:`tactsense.estimate.finger.model_fit.fit_frames` (maximum likelihood on the
   forward model, the estimator whose accuracy reaches the Cramer-Rao bound);
 * ``calibrated``: the section 4.1 knife-edge fit replaces the assumed depth and Poisson's
   ratio, then the section 3.1 sweep with the 50-g probe gives every tactel's gain against
@@ -25,10 +25,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tactsense.estimate import calibrate as cal
-from tactsense.estimate.deflection import baseline_from
-from tactsense.estimate.locate import locate
-from tactsense.estimate.model_fit import fit_frames
+from tactsense.estimate.finger import calibrate as cal
+from tactsense.estimate.finger.deflection import baseline_from
+from tactsense.estimate.finger.locate import locate
+from tactsense.estimate.finger.model_fit import fit_frames
 from tactsense.geometry import wrap_angle_deg
 from tactsense.physics.contact import Probe, grams_force
 from tactsense.physics.transduction import deflection_to_counts

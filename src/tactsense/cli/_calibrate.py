@@ -145,7 +145,7 @@ def calibrate(
     or a uniform press (--press), given first with the weights as --loads. Applied by
     locate, live and view with --calibration.
     """
-    from tactsense.estimate import calibrate as cal
+    from tactsense.estimate.finger import calibrate as cal
 
     try:
         check_output(out, force, inputs=[sweep, steps, knife, force_log, loads, knife_log])
@@ -257,8 +257,8 @@ def calibrate(
 
 def _calibrate_array(recording, out, *, press, force_log, loads, baseline_frames, partial,
                      threshold=None):  # fmt: skip
-    """``calibrate`` on a pad or a point set (tactsense.estimate.array_calibration)."""
-    from tactsense.estimate.array_calibration import calibrate_array, read_weights_log
+    """``calibrate`` on a pad or a point set (tactsense.estimate.contacts.array_calibration)."""
+    from tactsense.estimate.contacts.array_calibration import calibrate_array, read_weights_log
     from tactsense.io.recording import RecordingReader
 
     log = read_weights_log(force_log) if force_log is not None else None
@@ -433,7 +433,7 @@ def _deflection_of(rec, row, col, baseline_frames):
 
 
 def _fit_steps(rec, sensor, row, col, baseline_frames):
-    from tactsense.estimate import calibrate as cal
+    from tactsense.estimate.finger import calibrate as cal
 
     if rec.sensor != sensor:
         raise TactsenseInputError("the steps recording comes from another sensor than the sweep")
@@ -455,7 +455,7 @@ def _fit_knife(rec, sensor, row, col, baseline_frames, *, creep=None, log=None):
     its residual smaller: a knife held 0.5 s and lifted 0.5 s leaves the rubber's memory
     in every reading, which otherwise bends the fit (depth 4.07 mm and nu 0.228 for the
     twin's 3.8 mm and 0.4). Returns (fit, whether it is the compensated one)."""
-    from tactsense.estimate import calibrate as cal
+    from tactsense.estimate.finger import calibrate as cal
 
     if rec.sensor != sensor:
         raise TactsenseInputError("the knife recording comes from another sensor than the sweep")
@@ -466,7 +466,7 @@ def _fit_knife(rec, sensor, row, col, baseline_frames, *, creep=None, log=None):
         )
     signal = _deflection_of(rec, row, col, baseline_frames)
     if log is not None:
-        from tactsense.estimate.array_calibration import presses_from_log, read_stage_log
+        from tactsense.estimate.contacts.array_calibration import presses_from_log, read_stage_log
 
         # the tactel reads at its own moment of each scan: the log at those times
         sampled = np.asarray(rec.time_s) + float(np.asarray(rec.sample_offset_s)[row, col])

@@ -24,7 +24,7 @@ from tactsense.cli._live_sources import (
     TimeoutOption,
     _open_reader,
 )
-from tactsense.estimate.array_calibration import load_calibration
+from tactsense.estimate.contacts.array_calibration import load_calibration
 from tactsense.sensor import load_sensor
 
 
@@ -82,7 +82,7 @@ def view(
     """
     import webbrowser
 
-    from tactsense.estimate.deflection import baseline_from
+    from tactsense.estimate.finger.deflection import baseline_from
     from tactsense.view import LiveFeed, RecordingFeed, ViewServer, view_locator
     from tactsense.view.server import is_loopback
 

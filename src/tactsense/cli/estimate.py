@@ -176,7 +176,7 @@ def locate(
             sensor = reader.sensor
         calibrated = None
         if calibration is not None:
-            from tactsense.estimate.array_calibration import load_calibration
+            from tactsense.estimate.contacts.array_calibration import load_calibration
 
             calibrated = load_calibration(calibration, sensor)
         many = kind_of(sensor).multi_contact  # a pad's, a point set's: the long table

@@ -21,7 +21,7 @@ from tactsense.cli._common import (
     progress_bar,
     remove_stale_partials,
 )
-from tactsense.estimate.array_calibration import load_calibration
+from tactsense.estimate.contacts.array_calibration import load_calibration
 from tactsense.kinds import kind_of
 
 app = new_group("Other tools' formats: MCAP (ROS 2, Foxglove) and Rerun.")

@@ -71,7 +71,7 @@ from tactsense.cli._scenario import (
     run_scenario,
 )
 from tactsense.cli._view_command import view
-from tactsense.estimate.array_calibration import load_calibration
+from tactsense.estimate.contacts.array_calibration import load_calibration
 from tactsense.kinds import kind_of
 from tactsense.sensor import load_sensor
 

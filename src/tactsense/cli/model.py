@@ -194,7 +194,7 @@ def write_force_log(recording: Path, path: Path, chunk: int = 65_536) -> int:
 
     Columns ``time_s`` (the frame's time on the recording's clock [s]) and ``force_n``
     (the total force of the step the frame reads, jitter included [N]), the format
-    :func:`tactsense.estimate.array_calibration.read_force_log` reads; read from the
+    :func:`tactsense.estimate.contacts.array_calibration.read_force_log` reads; read from the
     file's truth in pieces (memory stays flat). Returns the number of rows.
     """
     import csv

@@ -3,14 +3,13 @@
 Two jobs: the paper's finger pipeline (:mod:`tactsense.estimate.finger`) and contacts on
 any array (:mod:`tactsense.estimate.contacts`); their result types and flags are
 :mod:`tactsense.estimate.results`, the writers :mod:`tactsense.estimate.output`. The
-modules beside them with the old names (``deflection``, ``locate``, ``calibrate``,
-``baseline``, ``track``, ``array_calibration``, ``_contacts_fast``, ...) are the old import
-paths of the moved modules: each is the moved module itself.
+finger's modules are ``tactsense.estimate.finger.<name>`` (``deflection``, ``force``,
+``angle``, ``interpolate``, ``localize``, ``locate``, ``realtime``, ``model_fit``,
+``contours``, ``calibrate``), the arrays' ``tactsense.estimate.contacts.<name>``
+(``find``, ``track``, ``baseline``, ``array_calibration``, ...); the names below are the
+public API and keep their paths.
 """
 
-# the old module path first: importing it later would rebind the name ``locate`` (the
-# function below) to the module
-from tactsense.estimate import locate as _locate_module  # noqa: F401
 from tactsense.estimate.finger.angle import angle_from_skew, even_odd, inverse_filter, skew_index
 from tactsense.estimate.finger.calibrate import Calibration, CalibrationError, calibrate_sweep
 from tactsense.estimate.finger.deflection import baseline_from, deflection_from_counts

@@ -331,7 +331,7 @@ class CreepCompensator:
     def coefficients(self) -> tuple[float, float, float, float, float]:
         """``(a_d e_d, a_c e_c, 1 / c, e_d, e_c)``: ``u = (y - a_d e_d m_d - a_c e_c
         m_c) / c``, then ``m <- e m + (1 - e) u`` for each memory (the compiled twin in
-        :mod:`tactsense.estimate.baseline`)."""
+        :mod:`tactsense.estimate.contacts.baseline`)."""
         return (
             self._a_d * self._e_d,
             self._a_c * self._e_c,

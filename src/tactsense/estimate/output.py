@@ -94,7 +94,7 @@ class EstimatesWriter:
     Every format has the same column names, those of :class:`Estimates` with ``frame``
     and ``time_s`` (units in the name or in :attr:`Estimates.UNITS`: ``axial_mm``,
     ``force_n``...; the names ``live`` writes), and flags as integers (bits of
-    :class:`~tactsense.estimate.deflection.Flag`); CSV adds ``flag_names`` (``A|B``,
+    :class:`~tactsense.estimate.finger.deflection.Flag`); CSV adds ``flag_names`` (``A|B``,
     empty when none). Parquet and HDF5 keep the units in their metadata. Floats keep
     full precision. HDF5 datasets are compressed (gzip) and checksummed (Fletcher-32),
     with chunks no longer than the data.

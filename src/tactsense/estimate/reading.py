@@ -103,7 +103,7 @@ def signal_from_counts(frames, baseline, sensor, *, dead=None):
     Unusable taxels (``dead``, a NaN baseline, one that gives no signal:
     :func:`unusable_baseline`) read 0 and set ``DEAD_TACTEL``; a reading at the rail the
     reading moves toward (full scale rising, 0 falling) sets ``SATURATED``; otherwise as
-    :func:`~tactsense.estimate.deflection.deflection_from_counts`.
+    :func:`~tactsense.estimate.finger.deflection.deflection_from_counts`.
 
     Returns
     -------

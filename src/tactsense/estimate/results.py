@@ -35,8 +35,8 @@ class Flag(IntFlag):
     """A taxel read below its baseline by more than the contact threshold where no
     tension beside a contact explains it (a resistive taxel, a frame without contact, or
     deeper than the frame's largest compression:
-    :func:`~tactsense.estimate.baseline.below_baseline`): the baseline was taken under
-    load, or has drifted (:class:`~tactsense.estimate.baseline.DriftBaseline`)."""
+    :func:`~tactsense.estimate.contacts.baseline.below_baseline`): the baseline was taken under
+    load, or has drifted (:class:`~tactsense.estimate.contacts.baseline.DriftBaseline`)."""
     NEGATIVE_FORCE = 512
     """A tactel is above the contact threshold but the deflections sum to zero or less:
     the skin reads as much tension as compression around the contact (as the solid 3-D
@@ -45,7 +45,7 @@ class Flag(IntFlag):
     BEYOND_CALIBRATION = 1024
     """The contact's total signal lies beyond the range its array calibration's weights
     covered (above the heaviest unsaturated weight): its force would be an extrapolation,
-    so it is NaN (:mod:`~tactsense.estimate.array_calibration`)."""
+    so it is NaN (:mod:`~tactsense.estimate.contacts.array_calibration`)."""
 
     @classmethod
     def describe(cls, value: int) -> str:
@@ -77,7 +77,7 @@ class Estimates:
     converged: np.ndarray
     """Newton reached 0.01 tactel."""
     flags: np.ndarray
-    """:class:`~tactsense.estimate.deflection.Flag` bits."""
+    """:class:`~tactsense.estimate.finger.deflection.Flag` bits."""
 
     UNITS: ClassVar[dict[str, str]] = {
         "row": "tactel",
@@ -142,7 +142,7 @@ class ContactTable:
     taxels: np.ndarray
     """Taxels in the contact's region [-], int32."""
     flags: np.ndarray
-    """:class:`~tactsense.estimate.deflection.Flag` bits of the contact, int64."""
+    """:class:`~tactsense.estimate.finger.deflection.Flag` bits of the contact, int64."""
     n_frames: int = 0
     """Frames the table covers (frames with no contact have no row)."""
     id: np.ndarray | None = None

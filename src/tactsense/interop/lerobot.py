@@ -368,7 +368,7 @@ def export_lerobot(
     ``episodes``, ``fps`` and the sensor's ``kind``.
     """
     from tactsense.batch import iter_locate
-    from tactsense.estimate.locate import CONTACT_THRESHOLD
+    from tactsense.estimate.finger.locate import CONTACT_THRESHOLD
     from tactsense.io.recording import RecordingReader
 
     out = Path(out)

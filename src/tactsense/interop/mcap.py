@@ -410,7 +410,7 @@ def export_mcap(
     """
     from tactsense.batch import iter_locate
     from tactsense.estimate import Flag
-    from tactsense.estimate.locate import CONTACT_THRESHOLD
+    from tactsense.estimate.finger.locate import CONTACT_THRESHOLD
     from tactsense.io.recording import RecordingReader
 
     with RecordingReader(recording) as reader, open(out, "wb") as stream:

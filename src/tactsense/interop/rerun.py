@@ -94,8 +94,8 @@ def export_rerun(
 
     from tactsense.batch import iter_locate
     from tactsense.estimate import Flag
-    from tactsense.estimate.deflection import deflection_from_counts
-    from tactsense.estimate.locate import CONTACT_THRESHOLD
+    from tactsense.estimate.finger.deflection import deflection_from_counts
+    from tactsense.estimate.finger.locate import CONTACT_THRESHOLD
     from tactsense.io.recording import RecordingReader
     from tactsense.physics.contact import newtons_to_grams
 
@@ -196,7 +196,7 @@ def _export_array(
     from matplotlib import colormaps
 
     from tactsense.batch import iter_contacts
-    from tactsense.estimate.array_calibration import ArrayCalibration
+    from tactsense.estimate.contacts.array_calibration import ArrayCalibration
     from tactsense.estimate.contacts import signal_from_counts
     from tactsense.physics.contact import newtons_to_grams
 

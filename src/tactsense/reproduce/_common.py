@@ -13,7 +13,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
 import tactsense as ts
-from tactsense.estimate import calibrate as cal
+from tactsense.estimate.finger import calibrate as cal
 from tactsense.physics.transduction import fractional_deflection
 from tactsense.reproduce.basis import BY_CONSTRUCTION, FITTED, basis_of
 

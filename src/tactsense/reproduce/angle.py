@@ -6,8 +6,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import tactsense as ts
-from tactsense.estimate.angle import even_odd, skew_index
-from tactsense.estimate.interpolate import surface
+from tactsense.estimate.finger.angle import even_odd, skew_index
+from tactsense.estimate.finger.interpolate import surface
 from tactsense.physics import halfplane as hp
 from tactsense.reproduce._common import (
     Claim,

@@ -6,7 +6,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import tactsense as ts
-from tactsense.estimate.interpolate import surface
+from tactsense.estimate.finger.interpolate import surface
 from tactsense.reproduce._common import (
     G50,
     MEASURED,

@@ -6,7 +6,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import tactsense as ts
-from tactsense.estimate import calibrate as cal
+from tactsense.estimate.finger import calibrate as cal
 from tactsense.physics import halfplane as hp
 from tactsense.reproduce._common import (
     Claim,

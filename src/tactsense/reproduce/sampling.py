@@ -9,8 +9,8 @@ from scipy.optimize import minimize_scalar
 
 import tactsense as ts
 from tactsense.analysis import aliasing as al
-from tactsense.estimate.contours import track_contour
-from tactsense.estimate.interpolate import surface
+from tactsense.estimate.finger.contours import track_contour
+from tactsense.estimate.finger.interpolate import surface
 from tactsense.geometry import tactel_to_surface
 from tactsense.reproduce._common import (
     Claim,

@@ -9,7 +9,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import tactsense as ts
-from tactsense.estimate.interpolate import surface
+from tactsense.estimate.finger.interpolate import surface
 from tactsense.physics.flaws import draw_gains
 from tactsense.physics.transduction import (
     deflection_to_counts,

@@ -10,9 +10,9 @@ import numpy as np
 from tactsense._validation import TactsenseInputError
 from tactsense.estimate import Flag, locate
 from tactsense.estimate.creep import CreepCompensator
-from tactsense.estimate.deflection import deflection_from_counts
-from tactsense.estimate.locate import CONTACT_THRESHOLD
-from tactsense.estimate.realtime import RealTimeLocator
+from tactsense.estimate.finger.deflection import deflection_from_counts
+from tactsense.estimate.finger.locate import CONTACT_THRESHOLD
+from tactsense.estimate.finger.realtime import RealTimeLocator
 from tactsense.kinds import kind_of
 from tactsense.physics.contact import newtons_to_grams
 from tactsense.sensor import SensorSpec
@@ -70,7 +70,7 @@ class LiveLocator:
     """The contact of every frame of a stream, with its latency.
 
     Without a calibration the first ``baseline_frames`` frames (untouched) give the
-    baseline and then :class:`~tactsense.estimate.realtime.RealTimeLocator` runs on
+    baseline and then :class:`~tactsense.estimate.finger.realtime.RealTimeLocator` runs on
     each frame. With a calibration its baseline, nonlinearity table, gains and excluded
     tactels apply from the first frame, and its creep model is inverted causally
     (:class:`~tactsense.estimate.creep.CreepCompensator`).
@@ -253,10 +253,10 @@ class LiveContacts:
 
     The first ``baseline_frames`` frames (untouched) make the baseline, which then
     follows slow drift where taxels are untouched
-    (:class:`~tactsense.estimate.baseline.DriftBaseline`, time constant ``drift_s``);
+    (:class:`~tactsense.estimate.contacts.baseline.DriftBaseline`, time constant ``drift_s``);
     :meth:`rezero` takes a new one from the next frames. Each frame goes through
     :func:`~tactsense.estimate.contacts.find_contacts` and a
-    :class:`~tactsense.estimate.track.ContactTracker`, so ids stay with their contacts
+    :class:`~tactsense.estimate.contacts.track.ContactTracker`, so ids stay with their contacts
     from frame to frame.
 
     Parameters
@@ -298,9 +298,9 @@ class LiveContacts:
         method: str = "interpolate",
         calibration=None,
     ):
-        from tactsense.estimate.array_calibration import ArrayCalibration
+        from tactsense.estimate.contacts.array_calibration import ArrayCalibration
         from tactsense.estimate.contacts import default_threshold, find_contacts
-        from tactsense.estimate.track import ContactTracker
+        from tactsense.estimate.contacts.track import ContactTracker
 
         if calibration is not None:
             if not isinstance(calibration, ArrayCalibration):
@@ -356,7 +356,7 @@ class LiveContacts:
         self.reset()
 
     def _set_baseline(self, baseline: np.ndarray) -> None:
-        from tactsense.estimate.baseline import DriftBaseline
+        from tactsense.estimate.contacts.baseline import DriftBaseline
         from tactsense.estimate.creep import described_compensation
 
         creep, stiffening = described_compensation(self.sensor)  # as 'locate' (docs/contacts.md)
@@ -384,7 +384,7 @@ class LiveContacts:
 
     def reset(self) -> None:
         """Forget the tracks (after a jump in time, e.g. a seek in a recording)."""
-        from tactsense.estimate.track import ContactTracker
+        from tactsense.estimate.contacts.track import ContactTracker
 
         self._tracker = ContactTracker(self.frame_period_s)
         self._serial = 0

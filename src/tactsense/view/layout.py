@@ -5,7 +5,7 @@ how to draw it: ``"unwrapped"`` (the paper's finger cut open), ``"grid"`` (a fla
 millimetres) or ``"dots"`` (any taxel set, projected onto the plane normal to its mean
 normal). The page draws the interpolated surface itself from weights sent once here:
 ``surface = W_rows @ deflection[cylinder rows] @ W_cols.T`` is the windowed-sinc
-reconstruction of eq. 48 (:func:`tactsense.estimate.interpolate.surface`) on a grid
+reconstruction of eq. 48 (:func:`tactsense.estimate.finger.interpolate.surface`) on a grid
 ``SURFACE_STEPS`` times finer than the tactels, periodic around a closed finger.
 """
 
@@ -17,7 +17,7 @@ import numpy as np
 from matplotlib import colormaps
 
 from tactsense.estimate import Flag
-from tactsense.estimate.interpolate import col_weights, row_weights
+from tactsense.estimate.finger.interpolate import col_weights, row_weights
 from tactsense.kinds import kind_of
 from tactsense.sensor import SensorSpec, SpecBase
 from tactsense.stream.reader import LOSS_KINDS

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from tactsense._validation import TactsenseInputError
-from tactsense.estimate.deflection import deflection_from_counts
+from tactsense.estimate.finger.deflection import deflection_from_counts
 from tactsense.kinds import kind_of, kinds
 from tactsense.sensor import SpecBase
 from tactsense.stream.live import LiveContacts, LiveLocator

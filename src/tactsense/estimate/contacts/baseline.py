@@ -308,7 +308,7 @@ class DriftBaseline:
     ----------
     baseline : array_like, shape (rows, cols)
         The untouched readings to start from [counts] (e.g. the median of the first
-        frames, :func:`~tactsense.estimate.deflection.baseline_from`).
+        frames, :func:`~tactsense.estimate.finger.deflection.baseline_from`).
     sensor : SensorSpec, PadSpec or PointsSpec
     frame_period_s : float
         Time between frames [s].

@@ -1,6 +1,6 @@
 """Calibration of any array from a lab's own data: pads and point sets.
 
-A finger's calibration (:class:`~tactsense.estimate.calibrate.Calibration`) follows the
+A finger's calibration (:class:`~tactsense.estimate.finger.calibrate.Calibration`) follows the
 paper's procedure. A pad or a point set is calibrated from what a lab can record on its
 bench:
 
@@ -104,7 +104,7 @@ class ArrayCalibration:
     def signal(self, frames, sensor, *, baseline=None):
         """Calibrated signal of every frame and the frames' flags: the signal against
         ``baseline`` (default this calibration's; a
-        :class:`~tactsense.estimate.baseline.DriftBaseline` started from it follows
+        :class:`~tactsense.estimate.contacts.baseline.DriftBaseline` started from it follows
         drift), divided by the gains, dead taxels zeroed."""
         from tactsense.estimate.reading import signal_from_counts
 
@@ -243,7 +243,7 @@ class ArrayCalibration:
 
 def load_calibration(path: str | Path, sensor=None):
     """A calibration file of either kind: a finger's
-    (:class:`~tactsense.estimate.calibrate.Calibration`) or an array's
+    (:class:`~tactsense.estimate.finger.calibrate.Calibration`) or an array's
     (:class:`ArrayCalibration`), checked against ``sensor`` when given."""
     from tactsense.estimate.finger.calibrate import Calibration
 

@@ -2,7 +2,7 @@
 
 A :class:`ContactTable` holds one row per contact per frame (a "long" table): the
 segmentation (:func:`find_contacts`) fills the geometric columns, the tracker
-(:mod:`tactsense.estimate.track`) the identity and motion columns. Frames without any
+(:mod:`tactsense.estimate.contacts.track`) the identity and motion columns. Frames without any
 contact have no row; ``n_frames`` says how many frames the table covers, so that empty
 frames are known.
 
@@ -78,7 +78,7 @@ def find_contacts(
     bonded to a rigid base has no net normal strain under a load (nu = 0.5). On the
     finger, the paper's integral (eq. 55) of the frame shared among the contacts in
     proportion to their summed deflection (one contact: exactly
-    :func:`~tactsense.estimate.locate`'s force). On a point set, the amplitude of the
+    :func:`~tactsense.estimate.finger.locate`'s force). On a point set, the amplitude of the
     response to a load at the nearest taxel.
 
     Parameters
@@ -89,7 +89,7 @@ def find_contacts(
     sensor : SensorSpec, PadSpec or PointsSpec
     baseline : array_like, shape (rows, cols), or DriftBaseline
         Untouched readings [counts]; required with counts unless ``calibration``. A
-        :class:`~tactsense.estimate.baseline.DriftBaseline` follows slow drift where taxels
+        :class:`~tactsense.estimate.contacts.baseline.DriftBaseline` follows slow drift where taxels
         are untouched (it moves on with every frame given).
     dead : array_like of bool, shape (rows, cols), optional
         Taxels to ignore.
@@ -97,9 +97,9 @@ def find_contacts(
         Smallest signal that counts as contact [-]; :func:`default_threshold`.
     calibration : Calibration or ArrayCalibration, optional
         A finger's calibration (its baseline, gains, nonlinearity, creep), or a pad's or
-        point set's (:class:`~tactsense.estimate.array_calibration.ArrayCalibration`:
+        point set's (:class:`~tactsense.estimate.contacts.array_calibration.ArrayCalibration`:
         baseline, gains, dead taxels, force curve); ``baseline`` may then be a
-        :class:`~tactsense.estimate.baseline.DriftBaseline` started from its baseline.
+        :class:`~tactsense.estimate.contacts.baseline.DriftBaseline` started from its baseline.
     max_contacts : int
         At most this many contacts per frame, the largest kept (1-64).
     method : {"interpolate", "cop"}
@@ -289,7 +289,7 @@ def _grid_contacts(
 
 
 def _finger_positions(signal, labels, seg, sensor, threshold, method):
-    """Each contact of a finger frame located by :func:`~tactsense.estimate.locate` on
+    """Each contact of a finger frame located by :func:`~tactsense.estimate.finger.locate` on
     the frame with the other contacts' taxels zeroed (one contact: the frame as read,
     so that the numbers are locate's own)."""
     from tactsense.estimate.finger.force import force_per_deflection

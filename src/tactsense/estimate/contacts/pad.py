@@ -79,7 +79,7 @@ FIT_STEPS = 32
 
 def pad_fit(signal, labels, seg, sensor):
     """Maximum-likelihood row, column [taxel] and force [N] of each contact of a pad
-    (:func:`~tactsense.estimate._contacts_fast.fit_into`)."""
+    (:func:`~tactsense.estimate.contacts._fast.fit_into`)."""
     from tactsense.estimate.contacts._fast import fit_into
 
     n = len(seg["frame"])
@@ -144,7 +144,7 @@ def pad_merged_force(signal, labels, seg, row, col, sensor, threshold, force) ->
     """A pad contact that holds two loads too close to part carries the force of both:
     ``force`` [N] is replaced in place by the two loads' summed amplitudes where two
     explain the contact's signal clearly better than one
-    (:func:`~tactsense.estimate._contacts_fast.merged_force`, :data:`MERGED_GAIN`)."""
+    (:func:`~tactsense.estimate.contacts._fast.merged_force`, :data:`MERGED_GAIN`)."""
     from tactsense.estimate.contacts._fast import merged_force
 
     if len(force) == 0:

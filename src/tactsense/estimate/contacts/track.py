@@ -86,7 +86,7 @@ class _Track:
 def assign(cost: np.ndarray, limit: float) -> list[tuple[int, int]]:
     """Pairs (row, col) of least total cost, none at or above ``limit`` (a row may stay
     unmatched rather than take such a pair): the compiled Hungarian method
-    (:func:`~tactsense.estimate._contacts_fast.hungarian`)."""
+    (:func:`~tactsense.estimate.contacts._fast.hungarian`)."""
     from tactsense.estimate.contacts._fast import hungarian
 
     cost = np.asarray(cost, dtype=float)

@@ -1,7 +1,7 @@
 """Compiled per-frame estimation (Numba): Newton on the interpolated surface, force, skew.
 
-The same mathematics as :mod:`~tactsense.estimate.interpolate`,
-:mod:`~tactsense.estimate.localize` and :mod:`~tactsense.estimate.angle`, written as
+The same mathematics as :mod:`~tactsense.estimate.finger.interpolate`,
+:mod:`~tactsense.estimate.finger.localize` and :mod:`~tactsense.estimate.finger.angle`, written as
 one loop over frames so that each frame stays in cache and no temporary arrays are
 made; the test suite checks that both give the same numbers. Trigonometric functions
 are evaluated once per axis and step and shifted with angle-addition identities.
@@ -407,7 +407,7 @@ def taxel_signal(
 def prepare_frames(frames, baseline, unusable, full_scale, nan_flag, saturated_flag, dead_flag):
     """Eq. 4 deflection, per-frame flags and the largest tactel, in one pass.
 
-    The compiled twin of :func:`tactsense.estimate.deflection.deflection_from_counts`.
+    The compiled twin of :func:`tactsense.estimate.finger.deflection.deflection_from_counts`.
 
     Parameters
     ----------

@@ -46,7 +46,7 @@ def locate(
         The finger the frames come from.
     baseline : array_like, shape (rows, cols)
         Undeflected readings [counts]; required with counts (see
-        :func:`~tactsense.estimate.deflection.baseline_from`).
+        :func:`~tactsense.estimate.finger.deflection.baseline_from`).
     dead : array_like of bool, shape (rows, cols), optional
         Tactels to ignore.
     threshold : float

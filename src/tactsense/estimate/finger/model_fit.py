@@ -4,7 +4,7 @@ With independent Gaussian reading noise of equal variance (docs/accuracy.md), th
 maximum-likelihood contact is the least-squares fit of the expected frame (eqs. 1-2
 through the converter, scaled by each tactel's baseline) to the readings. The
 parameters are the probe's position along and around the finger and its force; the
-fit starts from the interpolation estimate of :func:`~tactsense.estimate.locate`.
+fit starts from the interpolation estimate of :func:`~tactsense.estimate.finger.locate`.
 Only physics functions are used (the array response), never the simulator.
 """
 

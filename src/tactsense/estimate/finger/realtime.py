@@ -49,7 +49,7 @@ class Contact(NamedTuple):
 
 
 class RealTimeLocator:
-    """Everything :func:`~tactsense.estimate.locate` does, for one frame at a time, fast.
+    """Everything :func:`~tactsense.estimate.finger.locate` does, for one frame at a time, fast.
 
     The baseline, the excluded tactels and the constants are prepared once; each call
     runs one compiled function on the frame and a few float operations, about
@@ -165,7 +165,7 @@ class RealTimeLocator:
     def from_deflection(self, deflection) -> Contact:
         """Estimate the contact of one frame of fractional deflection [-], shape (rows,
         cols), that a calibration made (:meth:`Calibration.apply
-        <tactsense.estimate.calibrate.Calibration.apply>`: gains, nonlinearity and creep
+        <tactsense.estimate.finger.calibrate.Calibration.apply>`: gains, nonlinearity and creep
         applied, excluded tactels 0): the compiled path of ``live --calibration``."""
         deflection = np.ascontiguousarray(deflection, dtype=np.float64)
         if deflection.shape != self._shape:

@@ -16,7 +16,7 @@ def prepare_signal(
     """Signal of every taxel and the flags of each frame, in one pass.
 
     Compression positive whichever way the reading moves (``falling``):
-    :func:`~tactsense.estimate._fast.taxel_signal`. Unusable taxels (excluded, NaN, an
+    :func:`~tactsense.estimate.finger._fast.taxel_signal`. Unusable taxels (excluded, NaN, an
     open capacitive junction) read 0.
     """
     n, rows, cols = frames.shape

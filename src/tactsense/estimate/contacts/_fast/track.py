@@ -87,7 +87,7 @@ def track_into(
     dt, gate, weight, max_missing, smoothing, slip_speed, slip_rate, far, reach,
     out_id, out_vel, out_slip, ev_frame, ev_kind, ev_id, ev_other,
 ):  # fmt: skip
-    """The compiled :class:`~tactsense.estimate.track.ContactTracker` (same rules, same
+    """The compiled :class:`~tactsense.estimate.contacts.track.ContactTracker` (same rules, same
     order of events as its Python reference ``ReferenceTracker``).
 
     Tracks live in ``t_*[:counters[0]]``; ``counters`` = (tracks alive, next id,
