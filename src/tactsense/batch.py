@@ -203,11 +203,11 @@ class iter_contacts:
         tracker_options: dict | None = None,
         drift_s: float | None = None,
     ):
+        from tactsense.estimate.contacts import default_threshold
         from tactsense.estimate.contacts.array_calibration import ArrayCalibration
         from tactsense.estimate.contacts.baseline import DriftBaseline, ReadingRange, taxel_health
-        from tactsense.estimate.contacts import default_threshold
-        from tactsense.estimate.creep import creep_applied
         from tactsense.estimate.contacts.track import ContactTracker
+        from tactsense.estimate.creep import creep_applied
 
         sensor = reader.sensor
         self.reader = reader
@@ -327,8 +327,8 @@ def contacts_file(
         polarity, or no contact although they moved by more than the threshold,
         :func:`~tactsense.estimate.contacts.baseline.movement_warning`; else None).
     """
-    from tactsense.estimate.contacts.baseline import health_warning, movement_warning
     from tactsense.estimate.contacts import default_threshold, find_contacts
+    from tactsense.estimate.contacts.baseline import health_warning, movement_warning
     from tactsense.estimate.output import ContactsWriter
 
     output_format(out)

@@ -12,6 +12,7 @@ from typer.testing import CliRunner
 import tactsense as ts
 from tactsense import flat_scenarios as fs
 from tactsense.cli import app
+from tactsense.estimate.contacts import find_contacts
 from tactsense.estimate.contacts.array_calibration import (
     ArrayCalibration,
     ArrayCalibrationError,
@@ -20,7 +21,6 @@ from tactsense.estimate.contacts.array_calibration import (
     load_calibration,
     read_force_log,
 )
-from tactsense.estimate.contacts import find_contacts
 from tactsense.physics.indenters import SphereProbe
 from tactsense.simulate import Scenario, Step
 

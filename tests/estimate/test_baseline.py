@@ -9,8 +9,8 @@ import pytest
 import tactsense as ts
 from tactsense._validation import TactsenseInputError
 from tactsense.estimate import Flag
-from tactsense.estimate.contacts.baseline import DriftBaseline
 from tactsense.estimate.contacts import default_threshold, find_contacts
+from tactsense.estimate.contacts.baseline import DriftBaseline
 from tactsense.simulate import repeated_load
 
 

@@ -10,8 +10,8 @@ import pandas as pd
 import pytest
 
 from tactsense.estimate.contacts import find_contacts
-from tactsense.estimate.output import ContactsWriter
 from tactsense.estimate.contacts.track import ContactTracker
+from tactsense.estimate.output import ContactsWriter
 from tactsense.physics.indenters import CylinderProbe, SphereProbe, SquareStamp
 from tactsense.sensor.registry import load_sensor
 from tactsense.simulate import Scenario, Step, simulate

@@ -7,6 +7,7 @@ import pytest
 
 import tactsense as ts
 from tactsense import flat_scenarios as fs
+from tactsense.estimate.contacts import find_contacts, signal_from_counts
 from tactsense.estimate.contacts.array_calibration import (
     ArrayCalibration,
     ArrayCalibrationError,
@@ -17,7 +18,6 @@ from tactsense.estimate.contacts.array_calibration import (
     temperature_coefficient,
     weight_curve,
 )
-from tactsense.estimate.contacts import find_contacts, signal_from_counts
 from tactsense.estimate.finger.deflection import Flag
 
 G = 9.80665e-3  # N per gram-force

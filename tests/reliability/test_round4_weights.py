@@ -121,7 +121,11 @@ def test_threshold_is_for_arrays(tmp_path):
 
 def test_every_press_saturated_is_said_with_its_load(bench):
     """The lightest weight's load is named (1.96 N = 200 g)."""
-    from tactsense.estimate.contacts.array_calibration import ArrayCalibrationError, Presses, weight_curve
+    from tactsense.estimate.contacts.array_calibration import (
+        ArrayCalibrationError,
+        Presses,
+        weight_curve,
+    )
 
     with pytest.raises(ArrayCalibrationError, match=r"the lightest, 1\.96 N"):
         weight_curve(Presses(np.arange(3), np.arange(3) + 1, np.ones(3),

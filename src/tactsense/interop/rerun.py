@@ -196,8 +196,8 @@ def _export_array(
     from matplotlib import colormaps
 
     from tactsense.batch import iter_contacts
-    from tactsense.estimate.contacts.array_calibration import ArrayCalibration
     from tactsense.estimate.contacts import signal_from_counts
+    from tactsense.estimate.contacts.array_calibration import ArrayCalibration
     from tactsense.physics.contact import newtons_to_grams
 
     sensor = reader.sensor

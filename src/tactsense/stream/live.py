@@ -298,8 +298,8 @@ class LiveContacts:
         method: str = "interpolate",
         calibration=None,
     ):
-        from tactsense.estimate.contacts.array_calibration import ArrayCalibration
         from tactsense.estimate.contacts import default_threshold, find_contacts
+        from tactsense.estimate.contacts.array_calibration import ArrayCalibration
         from tactsense.estimate.contacts.track import ContactTracker
 
         if calibration is not None:
