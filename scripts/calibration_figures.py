@@ -15,7 +15,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import tactsense as ts
-from tactsense.estimate import calibrate as cal
+from tactsense.estimate.finger import calibrate as cal
 from tactsense.physics.flaws import draw_gains
 from tactsense.physics.transduction import fractional_deflection
 

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from tactsense.estimate import calibrate as cal
+from tactsense.estimate.finger import calibrate as cal
 
 
 def creep_calibration(spec, baseline, creep=(0.5, 0.05, 0.3, 10.0)) -> cal.Calibration:

@@ -9,7 +9,7 @@ import pytest
 import tactsense as ts
 from tactsense._validation import TactsenseInputError
 from tactsense.batch import EstimatesWriter, iter_locate, locate_file
-from tactsense.estimate import calibrate as cal
+from tactsense.estimate.finger import calibrate as cal
 from tactsense.io.recording import RecordingReader
 from tests._calibrations import creep_calibration
 

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import tactsense as ts
-from tactsense.estimate import calibrate as cal
+from tactsense.estimate.finger import calibrate as cal
 from tactsense.geometry import wrap_angle_deg
 from tactsense.physics.transduction import fractional_deflection
 

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 import tactsense as ts
-from tactsense.estimate import angle as ang
+from tactsense.estimate.finger import angle as ang
 from tactsense.estimate.finger.force import force_per_deflection, ideal_force_per_deflection
 from tactsense.physics import halfplane as hp
 

@@ -3,7 +3,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from tactsense.estimate import interpolate as ip
+from tactsense.estimate.finger import interpolate as ip
 
 
 def test_kernel_interpolates_samples_and_vanishes_outside_window():

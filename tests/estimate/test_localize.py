@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 import tactsense as ts
-from tactsense.estimate import interpolate as ip
+from tactsense.estimate.finger import interpolate as ip
 from tactsense.estimate.finger.localize import locate_contacts, newton_peak
 
 

@@ -401,7 +401,7 @@ def test_no_lift_no_rezero(unknown, name, monkeypatch):
     both above RELEASE_SHARE, so the release does not fire on them."""
     from functools import partial
 
-    from tactsense.estimate import baseline
+    from tactsense.estimate.contacts import baseline
 
     _, count, force, probes, step, _ = _measured_per_frame(unknown[name], 2.0)
     monkeypatch.setattr(baseline, "DriftBaseline", partial(baseline.DriftBaseline, release=False))

@@ -7,7 +7,7 @@ import time
 import numpy as np
 
 import tactsense as ts
-from tactsense.estimate import calibrate as cal
+from tactsense.estimate.finger import calibrate as cal
 from tactsense.stream import LiveLocator
 from tactsense.stream.reader import StreamFrame
 
