@@ -264,3 +264,4 @@ def load_calibration(path: str | Path, sensor=None):
             f"{path} is a finger's calibration; {sensor.name!r} is a {kind.label}: "
             "calibrate it with 'tactsense calibrate' on its own recording"
         )
+    return Calibration.load(path, sensor)
