@@ -61,5 +61,6 @@ def cli_env() -> dict[str, str]:
     import tactsense
 
     src = str(Path(tactsense.__file__).resolve().parents[1])
-    path = os.pathsep.join([src, *PATHS])
+    # the user's own PYTHONPATH stays (a kind of theirs made visible through it joins)
+    path = os.pathsep.join([src, *PATHS, *filter(None, [os.environ.get("PYTHONPATH")])])
     return dict(os.environ, PYTHONPATH=path, COLUMNS="200", NO_COLOR="1")

@@ -69,10 +69,25 @@ class HexPatchSpec(PointsSpec):
     }
 
     def __post_init__(self) -> None:
-        if not (isinstance(self.lattice.rings, int) and 0 <= self.lattice.rings <= 20):
-            raise ValueError(f"[lattice] rings = {self.lattice.rings!r}: expected 0 to 20")
-        object.__setattr__(self, "taxels", hexagon(self.lattice))
-        super().__post_init__()
+        if not self.lattice_problems():  # the taxels follow from a valid lattice
+            object.__setattr__(self, "taxels", hexagon(self.lattice))
+        super().__post_init__()  # every problem at once, as one SensorSpecError
+
+    def lattice_problems(self) -> list[str]:
+        """What is wrong with the ``[lattice]`` section, one sentence each."""
+        lattice, found = self.lattice, []
+        if not (isinstance(lattice.rings, int) and 0 <= lattice.rings <= 20):
+            found.append(f"[lattice] rings = {lattice.rings!r}: expected an integer from 0 to 20")
+        for key in ("pitch_mm", "area_mm2"):
+            value = getattr(lattice, key)
+            if not (isinstance(value, float | int) and math.isfinite(value) and value > 0):
+                found.append(f"[lattice] {key} = {value!r}: expected a positive number")
+        return found
+
+    def problems(self) -> list[str]:
+        """Every problem of the description (``SpecBase`` raises them as one error): the
+        lattice's, else the point set's (layer, transduction, electronics, flaws)."""
+        return self.lattice_problems() or super().problems()
 
     def summary(self) -> list[tuple[str, str]]:
         rows = super().summary()

@@ -15,7 +15,7 @@ from rich.table import Table
 from tactsense._validation import TactsenseInputError
 from tactsense.cli._common import atomic_output, check_output, fail
 from tactsense.io.recording import read_recording
-from tactsense.kinds import kind_of
+from tactsense.kinds import kind_of, kinds
 
 
 def calibrate(
@@ -156,7 +156,9 @@ def calibrate(
         if kind_of(kind).array_calibration:  # else the paper's finger calibration
             for name, value in (("--steps", steps), ("--knife", knife), ("--knife-log", knife_log)):
                 if value is not None:
-                    raise TactsenseInputError(f"{name} is for fingers; {sweep} holds a {kind}")
+                    raise TactsenseInputError(
+                        f"{name} is for fingers; {sweep} holds a {kind_of(kind).label}"
+                    )
             if loads is not None and force_log is None:
                 raise TactsenseInputError("--loads goes with --force-log (the load cell's log)")
             _calibrate_array(sweep, out, press=press, force_log=force_log, loads=loads,
@@ -166,8 +168,9 @@ def calibrate(
         for name, value in (("--press", press or None), ("--force-log", force_log),
                             ("--loads", loads), ("--threshold", threshold)):  # fmt: skip
             if value is not None:
+                arrays = " and ".join(k.plural for k in kinds().values() if k.array_calibration)
                 raise TactsenseInputError(
-                    f"{name} is for pads and point sets; {sweep} holds a finger"
+                    f"{name} is for {arrays}; {sweep} holds a {kind_of(kind).label}"
                 )
         # the sweep is read in pieces: any length fits in memory
         with RecordingReader(sweep) as reader:

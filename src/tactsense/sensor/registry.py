@@ -450,7 +450,13 @@ def sensor_from_dict(
         raise SensorSpecError(
             f"{source} describes a {kind} sensor; expected a {expected.kind} sensor"
         )
-    return cls.from_dict(data, source=source)
+    try:
+        return cls.from_dict(data, source=source)
+    except SensorSpecError:
+        raise
+    except (ValueError, TypeError, KeyError, AttributeError) as err:
+        # a kind from another package whose description checks by raising: one line
+        raise SensorSpecError(f"{source}: invalid {kind} description: {err}") from None
 
 
 use_registry(PRESETS, sensor_from_dict)
