@@ -182,6 +182,26 @@ BAD_FILES = [
 ]
 
 
+DEADLINE_S = 120
+"""Longest a bad-input case may take [s]: a command that accepts the bad input and goes on
+(a view serving, a live stream reading) fails the case instead of hanging the suite."""
+
+
+def _invoke_with_deadline(args: list[str]):
+    """``runner.invoke(app, args)``, interrupted by SIGALRM after :data:`DEADLINE_S`."""
+
+    def expire(signum, frame):
+        raise TimeoutError(f"tactsense {' '.join(args)} still ran after {DEADLINE_S} s")
+
+    previous = signal.signal(signal.SIGALRM, expire)
+    signal.alarm(DEADLINE_S)
+    try:
+        return runner.invoke(app, args)
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous)
+
+
 @pytest.mark.parametrize("line, names", BAD_FILES, ids=[line for line, _ in BAD_FILES])
 def test_bad_files(workspace, line, names):
     if not (workspace / "strings.h5").exists():
@@ -193,7 +213,7 @@ def test_bad_files(workspace, line, names):
         .replace("DIR", str(workspace))
         .split()
     )
-    result = runner.invoke(app, args)
+    result = _invoke_with_deadline(args)
     _check(result, names)
     assert not out.exists()
 
