@@ -264,6 +264,15 @@ class Kind:
         raise self.unsupported(spec, "a contact response")
 
 
-def positions_of(spec: Any) -> np.ndarray:
-    """Surface positions [mm] of every taxel, frame order, (N, 3)."""
-    return np.asarray(spec.taxel_positions_mm(), dtype=float)
+RESPONSE_PROBE_N = 0.49
+"""The load of the probe whose response :meth:`Kind.contact_response` tabulates: the
+scenarios' 50-g sphere [N]."""
+
+
+def signal_per_strain(spec: Any, strain: np.ndarray, *, signed: bool = False) -> np.ndarray:
+    """A taxel's signal [-] from its compressive strain [-]: times the dielectric's strain
+    gain on a capacitive taxel; on a resistive one the strain itself, clipped at zero (the
+    cell does not read tension) unless ``signed``."""
+    if spec.transduction.kind == "capacitive":
+        return spec.transduction.strain_gain * strain
+    return strain if signed else np.maximum(strain, 0.0)

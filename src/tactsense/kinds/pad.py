@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from tactsense.kinds.base import Kind
+from tactsense.kinds.base import RESPONSE_PROBE_N, Kind, signal_per_strain
 from tactsense.sensor.pad import PadSpec
 from tactsense.sensor.registry import dsa9205, fsr16, pad4, pad12x32, pad16
 
@@ -90,14 +90,13 @@ class PadKind(Kind):
         same pitch, electrodes, layer and transduction large enough for the window (the
         layer's response does not depend on where it is applied)."""
         from tactsense.physics.indenters import SphereProbe
-        from tactsense.physics.pad_response import pad_strain
         from tactsense.sensor.common import Flaws
 
         size = 2 * half + 2
         grid = dataclasses.replace(spec.grid, rows=size, cols=size)
         big = dataclasses.replace(spec, grid=grid, flaws=Flaws())
         g = big.grid
-        newtons = 0.49
+        newtons = RESPONSE_PROBE_N
         kernel = np.empty((n_sub + 1, n_sub + 1, 2 * half + 1, 2 * half + 1))
         step = 1.0 / n_sub
         for a in range(n_sub + 1):
@@ -105,11 +104,8 @@ class PadKind(Kind):
                 probe = SphereProbe(
                     (half + a * step) * g.row_pitch_mm, (half + b * step) * g.col_pitch_mm, newtons
                 )
-                strain = pad_strain(big, [probe])[: 2 * half + 1, : 2 * half + 1] / newtons
-                if spec.transduction.kind != "capacitive":
-                    kernel[a, b] = strain if signed else np.maximum(strain, 0.0)
-                else:
-                    kernel[a, b] = spec.transduction.strain_gain * strain
+                strain = self.layer_strain(big, [probe])[: 2 * half + 1, : 2 * half + 1]
+                kernel[a, b] = signal_per_strain(spec, strain / newtons, signed=signed)
         return kernel
 
 

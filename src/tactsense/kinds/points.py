@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from tactsense.kinds.base import Kind
+from tactsense.kinds.base import RESPONSE_PROBE_N, Kind, signal_per_strain
 from tactsense.sensor.points import PointsSpec
 from tactsense.sensor.registry import dome12, icub_fingertip
 
@@ -69,18 +69,13 @@ class PointsKind(Kind):
         centred on each taxel, shape (N, N) [-/N]: row i for the probe on taxel i
         (clipped at zero on resistive taxels whatever ``signed``)."""
         from tactsense.physics.indenters import SphereProbe
-        from tactsense.physics.pad_response import points_strain
 
-        newtons = 0.49
+        newtons = RESPONSE_PROBE_N
         n = spec.shape[1]
         kernel = np.empty((n, n))
         for i in range(n):
             probe = SphereProbe(0.0, 0.0, newtons, at_taxel=i)
-            strain = points_strain(spec, [probe])[0] / newtons
-            if spec.transduction.kind != "capacitive":
-                kernel[i] = np.maximum(strain, 0.0)
-            else:
-                kernel[i] = spec.transduction.strain_gain * strain
+            kernel[i] = signal_per_strain(spec, self.layer_strain(spec, [probe])[0] / newtons)
         return kernel
 
 
