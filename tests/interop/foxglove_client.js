@@ -1,0 +1,75 @@
+// A Foxglove WebSocket client as a Foxglove user's tools would run it, for
+// tests/interop/test_foxglove_live.py: @foxglove/ws-protocol's FoxgloveClient on a `ws`
+// socket, the messages decoded from CDR with the channel's advertised ros2msg schema by
+// @foxglove/rosmsg (parse) and @foxglove/rosmsg2-serialization (MessageReader), the
+// packages Foxglove's own app decodes ROS 2 data with. Nothing here comes from tactsense.
+//
+// usage: node foxglove_client.js URL SUBPROTOCOL COUNT TIMEOUT_MS [TOPIC ...]
+// Subscribes to every advertised channel (or the TOPICs), prints one JSON object per
+// line on stdout ("serverInfo", "advertise" with each channel, "subscribed", then each
+// "message": topic, timestamp [ns] as a string, the raw bytes in base64 and the decoded
+// message), and exits 0 after COUNT messages on each subscribed channel; 2 on a timeout.
+"use strict";
+
+const { FoxgloveClient } = require("@foxglove/ws-protocol");
+const { parse } = require("@foxglove/rosmsg");
+const { MessageReader } = require("@foxglove/rosmsg2-serialization");
+const WebSocket = require("ws");
+
+const [url, subprotocol, countText, timeoutText, ...topics] = process.argv.slice(2);
+const count = Number(countText);
+
+function print(object) {
+  process.stdout.write(
+    JSON.stringify(object, (_key, value) => {
+      if (typeof value === "bigint") return value.toString();
+      if (ArrayBuffer.isView(value) && !(value instanceof DataView)) return Array.from(value);
+      return value;
+    }) + "\n",
+  );
+}
+
+const ws = new WebSocket(url, [subprotocol]);
+const client = new FoxgloveClient({ ws });
+const bySubscription = new Map(); // subscription id -> {topic, reader}
+const received = new Map(); // topic -> messages so far
+
+setTimeout(() => {
+  print({ op: "timeout", received: Object.fromEntries(received) });
+  process.exit(2);
+}, Number(timeoutText));
+
+client.on("open", () => print({ op: "open", protocol: ws.protocol }));
+client.on("error", (error) => print({ op: "error", error: String(error) }));
+client.on("serverInfo", (info) => print(info));
+client.on("advertise", (channels) => {
+  for (const channel of channels) {
+    print({ op: "advertise", channel });
+    if (topics.length > 0 && !topics.includes(channel.topic)) continue;
+    const definitions = parse(channel.schema, { ros2: true });
+    const reader = new MessageReader(definitions);
+    const id = client.subscribe(channel.id);
+    bySubscription.set(id, { topic: channel.topic, reader });
+    received.set(channel.topic, 0);
+    print({ op: "subscribed", topic: channel.topic, subscriptionId: id });
+  }
+});
+client.on("message", ({ subscriptionId, timestamp, data }) => {
+  const entry = bySubscription.get(subscriptionId);
+  if (entry === undefined) return;
+  const bytes = new Uint8Array(data.buffer, data.byteOffset, data.byteLength);
+  const n = received.get(entry.topic);
+  if (n >= count) return;
+  received.set(entry.topic, n + 1);
+  print({
+    op: "message",
+    topic: entry.topic,
+    timestamp,
+    data: Buffer.from(bytes).toString("base64"),
+    decoded: entry.reader.readMessage(bytes),
+  });
+  if ([...received.values()].every((k) => k >= count)) {
+    client.close();
+    process.exit(0);
+  }
+});
