@@ -129,3 +129,61 @@ def write_estimates(stream, reader, locator, *, output_format, multi, frames, du
                 {k: repr(v) if isinstance(v, float) else v for k, v in estimate.items()}
             )
         stream.flush()
+
+
+# ---- foxglove live (r6-fox) ----
+FOXGLOVE_HELP = (
+    "Also serve the frames and contacts to Foxglove on a WebSocket at [HOST:]PORT: HOST "
+    "127.0.0.1 (this machine only) unless given, PORT 0-65535 (0: a free port; 8765 is "
+    "Foxglove's usual). The channels and schemas of the MCAP export (docs/foxglove.md)."
+)
+"""Help of ``--foxglove`` (live and view)."""
+
+
+def check_foxglove(address: str | None) -> tuple[str, int] | None:
+    """``--foxglove [HOST:]PORT`` parsed, and the extra there, before any work starts."""
+    if address is None:
+        return None
+    from tactsense._validation import TactsenseInputError
+    from tactsense.interop.foxglove_live import check_available, parse_address
+
+    try:
+        host_port = parse_address(address)
+        check_available()
+    except TactsenseInputError as error:
+        fail(str(error))
+    return host_port
+
+
+def serve_foxglove(address: tuple[str, int] | None, sensor):
+    """The Foxglove server of ``--foxglove`` (None without it), its address printed on
+    standard error; a warning when it listens beyond this machine."""
+    if address is None:
+        return None
+    from tactsense.cli._common import console
+    from tactsense.interop.foxglove_live import FoxgloveLive
+    from tactsense.view.server import is_loopback
+
+    host, port = address
+    server = FoxgloveLive(sensor, host=host, port=port)  # TactsenseInputError when it cannot
+    if not is_loopback(host):
+        console.print(
+            f"[bold red]warning:[/] Foxglove on {host}, not only on this machine: anyone who "
+            "can reach it sees the sensor (there is no login)."
+        )
+    console.print(f"foxglove: {server.url} (Foxglove: Open connection, Foxglove WebSocket)")
+    return server
+
+
+class Outlets:
+    """Several outlets (LSL, Foxglove) as one: ``push(frame, estimate)`` to each."""
+
+    def __init__(self, *outlets):
+        self.outlets = [o for o in outlets if o is not None]
+
+    def push(self, frame, estimate) -> None:
+        for outlet in self.outlets:
+            outlet.push(frame, estimate)
+
+
+# ---- /foxglove live (r6-fox) ----

@@ -17,7 +17,12 @@ from tactsense.cli._common import (
     console,
     fail,
 )
-from tactsense.cli._live_outputs import RECORDING_SUFFIXES
+from tactsense.cli._live_outputs import (
+    FOXGLOVE_HELP,
+    RECORDING_SUFFIXES,
+    check_foxglove,
+    serve_foxglove,
+)
 from tactsense.cli._live_sources import (
     LSL_PREFIX,
     StreamSensorOption,
@@ -66,6 +71,11 @@ def view(
     ] = 1.0,
     sensor: StreamSensorOption = None,
     timeout: TimeoutOption = None,
+    # ---- foxglove live (r6-fox) ----
+    foxglove: Annotated[
+        str | None, typer.Option("--foxglove", metavar="[HOST:]PORT", help=FOXGLOVE_HELP)
+    ] = None,
+    # ---- /foxglove live (r6-fox) ----
 ) -> None:
     """Show the sensor in a web browser: a live stream as it arrives, or a recording played
     back (play, pause, step, seek, speed).
@@ -86,6 +96,7 @@ def view(
     from tactsense.view import LiveFeed, RecordingFeed, ViewServer, view_locator
     from tactsense.view.server import is_loopback
 
+    foxglove_address = check_foxglove(foxglove)  # r6-fox
     listen = "127.0.0.1" if host is None else host.strip()
     if not listen:
         fail("--host is empty; give an address such as 127.0.0.1 or 0.0.0.0")
@@ -147,6 +158,17 @@ def view(
     except OSError as error:
         feed.stop()
         fail(f"cannot listen on {listen}:{port}: {error.strerror or error}")
+    # ---- foxglove live (r6-fox): the page's frames and estimates, to Foxglove too ----
+    try:
+        foxglove_server = serve_foxglove(foxglove_address, feed.sensor)
+    except TactsenseInputError as error:
+        feed.stop()
+        fail(str(error))
+    if foxglove_server is not None:
+        from tactsense.interop.foxglove_live import PublishingLocator
+
+        feed.locator = PublishingLocator(feed.locator, foxglove_server)
+    # ---- /foxglove live (r6-fox) ----
     if not is_loopback(listen):
         console.print(
             f"[bold red]warning:[/] listening on {listen}, not only on this machine: anyone "
@@ -162,4 +184,7 @@ def view(
         server.run()
     except KeyboardInterrupt:
         pass
+    finally:
+        if foxglove_server is not None:  # r6-fox
+            foxglove_server.close()
     console.print(f"stopped: {feed.frames_in} frames shown")

@@ -29,10 +29,14 @@ from tactsense.cli._common import (
     sensor_file,
 )
 from tactsense.cli._live_outputs import (
+    FOXGLOVE_HELP,
     LiveFormat,
+    Outlets,
     RecordFormat,
     _check_record_suffix,
     _listen_for_rezero,
+    check_foxglove,
+    serve_foxglove,
     write_estimates,
 )
 from tactsense.cli._live_sources import (
@@ -404,6 +408,11 @@ def live(
         ),
     ] = 2.0,
     force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
+    # ---- foxglove live (r6-fox) ----
+    foxglove: Annotated[
+        str | None, typer.Option("--foxglove", metavar="[HOST:]PORT", help=FOXGLOVE_HELP)
+    ] = None,
+    # ---- /foxglove live (r6-fox) ----
 ) -> None:
     """Estimate the contact of every frame as it arrives: position, force, skew, flags and
     latency (from the frame's last byte to its estimate), until --frames, --duration,
@@ -422,6 +431,7 @@ def live(
     from tactsense.stream import StreamError
 
     _check_duration(duration)
+    foxglove_address = check_foxglove(foxglove)  # r6-fox
     if out is not None:
         check_output(out, force, inputs=[calibration, *sensor_file(sensor), *_source_file(source)])
     try:
@@ -441,6 +451,11 @@ def live(
 
             rate = 1.0 / reader.frame_period_s if reader.frame_period_s else 0.0
             outlets = LslOutlets(reader.sensor, reader.identity, rate)
+        # ---- foxglove live (r6-fox) ----
+        foxglove_server = serve_foxglove(foxglove_address, reader.sensor)
+        if foxglove_server is not None:
+            outlets = Outlets(outlets, foxglove_server)
+        # ---- /foxglove live (r6-fox) ----
         reader.start()
     except TactsenseInputError as error:
         fail(str(error))
@@ -481,6 +496,9 @@ def live(
     except BrokenPipeError:
         sys.stderr.close()
         return
+    finally:
+        if foxglove_server is not None:  # r6-fox: clients see the connection close
+            foxglove_server.close()
     warmup = used[0] - len(latencies)
     summary = reader.stats.summary(used[0])
     if warmup:  # after "N frames"

@@ -4,11 +4,12 @@
 // @foxglove/rosmsg (parse) and @foxglove/rosmsg2-serialization (MessageReader), the
 // packages Foxglove's own app decodes ROS 2 data with. Nothing here comes from tactsense.
 //
-// usage: node foxglove_client.js URL SUBPROTOCOL COUNT TIMEOUT_MS [TOPIC ...]
-// Subscribes to every advertised channel (or the TOPICs), prints one JSON object per
-// line on stdout ("serverInfo", "advertise" with each channel, "subscribed", then each
-// "message": topic, timestamp [ns] as a string, the raw bytes in base64 and the decoded
-// message), and exits 0 after COUNT messages on each subscribed channel; 2 on a timeout.
+// usage: node client.js URL SUBPROTOCOL COUNTS TIMEOUT_MS
+// COUNTS is JSON, {"topic": messages wanted, ...}. Subscribes to those topics as they are
+// advertised, prints one JSON object per line on stdout ("open", "serverInfo",
+// "advertise" with each channel, "subscribed", then each "message": topic, timestamp
+// [ns] as a string, the raw bytes in base64 and the decoded message), and exits 0 once
+// every topic has had its count; 2 on a timeout (after TIMEOUT_MS).
 "use strict";
 
 const { FoxgloveClient } = require("@foxglove/ws-protocol");
@@ -16,8 +17,8 @@ const { parse } = require("@foxglove/rosmsg");
 const { MessageReader } = require("@foxglove/rosmsg2-serialization");
 const WebSocket = require("ws");
 
-const [url, subprotocol, countText, timeoutText, ...topics] = process.argv.slice(2);
-const count = Number(countText);
+const [url, subprotocol, countsText, timeoutText] = process.argv.slice(2);
+const counts = JSON.parse(countsText);
 
 function print(object) {
   process.stdout.write(
@@ -34,9 +35,13 @@ const client = new FoxgloveClient({ ws });
 const bySubscription = new Map(); // subscription id -> {topic, reader}
 const received = new Map(); // topic -> messages so far
 
+function finish(code) {
+  process.stdout.write("", () => process.exit(code)); // after every line is out
+}
+
 setTimeout(() => {
   print({ op: "timeout", received: Object.fromEntries(received) });
-  process.exit(2);
+  finish(2);
 }, Number(timeoutText));
 
 client.on("open", () => print({ op: "open", protocol: ws.protocol }));
@@ -45,7 +50,7 @@ client.on("serverInfo", (info) => print(info));
 client.on("advertise", (channels) => {
   for (const channel of channels) {
     print({ op: "advertise", channel });
-    if (topics.length > 0 && !topics.includes(channel.topic)) continue;
+    if (!(channel.topic in counts)) continue;
     const definitions = parse(channel.schema, { ros2: true });
     const reader = new MessageReader(definitions);
     const id = client.subscribe(channel.id);
@@ -59,7 +64,7 @@ client.on("message", ({ subscriptionId, timestamp, data }) => {
   if (entry === undefined) return;
   const bytes = new Uint8Array(data.buffer, data.byteOffset, data.byteLength);
   const n = received.get(entry.topic);
-  if (n >= count) return;
+  if (n >= counts[entry.topic]) return;
   received.set(entry.topic, n + 1);
   print({
     op: "message",
@@ -68,8 +73,9 @@ client.on("message", ({ subscriptionId, timestamp, data }) => {
     data: Buffer.from(bytes).toString("base64"),
     decoded: entry.reader.readMessage(bytes),
   });
-  if ([...received.values()].every((k) => k >= count)) {
+  const done = Object.keys(counts).every((topic) => (received.get(topic) ?? 0) >= counts[topic]);
+  if (done) {
     client.close();
-    process.exit(0);
+    finish(0);
   }
 });
