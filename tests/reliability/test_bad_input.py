@@ -112,6 +112,15 @@ BAD_OPTIONS = [
     ("record lsl: --out OUT.h5", "lsl: needs an outlet name"),
     ("record loop:// --format xml --out OUT", "--format"),
     ("live lsl:", "lsl: needs an outlet name"),
+    # ---- foxglove live (r6-fox) ----
+    ("live loop:// --foxglove abc", "--foxglove"),
+    ("live loop:// --foxglove 70000", "--foxglove"),
+    ("live loop:// --foxglove ::1:8765", "--foxglove"),
+    ("live loop:// --foxglove 127.0.0.1:", "--foxglove"),
+    ("view REC --foxglove host:", "--foxglove"),
+    ("view REC --foxglove -1", "--foxglove"),
+    ("view REC --foxglove 203.0.113.9:0", "cannot serve Foxglove on 203.0.113.9:0"),
+    # ---- /foxglove live (r6-fox) ----
 ]
 
 

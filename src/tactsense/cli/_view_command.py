@@ -162,6 +162,7 @@ def view(
     try:
         foxglove_server = serve_foxglove(foxglove_address, feed.sensor)
     except TactsenseInputError as error:
+        server.socket.close()
         feed.stop()
         fail(str(error))
     if foxglove_server is not None:

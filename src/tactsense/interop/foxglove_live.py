@@ -100,8 +100,12 @@ def _sdk():
 
 
 def check_available() -> None:
-    """Raise a one-line :class:`TactsenseInputError` when ``foxglove-sdk`` is missing."""
+    """Raise a one-line :class:`TactsenseInputError` when ``foxglove-sdk`` (or the MCAP
+    encoder the messages are built with) is missing."""
+    from tactsense.interop.mcap import _writer_class
+
     _sdk()
+    _writer_class()
 
 
 class _Channels:
