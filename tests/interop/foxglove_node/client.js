@@ -4,12 +4,14 @@
 // @foxglove/rosmsg (parse) and @foxglove/rosmsg2-serialization (MessageReader), the
 // packages Foxglove's own app decodes ROS 2 data with. Nothing here comes from tactsense.
 //
-// usage: node client.js URL SUBPROTOCOL COUNTS TIMEOUT_MS
+// usage: node client.js URL SUBPROTOCOL COUNTS TIMEOUT_MS [timing]
 // COUNTS is JSON, {"topic": messages wanted, ...}. Subscribes to those topics as they are
 // advertised, prints one JSON object per line on stdout ("open", "serverInfo",
 // "advertise" with each channel, "subscribed", then each "message": topic, timestamp
 // [ns] as a string, the raw bytes in base64 and the decoded message), and exits 0 once
-// every topic has had its count; 2 on a timeout (after TIMEOUT_MS).
+// every topic has had its count; 2 on a timeout (after TIMEOUT_MS). With "timing" each
+// message is still decoded, but its line has only the topic, the timestamp and
+// "received_ms", the Unix time [ms] of the callback (benchmarks/bench_foxglove_live.py).
 "use strict";
 
 const { FoxgloveClient } = require("@foxglove/ws-protocol");
@@ -17,7 +19,8 @@ const { parse } = require("@foxglove/rosmsg");
 const { MessageReader } = require("@foxglove/rosmsg2-serialization");
 const WebSocket = require("ws");
 
-const [url, subprotocol, countsText, timeoutText] = process.argv.slice(2);
+const [url, subprotocol, countsText, timeoutText, mode] = process.argv.slice(2);
+const timing = mode === "timing";
 const counts = JSON.parse(countsText);
 
 function print(object) {
@@ -66,13 +69,19 @@ client.on("message", ({ subscriptionId, timestamp, data }) => {
   const n = received.get(entry.topic);
   if (n >= counts[entry.topic]) return;
   received.set(entry.topic, n + 1);
-  print({
-    op: "message",
-    topic: entry.topic,
-    timestamp,
-    data: Buffer.from(bytes).toString("base64"),
-    decoded: entry.reader.readMessage(bytes),
-  });
+  if (timing) {
+    const receivedMs = performance.timeOrigin + performance.now();
+    entry.reader.readMessage(bytes);
+    print({ op: "message", topic: entry.topic, timestamp, received_ms: receivedMs });
+  } else {
+    print({
+      op: "message",
+      topic: entry.topic,
+      timestamp,
+      data: Buffer.from(bytes).toString("base64"),
+      decoded: entry.reader.readMessage(bytes),
+    });
+  }
   const done = Object.keys(counts).every((topic) => (received.get(topic) ?? 0) >= counts[topic]);
   if (done) {
     client.close();
