@@ -13,6 +13,7 @@ import base64
 import json
 import math
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -385,12 +386,17 @@ def test_live_command_serves_foxglove(tmp_path, node_client, finger_recording):
         for process in (client, live, emulator):
             if process is not None:
                 _stop(process)
-    assert live.returncode == 0, live.stderr.read()
+    rest = live.stderr.read()
+    assert live.returncode == 0, rest
+    sent = re.search(r"foxglove: sent (\d+) frames and (\d+) contacts", rest)
+    assert sent is not None, rest
     by_ns = {}
     for line in estimates.read_text().splitlines():
         estimate = json.loads(line)
         by_ns[round(estimate["host_time_s"] * 1e9)] = estimate
     got = messages_by_topic(lines)
+    assert int(sent[1]) >= len(got["/tactile_states"]) == 40
+    assert int(sent[2]) >= len(got["/tactile_contacts"]) == 20
     for line in got["/tactile_states"]:
         sensors = line["decoded"]["sensors"]
         assert [s["name"] for s in sensors] == [spec.name]

@@ -171,8 +171,29 @@ def serve_foxglove(address: tuple[str, int] | None, sensor):
             f"[bold red]warning:[/] Foxglove on {host}, not only on this machine: anyone who "
             "can reach it sees the sensor (there is no login)."
         )
-    console.print(f"foxglove: {server.url} (Foxglove: Open connection, Foxglove WebSocket)")
+    console.print(
+        f"foxglove: {server.url} (Foxglove: Open connection, Foxglove WebSocket)",
+        soft_wrap=True,
+        highlight=False,
+    )
     return server
+
+
+def close_foxglove(server) -> None:
+    """Stop the server of ``--foxglove`` (clients see the connection close) and say what
+    it sent."""
+    if server is None:
+        return
+    from tactsense.cli._common import console
+
+    server.close()
+    try:
+        console.print(
+            f"foxglove: sent {server.frames} frames and {server.contacts} contacts",
+            highlight=False,
+        )
+    except (OSError, ValueError):  # standard error closed (a broken pipe)
+        pass
 
 
 class Outlets:

@@ -21,6 +21,7 @@ from tactsense.cli._live_outputs import (
     FOXGLOVE_HELP,
     RECORDING_SUFFIXES,
     check_foxglove,
+    close_foxglove,
     serve_foxglove,
 )
 from tactsense.cli._live_sources import (
@@ -186,6 +187,5 @@ def view(
     except KeyboardInterrupt:
         pass
     finally:
-        if foxglove_server is not None:  # r6-fox
-            foxglove_server.close()
+        close_foxglove(foxglove_server)  # r6-fox
     console.print(f"stopped: {feed.frames_in} frames shown")

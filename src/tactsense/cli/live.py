@@ -36,6 +36,7 @@ from tactsense.cli._live_outputs import (
     _check_record_suffix,
     _listen_for_rezero,
     check_foxglove,
+    close_foxglove,
     serve_foxglove,
     write_estimates,
 )
@@ -497,8 +498,7 @@ def live(
         sys.stderr.close()
         return
     finally:
-        if foxglove_server is not None:  # r6-fox: clients see the connection close
-            foxglove_server.close()
+        close_foxglove(foxglove_server)  # r6-fox
     warmup = used[0] - len(latencies)
     summary = reader.stats.summary(used[0])
     if warmup:  # after "N frames"
