@@ -236,13 +236,13 @@ def test_finger_live_equals_the_mcap_export(tmp_path, node_client, finger_record
             assert line["decoded"] == plain(decoded)
 
 
-@pytest.fixture(scope="module")
-def pad_recording(tmp_path_factory):
+@pytest.fixture(scope="module", params=["pad16", "dome12"])
+def pad_recording(tmp_path_factory, request):
     from tactsense.flat_scenarios import two_probes
 
-    spec = ts.preset("pad16")
+    spec = ts.preset(request.param)
     rec = ts.simulate(spec, two_probes(spec), rng=2)
-    path = tmp_path_factory.mktemp("fox") / "pad.h5"
+    path = tmp_path_factory.mktemp("fox") / f"{request.param}.h5"
     ts.write_recording(path, rec)
     return spec, rec, path
 
@@ -250,12 +250,12 @@ def pad_recording(tmp_path_factory):
 def test_pad_live_frames_are_the_exports_and_contacts_the_estimates(
     tmp_path, node_client, pad_recording
 ):
-    """A pad: frames byte for byte the MCAP export's; each contact what ``live``'s
-    locator estimated, decoded by Foxglove's decoder (name ``<sensor>/<id>``, position
-    [m], the pad's normal +z, force -force_n * normal [N], torque position x force
-    [N m]), its bytes those of mcap-ros2-support's encoder for that message. (Live and
-    batch contacts of a pad are not the same numbers, so the export is no reference
-    for them.)"""
+    """A pad and a point set: frames byte for byte the MCAP export's; each contact what
+    ``live``'s locator estimated, decoded by Foxglove's decoder (name ``<sensor>/<id>``,
+    position [m], the outward normal of the taxel nearest the contact (a pad's: +z),
+    force -force_n * normal [N], torque position x force [N m]), its bytes those of
+    mcap-ros2-support's encoder for that message. (Live and batch contacts of these
+    kinds are not the same numbers, so the export is no reference for them.)"""
     from mcap_ros2._dynamic import serialize_dynamic
 
     from tactsense.interop.ros import TACTILE_CONTACT, TACTILE_CONTACT_MSGDEF
@@ -293,6 +293,9 @@ def test_pad_live_frames_are_the_exports_and_contacts_the_estimates(
         assert int(line["timestamp"]) == message.log_time
         assert base64.b64decode(line["data"]) == message.data
     encode = serialize_dynamic(TACTILE_CONTACT, TACTILE_CONTACT_MSGDEF)[TACTILE_CONTACT]
+    positions, normals = spec.taxel_positions_mm(), spec.taxel_normals()
+    if spec.name == "pad16":
+        assert (normals == [0.0, 0.0, 1.0]).all()  # a pad's outward normal is +z
     contacts = iter(got["/tactile_contacts"])
     lists = iter(got["/contact_states"])
     for k in range(len(rec.frames)):
@@ -306,14 +309,15 @@ def test_pad_live_frames_are_the_exports_and_contacts_the_estimates(
         for c, in_list in zip(mine, listed["decoded"]["contacts"], strict=True):
             line = next(contacts)
             point = [c["x_mm"] * 1e-3, c["y_mm"] * 1e-3, c["z_mm"] * 1e-3]
-            normal = np.array([0.0, 0.0, 1.0])  # the pad's outward normal
+            nearest = np.argmin(np.linalg.norm(positions - np.array(point) * 1e3, axis=1))
+            normal = normals[nearest]
             force = (-c["force_n"] * normal).tolist()  # upstream: what the object applies
             torque = np.cross(point, force).tolist()
             message = {
                 "header": {"stamp": stamp, "frame_id": "finger"},
-                "name": f"pad16/{c['id']}",
+                "name": f"{spec.name}/{c['id']}",
                 "position": dict(zip("xyz", point, strict=True)),
-                "normal": {"x": 0.0, "y": 0.0, "z": 1.0},
+                "normal": dict(zip("xyz", normal.tolist(), strict=True)),
                 "wrench": {"force": dict(zip("xyz", force, strict=True)),
                            "torque": dict(zip("xyz", torque, strict=True))},
             }  # fmt: skip
