@@ -245,10 +245,10 @@ def test_finger_live_equals_the_mcap_export(tmp_path, node_client, finger_record
 
 @pytest.fixture(scope="module", params=["pad16", "dome12"])
 def pad_recording(tmp_path_factory, request):
-    """Two probes on a pad and on a point set, the sensor saying its creep is known, as a
-    device's identity says it (a simulated recording's says not: then the live locator
-    does not compensate the creep where the batch export does, and their contacts
-    differ; the emulator's device says known, and ``live`` equals ``locate``)."""
+    """Two probes on a pad and on a point set, the sensor saying its creep is known, as
+    the emulator's identity says it (a simulated recording's sensor does not: the live
+    locator then leaves the creep in, while the batch export takes the simulation's out,
+    and their contacts differ; through the emulator ``live`` equals ``locate``)."""
     import dataclasses
 
     from tactsense.flat_scenarios import two_probes
