@@ -129,3 +129,48 @@ def write_estimates(stream, reader, locator, *, output_format, multi, frames, du
                 {k: repr(v) if isinstance(v, float) else v for k, v in estimate.items()}
             )
         stream.flush()
+
+
+# ---- ROS 2 topics (r6-ros2) ----
+def _check_ros2_options(ros2: bool, namespace: str | None, config: str | None) -> None:
+    """Refuse --namespace or --ros2-config without --ros2, a bad namespace, an unreadable
+    or non-Cyclone DDS configuration, or a missing extra: before any line is opened."""
+    from tactsense._validation import TactsenseInputError
+
+    if not ros2:
+        given = [n for n, v in (("--namespace", namespace), ("--ros2-config", config)) if v]
+        if given:
+            fail(f"{' and '.join(given)} appl{'y' if len(given) > 1 else 'ies'} to --ros2")
+        return
+    try:
+        from tactsense.interop.ros2.config import resolve_config
+        from tactsense.interop.ros2.publisher import (
+            _cyclonedds,
+            check_namespace,
+            domain_id_from_environment,
+        )
+
+        _cyclonedds()
+        if namespace is not None:
+            check_namespace(namespace)
+        resolve_config(config)
+        domain_id_from_environment()
+    except TactsenseInputError as error:
+        fail(str(error))
+
+
+class _Fanout:
+    """Several outputs that each take every frame and its estimate (``push``)."""
+
+    def __init__(self, *outputs):
+        self._outputs = [o for o in outputs if o is not None]
+
+    def push(self, frame, estimate) -> None:
+        for output in self._outputs:
+            if hasattr(output, "push"):
+                output.push(frame, estimate)
+            else:
+                output.publish(frame, estimate)
+
+
+# ---- /ROS 2 topics (r6-ros2) ----

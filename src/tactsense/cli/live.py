@@ -32,6 +32,8 @@ from tactsense.cli._live_outputs import (
     LiveFormat,
     RecordFormat,
     _check_record_suffix,
+    _check_ros2_options,
+    _Fanout,
     _listen_for_rezero,
     write_estimates,
 )
@@ -404,6 +406,35 @@ def live(
         ),
     ] = 2.0,
     force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
+    # ---- ROS 2 topics (r6-ros2) ----
+    ros2: Annotated[
+        bool,
+        typer.Option(
+            "--ros2",
+            help="Also publish every frame as ROS 2 topics over DDS, without ROS 2: "
+            "TactileState, TactileContacts, sensor_msgs/Image and geometry_msgs/"
+            "WrenchStamped under --namespace, best effort, keep last 5 (docs/ros2.md). "
+            "DDS stays on 127.0.0.1 unless --ros2-config or CYCLONEDDS_URI says otherwise.",
+        ),
+    ] = False,
+    namespace: Annotated[
+        str | None,
+        typer.Option(
+            "--namespace",
+            help="--ros2: the node's ROS 2 namespace, '/' or /name/... of letters, digits "
+            "and _ [default: /<sensor name>].",
+        ),
+    ] = None,
+    ros2_config: Annotated[
+        str | None,
+        typer.Option(
+            "--ros2-config",
+            help="--ros2: a Cyclone DDS configuration (an XML file, file://PATH or XML) "
+            "for a network other than the loopback [default: CYCLONEDDS_URI, else "
+            "127.0.0.1 only, multicast off].",
+        ),
+    ] = None,
+    # ---- /ROS 2 topics (r6-ros2) ----
 ) -> None:
     """Estimate the contact of every frame as it arrives: position, force, skew, flags and
     latency (from the frame's last byte to its estimate), until --frames, --duration,
@@ -424,6 +455,7 @@ def live(
     _check_duration(duration)
     if out is not None:
         check_output(out, force, inputs=[calibration, *sensor_file(sensor), *_source_file(source)])
+    _check_ros2_options(ros2, namespace, ros2_config)  # r6-ros2
     try:
         cal = None if calibration is None else load_calibration(calibration)
         from tactsense.estimate.contacts import METHODS
@@ -441,6 +473,12 @@ def live(
 
             rate = 1.0 / reader.frame_period_s if reader.frame_period_s else 0.0
             outlets = LslOutlets(reader.sensor, reader.identity, rate)
+        publisher = None  # ---- r6-ros2 ----
+        if ros2:
+            from tactsense.interop.ros2 import Ros2Publisher
+
+            publisher = Ros2Publisher(reader.sensor, namespace=namespace, config=ros2_config)
+            outlets = _Fanout(outlets, publisher)
         reader.start()
     except TactsenseInputError as error:
         fail(str(error))
@@ -491,6 +529,9 @@ def live(
         summary += f"; latency median {median:.3f} ms, p99 {p99:.3f} ms"
     stopped = f" (stopped by {stopped_by()})" if interrupted else ""
     console.print(f"{len(latencies)} estimates{stopped} from {summary}")
+    if publisher is not None:  # r6-ros2
+        console.print(publisher.summary())
+        publisher.close()
 
 
 app.command()(view)  # registered last, as it always was
