@@ -1,0 +1,183 @@
+"""``tactsense live --ros2``: a ROS 2 node over DDS, checked by an independent subscriber
+in another process (``ros2_subscriber.py``, written from the upstream ``.msg`` texts) and
+by rosbags' CDR serialiser; DDS on 127.0.0.1 with multicast off throughout."""
+
+import json
+import os
+import random
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+pytest.importorskip("cyclonedds")
+pytest.importorskip("rosbags")
+
+import tactsense as ts
+from tactsense import flat_scenarios as fs
+from tactsense.cli import app
+from tactsense.interop.ros2 import (
+    is_loopback_only,
+    loopback_config,
+)
+from tactsense.interop.ros2 import publisher as publisher_module
+
+from ..stream.test_record import CLI, emulator  # noqa: F401  (the fixture)
+from .ros2_subscriber import TOPIC_TYPES, typestore
+
+SUBSCRIBER = Path(__file__).with_name("ros2_subscriber.py")
+runner = CliRunner()
+
+
+@pytest.fixture(autouse=True)
+def loopback_dds(tmp_path, monkeypatch):
+    """Every participant of a test (this process's and the subscriber's) reads the
+    loopback-only configuration from CYCLONEDDS_URI, on a domain of its own; after the
+    test, every participant this process started must have had a loopback-only
+    configuration, or the test fails."""
+    path = loopback_config(tmp_path)
+    monkeypatch.setenv("CYCLONEDDS_URI", f"file://{path}")
+    monkeypatch.setenv("ROS_DOMAIN_ID", str(random.randint(100, 230)))
+    monkeypatch.delenv("ROS_DISTRO", raising=False)
+    before = len(publisher_module.started_configs)
+    yield
+    started = publisher_module.started_configs[before:]
+    assert all(is_loopback_only(config) for config in started), "a participant left loopback"
+
+
+@pytest.fixture(scope="module")
+def store():
+    return typestore()
+
+
+def _subscribe(tmp_path, namespace, count, seconds=60.0):
+    out = tmp_path / "received.pickle"
+    process = subprocess.Popen(
+        [sys.executable, str(SUBSCRIBER), str(out), "--domain", os.environ["ROS_DOMAIN_ID"],
+         "--namespace", namespace, "--count", str(count), "--seconds", str(seconds)],
+        stdout=subprocess.PIPE, text=True, env=dict(os.environ),
+    )  # fmt: skip
+    assert process.stdout.readline().strip() == "ready"
+    return process, out
+
+
+def _strip(raw: bytes, cdr: bytes) -> bytes:
+    """The raw sample without the padding to 4 bytes a DDS writer adds after the CDR."""
+    assert raw[: len(cdr)] == cdr and set(raw[len(cdr) :]) <= {0} and len(raw) - len(cdr) < 4
+    return raw[: len(cdr)]
+
+
+def test_live_ros2_every_sample_bit_for_bit(emulator, tmp_path, store):  # noqa: F811
+    """pad16, two probes pressing: every frame reaches the other process on the four
+    topics, and each sample is, bit for bit, the frame's counts and the contacts 'live'
+    located (its JSON lines, written at the same time); rosbags re-serialises every
+    decoded sample to the very bytes received; the node is on the graph."""
+    import pickle
+
+    pad = ts.preset("pad16")
+    truth = ts.simulate(pad, fs.two_probes(pad), rng=0)
+    n = truth.frames.shape[0]
+    namespace = "/test_ros2/pad"
+    process, out = _subscribe(tmp_path, namespace, n)
+    url = emulator("--sensor", "pad16", "--scenario", "two-probes", "--speed", "5")
+    lines = tmp_path / "live.jsonl"
+    result = runner.invoke(
+        app, ["live", url, "--ros2", "--namespace", namespace, "--out", str(lines),
+              "--frames", str(n)],
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    assert process.wait(90) == 0
+    received = pickle.loads(out.read_bytes())
+    assert f"{n} frames on {namespace}" in result.output
+    assert f"{4 * n} samples sent, 0 not sent" in result.output
+    assert received["lost"] == dict.fromkeys(TOPIC_TYPES, 0)
+    for topic in TOPIC_TYPES:  # every sample, none lost
+        assert len(received["received"][topic]) == n, topic
+
+    decoded = {}
+    for topic, ros_type in TOPIC_TYPES.items():
+        decoded[topic] = []
+        for _, raw in received["received"][topic]:
+            message = store.deserialize_cdr(raw, ros_type)
+            _strip(raw, bytes(store.serialize_cdr(message, ros_type)))  # rosbags' bytes
+            decoded[topic].append(message)
+    # frames: the recording's counts, row-major, as float32, bit for bit
+    states = decoded["tactile_states"]
+    for k, message in enumerate(states):
+        (channel,) = message.sensors
+        assert channel.name == "pad16" and message.header.frame_id == "finger"
+        np.testing.assert_array_equal(channel.values, truth.frames[k].ravel().astype(np.float32))
+        image = decoded["tactile_image"][k]
+        assert (image.height, image.width, image.encoding, image.step) == (16, 16, "32FC1", 64)
+        assert image.is_bigendian == 0
+        assert image.data.tobytes() == truth.frames[k].astype("<f4").tobytes()
+    # every sample of a frame carries that frame's stamp; stamps are distinct, rising
+    stamps = [m.header.stamp.sec * 10**9 + m.header.stamp.nanosec for m in states]
+    assert np.all(np.diff(stamps) > 0)
+    for topic in ("tactile_image", "wrench"):
+        got = [m.header.stamp.sec * 10**9 + m.header.stamp.nanosec for m in decoded[topic]]
+        assert got == stamps
+    # contacts: what live located (its JSON lines), bit for bit (repr round-trips floats)
+    rows = {r["sequence"]: r for r in map(json.loads, lines.read_text().splitlines())}
+    normals = pad.taxel_normals()
+    positions = pad.taxel_positions_mm()
+    seen_two = 0
+    for k, message in enumerate(decoded["contact_states"]):
+        contacts = rows[k]["contacts"] if k in rows else []
+        assert len(message.contacts) == len(contacts)
+        seen_two += len(contacts) == 2
+        wrench = np.zeros(6)
+        for got, want in zip(message.contacts, contacts, strict=True):
+            assert got.name == f"pad16/{want['id']}"
+            assert got.header.stamp.sec * 10**9 + got.header.stamp.nanosec == stamps[k]
+            xyz = np.array([want["x_mm"], want["y_mm"], want["z_mm"]])
+            normal = normals[np.argmin(((positions - xyz) ** 2).sum(axis=1))]
+            point = xyz * 1e-3
+            force = -want["force_n"] * normal
+            torque = np.array([point[1] * force[2] - point[2] * force[1],
+                               point[2] * force[0] - point[0] * force[2],
+                               point[0] * force[1] - point[1] * force[0]])  # fmt: skip
+            p, v = got.position, got.normal
+            f, t = got.wrench.force, got.wrench.torque
+            assert [p.x, p.y, p.z] == point.tolist() and [v.x, v.y, v.z] == normal.tolist()
+            assert [f.x, f.y, f.z] == force.tolist() and [t.x, t.y, t.z] == torque.tolist()
+            wrench += np.concatenate([force, torque])
+        w = decoded["wrench"][k].wrench
+        got_total = [w.force.x, w.force.y, w.force.z, w.torque.x, w.torque.y, w.torque.z]
+        assert got_total == wrench.tolist()
+    assert seen_two > 10  # the two probes were published as two named contacts
+    # a pair of contacts of one frame never share a name
+    for message in decoded["contact_states"]:
+        names = [c.name for c in message.contacts]
+        assert len(set(names)) == len(names)
+
+    # the node as ROS 2 sees it: names, types and QoS on the wire, enclave, discovery
+    publications = [
+        p for p in received["publications"].values() if p["topic"] != "ros_discovery_info"
+    ]
+    mine = {p["topic"]: p for p in publications if p["topic"].startswith("rt" + namespace)}
+    assert set(mine) == {f"rt{namespace}/{t}" for t in TOPIC_TYPES}
+    for topic, ros_type in TOPIC_TYPES.items():
+        package, _, name = ros_type.split("/")
+        p = mine[f"rt{namespace}/{topic}"]
+        assert p["type"] == f"{package}::msg::dds_::{name}_"
+        assert "BestEffort" in p["reliability"] and "KeepLast(depth=5)" in p["history"]
+    owner = {p["participant"] for p in mine.values()}
+    assert len(owner) == 1
+    (participant,) = owner
+    assert received["participants"][participant][0] == b"enclave=/;"
+    infos = [
+        d
+        for d in received["discovery"]
+        if d["nodes"] and d["nodes"][0][:2] == (namespace, "tactsense")
+    ]
+    assert infos, received["discovery"]
+    import uuid
+
+    assert uuid.UUID(bytes=infos[-1]["gid"]) == uuid.UUID(participant)
+    writer_gids = {uuid.UUID(bytes=g) for g in infos[-1]["nodes"][0][2]}
+    assert writer_gids == {uuid.UUID(k) for k, p in received["publications"].items()
+                           if p["topic"].startswith("rt" + namespace)}  # fmt: skip
