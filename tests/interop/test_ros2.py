@@ -7,6 +7,7 @@ import os
 import random
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -20,10 +21,13 @@ import tactsense as ts
 from tactsense import flat_scenarios as fs
 from tactsense.cli import app
 from tactsense.interop.ros2 import (
+    LOOPBACK_XML,
+    Ros2Publisher,
     is_loopback_only,
     loopback_config,
 )
 from tactsense.interop.ros2 import publisher as publisher_module
+from tactsense.stream.reader import StreamFrame
 
 from ..stream.test_record import CLI, emulator  # noqa: F401  (the fixture)
 from .ros2_subscriber import TOPIC_TYPES, typestore
@@ -181,3 +185,92 @@ def test_live_ros2_every_sample_bit_for_bit(emulator, tmp_path, store):  # noqa:
     writer_gids = {uuid.UUID(bytes=g) for g in infos[-1]["nodes"][0][2]}
     assert writer_gids == {uuid.UUID(k) for k, p in received["publications"].items()
                            if p["topic"].startswith("rt" + namespace)}  # fmt: skip
+
+
+def _frame(counts, host_time_s=1_700_000_000.123456789):
+    return StreamFrame(0, 0, 0.0, host_time_s, time.perf_counter(), counts)
+
+
+@pytest.mark.parametrize("name", ["pad16", "initial"])
+def test_template_bytes_are_rosbags_bytes(store, name):
+    """The publisher's template bytes (a pad's two contacts; the finger's one) equal
+    Cyclone DDS's serialiser's and rosbags' serialiser's for the same messages; the
+    stamp is the frame's host time to the nanosecond."""
+    from tactsense.interop.ros2.messages import Header  # noqa: F401  (the module loads)
+
+    sensor = ts.preset(name)
+    publisher = Ros2Publisher(sensor, namespace="/unit", frame_id="link_a")
+    try:
+        counts = np.arange(np.prod(sensor.shape), dtype=np.uint16).reshape(sensor.shape) + 900
+        if sensor.kind == "finger":
+            estimate = {"flags": 0, "axial_mm": 3.25, "angle_deg": 12.5, "force_n": 0.4}
+        else:
+            estimate = {"contacts": [
+                {"id": 4, "x_mm": 3.1, "y_mm": 7.7, "z_mm": 0.0, "force_n": 0.25},
+                {"id": 11, "x_mm": 9.0, "y_mm": 2.5, "z_mm": 0.0, "force_n": 1.5},
+            ]}  # fmt: skip
+        frame = _frame(counts)
+        fast = publisher.encode(frame, estimate)
+        publisher._fast = False
+        slow = publisher.encode(frame, estimate)
+        for topic, ros_type in TOPIC_TYPES.items():
+            reference = bytes(slow[topic].serialize())
+            assert fast[topic] == reference + b"\0" * (-len(reference) % 4), topic
+            message = store.deserialize_cdr(fast[topic], ros_type)
+            assert _strip(fast[topic], bytes(store.serialize_cdr(message, ros_type)))
+        state = store.deserialize_cdr(fast["tactile_states"], TOPIC_TYPES["tactile_states"])
+        # the host time [s] to the nanosecond nearest its float64 (123456768 ns here)
+        expected_ns = divmod(round(frame.host_time_s * 1e9), 10**9)
+        assert (state.header.stamp.sec, state.header.stamp.nanosec) == expected_ns
+        assert state.header.frame_id == "link_a"
+        contacts = store.deserialize_cdr(fast["contact_states"], TOPIC_TYPES["contact_states"])
+        expected = 1 if sensor.kind == "finger" else 2
+        assert len(contacts.contacts) == expected
+        assert len({c.name for c in contacts.contacts}) == expected
+    finally:
+        publisher.close()
+
+
+def test_the_loopback_configuration_is_recognised(tmp_path):
+    """The loopback check says no to Cyclone DDS's defaults (no interface named, multicast
+    allowed), to another interface and to a remote peer."""
+    assert is_loopback_only(LOOPBACK_XML) and is_loopback_only(
+        f"file://{loopback_config(tmp_path)}"
+    )
+    assert not is_loopback_only('<CycloneDDS xmlns="https://cdds.io/config"/>')
+    for old, new in [
+        ("<AllowMulticast>false", "<AllowMulticast>true"),
+        ('address="127.0.0.1" multicast', 'address="192.168.1.5" multicast'),
+        ('<Peer address="127.0.0.1"/>', '<Peer address="10.0.0.2"/>'),
+    ]:
+        assert not is_loopback_only(LOOPBACK_XML.replace(old, new)), new
+
+
+def test_the_subscriber_refuses_to_start_off_loopback(tmp_path, monkeypatch):
+    """The independent subscriber starts no participant without a loopback-only
+    CYCLONEDDS_URI (exit 3)."""
+    monkeypatch.delenv("CYCLONEDDS_URI")
+    done = subprocess.run(
+        [sys.executable, str(SUBSCRIBER), str(tmp_path / "x"), "--domain", "1",
+         "--namespace", "/", "--seconds", "1"], capture_output=True, text=True, timeout=60,
+    )  # fmt: skip
+    assert done.returncode == 3 and "127.0.0.1" in done.stderr
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--namespace", "/a"], "--namespace applies to --ros2"),
+        (["--ros2-config", "x.xml"], "--ros2-config applies to --ros2"),
+        (["--ros2", "--namespace", "/1a"], "a ROS 2 namespace is"),
+        (["--ros2", "--namespace", "/a b"], "a ROS 2 namespace is"),
+        (["--ros2", "--ros2-config", "/nonexistent/c.xml"], "cannot read it"),
+        (["--ros2", "--ros2-config", "<a/>"], "root element <CycloneDDS>"),
+        (["--ros2", "--ros2-config", "<CycloneDDS"], "not XML"),
+    ],
+)
+def test_live_refuses_bad_ros2_options_before_opening_the_line(args, message):
+    """Checked before the device is opened (the port named does not exist)."""
+    result = runner.invoke(app, ["live", "socket://127.0.0.1:9", *args])
+    assert result.exit_code != 0
+    assert message in " ".join(result.output.split()), result.output
