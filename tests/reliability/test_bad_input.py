@@ -112,6 +112,14 @@ BAD_OPTIONS = [
     ("record lsl: --out OUT.h5", "lsl: needs an outlet name"),
     ("record loop:// --format xml --out OUT", "--format"),
     ("live lsl:", "lsl: needs an outlet name"),
+    # ---- live --ros2 (r6-ros2) ----
+    ("live loop:// --namespace /a", "--namespace applies to --ros2"),
+    ("live loop:// --ros2-config REC", "--ros2-config applies to --ros2"),
+    ("live loop:// --ros2 --namespace /9a", "--namespace '/9a'"),
+    ("live loop:// --ros2 --namespace /a//b", "--namespace"),
+    ("live loop:// --ros2 --ros2-config no_such.xml", "--ros2-config no_such.xml: cannot read"),
+    ("live loop:// --ros2 --ros2-config REC", "--ros2-config"),
+    # ---- /live --ros2 (r6-ros2) ----
 ]
 
 

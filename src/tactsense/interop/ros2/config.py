@@ -76,6 +76,10 @@ def _text(config: str) -> str:
         raise Ros2ConfigError(
             f"--ros2-config {config}: cannot read it ({error.strerror or error})"
         ) from None
+    except UnicodeDecodeError:
+        raise Ros2ConfigError(
+            f"--ros2-config {config}: not a text file (a Cyclone DDS XML configuration)"
+        ) from None
 
 
 def is_loopback_only(config: str) -> bool:
