@@ -274,3 +274,33 @@ def test_live_refuses_bad_ros2_options_before_opening_the_line(args, message):
     result = runner.invoke(app, ["live", "socket://127.0.0.1:9", *args])
     assert result.exit_code != 0
     assert message in " ".join(result.output.split()), result.output
+
+
+def test_ci_keeps_dds_on_the_loopback():
+    """.ci/run exports a CYCLONEDDS_URI that the loopback check accepts."""
+    import re
+
+    run = (Path(__file__).parents[2] / ".ci" / "run").read_text()
+    (uri,) = re.findall(r"^export CYCLONEDDS_URI='(.*)'$", run, flags=re.M)
+    assert is_loopback_only(uri)
+
+
+@pytest.mark.parametrize(("distro", "size"), [("humble", 24), ("jazzy", 16), ("", 16)])
+def test_discovery_gids_follow_the_distribution(store, distro, size):
+    """ros_discovery_info's gids: 24 bytes for Humble (char[24] data), 16 since Iron
+    (char[16] data, rmw_dds_common's Gid.msg); the participant's and writers' GUIDs first."""
+    publisher = Ros2Publisher(ts.preset("pad16"), namespace="/gid", distro=distro)
+    try:
+        info = publisher.discovery_info
+        assert len(info.gid.data) == size
+        guid = publisher.participant.get_guid().bytes
+        assert bytes(info.gid.data[:16]) == guid and not any(info.gid.data[16:])
+        (node,) = info.node_entities_info_seq
+        assert (node.node_namespace, node.node_name) == ("/gid", "tactsense")
+        assert len(node.writer_gid_seq) == 4 and node.reader_gid_seq == []
+        if size == 16:  # the upstream text decodes what was sent
+            raw = bytes(info.serialize())
+            back = store.deserialize_cdr(raw, "rmw_dds_common/msg/ParticipantEntitiesInfo")
+            assert bytes(back.gid.data) == guid
+    finally:
+        publisher.close()
