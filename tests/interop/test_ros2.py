@@ -304,3 +304,54 @@ def test_discovery_gids_follow_the_distribution(store, distro, size):
             assert bytes(back.gid.data) == guid
     finally:
         publisher.close()
+
+
+def test_live_ros2_finger(emulator, tmp_path, store):  # noqa: F811
+    """The paper's finger (one contact a frame): every frame's counts bit for bit, and
+    each contact where live's estimate puts it (tactsense.geometry's surface point and
+    normal of its axial and angle), named as the sensor."""
+    import pickle
+
+    from tactsense.interop.ros import contact_geometry
+
+    n = 60
+    namespace = "/test_ros2/finger"
+    process, out = _subscribe(tmp_path, namespace, n)
+    url = emulator("--speed", "10", "--seed", "4")
+    lines = tmp_path / "live.jsonl"
+    result = runner.invoke(
+        app, ["live", url, "--ros2", "--namespace", namespace, "--out", str(lines),
+              "--frames", str(n)],
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    assert process.wait(90) == 0
+    received = pickle.loads(out.read_bytes())
+    assert {t: len(s) for t, s in received["received"].items()} == dict.fromkeys(TOPIC_TYPES, n)
+    sensor = ts.preset("initial")
+    rows = {r["sequence"]: r for r in map(json.loads, lines.read_text().splitlines())}
+    touched = 0
+    for k, (_, raw) in enumerate(received["received"]["contact_states"]):
+        message = store.deserialize_cdr(raw, TOPIC_TYPES["contact_states"])
+        row = rows.get(k)
+        if row is None or "NO_CONTACT" in row["flag_names"] or row["force_n"] is None:
+            assert message.contacts == []
+            continue
+        touched += 1
+        (contact,) = message.contacts
+        point, normal = contact_geometry(
+            sensor, np.array([row["axial_mm"]]), np.array([row["angle_deg"]])
+        )
+        p, v = contact.position, contact.normal
+        assert contact.name == sensor.name
+        assert [p.x, p.y, p.z] == point[0].tolist() and [v.x, v.y, v.z] == normal[0].tolist()
+        f = contact.wrench.force
+        assert [f.x, f.y, f.z] == (-row["force_n"] * normal[0]).tolist()
+    assert touched > 0
+    states = [store.deserialize_cdr(raw, TOPIC_TYPES["tactile_states"])
+              for _, raw in received["received"]["tactile_states"]]  # fmt: skip
+    # the emulator plays what 'simulate --seed 4' writes (tests/stream/test_record.py)
+    simulated = tmp_path / "sim.h5"
+    assert runner.invoke(app, ["simulate", "--out", str(simulated), "--seed", "4"]).exit_code == 0
+    frames = ts.read_recording(simulated).frames[:n]
+    for state, counts in zip(states, frames, strict=True):
+        np.testing.assert_array_equal(state.sensors[0].values, counts.ravel().astype(np.float32))
