@@ -39,14 +39,32 @@ runner = CliRunner()
 @pytest.fixture(autouse=True)
 def loopback_dds(tmp_path, monkeypatch):
     """Every participant of a test (this process's and the subscriber's) reads the
-    loopback-only configuration from CYCLONEDDS_URI, on a domain of its own; after the
-    test, every participant this process started must have had a loopback-only
-    configuration, or the test fails."""
+    loopback-only configuration from CYCLONEDDS_URI, on a domain of its own. A
+    participant this process starts without a loopback-only configuration (its domain's,
+    else CYCLONEDDS_URI) fails the test as it starts; and after the test, every
+    configuration the publisher started with is checked again."""
+    from cyclonedds import domain as dds
+
     path = loopback_config(tmp_path)
     monkeypatch.setenv("CYCLONEDDS_URI", f"file://{path}")
     monkeypatch.setenv("ROS_DOMAIN_ID", str(random.randint(100, 230)))
     monkeypatch.delenv("ROS_DISTRO", raising=False)
     before = len(publisher_module.started_configs)
+    domains: dict[int, str | None] = {}
+    make_domain, make_participant = dds.Domain.__init__, dds.DomainParticipant.__init__
+
+    def domain(self, domain_id, config=None):
+        domains[domain_id] = config
+        make_domain(self, domain_id, config)
+
+    def participant(self, domain_id=dds.dds_domain_default, *args, **kwargs):
+        config = domains.get(domain_id) or os.environ.get("CYCLONEDDS_URI")
+        if not (config and is_loopback_only(config)):
+            pytest.fail("a DDS participant started without the loopback-only configuration")
+        make_participant(self, domain_id, *args, **kwargs)
+
+    monkeypatch.setattr(dds.Domain, "__init__", domain)
+    monkeypatch.setattr(dds.DomainParticipant, "__init__", participant)
     yield
     started = publisher_module.started_configs[before:]
     assert all(is_loopback_only(config) for config in started), "a participant left loopback"
@@ -355,3 +373,14 @@ def test_live_ros2_finger(emulator, tmp_path, store):  # noqa: F811
     frames = ts.read_recording(simulated).frames[:n]
     for state, counts in zip(states, frames, strict=True):
         np.testing.assert_array_equal(state.sensors[0].values, counts.ravel().astype(np.float32))
+
+
+def test_a_participant_off_the_loopback_fails_the_test(monkeypatch):
+    """The guard above fires: a configuration with multicast on (given to the publisher,
+    as --ros2-config would) stops the participant before it starts."""
+    with pytest.raises(pytest.fail.Exception, match="loopback-only"):
+        Ros2Publisher(
+            ts.preset("pad16"),
+            config=LOOPBACK_XML.replace("<AllowMulticast>false", "<AllowMulticast>true"),
+        )
+    publisher_module.started_configs.pop()  # the refused one, for the fixture's check

@@ -478,6 +478,7 @@ def live(
             from tactsense.interop.ros2 import Ros2Publisher
 
             publisher = Ros2Publisher(reader.sensor, namespace=namespace, config=ros2_config)
+            publisher.wait_for_subscribers(1.0)  # those already listening get the first frame
             outlets = _Fanout(outlets, publisher)
         reader.start()
     except TactsenseInputError as error:

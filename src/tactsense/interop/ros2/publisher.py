@@ -379,6 +379,21 @@ class Ros2Publisher:
             self.published[name] += 1
         self.frames += 1
 
+    def wait_for_subscribers(self, timeout_s: float = 1.0) -> int:
+        """Wait until the subscribers already on the network have matched all four topics
+        (at most ``timeout_s`` [s]; discovery on the loopback takes tens of milliseconds,
+        more on a loaded machine), so that they get the first frame too; returns the
+        subscribers matched on ``tactile_states``. Nobody there: returns 0 after the wait."""
+        import time
+
+        deadline = time.monotonic() + timeout_s
+        while time.monotonic() < deadline:
+            counts = [len(w.get_matched_subscriptions()) for w in self._writers.values()]
+            if min(counts) > 0:
+                return counts[0]
+            time.sleep(0.01)
+        return self.subscribers()
+
     def subscribers(self) -> int:
         """Readers matched now on the frames' topic (``tactile_states``)."""
         return len(self._writers["tactile_states"].get_matched_subscriptions())
