@@ -15,10 +15,17 @@ alone (encode + DDS write of the four messages of one frame, no subscriber), tem
 against Cyclone DDS's own serialiser (the straightforward path) in the same run, and
 the fastest unpaced rate (estimate + publish, as fast as the loop goes).
 
+Last, ``tactsense live --ros2`` itself (a subprocess) reading the emulated pad16 over
+TCP at ``--cli-speed`` times its 100 frames/s scan rate (default 10: 1,000 frames/s),
+estimates written to a file: its rate from the stamps the subscriber received, the
+latency from each frame's last byte (its stamp, wall clock) to the subscriber's callback
+(wall clock), losses per topic, and what ``live`` printed.
+
 DDS runs on 127.0.0.1 only, multicast off (the loopback configuration through
 ``CYCLONEDDS_URI``), on a domain of its own.
 
-    PYTHONPATH=src python benchmarks/bench_ros2.py [--rate 1000] [--seconds 10] [--write-docs]
+    PYTHONPATH=src python benchmarks/bench_ros2.py [--rate 1000] [--seconds 10] [--cli-speed 10]
+        [--write-docs]
 """
 
 from __future__ import annotations
@@ -26,6 +33,7 @@ from __future__ import annotations
 import argparse
 import os
 import pickle
+import re
 import struct
 import subprocess
 import sys
@@ -141,7 +149,7 @@ def paced(pad, frames, locator, rate, seconds, folder: Path, *, estimate_live=Tr
         ms = []
         # a TactileContacts has no header: its first contact's stamp (empty lists: none)
         offset = 8 if topic == "contact_states" else 4
-        for when, raw in samples:
+        for when, _, raw in samples:
             if len(raw) < offset + STAMP.size:
                 continue
             sec, nanosec = STAMP.unpack_from(raw, offset)
@@ -156,10 +164,58 @@ def paced(pad, frames, locator, rate, seconds, folder: Path, *, estimate_live=Tr
     }  # fmt: skip
 
 
+def live_command(rate_scale: float, seconds: float, folder: Path) -> dict:
+    """``tactsense live --ros2`` itself on the emulated pad16 (``emulate --speed``: frames
+    at ``rate_scale`` times its 100 frames/s scan rate, over TCP), estimates to a file;
+    the independent subscriber counts the samples. Latency: the subscriber's callback on
+    the wall clock minus the header's stamp, the frame's last byte on the same clock."""
+    cli = [sys.executable, "-m", "tactsense"]
+    emulator = subprocess.Popen(
+        [*cli, "emulate", "--sensor", "pad16", "--scenario", "two-probes", "--loop",
+         "--speed", f"{rate_scale:g}", "--port", "0"],
+        stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True,
+    )  # fmt: skip
+    url = emulator.stdout.readline().strip()
+    out = folder / "received_cli.pickle"
+    subscriber = subprocess.Popen(
+        [sys.executable, str(SUBSCRIBER), str(out), "--domain", os.environ["ROS_DOMAIN_ID"],
+         "--namespace", "/bench_cli", "--seconds", str(seconds + 20)],
+        stdout=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    assert subscriber.stdout.readline().strip() == "ready"
+    try:
+        done = subprocess.run(
+            [*cli, "live", url, "--ros2", "--namespace", "/bench_cli", "--duration",
+             f"{seconds:g}", "--out", str(folder / "live.jsonl")],
+            capture_output=True, text=True, timeout=seconds + 120,
+        )  # fmt: skip
+    finally:
+        emulator.terminate()
+        emulator.wait(10)
+    subscriber.wait(seconds + 60)
+    summary = " ".join(done.stderr.split())
+    frames = int(re.search(r"ROS 2: (\d+) frames", summary).group(1))
+    received = pickle.loads(out.read_bytes())["received"]
+    states = received["tactile_states"]
+    stamps = np.array(
+        [sum(STAMP.unpack_from(raw, 4) * np.array([1.0, 1e-9])) for *_, raw in states]
+    )
+    latency_ms = np.array([wall for _, wall, _ in states]) * 1e3 - stamps * 1e3
+    return {
+        "frames": frames, "rate": (len(stamps) - 1) / (stamps[-1] - stamps[0]),
+        "latency": np.percentile(latency_ms, [50, 99]),
+        "lost": {topic: frames - len(samples) for topic, samples in received.items()},
+        "summary": summary,
+    }  # fmt: skip
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rate", type=float, default=1000.0, help="frames/s to publish")
     parser.add_argument("--seconds", type=float, default=10.0, help="how long [s]")
+    parser.add_argument(
+        "--cli-speed", type=float, default=10.0, help="emulator speed for the live run (x 100/s)"
+    )
     parser.add_argument("--write-docs", action="store_true", help="update docs/ros2.md's block")
     args = parser.parse_args()
     from tactsense.interop.ros2 import loopback_config
@@ -178,6 +234,8 @@ def main() -> None:
                 pad, frames, locator, args.rate, args.seconds, Path(tmp), estimate_live=False
             ),
         }
+        cli = live_command(args.cli_speed, args.seconds, Path(tmp))
+    stream = re.search(r"\d+ estimates.*?(?=ROS 2:)", cli["summary"])
     lines = [
         f"publish path (encode + write, 4 messages, pad16, no subscriber): templates "
         f"{path[True]:.1f} us/frame, Cyclone DDS serialiser {path[False]:.1f} us/frame "
@@ -197,6 +255,15 @@ def main() -> None:
                 f"{p99:.3f} ms; lost {run['lost'][topic]} of {run['n']:,} "
                 f"(DDS sample-lost status {run['lost_dds'][topic]})"
             )
+    p50, p99 = cli["latency"]
+    lines.append(
+        f"tactsense live --ros2 on the emulated pad16 at {100 * args.cli_speed:g} frames/s "
+        f"for {args.seconds:g} s: {cli['frames']:,} frames published at "
+        f"{cli['rate']:,.0f} frames/s (from the stamps); last byte -> subscriber callback "
+        f"(wall clock) p50 {p50:.3f} ms, p99 {p99:.3f} ms; lost per topic "
+        + ", ".join(f"{t} {n}" for t, n in cli["lost"].items())
+        + (f"; live said: {stream.group(0).strip()}" if stream else "")
+    )
     lines.append(f"load average at the end (2 cores, shared): {os.getloadavg()[0]:.2f}")
     text = "\n".join(lines)
     print(text)
@@ -205,7 +272,10 @@ def main() -> None:
         from docblock import replace_block
 
         begin, end = "<!-- bench_ros2 -->", "<!-- /bench_ros2 -->"
-        command = f"python benchmarks/bench_ros2.py --rate {args.rate:g} --seconds {args.seconds:g}"
+        command = (
+            f"python benchmarks/bench_ros2.py --rate {args.rate:g} --seconds {args.seconds:g} "
+            f"--cli-speed {args.cli_speed:g}"
+        )
         block = f"{begin}\n```text\n$ {command}\n{text}\n```\n{end}"
         for doc in ("docs/ros2.md", "docs/performance.md"):
             replace_block(ROOT / doc, begin, end, block)

@@ -4,8 +4,8 @@ Written from the upstream ``.msg`` texts (below, as the ROS tactile toolbox and 
 common_interfaces publish them), not from tactsense's code: the DDS types it subscribes
 with are generated here from rosbags' parse of those texts, named as ROS 2 names them
 on the wire (``pkg::msg::dds_::Type_``), and it keeps every sample's raw CDR bytes and
-its arrival on ``time.perf_counter`` (the listener's callback, in Cyclone DDS's receive
-thread), for the test to decode with rosbags. It also records what DDS discovery says
+its arrival on ``time.perf_counter`` and ``time.time`` (the listener's callback, in
+Cyclone DDS's receive thread), for the test to decode with rosbags. It also records what DDS discovery says
 about the publisher: participants' user data, endpoints' topic and type names and QoS,
 and the ``ros_discovery_info`` samples.
 
@@ -173,10 +173,10 @@ def main() -> int:
 
     def listener_for(name):
         def on_data_available(reader):
-            now = time.perf_counter()
+            now, wall = time.perf_counter(), time.time()
             for data, info in ddspy_take(reader._ref, mask, 64):
                 if info.valid_data:
-                    received[name].append((now, bytes(data)))
+                    received[name].append((now, wall, bytes(data)))
             last[0] = now
             if args.count and len(received["tactile_states"]) >= args.count:
                 done.set()

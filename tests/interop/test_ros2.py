@@ -122,7 +122,7 @@ def test_live_ros2_every_sample_bit_for_bit(emulator, tmp_path, store):  # noqa:
     decoded = {}
     for topic, ros_type in TOPIC_TYPES.items():
         decoded[topic] = []
-        for _, raw in received["received"][topic]:
+        for *_, raw in received["received"][topic]:
             message = store.deserialize_cdr(raw, ros_type)
             _strip(raw, bytes(store.serialize_cdr(message, ros_type)))  # rosbags' bytes
             decoded[topic].append(message)
@@ -348,7 +348,7 @@ def test_live_ros2_finger(emulator, tmp_path, store):  # noqa: F811
     sensor = ts.preset("initial")
     rows = {r["sequence"]: r for r in map(json.loads, lines.read_text().splitlines())}
     touched = 0
-    for k, (_, raw) in enumerate(received["received"]["contact_states"]):
+    for k, (*_, raw) in enumerate(received["received"]["contact_states"]):
         message = store.deserialize_cdr(raw, TOPIC_TYPES["contact_states"])
         row = rows.get(k)
         if row is None or "NO_CONTACT" in row["flag_names"] or row["force_n"] is None:
@@ -366,7 +366,7 @@ def test_live_ros2_finger(emulator, tmp_path, store):  # noqa: F811
         assert [f.x, f.y, f.z] == (-row["force_n"] * normal[0]).tolist()
     assert touched > 0
     states = [store.deserialize_cdr(raw, TOPIC_TYPES["tactile_states"])
-              for _, raw in received["received"]["tactile_states"]]  # fmt: skip
+              for *_, raw in received["received"]["tactile_states"]]  # fmt: skip
     # the emulator plays what 'simulate --seed 4' writes (tests/stream/test_record.py)
     simulated = tmp_path / "sim.h5"
     assert runner.invoke(app, ["simulate", "--out", str(simulated), "--seed", "4"]).exit_code == 0
