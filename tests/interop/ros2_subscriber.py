@@ -5,9 +5,9 @@ common_interfaces publish them), not from tactsense's code: the DDS types it sub
 with are generated here from rosbags' parse of those texts, named as ROS 2 names them
 on the wire (``pkg::msg::dds_::Type_``), and it keeps every sample's raw CDR bytes and
 its arrival on ``time.perf_counter`` and ``time.time`` (the listener's callback, in
-Cyclone DDS's receive thread), for the test to decode with rosbags. It also records what DDS discovery says
-about the publisher: participants' user data, endpoints' topic and type names and QoS,
-and the ``ros_discovery_info`` samples.
+Cyclone DDS's receive thread), for the test to decode with rosbags. It also records
+what DDS discovery says about the publisher: participants' user data, endpoints' topic
+and type names and QoS, and the ``ros_discovery_info`` samples.
 
 Run: ``python ros2_subscriber.py OUT.pickle --domain D --namespace /ns --seconds S
 [--count N]``; prints ``ready`` once its readers exist; stops after S seconds, or once N
