@@ -121,6 +121,14 @@ BAD_OPTIONS = [
     ("view REC --foxglove -1", "--foxglove"),
     ("view REC --foxglove 203.0.113.9:0", "cannot serve Foxglove on 203.0.113.9:0"),
     # ---- /foxglove live (r6-fox) ----
+    # ---- live --ros2 (r6-ros2) ----
+    ("live loop:// --namespace /a", "--namespace applies to --ros2"),
+    ("live loop:// --ros2-config REC", "--ros2-config applies to --ros2"),
+    ("live loop:// --ros2 --namespace /9a", "--namespace '/9a'"),
+    ("live loop:// --ros2 --namespace /a//b", "--namespace"),
+    ("live loop:// --ros2 --ros2-config no_such.xml", "--ros2-config no_such.xml: cannot read"),
+    ("live loop:// --ros2 --ros2-config REC", "--ros2-config"),
+    # ---- /live --ros2 (r6-ros2) ----
 ]
 
 

@@ -197,14 +197,47 @@ def close_foxglove(server) -> None:
 
 
 class Outlets:
-    """Several outlets (LSL, Foxglove) as one: ``push(frame, estimate)`` to each."""
+    """Several outlets (LSL, Foxglove, ROS 2) as one: each takes every frame and its
+    estimate (``push``, or a ROS 2 publisher's ``publish``)."""
 
     def __init__(self, *outlets):
         self.outlets = [o for o in outlets if o is not None]
 
     def push(self, frame, estimate) -> None:
         for outlet in self.outlets:
-            outlet.push(frame, estimate)
+            if hasattr(outlet, "push"):
+                outlet.push(frame, estimate)
+            else:
+                outlet.publish(frame, estimate)
 
 
 # ---- /foxglove live (r6-fox) ----
+# ---- ROS 2 topics (r6-ros2) ----
+def _check_ros2_options(ros2: bool, namespace: str | None, config: str | None) -> None:
+    """Refuse --namespace or --ros2-config without --ros2, a bad namespace, an unreadable
+    or non-Cyclone DDS configuration, or a missing extra: before any line is opened."""
+    from tactsense._validation import TactsenseInputError
+
+    if not ros2:
+        given = [n for n, v in (("--namespace", namespace), ("--ros2-config", config)) if v]
+        if given:
+            fail(f"{' and '.join(given)} appl{'y' if len(given) > 1 else 'ies'} to --ros2")
+        return
+    try:
+        from tactsense.interop.ros2.config import resolve_config
+        from tactsense.interop.ros2.publisher import (
+            _cyclonedds,
+            check_namespace,
+            domain_id_from_environment,
+        )
+
+        _cyclonedds()
+        if namespace is not None:
+            check_namespace(namespace)
+        resolve_config(config)
+        domain_id_from_environment()
+    except TactsenseInputError as error:
+        fail(str(error))
+
+
+# ---- /ROS 2 topics (r6-ros2) ----

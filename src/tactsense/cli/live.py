@@ -34,6 +34,7 @@ from tactsense.cli._live_outputs import (
     Outlets,
     RecordFormat,
     _check_record_suffix,
+    _check_ros2_options,
     _listen_for_rezero,
     check_foxglove,
     close_foxglove,
@@ -414,6 +415,35 @@ def live(
         str | None, typer.Option("--foxglove", metavar="[HOST:]PORT", help=FOXGLOVE_HELP)
     ] = None,
     # ---- /foxglove live (r6-fox) ----
+    # ---- ROS 2 topics (r6-ros2) ----
+    ros2: Annotated[
+        bool,
+        typer.Option(
+            "--ros2",
+            help="Also publish every frame as ROS 2 topics over DDS, without ROS 2: "
+            "TactileState, TactileContacts, sensor_msgs/Image and geometry_msgs/"
+            "WrenchStamped under --namespace, best effort, keep last 5 (docs/ros2.md). "
+            "DDS stays on 127.0.0.1 unless --ros2-config or CYCLONEDDS_URI says otherwise.",
+        ),
+    ] = False,
+    namespace: Annotated[
+        str | None,
+        typer.Option(
+            "--namespace",
+            help="--ros2: the node's ROS 2 namespace, '/' or /name/... of letters, digits "
+            "and _ [default: /<sensor name>].",
+        ),
+    ] = None,
+    ros2_config: Annotated[
+        str | None,
+        typer.Option(
+            "--ros2-config",
+            help="--ros2: a Cyclone DDS configuration (an XML file, file://PATH or XML) "
+            "for a network other than the loopback [default: CYCLONEDDS_URI, else "
+            "127.0.0.1 only, multicast off].",
+        ),
+    ] = None,
+    # ---- /ROS 2 topics (r6-ros2) ----
 ) -> None:
     """Estimate the contact of every frame as it arrives: position, force, skew, flags and
     latency (from the frame's last byte to its estimate), until --frames, --duration,
@@ -435,6 +465,7 @@ def live(
     foxglove_address = check_foxglove(foxglove)  # r6-fox
     if out is not None:
         check_output(out, force, inputs=[calibration, *sensor_file(sensor), *_source_file(source)])
+    _check_ros2_options(ros2, namespace, ros2_config)  # r6-ros2
     try:
         cal = None if calibration is None else load_calibration(calibration)
         from tactsense.estimate.contacts import METHODS
@@ -457,6 +488,13 @@ def live(
         if foxglove_server is not None:
             outlets = Outlets(outlets, foxglove_server)
         # ---- /foxglove live (r6-fox) ----
+        publisher = None  # ---- r6-ros2 ----
+        if ros2:
+            from tactsense.interop.ros2 import Ros2Publisher
+
+            publisher = Ros2Publisher(reader.sensor, namespace=namespace, config=ros2_config)
+            publisher.wait_for_subscribers(1.0)  # those already listening get the first frame
+            outlets = Outlets(outlets, publisher)
         reader.start()
     except TactsenseInputError as error:
         fail(str(error))
@@ -509,6 +547,9 @@ def live(
         summary += f"; latency median {median:.3f} ms, p99 {p99:.3f} ms"
     stopped = f" (stopped by {stopped_by()})" if interrupted else ""
     console.print(f"{len(latencies)} estimates{stopped} from {summary}")
+    if publisher is not None:  # r6-ros2
+        console.print(publisher.summary())
+        publisher.close()
 
 
 app.command()(view)  # registered last, as it always was
