@@ -171,6 +171,33 @@ def test_live_ros2_every_sample_bit_for_bit(emulator, tmp_path, store):  # noqa:
         got_total = [w.force.x, w.force.y, w.force.z, w.torque.x, w.torque.y, w.torque.z]
         assert got_total == wrench.tolist()
     assert seen_two > 10  # the two probes were published as two named contacts
+    # and what 'tactsense locate' computes on the same frames (a recording of them, its
+    # creep described as the emulator's identity says), bit for bit: parquet keeps float64
+    import dataclasses
+
+    import pyarrow.parquet as pq
+
+    known = pad.replace(flaws=dataclasses.replace(pad.flaws, creep_known=True))
+    same = ts.simulate(known, fs.two_probes(known), rng=0)
+    np.testing.assert_array_equal(same.frames, truth.frames)
+    ts.write_recording(tmp_path / "same.h5", same)
+    located = tmp_path / "located.parquet"
+    result = runner.invoke(app, ["locate", str(tmp_path / "same.h5"), "-o", str(located)])
+    assert result.exit_code == 0, result.output
+    table = pq.read_table(located).to_pylist()
+    by_frame: dict[int, list[dict]] = {}
+    for row in table:
+        by_frame.setdefault(row["frame"], []).append(row)
+    compared = 0
+    for k, message in enumerate(decoded["contact_states"]):
+        rows_k = sorted(by_frame.get(k, []), key=lambda r: r["contact"])
+        assert [c.name for c in message.contacts] == [f"pad16/{r['id']}" for r in rows_k], k
+        for got, want in zip(message.contacts, rows_k, strict=True):
+            xyz = np.array([want["x_mm"], want["y_mm"], want["z_mm"]]) * 1e-3
+            assert [got.position.x, got.position.y, got.position.z] == xyz.tolist()
+            assert -got.wrench.force.z == want["force_n"]  # a pad's normal is +z
+            compared += 1
+    assert compared == len(table) > 2 * 10
     # a pair of contacts of one frame never share a name
     for message in decoded["contact_states"]:
         names = [c.name for c in message.contacts]
