@@ -3,7 +3,7 @@ contact equal to ``locate``; pads and point sets from the simulator."""
 
 import numpy as np
 import pytest
-from scipy import ndimage, special
+from scipy import ndimage
 from skimage.morphology import local_maxima
 
 import tactsense as ts
@@ -12,9 +12,9 @@ from tactsense._validation import TactsenseInputError
 from tactsense.estimate import locate
 from tactsense.estimate.contacts import ContactTable, find_contacts
 from tactsense.physics.indenters import SphereProbe
-from tactsense.physics.layer import transfer_functions
 from tactsense.physics.pad_response import pad_strain
 from tactsense.sensor.registry import load_sensor
+from tests._layer_truth import hankel_hertz_strain
 
 
 @pytest.fixture(scope="module")
@@ -121,41 +121,6 @@ def test_extent_of_an_elongated_blob(pad16):
     np.testing.assert_allclose(table.major_mm[0], 2.0 * 2.5, rtol=0.1)
     np.testing.assert_allclose(table.minor_mm[0], 0.7 * 2.5, rtol=0.1)
     np.testing.assert_allclose(table.orientation_deg[0], 30.0, atol=2.0)
-
-
-def hankel_hertz_strain(spec, x_mm, y_mm, force_n, radius_mm=1.6, sub=12):
-    """Compressive strain at every taxel of a pad under a Hertzian sphere, by an
-    evaluation that shares nothing with the simulator's FFT grid: the Hertz pressure
-    ``p0 sqrt(1 - r^2/a^2)`` (a from the half space, as the simulator takes it) has the
-    Hankel transform ``3 F (sin q - q cos q) / q^3`` (q = k a); the bonded layer's strain
-    is its inverse Hankel transform against the layer's transfer function (16-point
-    Gauss-Legendre panels, as ``tests/physics/test_layer.py``), averaged over each
-    electrode on ``sub`` x ``sub`` points. Against the FFT grid: 0.56 % of the peak on
-    the thick pad; 8 vs 16 electrode points change it by 0.09 %."""
-    lay = spec.layer
-    h, z = 1e-3 * lay.thickness_mm, 1e-3 * lay.sensing_depth_mm
-    nu = lay.poisson_ratio
-    mu = lay.youngs_modulus_pa / (2 * (1 + nu))
-    e_star = lay.youngs_modulus_pa / (1 - nu**2)
-    a = 1e-3 * min((3 * force_n * 1e-3 * radius_mm / (4 * e_star)) ** (1 / 3) * 1e3, radius_mm)
-    nodes, weights = np.polynomial.legendre.leggauss(16)
-    edges = np.linspace(0.0, 80.0 / max(z, 0.05 * a), 401)
-    half = np.diff(edges)[:, None] / 2
-    k = ((edges[:-1, None] + edges[1:, None]) / 2 + half * nodes).ravel()
-    q = k * a
-    spectrum = 3 * force_n * (np.sin(q) - q * np.cos(q)) / q**3
-    tf = transfer_functions(k, z, h, nu)["dW_P"].real
-    weight = (half * weights).ravel() * spectrum * tf * k / (2 * np.pi) / (2 * mu)
-    g = spec.grid
-    offsets = (np.arange(sub) + 0.5) / sub - 0.5
-    ex = np.arange(g.rows)[:, None] * g.row_pitch_mm + offsets * g.electrode_x_mm
-    ey = np.arange(g.cols)[:, None] * g.col_pitch_mm + offsets * g.electrode_y_mm
-    r = 1e-3 * np.hypot(ex[:, None, :, None] - x_mm, ey[None, :, None, :] - y_mm)
-    radii = np.linspace(0.0, 1.0001 * r.max(), 1500)
-    eps = np.concatenate(
-        [special.j0(np.outer(part, k)) @ weight for part in np.array_split(radii, 10)]
-    )
-    return -np.interp(r, radii, eps).mean(axis=(2, 3))
 
 
 @pytest.mark.parametrize("load", [0.2, 0.49, 0.98])
