@@ -40,10 +40,43 @@ def coarse_profiles():
     return [_probe_profile(spec, XS) for spec in f.LEVELS[:2]]
 
 
-def test_probe_strain_is_compressive_and_local(coarse_profiles):
-    """Under the 50 g probe eps_rr < 0; 12 mm away it is below 5 % of the peak."""
+def flat_layer_profile(xs, force=0.05 * 9.80665, nu=0.49):
+    """eps_zz at the ring depth of a FLAT layer of the skin's thickness bonded to a rigid
+    base, under the same Hertz pressure: the Hankel transform of the layer's transfer
+    function (checked in ``test_layer.py`` against Love's 4x4 solve and a Navier
+    collocation), no finite elements, no curvature."""
+    from scipy import special
+
+    from tactsense.physics.layer import transfer_functions
+
+    h, z = f.OUTER_M - f.CORE_M, f.RING_DEPTH_M
+    mu = f.YOUNGS_PA / (2 * (1 + nu))
+    _, a = f.hertz_probe(force)
+    nodes, weights = np.polynomial.legendre.leggauss(16)
+    edges = np.linspace(0.0, 80.0 / max(z, 0.05 * a), 401)
+    half = np.diff(edges)[:, None] / 2
+    k = ((edges[:-1, None] + edges[1:, None]) / 2 + half * nodes).ravel()
+    q = k * a
+    spectrum = 3 * force * (np.sin(q) - q * np.cos(q)) / q**3
+    weight = (half * weights).ravel() * spectrum * k / (2 * np.pi) / (2 * mu)
+    weight = weight * transfer_functions(k, z, h, nu)["dW_P"].real
+    return np.array([special.j0(k * x) @ weight for x in np.atleast_1d(xs)])
+
+
+def test_probe_strain_against_a_flat_bonded_layer(coarse_profiles):
+    """Under the 50 g probe, along the cylinder (where the skin is straight), the FEM's
+    eps_rr at the ring depth against the flat bonded layer of the skin's thickness
+    (``flat_layer_profile``, independent of the FEM): the peak within 10 % (measured
+    -7 % on level 0, +6 % on level 1: the skin is curved around, its radius 3.3 skin
+    thicknesses, and the FE amplitude is not converged, issue 34 item 5), the
+    peak-normalised profile within 0.1 of the peak (measured 0.08 and 0.05), and 12 mm
+    away below 5 % of the peak."""
+    flat = flat_layer_profile(XS)
+    assert flat[0] < 0
     for profile in coarse_profiles:
         assert profile[0] < 0
+        assert profile[0] == pytest.approx(flat[0], rel=0.1)
+        assert np.max(np.abs(profile / abs(profile[0]) - flat / abs(flat[0]))) < 0.1
         assert abs(profile[-1]) < 0.05 * abs(profile[0])
 
 
@@ -170,9 +203,16 @@ def test_model_md_dielectric_block_is_the_recorded_study():
 
 
 @pytest.mark.slow
-def test_dielectric_study_is_reproduced():
+def test_regression_dielectric_study_is_reproduced():
     """One case of the recorded study, solved again: the fitted depth and nu agree to the
-    printed digits."""
+    printed digits.
+
+    Regression test, not a check of correctness: the same solver and the same mesh as
+    the table's, so it shows the recorded study is what today's code computes (the
+    pipeline has not changed), and would pass with a wrong solver. Correctness is
+    checked against independent solutions in this file (Lame, two bonded
+    cylinders, a flat bonded layer, the mesh study).
+    """
     import json
 
     script = _dielectric_script()
