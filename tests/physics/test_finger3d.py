@@ -89,14 +89,55 @@ def test_mesh_study_shape_converges(coarse_profiles):
     assert np.max(np.abs(a - b)) < 0.04
 
 
+@pytest.fixture(scope="module")
+def fine_profile():
+    return _probe_profile(f.LEVELS[2], XS)
+
+
+def observed_order(peaks):
+    """Order p of convergence of the peak over the three levels, with the fine zone's
+    real element sizes h ~ 1 / n_fine (6, 9, 12 elements: ratios 1.5 and 1.33, not 2):
+    p solves (h1^p - h2^p) / (h0^p - h1^p) = (P2 - P1) / (P1 - P0); and the
+    the Richardson-extrapolated peak P0 - C h0^p with C = (P0 - P1) / (h0^p - h1^p)."""
+    from scipy.optimize import brentq
+
+    h = 1.0 / np.array([spec.n_fine for spec in f.LEVELS[:3]], float)
+    ratio = (peaks[2] - peaks[1]) / (peaks[1] - peaks[0])
+
+    def mismatch(p):
+        return (h[1] ** p - h[2] ** p) / (h[0] ** p - h[1] ** p) - ratio
+
+    order = brentq(mismatch, 0.05, 8.0)
+    slope = (peaks[0] - peaks[1]) / (h[0] ** order - h[1] ** order)
+    return order, peaks[0] - slope * h[0] ** order
+
+
 @pytest.mark.slow
-def test_mesh_study_amplitude_converges(coarse_profiles):
-    """Level 2: the peak's change shrinks (ratio < 0.7) and the shape agrees within 1 %."""
-    fine = _probe_profile(f.LEVELS[2], XS)
+def test_mesh_study_amplitude_converges(coarse_profiles, fine_profile):
+    """Level 2: the peak's change shrinks (ratio < 0.7) and the shape agrees within 1 %;
+    the peaks converge monotonically at a positive order (measured 0.89 with the fine
+    zone's real ratios, toward -0.0974: level 1 is 22 % low; issue 34 item 5)."""
+    fine = fine_profile
     p0, p1 = (p[0] for p in coarse_profiles)
     assert abs(fine[0] - p1) < 0.7 * abs(p1 - p0)
     assert abs(fine[0] - p1) < 0.1 * abs(fine[0])
     assert np.max(np.abs(fine / abs(fine[0]) - coarse_profiles[1] / abs(p1))) < 0.01
+    assert p0 > p1 > fine[0]  # monotone, more compressive with each level
+    order, limit = observed_order([p0, p1, fine[0]])
+    assert order > 0.5 and limit < fine[0]
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(
+    strict=True,
+    reason="finding (issue 34 items 5, 7): the ratio < 0.7 above passes with first-order "
+    "convergence (0.5 for p = 1 at these refinement ratios); the peak converges at order "
+    "0.89, not the second order quadratic elements give a smooth solution (the core's "
+    "boundary layer is not resolved)",
+)
+def test_mesh_study_amplitude_converges_at_second_order(coarse_profiles, fine_profile):
+    order, _ = observed_order([coarse_profiles[0][0], coarse_profiles[1][0], fine_profile[0]])
+    assert order > 1.5
 
 
 def test_far_cut_does_not_matter(coarse_profiles):
