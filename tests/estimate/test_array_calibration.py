@@ -85,23 +85,34 @@ def test_the_force_curve_brings_forces_to_the_load_cell(bench):
     cal = calibrate_array(rec.frames, pad, loads=(loads.frames, loads.time_s), force_log=(t, f))
     x, y = cal.force_curve
     assert len(x) >= 2 and np.all(np.diff(x) > 0) and np.all(np.diff(y) >= 0)
-    # the 24 presses: the last frame of each, estimated without calibration, with the
-    # gains alone, and with gains and curve (against the force applied)
-    step = loads.truth["frame_step"]
-    force = np.asarray(loads.truth["step_force_n"])
-    last = np.flatnonzero(np.r_[step[1:] != step[:-1], True])
-    last = last[np.isfinite(force[step[last]]) & (force[step[last]] > 0)]
-    truth = force[step[last]]
-    base = np.median(loads.frames[:5].astype(float), axis=0)
-    own = ArrayCalibration(cal.sensor_toml, base, cal.gains, cal.dead, cal.force_curve)
 
-    def error(table):
-        return np.median(np.abs(table.force_n / truth[table.frame] - 1))
+    def errors(presses):
+        """Median force error of the last frame of each press, without calibration and
+        with gains and curve (against the force applied)."""
+        step = presses.truth["frame_step"]
+        force = np.asarray(presses.truth["step_force_n"])
+        last = np.flatnonzero(np.r_[step[1:] != step[:-1], True])
+        last = last[np.isfinite(force[step[last]]) & (force[step[last]] > 0)]
+        assert len(last) == 24
+        truth = force[step[last]]
+        base = np.median(presses.frames[:5].astype(float), axis=0)
+        own = ArrayCalibration(cal.sensor_toml, base, cal.gains, cal.dead, cal.force_curve)
 
-    raw = error(find_contacts(loads.frames[last], pad, baseline=base, max_contacts=1))
-    curve = error(find_contacts(loads.frames[last], pad, calibration=own, max_contacts=1))
-    # fitted on these same presses (a fit, not a prediction): the median error falls to
-    # half or less
+        def error(table):
+            return np.median(np.abs(table.force_n / truth[table.frame] - 1))
+
+        frames = presses.frames[last]
+        raw = error(find_contacts(frames, pad, baseline=base, max_contacts=1))
+        return raw, error(find_contacts(frames, pad, calibration=own, max_contacts=1))
+
+    # on the presses it was fitted to (a fit, not a prediction) the median error falls to
+    # half or less (measured 0.50 -> 0.18)
+    raw, curve = errors(loads)
+    assert curve < 0.5 * raw, (raw, curve)
+    # held out: 24 other presses (other places, noise and jitter: another seed) the
+    # calibration never saw; measured 0.50 -> 0.22 (seed 7; seeds 2, 3, 11: ratios
+    # 0.36-0.44)
+    raw, curve = errors(_loads(pad, rng=7))
     assert curve < 0.5 * raw, (raw, curve)
 
 

@@ -14,6 +14,7 @@ from tactsense.estimate.contacts import ContactTable, find_contacts
 from tactsense.physics.indenters import SphereProbe
 from tactsense.physics.pad_response import pad_strain
 from tactsense.sensor.registry import load_sensor
+from tests._layer_truth import hankel_hertz_strain
 
 
 @pytest.fixture(scope="module")
@@ -122,39 +123,73 @@ def test_extent_of_an_elongated_blob(pad16):
     np.testing.assert_allclose(table.orientation_deg[0], 30.0, atol=2.0)
 
 
+@pytest.mark.parametrize("load", [0.2, 0.49, 0.98])
 @pytest.mark.parametrize("offset", [(0.0, 0.0), (0.25, 0.0), (0.5, 0.5), (0.3, 0.7)])
-def test_pad_round_trip_from_the_layer(thick, offset):
-    """The layer's own (noise-free) response to a 50-g probe: the ML fit places it within
-    0.02 taxel and within 1 % of its force (the table's 1/8-taxel step, bilinear); the
-    sinc interpolation within 0.1 taxel, the centre of pressure within 0.05 taxel (a
-    response 3-4 taxels wide, sampled at every taxel)."""
+def test_pad_round_trip_from_an_independent_layer_solution(thick, offset, load):
+    """Frames from the Hankel-transform solution of the bonded layer (not the FFT grid
+    the estimator's table was made on), noise-free, at the table's load (0.49 N) and at
+    20 g and 100 g, whose Hertz contacts are 26 % narrower and wider: the ML fit places
+    the probe within 0.02 taxel (measured 0.004), the sinc interpolation within 0.1
+    (0.08), the centre of pressure within 0.05 (0.025). The fit's force is within 1 % at
+    the table's load (measured 0.6 %: the two layer solutions differ by 0.56 % of the
+    peak) and within 3 % at the other two (measured +2.7 % and -2.5 %: the table's shape
+    is a 0.49-N contact's; issue 34 item 1)."""
     g = thick.grid
     x, y = (7 + offset[0]) * g.row_pitch_mm, (8 + offset[1]) * g.col_pitch_mm
-    strain = np.maximum(pad_strain(thick, [SphereProbe(x, y, 0.49)]), 0.0)
+    strain = np.maximum(hankel_hertz_strain(thick, x, y, load), 0.0)
     for method, tol in (("fit", 0.02), ("interpolate", 0.1), ("cop", 0.05)):
         table = find_contacts(strain, thick, counts=False, method=method)
         assert len(table) == 1
         error = np.hypot(table.x_mm[0] - x, table.y_mm[0] - y) / g.row_pitch_mm
         assert error < tol, (method, error)
     fit = find_contacts(strain, thick, counts=False, method="fit")
-    np.testing.assert_allclose(fit.force_n, 0.49, rtol=0.01)
+    np.testing.assert_allclose(fit.force_n, load, rtol=0.01 if load == 0.49 else 0.03)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="finding (issue 34 item 1): the fit's table is one 0.49-N contact's shape; "
+    "at 20 g and 100 g its force misses by +2.7 % and -2.5 % on independent frames",
+)
+@pytest.mark.parametrize("load", [0.2, 0.98])
+def test_pad_fit_force_within_two_percent_at_any_load(thick, load):
+    """Issue 34 item 1's goal: noise-free force within 2 % at any load (10-500 g)."""
+    g = thick.grid
+    x, y = 7.3 * g.row_pitch_mm, 8.7 * g.col_pitch_mm
+    strain = np.maximum(hankel_hertz_strain(thick, x, y, load), 0.0)
+    fit = find_contacts(strain, thick, counts=False, method="fit")
+    np.testing.assert_allclose(fit.force_n, load, rtol=0.02)
 
 
 def test_force_is_linear_in_the_load(thick):
-    """Twice the signal, twice the force (the layer is linear; the fit's amplitude too)."""
+    """Twice the load, about twice the force. Twice the signal is exactly twice the
+    force (the fit's amplitude is linear: 1e-9); twice the LOAD is not twice the signal,
+    as the Hertz contact widens as F^(1/3) (26 %) while the fit's table keeps a 0.49-N
+    contact's shape: the force doubles within 4 % (measured 1.943 = -2.9 %), and each
+    force is within 3 % of its load (0.0 % and -2.9 %)."""
     g = thick.grid
-    strain = np.maximum(
-        pad_strain(thick, [SphereProbe(7.3 * g.row_pitch_mm, 8.6 * g.col_pitch_mm, 0.49)]), 0
-    )
+    x, y = 7.3 * g.row_pitch_mm, 8.6 * g.col_pitch_mm
+    strain = np.maximum(pad_strain(thick, [SphereProbe(x, y, 0.49)]), 0)
     one = find_contacts(strain, thick, counts=False)
     two = find_contacts(2 * strain, thick, counts=False, threshold=0.01)
     np.testing.assert_allclose(two.force_n, 2 * one.force_n, rtol=1e-9)
+    heavier = np.maximum(pad_strain(thick, [SphereProbe(x, y, 0.98)]), 0)
+    assert np.abs(heavier - 2 * strain).max() > 0.01 * strain.max()  # not the same frame
+    double = find_contacts(heavier, thick, counts=False)
+    assert len(double) == len(one) == 1
+    np.testing.assert_allclose(double.force_n / one.force_n, 2.0, rtol=0.04)
+    np.testing.assert_allclose(one.force_n, 0.49, rtol=0.03)
+    np.testing.assert_allclose(double.force_n, 0.98, rtol=0.03)
 
 
 def test_two_probes_on_pad16_from_counts(pad16):
     """The simulated two-probes scenario (every flaw on): two contacts in each loaded
-    frame, 5 mm apart along y (2 taxels) within one taxel each: the preset's 35 % gain
-    spread is not calibrated out, so positions are good to a taxel, not better."""
+    frame, 5 mm apart along y (2 taxels), each nearer its own probe than the other and
+    within 0.6 taxel (1.5 mm) of it (measured up to 1.28 mm, 0.51 taxel): the preset's
+    35 % gain spread is not calibrated out, so positions are good to about half a taxel,
+    not better. Both contacts at the pair's midpoint (1 taxel off each) fail."""
+    import json
+
     rec = ts.simulate(pad16, fs.two_probes(pad16), rng=0)
     base = np.median(rec.frames[:5], axis=0)
     table = find_contacts(rec.frames, pad16, baseline=base)
@@ -162,12 +197,20 @@ def test_two_probes_on_pad16_from_counts(pad16):
     assert table.n_frames == len(rec.frames)
     loaded = counts[25:75]
     assert (loaded == 2).all()
-    cx = cy = 7.5 * 2.5
-    for f in range(25, 75, 10):
+    steps = rec.truth["frame_step"]
+    per_step = json.loads(str(rec.truth["step_contacts_json"]))
+    checked = [f for f in range(25, 75, 5) if per_step[steps[f]]]  # the probes are down
+    assert len(checked) >= 8
+    for f in checked:
+        probes = per_step[steps[f]]
+        truth = np.array([[p["x_mm"], p["y_mm"]] for p in probes])
+        assert len(truth) == 2 and np.ptp(truth[:, 1]) == pytest.approx(5.0, abs=0.1)
         rows = table.frame == f
-        ys = np.sort(table.y_mm[rows])
-        np.testing.assert_allclose(ys, [cy - 2.5, cy + 2.5], atol=2.5)
-        np.testing.assert_allclose(table.x_mm[rows], cx, atol=2.5)
+        found = np.column_stack([table.x_mm[rows], table.y_mm[rows]])
+        distance = np.linalg.norm(found[:, None] - truth[None], axis=-1)  # found x truth
+        nearest = distance.argmin(axis=1)
+        assert sorted(nearest) == [0, 1], (f, found, truth)
+        assert distance[[0, 1], nearest].max() < 1.5, (f, found, truth)
 
 
 def test_finger_single_contact_equals_locate(initial):
@@ -187,23 +230,51 @@ def test_finger_single_contact_equals_locate(initial):
     assert not np.isin(table.frame, none).any()
 
 
-def test_point_set_press_at_a_taxel():
-    """dome12: a 50-g probe on taxel 5 is found nearest to taxel 5 (the weighted
-    quadratic fit on its neighbours), with a force within 35 % (uncalibrated gains)."""
+def _dome12_press(flaws):
+    """dome12 pressed with 50 g on taxel 5: the contacts of the loaded frames (the
+    truth's loaded steps, not a frame window that reaches into the lift), the press's
+    force [N] and the taxel positions [mm]."""
     spec = load_sensor("dome12")
     positions = spec.taxel_positions_mm()
     rec = ts.simulate(
-        spec, fs.press(spec, x_mm=float(positions[5, 0]), y_mm=float(positions[5, 1])), rng=0
+        spec,
+        fs.press(spec, x_mm=float(positions[5, 0]), y_mm=float(positions[5, 1])),
+        rng=0,
+        flaws=flaws,
     )
     base = np.median(rec.frames[:5], axis=0)
     table = find_contacts(rec.frames, spec, baseline=base)
-    loaded = table.frame[(table.frame > 30) & (table.frame < 50)]
-    assert len(loaded)
+    loaded = np.flatnonzero(rec.truth["step_n_contacts"][rec.truth["frame_step"]] > 0)
+    assert len(loaded) >= 10
     rows = np.isin(table.frame, loaded) & (table.contact == 0)
+    assert np.array_equal(np.unique(table.frame[rows]), loaded)  # one contact in each
+    force = float(rec.truth["step_force_n"][rec.truth["frame_step"][loaded[0]]])
+    return table, rows, force, positions
+
+
+def test_point_set_press_at_a_taxel():
+    """dome12: a 50-g probe on taxel 5 is found nearest to taxel 5 (the weighted
+    quadratic fit on its neighbours) in every loaded frame, every flaw on; without the
+    gain spread (read noise and quantization only) its force is within 2 % of the load
+    (measured -0.7 %)."""
+    table, rows, _, positions = _dome12_press("all")
     points = np.column_stack([table.x_mm[rows], table.y_mm[rows], table.z_mm[rows]])
     nearest = np.argmin(np.linalg.norm(points[:, None, :] - positions[None], axis=-1), axis=1)
     assert (nearest == 5).all()
     assert np.all(np.isnan(table.row[rows]))
+    table, rows, force, _ = _dome12_press(["noise", "quantization"])
+    np.testing.assert_allclose(table.force_n[rows], force, rtol=0.02)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="finding (issue 34 item 7): the test promised a force within 35 % with the "
+    "gains uncalibrated and never asserted it; with every flaw the force is 41-51 % low "
+    "(the preset's gain draw alone: 37 % low)",
+)
+def test_point_set_press_force_within_35_percent_uncalibrated():
+    table, rows, force, _ = _dome12_press("all")
+    np.testing.assert_allclose(table.force_n[rows], force, rtol=0.35)
 
 
 @pytest.mark.parametrize(

@@ -123,20 +123,53 @@ def test_chunks_give_the_same_result():
     assert evs == events
 
 
-def test_slide_slips_and_hold_does_not():
-    """pad16, from counts: a probe sliding at 10 mm/s under 50 g is flagged as slip in
-    some frames of its path; a press and hold in none. The slide's id stays one for most
-    of the path (the gate is 5 mm; the taxel pitch 2.5 mm)."""
+def _slide_and_hold():
+    """pad16, from counts: the tracked main contact of a 50-g probe sliding at 10 mm/s
+    along +y, and of a press and hold; with the truth's step of each frame."""
     spec = load_sensor("pad16")
-    for scenario, slips in ((fs.slide(spec), True), (fs.hold(spec), False)):
+    out = {}
+    for name, scenario in (("slide", fs.slide(spec)), ("hold", fs.hold(spec))):
         rec = ts.simulate(spec, scenario, rng=0)
         base = np.median(rec.frames[:5], axis=0)
         table = find_contacts(rec.frames, spec, baseline=base)
-        out, _ = track(table, spec.scan_period_s)
-        main = out.contact == 0
-        assert out.slip[main].any() == slips
-        _, counts = np.unique(out.id[main], return_counts=True)
-        assert counts.max() >= 0.9 * main.sum()
+        tracked, _ = track(table, spec.scan_period_s)
+        main = tracked.contact == 0
+        labels = [step.label for step in scenario.steps]
+        step_of = rec.truth["frame_step"][tracked.frame[main]]
+        out[name] = (tracked, main, [labels[k] for k in step_of])
+    return out
+
+
+def test_slide_slips_and_hold_does_not():
+    """A probe sliding at 10 mm/s under 50 g is flagged as slip in some frames, and
+    only WHEN it slides: every flagged frame lies within the slide after its first
+    position (not the settling, not the lift) and moves along the slide (+y); a press
+    and hold is flagged in none. The slide's id stays one for most of the path (the gate
+    is 5 mm; the taxel pitch 2.5 mm)."""
+    runs = _slide_and_hold()
+    tracked, main, labels = runs["slide"]
+    slip = tracked.slip[main]
+    assert slip.any()
+    flagged = [label for label, s in zip(labels, slip, strict=True) if s]
+    assert all(label.startswith("slide ") and label != "slide 0" for label in flagged), flagged
+    assert np.all(tracked.vy_mm_s[main][slip] > 0)
+    hold, hold_main, _ = runs["hold"]
+    assert not hold.slip[hold_main].any()
+    for out, m, _ in runs.values():
+        _, counts = np.unique(out.id[m], return_counts=True)
+        assert counts.max() >= 0.9 * m.sum()
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="finding (issue 34 item 7): on a steady 10-mm/s slide slip is flagged in 12 "
+    "of 325 sliding frames (3.7 %): the pad's force estimate ripples as the probe crosses "
+    "taxels (median |dF/dt| / F = 5.7 /s) far beyond slip_force_rate (0.5 /s)",
+)
+def test_a_steady_slide_is_slip_in_most_of_its_frames():
+    tracked, main, labels = _slide_and_hold()["slide"]
+    sliding = np.array([label.startswith("slide ") and label != "slide 0" for label in labels])
+    assert tracked.slip[main][sliding].mean() >= 0.5
 
 
 @pytest.mark.parametrize(

@@ -40,10 +40,43 @@ def coarse_profiles():
     return [_probe_profile(spec, XS) for spec in f.LEVELS[:2]]
 
 
-def test_probe_strain_is_compressive_and_local(coarse_profiles):
-    """Under the 50 g probe eps_rr < 0; 12 mm away it is below 5 % of the peak."""
+def flat_layer_profile(xs, force=0.05 * 9.80665, nu=0.49):
+    """eps_zz at the ring depth of a FLAT layer of the skin's thickness bonded to a rigid
+    base, under the same Hertz pressure: the Hankel transform of the layer's transfer
+    function (checked in ``test_layer.py`` against Love's 4x4 solve and a Navier
+    collocation), no finite elements, no curvature."""
+    from scipy import special
+
+    from tactsense.physics.layer import transfer_functions
+
+    h, z = f.OUTER_M - f.CORE_M, f.RING_DEPTH_M
+    mu = f.YOUNGS_PA / (2 * (1 + nu))
+    _, a = f.hertz_probe(force)
+    nodes, weights = np.polynomial.legendre.leggauss(16)
+    edges = np.linspace(0.0, 80.0 / max(z, 0.05 * a), 401)
+    half = np.diff(edges)[:, None] / 2
+    k = ((edges[:-1, None] + edges[1:, None]) / 2 + half * nodes).ravel()
+    q = k * a
+    spectrum = 3 * force * (np.sin(q) - q * np.cos(q)) / q**3
+    weight = (half * weights).ravel() * spectrum * k / (2 * np.pi) / (2 * mu)
+    weight = weight * transfer_functions(k, z, h, nu)["dW_P"].real
+    return np.array([special.j0(k * x) @ weight for x in np.atleast_1d(xs)])
+
+
+def test_probe_strain_against_a_flat_bonded_layer(coarse_profiles):
+    """Under the 50 g probe, along the cylinder (where the skin is straight), the FEM's
+    eps_rr at the ring depth against the flat bonded layer of the skin's thickness
+    (``flat_layer_profile``, independent of the FEM): the peak within 10 % (measured
+    -7 % on level 0, +6 % on level 1: the skin is curved around, its radius 3.3 skin
+    thicknesses, and the FE amplitude is not converged, issue 34 item 5), the
+    peak-normalised profile within 0.1 of the peak (measured 0.08 and 0.05), and 12 mm
+    away below 5 % of the peak."""
+    flat = flat_layer_profile(XS)
+    assert flat[0] < 0
     for profile in coarse_profiles:
         assert profile[0] < 0
+        assert profile[0] == pytest.approx(flat[0], rel=0.1)
+        assert np.max(np.abs(profile / abs(profile[0]) - flat / abs(flat[0]))) < 0.1
         assert abs(profile[-1]) < 0.05 * abs(profile[0])
 
 
@@ -56,14 +89,55 @@ def test_mesh_study_shape_converges(coarse_profiles):
     assert np.max(np.abs(a - b)) < 0.04
 
 
+@pytest.fixture(scope="module")
+def fine_profile():
+    return _probe_profile(f.LEVELS[2], XS)
+
+
+def observed_order(peaks):
+    """Order p of convergence of the peak over the three levels, with the fine zone's
+    real element sizes h ~ 1 / n_fine (6, 9, 12 elements: ratios 1.5 and 1.33, not 2):
+    p solves (h1^p - h2^p) / (h0^p - h1^p) = (P2 - P1) / (P1 - P0); and the
+    the Richardson-extrapolated peak P0 - C h0^p with C = (P0 - P1) / (h0^p - h1^p)."""
+    from scipy.optimize import brentq
+
+    h = 1.0 / np.array([spec.n_fine for spec in f.LEVELS[:3]], float)
+    ratio = (peaks[2] - peaks[1]) / (peaks[1] - peaks[0])
+
+    def mismatch(p):
+        return (h[1] ** p - h[2] ** p) / (h[0] ** p - h[1] ** p) - ratio
+
+    order = brentq(mismatch, 0.05, 8.0)
+    slope = (peaks[0] - peaks[1]) / (h[0] ** order - h[1] ** order)
+    return order, peaks[0] - slope * h[0] ** order
+
+
 @pytest.mark.slow
-def test_mesh_study_amplitude_converges(coarse_profiles):
-    """Level 2: the peak's change shrinks (ratio < 0.7) and the shape agrees within 1 %."""
-    fine = _probe_profile(f.LEVELS[2], XS)
+def test_mesh_study_amplitude_converges(coarse_profiles, fine_profile):
+    """Level 2: the peak's change shrinks (ratio < 0.7) and the shape agrees within 1 %;
+    the peaks converge monotonically at a positive order (measured 0.89 with the fine
+    zone's real ratios, toward -0.0974: level 1 is 22 % low; issue 34 item 5)."""
+    fine = fine_profile
     p0, p1 = (p[0] for p in coarse_profiles)
     assert abs(fine[0] - p1) < 0.7 * abs(p1 - p0)
     assert abs(fine[0] - p1) < 0.1 * abs(fine[0])
     assert np.max(np.abs(fine / abs(fine[0]) - coarse_profiles[1] / abs(p1))) < 0.01
+    assert p0 > p1 > fine[0]  # monotone, more compressive with each level
+    order, limit = observed_order([p0, p1, fine[0]])
+    assert order > 0.5 and limit < fine[0]
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(
+    strict=True,
+    reason="finding (issue 34 items 5, 7): the ratio < 0.7 above passes with first-order "
+    "convergence (0.5 for p = 1 at these refinement ratios); the peak converges at order "
+    "0.89, not the second order quadratic elements give a smooth solution (the core's "
+    "boundary layer is not resolved)",
+)
+def test_mesh_study_amplitude_converges_at_second_order(coarse_profiles, fine_profile):
+    order, _ = observed_order([coarse_profiles[0][0], coarse_profiles[1][0], fine_profile[0]])
+    assert order > 1.5
 
 
 def test_far_cut_does_not_matter(coarse_profiles):
@@ -170,9 +244,16 @@ def test_model_md_dielectric_block_is_the_recorded_study():
 
 
 @pytest.mark.slow
-def test_dielectric_study_is_reproduced():
+def test_regression_dielectric_study_is_reproduced():
     """One case of the recorded study, solved again: the fitted depth and nu agree to the
-    printed digits."""
+    printed digits.
+
+    Regression test, not a check of correctness: the same solver and the same mesh as
+    the table's, so it shows the recorded study is what today's code computes (the
+    pipeline has not changed), and would pass with a wrong solver. Correctness is
+    checked against independent solutions in this file (Lame, two bonded
+    cylinders, a flat bonded layer, the mesh study).
+    """
     import json
 
     script = _dielectric_script()

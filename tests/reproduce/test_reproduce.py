@@ -226,6 +226,19 @@ def test_fits_and_echoes_never_count_as_agreement(report):
             results["claims"][source]["computed"] / spacing, rel=1e-12
         )
     assert "localization_tactel" not in results["claims"]
+    # issue 34 item 6: a restated claim carries the verdict of what it restates (the
+    # along error agreed in tactels while it differed in millimetres); the strip claims
+    # evaluate the paper's own strip model: arithmetic, one computation each
+    for side, (source, _) in tactel.items():
+        entry = results["claims"][f"localization_tactel_{side}"]
+        assert entry["restates"] == source
+        assert entry["verdict"] == results["claims"][source]["verdict"]
+        assert f"its verdict is that of {source}" in entry["note"]
+    for strip_claim in ("strip_gain_d0_0.5mm", "strip_gain_increase_backing"):
+        assert results["claims"][strip_claim]["basis"] == "arithmetic"
+    assert "chosen here" in results["claims"]["strip_gain_increase_backing"]["note"]
+    assert "plane-stress twin" in results["claims"]["force_error_pct"]["basis_note"]
+    assert "3-D skin" in results["claims"]["force_error_pct"]["note"]
     # the creep and nonlinearity constants were set from these sentences
     for fitted in ("nonlinearity_1N_pct", "creep_decay_time_s", "creep_residual_pct"):
         assert results["claims"][fitted]["basis"] == "fitted"
@@ -238,6 +251,15 @@ def test_fits_and_echoes_never_count_as_agreement(report):
         Claim("creep_residual_pct", "", 5.0, 5.0, "", 0.15, ""),
     ]
     assert [c.verdict for c in claims] == ["agrees", "differs", "consistent"]
+    # a restatement within its own (looser) bound still differs when its source differs
+    differing = Claim("localization_length_mm", "", 0.5, 0.62, "mm", 0.15, "", kind="within")
+    restated = Claim("localization_tactel_along", "", 0.2, 0.163, "", 0.15, "", "within", differing)
+    assert restated.within_tolerance and restated.verdict == "differs"
+    agreeing = Claim("localization_length_mm", "", 0.5, 0.45, "mm", 0.15, "", kind="within")
+    restated.restates = agreeing
+    assert restated.verdict == "agrees"
+    restated.computed = 0.5  # out of its own bound, but its source agrees
+    assert not restated.within_tolerance and restated.verdict == "agrees"
     assert summary(claims).startswith("1 of 2 predictions agree")
     assert "1 of 1 claims the twin was fitted to" in summary(claims)
     text = (out / "report.md").read_text()
@@ -295,6 +317,7 @@ def test_readme_table_lists_every_claim_with_its_basis(report):
         claim_id: basis for claim_id, (basis, _) in BASIS.items()
     }
     claims = []
+    by_id = {}
     for claim_id, (_, paper, computed, unit, difference, _, verdict) in rows.items():
         entry = results["claims"][claim_id]
         assert unit == entry["unit"]
@@ -311,7 +334,9 @@ def test_readme_table_lists_every_claim_with_its_basis(report):
             entry["tolerance"],
             "",
             kind=entry["kind"],
+            restates=by_id[entry["restates"]] if entry["restates"] else None,
         )
+        by_id[claim_id] = claim
         if difference != "-":
             expected = 100 * (float(computed) - entry["paper"]) / abs(entry["paper"])
             assert float(difference.rstrip(" %")) == pytest.approx(expected, abs=0.1)

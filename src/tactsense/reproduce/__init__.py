@@ -8,6 +8,7 @@ from pathlib import Path
 
 from tactsense._version import __version__
 from tactsense.reproduce._common import Claim, Context, Figure
+from tactsense.reproduce.basis import RESTATED
 from tactsense.reproduce.registry import EXPERIMENTS
 from tactsense.reproduce.report import write_html, write_markdown, write_results
 from tactsense.sensor import SensorSpec, fearing1990_initial
@@ -52,6 +53,9 @@ def reproduce(
         if progress is not None:
             progress(name, k, len(EXPERIMENTS))
         experiment(ctx)
+    unlinked = [c.id for c in ctx.claims if c.basis == RESTATED and c.restates is None]
+    if unlinked:  # a restated claim carries the verdict of what it restates
+        raise RuntimeError(f"restated claims without the claim they restate: {unlinked}")
     if progress is not None:
         progress("report", len(EXPERIMENTS), len(EXPERIMENTS))
     meta = {

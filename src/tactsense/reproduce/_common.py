@@ -15,7 +15,7 @@ import matplotlib.pyplot as plt
 import tactsense as ts
 from tactsense.estimate.finger import calibrate as cal
 from tactsense.physics.transduction import fractional_deflection
-from tactsense.reproduce.basis import BY_CONSTRUCTION, FITTED, basis_of
+from tactsense.reproduce.basis import BY_CONSTRUCTION, FITTED, RESTATED, basis_of
 
 G50 = ts.grams_force(50)
 
@@ -62,6 +62,10 @@ class Claim:
     may be up to paper * (1 + tolerance))."""
     note: str
     kind: str = "value"  # "value", "within" (paper is a bound), "qualitative"
+    restates: Claim | None = None
+    """For a ``restated`` claim: the claim whose measurement it states in other units.
+    Its verdict is that claim's: a measurement that differs in millimetres does not
+    agree because the paper's restatement in tactels is looser."""
 
     @property
     def relative_difference(self) -> float | None:
@@ -91,7 +95,10 @@ class Claim:
     def verdict(self) -> str:
         """``agrees`` or ``differs`` for predictions and arithmetic; a fitted or
         by-construction claim within tolerance is ``consistent`` (an echo of what the
-        twin was set to, not evidence)."""
+        twin was set to, not evidence); a restated claim carries the verdict of the claim
+        it restates (:attr:`restates`), whatever its own tolerance says."""
+        if self.basis == RESTATED and self.restates is not None:
+            return self.restates.verdict
         if not self.within_tolerance:
             return "differs"
         return "consistent" if self.basis in (FITTED, BY_CONSTRUCTION) else "agrees"
@@ -108,6 +115,7 @@ class Claim:
             "basis": self.basis,
             "basis_note": self.basis_note,
             "verdict": self.verdict,
+            "restates": None if self.restates is None else self.restates.id,
             "note": self.note,
         }
 

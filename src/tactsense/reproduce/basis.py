@@ -4,7 +4,8 @@ model's definition, or arithmetic.
 A number the twin was tuned to is a fit, not a prediction: its agreement with the paper
 is an echo, and is reported as ``consistent``, never as ``agrees``. Only ``predicted``
 claims count as agreements in the summary. A claim that states a measurement already
-claimed, in other units, is ``restated``: shown, never counted.
+claimed, in other units, is ``restated``: shown, never counted, and it carries the verdict
+of the claim it restates (``Claim.restates``).
 """
 
 from __future__ import annotations
@@ -71,11 +72,18 @@ BASIS: dict[str, tuple[str, str]] = {
     ),
     "planestress_equivalent_nu": (ARITHMETIC, "Eq. 10: nu / (1 + nu) at nu = 0.5."),
     "strip_gain_d0_0.5mm": (
-        PREDICTED,
-        "The strip model with the paper's stated sizes; the unstated ones from the "
-        "finger's description.",
+        ARITHMETIC,
+        "The paper's own strip model (section 5, derived anew: docs/strip.md) evaluated "
+        "once, with the paper's stated sizes and the unstated ones from the finger's "
+        "description: one computation of the paper's formula, not a prediction of a "
+        "measurement.",
     ),
-    "strip_gain_increase_backing": (PREDICTED, "The strip model with and without backing."),
+    "strip_gain_increase_backing": (
+        ARITHMETIC,
+        "The same strip model evaluated with and without a soft backing: one computation. "
+        "The paper gives no number; the threshold for 'substantially' (15 %) was chosen "
+        "here, not by the paper.",
+    ),
     "frequency_peak_per_mm": (
         ARITHMETIC,
         "The maximum of eq. 39's closed form, evaluated numerically.",
@@ -94,18 +102,22 @@ BASIS: dict[str, tuple[str, str]] = {
     "localization_tactel_along": (
         RESTATED,
         "localization_length_mm divided by the ring spacing: the same measurement, not "
-        "counted again.",
+        "counted again; it carries the verdict of localization_length_mm.",
     ),
     "localization_tactel_around": (
         RESTATED,
         "localization_circumference_deg divided by the strip spacing: the same "
-        "measurement, not counted again.",
+        "measurement, not counted again; it carries the verdict of "
+        "localization_circumference_deg.",
     ),
     "force_error_pct": (
         PREDICTED,
         "Simulated frames with the measured flaws, estimated after calibration; the "
         "force conversion (force per summed deflection) is calibrated on the twin's own "
-        "model, so only the flaws and the sampling can make it err.",
+        "model, so only the flaws and the sampling can make it err. It agrees only on the "
+        "plane-stress twin: on frames of the 3-D finite-element skin the same estimator, "
+        "calibrated, misses the force by far more than 20 % (the robustness study below; "
+        "docs/accuracy.md).",
     ),
     "skew_slope": (ARITHMETIC, "Eq. 67's closed form for a line load."),
     "skew_odd_peak_x_over_z": (ARITHMETIC, "Eq. 65 solved in closed form."),

@@ -61,6 +61,7 @@ def robustness(ctx: Context) -> None:
                 f"{fixed.fitted_nu:.2f} (the paper fitted 3.8 mm and 0.4) and the model fit's "
                 f"worst force error after calibration is {fixed.force_pct:.0f} %."
             )
+    _force_claim_on_the_skin(ctx, by, names, changes)
     ctx.save(
         fig,
         99,
@@ -77,4 +78,30 @@ def robustness(ctx: Context) -> None:
         label="Beyond the paper, R1",
         stem="robustness",
         table=markdown_table(rows, spec),
+    )
+
+
+def _force_claim_on_the_skin(ctx: Context, by: dict, names: list[str], changes: dict) -> None:
+    """force_error_pct agrees on the plane-stress twin only: its note gets the same
+    estimator's (the interpolation's) force error after calibration on the 3-D skin, as
+    measured here (the quick run leaves the 3-D skin out and says so)."""
+    claim = next((c for c in ctx.claims if c.id == "force_error_pct"), None)
+    if claim is None:
+        return
+    skin = [n for n in names if changes[n].get(FORWARD) == "finger3d"]
+    if not skin:
+        claim.note += (
+            " This run did not simulate the 3-D skin (the full run's robustness study "
+            "measures the same estimator on it)."
+        )
+        return
+    errors = [by[(n, "interpolation", True)].force_pct for n in skin]
+    low, high = min(errors), max(errors)
+    span = f"{low:.0f} %" if round(low) == round(high) else f"{low:.0f}-{high:.0f} %"
+    claim.note += (
+        f" The agreement holds on the plane-stress twin only: on frames of the 3-D "
+        f"finite-element skin (rows {', '.join(repr(n) for n in skin)} of Beyond the "
+        "paper, R1) the same "
+        f"estimator, calibrated, misses the force by {span} (a contact given no force "
+        "counts as 100 %)."
     )

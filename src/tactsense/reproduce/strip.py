@@ -62,7 +62,8 @@ def fig17_strip_gain(ctx: Context) -> None:
             float(increase),
             "%",
             15.0,
-            "Qualitative; agreement is counted as an increase below 15 %.",
+            "Qualitative: the paper gives no number, so the threshold is chosen here, not "
+            "by the paper: an increase below 15 % counts as not substantial.",
             kind="qualitative",
         ),
     ]
