@@ -289,9 +289,10 @@ class MujocoSensor:
         )
 
 
-def contact_batch(readings: list[SurfaceContacts]):
+def contact_batch(readings: list[SurfaceContacts], *, shear: bool = True):
     """The readings of N frames as one :class:`~tactsense.simulate.ContactBatch` (N frames
-    x the most contacts any of them has; a missing contact has force 0)."""
+    x the most contacts any of them has; a missing contact has force 0); without their
+    tangential forces unless ``shear`` (for a kind that does not take them)."""
     from tactsense.simulate import ContactBatch
 
     n = len(readings)
@@ -307,7 +308,7 @@ def contact_batch(readings: list[SurfaceContacts]):
     return ContactBatch(
         position_mm=position,
         normal_force_n=normal,
-        tangential_force_n=tangential,
+        tangential_force_n=tangential if shear else None,
         radius_mm=radius,
         shape="sphere",
     )

@@ -70,7 +70,6 @@ from tactsense.kinds import kind_of
 __all__ = [
     "CHUNK_FRAMES",
     "DEFAULT_FLAT_RADIUS_MM",
-    "PER_FRAME_FLAWS",
     "SLIP_TOLERANCE",
     "Controls",
     "MujocoError",
@@ -90,31 +89,27 @@ __all__ = [
 
 # ---- stepping a model: frames at the sensor's scan rate ------------------------------
 
-PER_FRAME_FLAWS = (
-    "gain_spread", "noise", "quantization", "dead", "crosstalk", "nonlinearity",
-)  # fmt: skip
-"""The flaws a frame made from one instant's contacts has (``frames_from_contacts``);
-the memory flaws (viscoelastic creep, hysteresis, drift) and the scenario's jitter are
-left out."""
-
 CHUNK_FRAMES = 256
 """Frames made by one call of ``frames_from_contacts`` and written at a time [-]."""
 
 
 def active_flaws(flaws) -> tuple[str, ...]:
-    """``flaws`` ('all', 'none' or a comma list) as the per-frame flaws switched on; a
-    one-line error for an unknown name or a memory flaw asked by name."""
+    """``flaws`` ('all', 'none' or a comma list) as the per-frame flaws switched on
+    (``frames_from_contacts``'s); a one-line error for an unknown name, or for a flaw
+    with memory (or ``jitter``) asked by name, which frames made one instant at a time
+    cannot have."""
+    from tactsense.simulate.contact_frames import LEFT_OUT_FLAWS, resolve_flaws
     from tactsense.simulate.run import _resolve_flaws
 
-    names = _resolve_flaws(flaws)
     if flaws not in (None, "all", "none"):
-        memory = [n for n in names if n not in PER_FRAME_FLAWS]
-        if memory:
+        left_out = [n for n in _resolve_flaws(flaws) if n in LEFT_OUT_FLAWS]
+        if left_out:
             raise MujocoError(
-                f"flaw(s) {', '.join(memory)} need the frame sequence (memory or jitter); "
-                f"frames from MuJoCo's contacts take {', '.join(PER_FRAME_FLAWS)}"
+                f"flaw(s) {', '.join(left_out)} need the frame sequence (memory or jitter); "
+                "frames from MuJoCo's contacts take the per-frame flaws only "
+                "(gain_spread, noise, quantization, dead, crosstalk, nonlinearity)"
             )
-    return tuple(n for n in names if n in PER_FRAME_FLAWS)
+    return resolve_flaws(flaws)
 
 
 def frame_count(spec, seconds: float) -> int:
@@ -164,6 +159,7 @@ def frame_blocks(
     rng = np.random.default_rng(rng)
     period, dt, t0 = spec.scan_period_s, model.opt.timestep, float(data.time)
     rows, cols = spec.shape
+    shear = kind_of(spec).senses_shear  # a kind without shear is not given it
     for first in range(0, n_frames, chunk_frames):
         last = min(n_frames, first + chunk_frames)
         readings = []
@@ -174,9 +170,8 @@ def frame_blocks(
                     data.ctrl[:] = controls.at(data.time - t0)
                 mujoco.mj_step(model, data)
             readings.append(sensor.read(data))
-        counts = frames_from_contacts(
-            spec, contact_batch(readings), flaws=active or "none", rng=rng, gains=gains
-        )
+        batch = contact_batch(readings, shear=shear)
+        counts = frames_from_contacts(spec, batch, flaws=active, rng=rng, gains=gains)
         yield (
             first,
             last,

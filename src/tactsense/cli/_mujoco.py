@@ -1,0 +1,150 @@
+"""``tactsense mujoco``: step a MuJoCo model and record a tactile sensor's frames from its
+contacts (:mod:`tactsense.interop.mujoco`, docs/mujoco.md)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from tactsense.cli._common import (
+    SensorOption,
+    atomic_output,
+    check_output,
+    console,
+    fail,
+    new_group,
+    progress_bar,
+    sensor_file,
+)
+
+app = new_group("MuJoCo in, taxel frames out.")
+
+
+@app.command("mujoco")
+def mujoco_command(
+    model: Annotated[
+        Path | None,
+        typer.Argument(
+            help="MuJoCo model (MJCF XML). Default: tactsense's example, a finger with a "
+            "40 x 40 mm pad pressing on and sliding across a ball and a rod, moved by its "
+            "own --controls table (docs/mujoco.md)."
+        ),
+    ] = None,
+    out: Annotated[Path, typer.Option("--out", "-o", help="HDF5 recording to write (.h5).")] = (
+        Path("mujoco.h5")
+    ),
+    geom: Annotated[
+        str | None,
+        typer.Option(
+            "--geom",
+            help="The geom the sensor covers; its local +z face is the sensing face "
+            "(default for the example: pad).",
+        ),
+    ] = None,
+    site: Annotated[
+        str | None,
+        typer.Option(
+            "--site",
+            help="Instead of --geom: a site; the sensor covers every geom of its body, in "
+            "the site's frame.",
+        ),
+    ] = None,
+    sensor: SensorOption = "pad16",
+    seconds: Annotated[
+        float | None,
+        typer.Option(
+            "--seconds",
+            min=0.0,
+            max=1e6,
+            help="Simulated time to record [s], (0, 1e6]. Default: the controls table's "
+            "last time (10 s for the example), else 1 s.",
+        ),
+    ] = None,
+    controls: Annotated[
+        Path | None,
+        typer.Option(
+            "--controls",
+            help="CSV of actuator controls over time: a time_s column [s] and one column "
+            "per actuator named as in the model (a position servo's target [m] or [rad]), "
+            "linearly interpolated. Default for the example: its own motion; else none "
+            "(every control 0).",
+        ),
+    ] = None,
+    flat_radius_mm: Annotated[
+        float,
+        typer.Option(
+            "--flat-radius-mm",
+            min=0.01,
+            max=1000.0,
+            help="Radius of the sphere each contact point of a flat body (box, plane, mesh) "
+            "stands for [mm], 0.01-1000.",
+        ),
+    ] = 1.6,
+    flaws: Annotated[
+        str,
+        typer.Option(
+            help="Per-frame flaws to switch on: 'all', 'none' or a comma list of "
+            "gain_spread, noise, quantization, dead, crosstalk, nonlinearity (the flaws "
+            "with memory need a frame sequence and are left out)."
+        ),
+    ] = "all",
+    seed: Annotated[
+        int | None, typer.Option(min=0, help="Seed of the read noise, for a repeatable run.")
+    ] = 0,
+    quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,
+    force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
+) -> None:
+    """Step a MuJoCo model and write a tactile sensor's frames, made from the model's
+    contacts on a geom (or site) at the sensor's scan rate, as a recording that
+    'locate', 'view' and 'export' read; MuJoCo's contacts are its truth."""
+    from tactsense.interop import mujoco as adapter
+    from tactsense.sensor import load_sensor
+
+    example = model is None
+    model_path = adapter.example_model_path() if example else model
+    if example and geom is None and site is None:
+        geom = "pad"
+    if controls is None and example:
+        controls = adapter.example_controls_path()
+    inputs = [model_path, controls, *sensor_file(sensor)]
+    check_output(out, force, inputs=inputs)
+    if out.suffix.lower() not in (".h5", ".hdf5"):
+        fail(f"--out {out}: a recording is an HDF5 file; use the extension .h5 (or .hdf5)")
+    if geom is None and site is None:
+        fail("say which geom the sensor covers (--geom NAME) or its site (--site NAME)")
+    if geom is not None and site is not None:
+        fail("--geom and --site are two mounts; give one")
+    if seconds is not None and seconds <= 0:
+        fail(f"--seconds {seconds:g}: expected a time above 0 [s]")
+    spec = load_sensor(sensor)
+    mj_model = adapter.load_model(model_path)
+    table = adapter.read_controls(controls, mj_model) if controls is not None else None
+    mount = adapter.MujocoSensor(
+        mj_model, spec, geom=geom, site=site, flat_radius_mm=flat_radius_mm
+    )
+    if seconds is None:
+        seconds = float(table.time_s[-1]) if table is not None and table.time_s[-1] > 0 else 1.0
+    n = adapter.frame_count(spec, seconds)
+    adapter.active_flaws(flaws)  # a bad name is an error before the work
+    with progress_bar("stepping", unit="frames", quiet=quiet) as bar:
+        task = bar.add_task("mujoco", total=n)
+        with atomic_output(out) as temporary:
+            written = adapter.record_mujoco(
+                temporary,
+                mount,
+                seconds=seconds,
+                controls=table,
+                flaws=flaws,
+                rng=seed,
+                model_path=model_path,
+                progress=lambda done, total: bar.update(task, completed=done),
+            )
+    rows, cols = spec.shape
+    console.print(
+        f"wrote {out}: {written} frames of {rows}x{cols} counts at "
+        f"{spec.electronics.scan_rate_hz:g} Hz ({spec.name} on "
+        f"{'geom' if geom else 'site'} {geom or site} of {Path(model_path).name}, "
+        f"{round(seconds / mj_model.opt.timestep)} MuJoCo steps)"
+    )
