@@ -102,8 +102,10 @@ def read_controls(path, model) -> Controls:
     try:
         with path.open(newline="") as handle:
             rows = list(csv.reader(handle))
-    except (OSError, UnicodeDecodeError) as error:
-        raise MujocoError(f"--controls {path}: cannot read it ({error})") from None
+    except UnicodeDecodeError:
+        raise MujocoError(f"--controls {path}: not a text CSV file") from None
+    except OSError as error:
+        raise MujocoError(f"--controls {path}: cannot read it ({error.strerror})") from None
     if not rows or "time_s" not in [h.strip() for h in rows[0]]:
         raise MujocoError(
             f"--controls {path}: expected a CSV with a header naming 'time_s' [s] and "
