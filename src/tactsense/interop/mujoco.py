@@ -135,12 +135,16 @@ def frame_blocks(
     rng=None,
     gains: np.ndarray | None = None,
     chunk_frames: int = CHUNK_FRAMES,
+    on_read=None,
+    fast: bool = True,
 ):
     """Step the model and yield the sensor's frames a chunk at a time.
 
     Frame ``j``'s contacts are read at the model step nearest the middle of its scan,
     ``t0 + (j + 1/2) period`` (``t0``: ``data.time`` at the start); before every step the
-    controls at the step's time are applied.
+    controls at the step's time are applied. ``on_read(j, data)``, if given, is called
+    at that instant (to read the model's own sensors beside the frames); ``fast`` is
+    ``frames_from_contacts``'s (False: the reference, the kind's frame-by-frame path).
 
     Yields
     ------
@@ -170,8 +174,10 @@ def frame_blocks(
                     data.ctrl[:] = controls.at(data.time - t0)
                 mujoco.mj_step(model, data)
             readings.append(sensor.read(data))
+            if on_read is not None:
+                on_read(j, data)
         batch = contact_batch(readings, shear=shear)
-        counts = frames_from_contacts(spec, batch, flaws=active, rng=rng, gains=gains)
+        counts = frames_from_contacts(spec, batch, flaws=active, rng=rng, gains=gains, fast=fast)
         yield (
             first,
             last,
