@@ -1,7 +1,8 @@
 """Throughput of MuJoCo in, taxel frames out (``tactsense.interop.mujoco``).
 
-Run: ``python benchmarks/bench_mujoco.py [SECONDS]`` (default 10: the example's whole
-motion, 10,000 MuJoCo steps of 1 ms and 1,000 pad16 frames at 100 Hz). On the example
+Run: ``python benchmarks/bench_mujoco.py [SECONDS] [--doc]`` (default 10: the example's
+whole motion, 10,000 MuJoCo steps of 1 ms and 1,000 pad16 frames at 100 Hz); ``--doc``
+also writes the table into docs/performance.md (its MuJoCo block). On the example
 model (a finger with a 16 x 16 pad pressing on and sliding across a ball and a rod),
 one core, in the same run:
 
@@ -21,6 +22,7 @@ from __future__ import annotations
 
 import sys
 import time
+from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -83,21 +85,40 @@ def main(seconds: float = 10.0) -> None:
     t_ref, n_ref, reference = _frames(spec, model, controls, sensor, seconds, False)
     t_every, _ = _steps_only(model, controls, seconds, read=sensor.read)
     same = float(np.max(np.abs(fast - reference)))
-    print(f"example model, {seconds:g} s simulated: {steps} MuJoCo steps, {frames} pad16 frames")
-    print(f"mj_step alone:                {steps / t_step:10.0f} steps/s  "
-          f"real-time x{seconds / t_step:.1f}")  # fmt: skip
-    print(f"+ contacts read per frame:    {steps / t_read:10.0f} steps/s  "
-          f"real-time x{seconds / t_read:.1f}")  # fmt: skip
-    print(f"+ contacts read every step:   {steps / t_every:10.0f} steps/s  "
-          f"real-time x{seconds / t_every:.1f}")  # fmt: skip
-    for label, t, n in (("fast", t_fast, n_fast), ("reference", t_ref, n_ref)):
-        print(f"+ frames ({label:9s}):       {n / t:10.0f} frames/s "
-              f"{n * taxels / t:12.3g} readings/s  real-time x{seconds / t:.1f}")  # fmt: skip
-    print(
-        f"fast / reference: {t_ref / t_fast:.2f}x; largest difference {same:g} counts "
-        "(the noise is drawn in another order when the paths differ)"
-    )
+    rows = [
+        ("`mj_step` alone, controls applied", steps / t_step, "steps/s", seconds / t_step),
+        ("+ contacts read at every frame (100 Hz)", steps / t_read, "steps/s", seconds / t_read),
+        ("+ contacts read at every step (1 kHz)", steps / t_every, "steps/s", seconds / t_every),
+        ("+ frames, `frames_from_contacts` fast", n_fast / t_fast, "frames/s", seconds / t_fast),
+        ("+ frames, its reference (`fast=False`)", n_ref / t_ref, "frames/s", seconds / t_ref),
+    ]
+    lines = [
+        f"Example model, {seconds:g} s simulated: {steps} MuJoCo steps of "
+        f"{model.opt.timestep * 1e3:g} ms, {frames} pad16 frames (16 x 16) at 100 Hz, every "
+        "per-frame flaw on; one core.",
+        "",
+        "| what | throughput | taxel readings/s | real-time factor |",
+        "|---|---|---|---|",
+    ]
+    for label, rate, unit, factor in rows:
+        readings = f"{rate * taxels:.3g}" if unit == "frames/s" else ""
+        lines.append(f"| {label} | {rate:,.0f} {unit} | {readings} | {factor:.1f}x |")
+    lines += [
+        "",
+        f"Fast against reference in the same run: {t_ref / t_fast:.2f}x (largest difference "
+        f"between their frames: {same:g} counts).",
+    ]
+    text = "\n".join(lines)
+    print(text)
+    if "--doc" in sys.argv:
+        sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts"))
+        from docblock import replace_block
+
+        begin, end = "<!-- begin bench_mujoco -->", "<!-- end bench_mujoco -->"
+        doc = Path(__file__).resolve().parents[1] / "docs" / "performance.md"
+        replace_block(doc, begin, end, f"{begin}\n{text}\n{end}")
 
 
 if __name__ == "__main__":
-    main(float(sys.argv[1]) if len(sys.argv) > 1 else 10.0)
+    numbers = [a for a in sys.argv[1:] if not a.startswith("--")]
+    main(float(numbers[0]) if numbers else 10.0)
