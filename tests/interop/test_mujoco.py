@@ -187,3 +187,40 @@ def test_force_with_the_sensors_calibration_within_two_percent(recording):
         frames = list(frames)
         ratio = total.reindex(frames).to_numpy() / mujoco_sum[frames]
         assert np.all(np.abs(ratio - 1) < 0.02), ratio
+
+
+def test_the_view_plays_the_recording_and_export_reads_it(recording):
+    import json
+    import time
+
+    from tactsense.estimate.finger.deflection import baseline_from
+    from tactsense.view import RecordingFeed
+    from tactsense.view.locators import view_locator
+
+    folder, out = recording
+
+    def locator(spec, file):
+        return view_locator(spec, baseline=baseline_from(file.frames(0, 5)))  # as 'view' does
+
+    feed = RecordingFeed(out, locator, speed=1000.0)
+    contacts = []
+
+    def publish(text):
+        message = json.loads(text)
+        if message["type"] == "frame":
+            contacts.append(len((message["estimate"] or {}).get("contacts") or []))
+
+    feed.start(publish)
+    try:
+        deadline = time.monotonic() + 60
+        while feed.status != "ended":
+            assert time.monotonic() < deadline, "the view did not play the recording"
+            time.sleep(0.01)
+    finally:
+        feed.stop()
+    assert feed.n_frames == 1000 and feed.position == 999
+    assert contacts and max(contacts) >= 1  # the view shows the located contacts
+    mcap = folder / "example.mcap"
+    result = runner.invoke(app, ["export", str(out), "--out", str(mcap), "--quiet"])
+    assert result.exit_code == 0, result.output
+    assert mcap.stat().st_size > 0
