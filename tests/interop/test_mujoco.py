@@ -224,3 +224,49 @@ def test_the_view_plays_the_recording_and_export_reads_it(recording):
     result = runner.invoke(app, ["export", str(out), "--out", str(mcap), "--quiet"])
     assert result.exit_code == 0, result.output
     assert mcap.stat().st_size > 0
+
+
+RESTING_BLOCK = """
+<mujoco>
+  <option timestep="0.001" cone="elliptic"/>
+  <worldbody>
+    <body name="palm" pos="0 0 0.1">
+      <geom name="pad" type="box" size="0.02 0.02 0.002"/>
+      <site name="palm_site" pos="0 0 0.002" size="0.02 0.02 0.001" type="box"/>
+    </body>
+    <body name="block" pos="0.005 -0.004 0.108">
+      <freejoint/>
+      <geom name="block" type="box" size="0.004 0.003 0.006" mass="0.05"/>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+"""A 50-g block resting on a pad that faces up (+z, the sensing face, up as declared):
+the pad is ``geom1`` of every contact (declared first), the block's face gives four
+contact points at its corners."""
+
+
+@pytest.mark.parametrize("mount", [{"geom": "pad"}, {"site": "palm_site"}])
+def test_a_resting_block_weighs_its_weight_at_its_corners(mount):
+    model = mujoco.MjModel.from_xml_string(RESTING_BLOCK)
+    data = mujoco.MjData(model)
+    spec = load_sensor("pad16")
+    sensor = adapter.MujocoSensor(model, spec, **mount)
+    for _ in range(1000):  # settle [1 s]
+        mujoco.mj_step(model, data)
+    reading = sensor.read(data)
+    pad = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "pad")
+    assert all(data.contact[i].geom1 == pad for i in range(data.ncon))  # the other sign
+    weight = 0.05 * -model.opt.gravity[2]  # [N]
+    assert len(reading) == 4
+    assert reading.normal_force_n.sum() == pytest.approx(weight, rel=1e-6)
+    np.testing.assert_allclose(reading.tangential_force_n, 0.0, atol=1e-6)
+    # the corners, in surface coordinates: the pad's centre is taxel (7.5, 7.5) [mm]
+    centre = 7.5 * 2.5
+    xs, ys = (
+        sorted(set(np.round(reading.position_mm[:, 0], 3))),
+        sorted(set(np.round(reading.position_mm[:, 1], 3))),
+    )
+    np.testing.assert_allclose(xs, [centre + 5.0 - 4.0, centre + 5.0 + 4.0], atol=1e-3)
+    np.testing.assert_allclose(ys, [centre - 4.0 - 3.0, centre - 4.0 + 3.0], atol=1e-3)
+    assert np.all(reading.radius_mm == adapter.DEFAULT_FLAT_RADIUS_MM)  # a flat body
