@@ -270,3 +270,11 @@ def test_a_resting_block_weighs_its_weight_at_its_corners(mount):
     np.testing.assert_allclose(xs, [centre + 5.0 - 4.0, centre + 5.0 + 4.0], atol=1e-3)
     np.testing.assert_allclose(ys, [centre - 4.0 - 3.0, centre - 4.0 + 3.0], atol=1e-3)
     assert np.all(reading.radius_mm == adapter.DEFAULT_FLAT_RADIUS_MM)  # a flat body
+
+
+def test_controls_interpolate_as_numpy_does():
+    model = adapter.load_model(adapter.example_model_path())
+    controls = adapter.read_controls(adapter.example_controls_path(), model)
+    for t in np.linspace(-1.0, 12.0, 1301):  # before, inside and after the table [s]
+        expected = [np.interp(t, controls.time_s, column) for column in controls.values.T]
+        np.testing.assert_allclose(controls.at(t), expected, rtol=0, atol=1e-15)

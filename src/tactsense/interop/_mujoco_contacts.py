@@ -83,12 +83,16 @@ class Controls:
     values: np.ndarray
 
     def at(self, t_s: float) -> np.ndarray:
-        """Every actuator's control at time ``t_s`` [s], shape (nu,)."""
+        """Every actuator's control at time ``t_s`` [s], shape (nu,): linear between the
+        rows around it, the first row before the table and the last after it."""
         t = self.time_s
-        out = np.empty(self.values.shape[1])
-        for a in range(self.values.shape[1]):
-            out[a] = np.interp(t_s, t, self.values[:, a])
-        return out
+        if t_s <= t[0]:
+            return self.values[0].copy()
+        if t_s >= t[-1]:
+            return self.values[-1].copy()
+        i = int(np.searchsorted(t, t_s, side="right")) - 1
+        weight = (t_s - t[i]) / (t[i + 1] - t[i])
+        return self.values[i] + weight * (self.values[i + 1] - self.values[i])
 
 
 def read_controls(path, model) -> Controls:
