@@ -278,3 +278,38 @@ def test_controls_interpolate_as_numpy_does():
     for t in np.linspace(-1.0, 12.0, 1301):  # before, inside and after the table [s]
         expected = [np.interp(t, controls.time_s, column) for column in controls.values.T]
         np.testing.assert_allclose(controls.at(t), expected, rtol=0, atol=1e-15)
+
+
+def test_the_fingers_skin_reads_the_ball_and_its_axial_friction():
+    # the paper's finger as a capsule along world x, its local x down: the ball under
+    # the middle of its cylinder is at axial 12.5 mm (half its 25 mm), angle 0; slid
+    # toward its tip (+x), the ball's friction pulls toward the base (+axial)
+    spec = load_sensor("initial")
+    folder = adapter.fingertip_model_path().parent
+    model = adapter.load_model(adapter.fingertip_model_path())
+    controls = adapter.read_controls(folder / "mujoco_fingertip.csv", model)
+    sensor = adapter.MujocoSensor(model, spec, geom="finger")
+    data = mujoco.MjData(model)
+    readings = {}
+    while data.time < 8.0:
+        data.ctrl[:] = controls.at(data.time)
+        mujoco.mj_step(model, data)
+        if round(data.time * 1e3) in (2500, 7000):
+            readings[round(data.time * 1e3)] = sensor.read(data)
+    held, sliding = readings[2500], readings[7000]
+    np.testing.assert_allclose(held.position_mm[0], [12.5, 0.0], atol=1e-6)
+    assert held.radius_mm[0] == pytest.approx(3.0)
+    assert held.normal_force_n[0] > 0.5
+    assert sliding.slipping.all()
+    assert sliding.position_mm[0, 0] > 14.0  # the ball moved toward the base [mm]
+    ratio = sliding.tangential_force_n[0] / sliding.normal_force_n[0]
+    np.testing.assert_allclose(ratio, [0.5, 0.0], atol=2e-3)  # friction 0.5, along the axis
+    batch = adapter.contact_batch([held, sliding], shear=True)
+    from tactsense.simulate import frames_from_contacts
+
+    frames = frames_from_contacts(spec, batch, flaws="none").reshape(2, *spec.shape)
+    still = frames_from_contacts(
+        spec, adapter.contact_batch([held, sliding], shear=False), flaws="none"
+    ).reshape(2, *spec.shape)
+    assert np.argmax(frames[0, :, 0]) in (3, 4)  # the rows around 12.5 mm, column 0
+    assert not np.allclose(frames[1], still[1])  # the finger's frames carry the shear

@@ -50,6 +50,12 @@ def example_controls_path() -> Path:
     return Path(str(resources.files("tactsense.interop") / "data" / "mujoco_finger.csv"))
 
 
+def fingertip_model_path() -> Path:
+    """The second example: the paper's finger as a capsule slid along its axis over a
+    ball (``mujoco_fingertip.xml``; its motion ``mujoco_fingertip.csv`` beside it)."""
+    return Path(str(resources.files("tactsense.interop") / "data" / "mujoco_fingertip.xml"))
+
+
 def load_model(path) -> Any:
     """A ``mujoco.MjModel`` from an MJCF (XML) file; a one-line error if it does not load."""
     mujoco = _mujoco()
@@ -201,8 +207,12 @@ class MujocoSensor:
     ):
         mujoco = _mujoco()
         kind = kind_of(spec)
-        if tuple(kind.position_units) != ("mm", "mm"):
-            raise kind.unsupported(spec, "MuJoCo contacts (a curved surface; flat kinds only)")
+        units = tuple(kind.position_units)
+        if units not in (("mm", "mm"), ("mm", "deg")):
+            raise kind.unsupported(spec, f"MuJoCo contacts (surface coordinates in {units})")
+        self.curved = units == ("mm", "deg")  # along an axis [mm] and around it [deg]
+        if geom is None and self.curved:
+            raise MujocoError(f"{spec.name!r} is a skin around an axis: mount it on a geom")
         if (geom is None) == (site is None):
             raise MujocoError("give the sensor's geom or its site (one of them)")
         if not (isinstance(flat_radius_mm, float | int) and 0 < flat_radius_mm < 1e3):
@@ -222,8 +232,21 @@ class MujocoSensor:
             body = model.site_bodyid[self.site_id]
             self.members = frozenset(np.flatnonzero(model.geom_bodyid == body).tolist())
         self.name = geom if geom is not None else site
+        self.half_length_mm = 0.0
         grid = kind.surface_grid(spec)
-        if grid is not None:
+        if self.curved:
+            types = mujoco.mjtGeom
+            if int(model.geom_type[self.geom_id]) not in (
+                int(types.mjGEOM_CAPSULE), int(types.mjGEOM_CYLINDER)
+            ):  # fmt: skip
+                raise MujocoError(
+                    f"--geom {geom}: {spec.name!r} is a skin around an axis; mount it on a "
+                    "capsule or a cylinder (its local z the axis, the tip at +z)"
+                )
+            self.half_length_mm = float(model.geom_size[self.geom_id][1]) * 1e3
+            self.radius_mm = float(spec.radius_mm)
+            self.origin_mm = np.zeros(2)
+        elif grid is not None:
             (x_pitch, rows), (y_pitch, cols) = grid
             self.origin_mm = np.array([(rows - 1) * x_pitch / 2, (cols - 1) * y_pitch / 2])
         else:  # taxels around their centroid
@@ -246,6 +269,18 @@ class MujocoSensor:
             return float(np.min(size)) * 1e3
         return self.flat_radius_mm
 
+    def _around(self, point_mm, force_n):
+        """A contact on a skin around the geom's z axis (the tip at +z): its position
+        (axial [mm] from where the tip meets the cylinder, toward the base; arc around
+        [mm] at the sensor's radius from the local x axis), the normal force pressing
+        in [N], and the tangential force along the axial and the arc direction [N]."""
+        angle = math.atan2(point_mm[1], point_mm[0])
+        outward = np.array([math.cos(angle), math.sin(angle), 0.0])
+        around = np.array([-math.sin(angle), math.cos(angle), 0.0])
+        axial = self.half_length_mm - point_mm[2]
+        position = (axial, angle * self.radius_mm)
+        return position, -float(force_n @ outward), (-float(force_n[2]), float(force_n @ around))
+
     def read(self, data) -> SurfaceContacts:
         """The contacts on the sensor now (after ``mj_step`` or ``mj_forward``)."""
         mujoco = _mujoco()
@@ -264,8 +299,13 @@ class MujocoSensor:
             frame = contact.frame.reshape(3, 3)  # rows: normal (geom1 -> geom2), tangents
             on_sensor = sign * (frame.T @ self._force[:3])  # world [N]
             local_force = rotation.T @ on_sensor
-            local_point = rotation.T @ (contact.pos - origin)
-            normal = -local_force[2]  # pressing into the +z face
+            local_point = rotation.T @ (contact.pos - origin) * 1e3  # [mm]
+            if self.curved:
+                position, normal, tangential = self._around(local_point, local_force)
+            else:
+                position = local_point[:2] + self.origin_mm
+                normal = -local_force[2]  # pressing into the +z face
+                tangential = local_force[:2]
             if normal <= 0:
                 continue
             mu = contact.friction[:2]
@@ -274,11 +314,11 @@ class MujocoSensor:
             slipping = mu[0] > 0 and cone >= (1.0 - SLIP_TOLERANCE) * self._force[0] > 0
             rows.append(
                 (
-                    local_point[0] * 1e3 + self.origin_mm[0],
-                    local_point[1] * 1e3 + self.origin_mm[1],
+                    position[0],
+                    position[1],
                     normal,
-                    local_force[0],
-                    local_force[1],
+                    tangential[0],
+                    tangential[1],
                     self._radius_mm(other),
                     slipping,
                     other,

@@ -22,6 +22,14 @@ sensor's taxel grid (a pad: x along rows, y along columns, taxel (0, 0) at
 the geom in the model so that its +z face is the pad's outer face (the example model
 does: ``euler="180 0 0"`` on a pad that faces down).
 
+A skin around an axis (a kind whose surface coordinates are an axial position [mm] and
+an angle [deg]: the paper's finger) is mounted on a capsule or cylinder geom whose local
+z is its axis, the tip at +z: the axial position is measured from the end of the
+geom's cylinder at +z toward -z, the angle from the local x axis about z, and the
+normal force is the one pressing toward the axis; the tangential force is given along
+the axis (toward the base) and around it. A contact on a capsule's hemispherical end is
+projected onto the axis (a negative axial position).
+
 What a contact becomes
 ----------------------
 * A sphere, capsule or cylinder pressing: a sphere of its radius (Hertz contact, radius
@@ -62,6 +70,7 @@ from tactsense.interop._mujoco_contacts import (
     contact_labels,
     example_controls_path,
     example_model_path,
+    fingertip_model_path,
     load_model,
     read_controls,
 )
@@ -80,6 +89,7 @@ __all__ = [
     "contact_labels",
     "example_controls_path",
     "example_model_path",
+    "fingertip_model_path",
     "frame_blocks",
     "frame_count",
     "load_model",
