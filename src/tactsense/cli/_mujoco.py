@@ -9,7 +9,6 @@ from typing import Annotated
 import typer
 
 from tactsense.cli._common import (
-    SensorOption,
     atomic_output,
     check_output,
     console,
@@ -27,11 +26,20 @@ def mujoco_command(
     model: Annotated[
         Path | None,
         typer.Argument(
-            help="MuJoCo model (MJCF XML). Default: tactsense's example, a finger with a "
-            "40 x 40 mm pad pressing on and sliding across a ball and a rod, moved by its "
-            "own --controls table (docs/mujoco.md)."
+            help="MuJoCo model (MJCF XML). Default: tactsense's example (--example), moved "
+            "by its own --controls table (docs/mujoco.md)."
         ),
     ] = None,
+    example: Annotated[
+        str,
+        typer.Option(
+            "--example",
+            metavar="[pad|fingertip]",
+            help="Without MODEL, which example: 'pad' (a finger with a 40 x 40 mm pad16 "
+            "pressing on and sliding across a ball and a rod) or 'fingertip' (the paper's "
+            "finger, the 'initial' preset, slid along its axis over a ball).",
+        ),
+    ] = "pad",
     out: Annotated[Path, typer.Option("--out", "-o", help="HDF5 recording to write (.h5).")] = (
         Path("mujoco.h5")
     ),
@@ -39,8 +47,9 @@ def mujoco_command(
         str | None,
         typer.Option(
             "--geom",
-            help="The geom the sensor covers; its local +z face is the sensing face "
-            "(default for the example: pad).",
+            help="The geom the sensor covers: a pad's sensing face is the geom's local +z "
+            "face; a finger's skin wraps a capsule or cylinder about its local z, tip at +z "
+            "(default for the examples: pad, finger).",
         ),
     ] = None,
     site: Annotated[
@@ -51,7 +60,15 @@ def mujoco_command(
             "the site's frame.",
         ),
     ] = None,
-    sensor: SensorOption = "pad16",
+    sensor: Annotated[
+        str | None,
+        typer.Option(
+            "--sensor",
+            help="The tactile sensor: a preset (pad16, pad12x32, fsr16, dome12, initial, "
+            "...; 'tactsense sensor list') or a sensor TOML file. Default: pad16 (the "
+            "fingertip example: initial).",
+        ),
+    ] = None,
     seconds: Annotated[
         float | None,
         typer.Option(
@@ -102,12 +119,22 @@ def mujoco_command(
     from tactsense.interop import mujoco as adapter
     from tactsense.sensor import load_sensor
 
-    example = model is None
-    model_path = adapter.example_model_path() if example else model
-    if example and geom is None and site is None:
-        geom = "pad"
-    if controls is None and example:
-        controls = adapter.example_controls_path()
+    examples = {
+        "pad": (adapter.example_model_path(), "pad", "pad16"),
+        "fingertip": (adapter.fingertip_model_path(), "finger", "initial"),
+    }
+    if example not in examples:
+        fail(f"--example {example}: expected one of {', '.join(examples)}")
+    if model is None:
+        model_path, mount, preset = examples[example]
+        if geom is None and site is None:
+            geom = mount
+        if controls is None:
+            controls = model_path.with_suffix(".csv")
+        sensor = sensor or preset
+    else:
+        model_path = model
+        sensor = sensor or "pad16"
     inputs = [model_path, controls, *sensor_file(sensor)]
     check_output(out, force, inputs=inputs)
     if out.suffix.lower() not in (".h5", ".hdf5"):
