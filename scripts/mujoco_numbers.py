@@ -23,6 +23,11 @@ How the numbers are made (seeded, so a run repeats them):
 * **Slip**: MuJoCo's onset (the first frame with a contact at the friction cone's limit
   after the ball press) against the first frame of the slide that ``locate`` flags
   ``slip`` (a contact moving under a steady force).
+* **The finger** (``tactsense mujoco --example fingertip --seed 3``: the paper's finger
+  slid along its axis over a ball; it takes the axial shear): ``tactsense locate``'s skew
+  index per frame turned into ``tan(alpha)`` (``skew / k(nu)``, section 9 of the paper,
+  ``angle_from_skew``) against MuJoCo's friction over normal force, in the stick before
+  the onset and while sliding.
 """
 
 from __future__ import annotations
@@ -191,8 +196,36 @@ def _numbers(folder: Path, spec, touch, grid) -> str:
         f"largest difference {touch_gap:.1e} N; against the touch grid's summed normal "
         f"channel: {grid_gap:.1e} N.",
         f"* Calibration: {len(loads)} presses, {min(loads):.3f}-{max(loads):.3f} N.",
+        _fingertip(folder),
     ]
     return "\n".join(out)
+
+
+def _fingertip(folder: Path) -> str:
+    """The finger's slip onset in MuJoCo against the force angle its frames give."""
+    from tactsense.physics.halfplane import line_load_skew_coefficient
+
+    rec, table = folder / "fingertip.h5", folder / "fingertip.csv"
+    _tactsense("mujoco", "--example", "fingertip", "--out", str(rec), "--seed", "3", "-q")
+    _tactsense("locate", str(rec), "--out", str(table))
+    recording = read_recording(rec)
+    truth, period = recording.truth, recording.sensor.scan_period_s
+    true_ratio = truth["mujoco_tangential_force_n"][:, 0] / np.maximum(truth["step_force_n"], 1e-12)
+    estimate = pd.read_csv(table).set_index("frame")["skew"].reindex(range(len(true_ratio)))
+    estimated = estimate.to_numpy() / line_load_skew_coefficient(0.5)
+    slip = truth["mujoco_slip"]
+    onset = int(np.argmax(slip))
+    sliding = np.flatnonzero(slip)
+    stick = np.flatnonzero((true_ratio > 0.01) & ~slip & (np.arange(len(slip)) < onset))
+    return (
+        f"* The finger (`--example fingertip`, {1 / period:g} Hz): MuJoCo's onset at frame "
+        f"{onset} ({(onset + 0.5) * period:.2f} s), friction over normal force rising "
+        f"{true_ratio[stick].min():.3f}-{true_ratio[stick].max():.3f} in the {len(stick)} "
+        f"frames of stick before it; the frames' skew gives tan(alpha) "
+        f"{np.nanmin(estimated[stick]):+.3f} to {np.nanmax(estimated[stick]):+.3f} there, "
+        f"and {np.nanmin(estimated[sliding]):+.3f} to {np.nanmax(estimated[sliding]):+.3f} "
+        f"over the {len(sliding)} sliding frames (MuJoCo: {true_ratio[sliding].mean():.3f})."
+    )
 
 
 def main() -> None:
