@@ -313,3 +313,10 @@ def test_the_fingers_skin_reads_the_ball_and_its_axial_friction():
     ).reshape(2, *spec.shape)
     assert np.argmax(frames[0, :, 0]) in (3, 4)  # the rows around 12.5 mm, column 0
     assert not np.allclose(frames[1], still[1])  # the finger's frames carry the shear
+
+
+def test_a_face_that_does_not_fit_the_taxels_is_said():
+    model = adapter.load_model(adapter.example_model_path())
+    assert adapter.MujocoSensor(model, load_sensor("pad16"), geom="pad").size_note() is None
+    note = adapter.MujocoSensor(model, load_sensor("pad12x32"), geom="pad").size_note()
+    assert "40 x 40 mm" in note and "24 x 64 mm" in note

@@ -151,6 +151,9 @@ def mujoco_command(
     mount = adapter.MujocoSensor(
         mj_model, spec, geom=geom, site=site, flat_radius_mm=flat_radius_mm
     )
+    note = mount.size_note()
+    if note is not None:
+        console.print(f"[yellow]note:[/] {note}", soft_wrap=True, markup=True, emoji=False)
     if seconds is None:
         seconds = float(table.time_s[-1]) if table is not None and table.time_s[-1] > 0 else 1.0
     n = adapter.frame_count(spec, seconds)

@@ -253,6 +253,26 @@ class MujocoSensor:
             self.origin_mm = np.asarray(spec.taxel_positions_mm(), float)[:, :2].mean(axis=0)
         self._force = np.zeros(6)
 
+    def size_note(self) -> str | None:
+        """A sentence when the geom's face (a box's x and y) and the sensor's taxel grid
+        differ by more than a pitch [mm]; None when they agree or cannot be compared."""
+        mujoco = _mujoco()
+        grid = kind_of(self.spec).surface_grid(self.spec)
+        if self.geom_id < 0 or grid is None or self.curved:
+            return None
+        if int(self.model.geom_type[self.geom_id]) != int(mujoco.mjtGeom.mjGEOM_BOX):
+            return None
+        (x_pitch, rows), (y_pitch, cols) = grid
+        face = 2e3 * self.model.geom_size[self.geom_id][:2]
+        grid_mm = np.array([rows * x_pitch, cols * y_pitch])
+        if np.all(np.abs(face - grid_mm) <= np.array([x_pitch, y_pitch])):
+            return None
+        return (
+            f"the geom's face is {face[0]:.4g} x {face[1]:.4g} mm and the taxels of "
+            f"{self.spec.name!r} span {grid_mm[0]:.4g} x {grid_mm[1]:.4g} mm (centred on it): "
+            "contacts beyond the taxels read little or nothing"
+        )
+
     def _pose(self, data) -> tuple[np.ndarray, np.ndarray]:
         if self.geom_id >= 0:
             return data.geom_xpos[self.geom_id], data.geom_xmat[self.geom_id].reshape(3, 3)
