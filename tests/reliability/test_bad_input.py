@@ -426,7 +426,7 @@ def test_view_port_in_use(workspace):
 BAD_MUJOCO = [
     # (command line, what the message must say); MODEL: the example model
     ("mujoco --seconds 0 --out OUT.h5", "--seconds"),
-    ("mujoco --example bogus --out OUT.h5", "expected one of pad, fingertip"),
+    ("mujoco --example bogus --out OUT.h5", "expected one of gripper, fingertip"),
     ("mujoco --seconds nan --out OUT.h5", "--seconds"),
     ("mujoco --seconds 0.001 --out OUT.h5", "shorter than one scan"),
     ("mujoco --flat-radius-mm 0 --out OUT.h5", "--flat-radius-mm"),

@@ -34,12 +34,13 @@ def mujoco_command(
         str,
         typer.Option(
             "--example",
-            metavar="[pad|fingertip]",
-            help="Without MODEL, which example: 'pad' (a finger with a 40 x 40 mm pad16 "
-            "pressing on and sliding across a ball and a rod) or 'fingertip' (the paper's "
+            metavar="[gripper|fingertip]",
+            help="Without MODEL, which example: 'gripper' (a gripper finger with a "
+            "40 x 40 mm pad16 pressing on and sliding across a ball and a rod) or "
+            "'fingertip' (the paper's "
             "finger, the 'initial' preset, slid along its axis over a ball).",
         ),
-    ] = "pad",
+    ] = "gripper",
     out: Annotated[Path, typer.Option("--out", "-o", help="HDF5 recording to write (.h5).")] = (
         Path("mujoco.h5")
     ),
@@ -120,7 +121,7 @@ def mujoco_command(
     from tactsense.sensor import load_sensor
 
     examples = {
-        "pad": (adapter.example_model_path(), "pad", "pad16"),
+        "gripper": (adapter.example_model_path(), "pad", "pad16"),
         "fingertip": (adapter.fingertip_model_path(), "finger", "initial"),
     }
     if example not in examples:
