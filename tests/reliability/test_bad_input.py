@@ -427,6 +427,7 @@ BAD_MUJOCO = [
     # (command line, what the message must say); MODEL: the example model
     ("mujoco --seconds 0 --out OUT.h5", "--seconds"),
     ("mujoco --example bogus --out OUT.h5", "expected one of gripper, fingertip"),
+    ("mujoco --frames-path quick --out OUT.h5", "expected one of auto, fast, reference"),
     ("mujoco --seconds nan --out OUT.h5", "--seconds"),
     ("mujoco --seconds 0.001 --out OUT.h5", "shorter than one scan"),
     ("mujoco --flat-radius-mm 0 --out OUT.h5", "--flat-radius-mm"),

@@ -111,6 +111,17 @@ def mujoco_command(
     seed: Annotated[
         int | None, typer.Option(min=0, help="Seed of the read noise, for a repeatable run.")
     ] = 0,
+    frames_path: Annotated[
+        str,
+        typer.Option(
+            "--frames-path",
+            metavar="[auto|fast|reference]",
+            help="How the frames are made from the contacts: 'fast' (the kind's tabulated "
+            "response: a one-off start-up per run, then many times faster), 'reference' "
+            "(the kind's own model frame by frame: no start-up), or 'auto' (fast from "
+            "20,000 frames on; docs/performance.md has the figures).",
+        ),
+    ] = "auto",
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,
     force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
 ) -> None:
@@ -146,6 +157,9 @@ def mujoco_command(
         fail("--geom and --site are two mounts; give one")
     if seconds is not None and seconds <= 0:
         fail(f"--seconds {seconds:g}: expected a time above 0 [s]")
+    paths = {"auto": None, "fast": True, "reference": False}
+    if frames_path not in paths:
+        fail(f"--frames-path {frames_path}: expected one of {', '.join(paths)}")
     spec = load_sensor(sensor)
     mj_model = adapter.load_model(model_path)
     table = adapter.read_controls(controls, mj_model) if controls is not None else None
@@ -171,6 +185,7 @@ def mujoco_command(
                 rng=seed,
                 model_path=model_path,
                 progress=lambda done, total: bar.update(task, completed=done),
+                fast=paths[frames_path],
             )
     rows, cols = spec.shape
     console.print(

@@ -77,6 +77,7 @@ from tactsense.interop._mujoco_contacts import (
 from tactsense.kinds import kind_of
 
 __all__ = [
+    "AUTO_FAST_FRAMES",
     "CHUNK_FRAMES",
     "DEFAULT_FLAT_RADIUS_MM",
     "SLIP_TOLERANCE",
@@ -98,6 +99,12 @@ __all__ = [
 ]
 
 # ---- stepping a model: frames at the sensor's scan rate ------------------------------
+
+AUTO_FAST_FRAMES = 20_000
+"""From this many frames on, :func:`record_mujoco` takes ``frames_from_contacts``'s fast
+path by default [-]: the fast path tabulates the layer's response once per process and
+is then many times faster than the reference, which has no start-up
+(``benchmarks/bench_mujoco.py``, docs/performance.md)."""
 
 CHUNK_FRAMES = 256
 """Frames made by one call of ``frames_from_contacts`` and written at a time [-]."""
@@ -217,6 +224,7 @@ def record_mujoco(
     rng=None,
     model_path=None,
     progress=None,
+    fast: bool | None = None,
 ) -> int:
     """Step a model for ``seconds`` and write the sensor's frames to a new recording.
 
@@ -229,7 +237,8 @@ def record_mujoco(
     ``mujoco_tangential_force_n`` (friction (x, y) [N]) and ``mujoco_slip`` (a contact
     at the friction cone's limit). Frames go to the file a chunk at a time (memory does
     not grow with the run); an existing file is refused, and an interrupted run leaves
-    none behind.
+    none behind. ``fast``: ``frames_from_contacts``'s path; None (the default) the fast
+    one from :data:`AUTO_FAST_FRAMES` frames on, the reference below.
 
     Returns
     -------
@@ -303,8 +312,9 @@ def record_mujoco(
                 sets[key].attrs["units"] = unit
             written = 0
             blocks = frame_blocks(
-                sensor, data, n_frames=n, controls=controls, flaws=flaws, rng=rng, gains=gains
-            )
+                sensor, data, n_frames=n, controls=controls, flaws=flaws, rng=rng, gains=gains,
+                fast=n >= AUTO_FAST_FRAMES if fast is None else fast,
+            )  # fmt: skip
             for first, last, counts, labels in blocks:
                 frames[first:last] = np.clip(counts, 0, np.inf).astype(dtype, copy=False)
                 times[first:last] = np.arange(first, last) * spec.scan_period_s
