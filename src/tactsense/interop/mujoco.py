@@ -153,7 +153,7 @@ def frame_blocks(
     gains: np.ndarray | None = None,
     chunk_frames: int = CHUNK_FRAMES,
     on_read=None,
-    fast: bool = True,
+    fast: bool | None = None,
 ):
     """Step the model and yield the sensor's frames a chunk at a time.
 
@@ -161,7 +161,8 @@ def frame_blocks(
     ``t0 + (j + 1/2) period`` (``t0``: ``data.time`` at the start); before every step the
     controls at the step's time are applied. ``on_read(j, data)``, if given, is called
     at that instant (to read the model's own sensors beside the frames); ``fast`` is
-    ``frames_from_contacts``'s (False: the reference, the kind's frame-by-frame path).
+    ``frames_from_contacts``'s (False: the reference, the kind's frame-by-frame path;
+    None: fast from :data:`AUTO_FAST_FRAMES` frames on).
 
     Yields
     ------
@@ -181,6 +182,7 @@ def frame_blocks(
     period, dt, t0 = spec.scan_period_s, model.opt.timestep, float(data.time)
     rows, cols = spec.shape
     shear = kind_of(spec).senses_shear  # a kind without shear is not given it
+    fast = n_frames >= AUTO_FAST_FRAMES if fast is None else fast
     for first in range(0, n_frames, chunk_frames):
         last = min(n_frames, first + chunk_frames)
         readings = []
@@ -313,7 +315,7 @@ def record_mujoco(
             written = 0
             blocks = frame_blocks(
                 sensor, data, n_frames=n, controls=controls, flaws=flaws, rng=rng, gains=gains,
-                fast=n >= AUTO_FAST_FRAMES if fast is None else fast,
+                fast=fast,
             )  # fmt: skip
             for first, last, counts, labels in blocks:
                 frames[first:last] = np.clip(counts, 0, np.inf).astype(dtype, copy=False)
