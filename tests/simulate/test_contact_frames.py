@@ -222,7 +222,9 @@ def test_fast_pad_frames_are_the_layers_exact_solution(make, shape):
     for i in range(n):
         on = force[i] > 0
         exact = _exact_frame(
-            spec, zip(position[i, on, 0], position[i, on, 1], force[i, on], a[i, on]), shape
+            spec,
+            zip(position[i, on, 0], position[i, on, 1], force[i, on], a[i, on], strict=True),
+            shape,
         )
         peak = np.abs(exact).max()
         assert np.abs(fast[i] - exact).max() <= 1e-3 * peak

@@ -163,7 +163,7 @@ def layer_response_table(
     matrix = grid.reshape(n_a * size, size)
     # the dy basis: eigenvectors of the Gram matrix, largest first (its singular values
     # squared; the terms kept are far above the round-off of the squares)
-    values, vectors = np.linalg.eigh(matrix.T @ matrix)
+    _, vectors = np.linalg.eigh(matrix.T @ matrix)
     basis = vectors[:, ::-1]
     for rank in range(1, size + 1):
         y_factors = np.ascontiguousarray(basis[:, :rank])
