@@ -58,8 +58,11 @@ def accuracy_cases(make, shape: str, n: int = 6, seed: int = 7):
         exact[i] = _exact_frame(spec, contacts, shape)
         r = np.broadcast_to(np.asarray(radius, dtype=float), (n, 3))
         today[i] = kind.layer_strain(
-            spec, [cls(x, y, f, radius_mm=rr) for (x, y), f, rr in
-                   zip(position[i, on], force[i, on], r[i, on], strict=True)]  # fmt: skip
+            spec,
+            [
+                cls(x, y, f, radius_mm=rr)
+                for (x, y), f, rr in zip(position[i, on], force[i, on], r[i, on], strict=True)
+            ],  # fmt: skip
         )
     return spec, batch, fast, today, exact
 
@@ -155,8 +158,7 @@ def main() -> None:
         DOC,
         "<!-- begin contact-frames accuracy -->",
         "<!-- end contact-frames accuracy -->",
-        f"<!-- begin contact-frames accuracy -->\n{accuracy}\n"
-        "<!-- end contact-frames accuracy -->",
+        f"<!-- begin contact-frames accuracy -->\n{accuracy}\n<!-- end contact-frames accuracy -->",
     )
     print(table)
     print(accuracy)

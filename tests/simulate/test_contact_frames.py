@@ -286,8 +286,11 @@ def test_the_fast_chain_is_the_scan_loops(make, flaws):
     gains = check_gains(spec, None, active)
     ref = reference_frames(spec, batch, active, gains, np.random.default_rng(0))
     fast = fast_frames(spec, batch, _ReferenceForward(spec), active, gains, None)
-    assert np.abs(fast - ref).max() <= (1.0 if "quantization" in active else 1e-9 * ref.max())
-    assert np.mean(fast != ref) < 0.01
+    if "quantization" in active:  # a count apart only where the value sits on an edge
+        assert np.abs(fast - ref).max() <= 1.0
+        assert np.mean(fast != ref) < 0.01
+    else:
+        assert np.abs(fast - ref).max() <= 1e-9 * ref.max()
 
 
 def test_fast_noise_has_the_read_noise_and_every_frame_its_own():
