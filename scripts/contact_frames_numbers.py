@@ -18,14 +18,14 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT), str(ROOT / "benchmarks"), str(ROOT / "scripts")]
 
-from bench_contact_frames import measure  # noqa: E402
 from docblock import replace_block, save_figure  # noqa: E402
+from tests.simulate.test_contact_frames import _exact_frame  # noqa: E402
 
+from bench_contact_frames import measure  # noqa: E402
 from tactsense.kinds import kind_of  # noqa: E402
 from tactsense.physics.indenters import DiscProbe, SphereProbe  # noqa: E402
 from tactsense.sensor.registry import pad12x32, pad16  # noqa: E402
 from tactsense.simulate import ContactBatch  # noqa: E402
-from tests.simulate.test_contact_frames import _exact_frame  # noqa: E402
 
 DOC = ROOT / "docs" / "batch-frames.md"
 PERFORMANCE = ROOT / "docs" / "performance.md"
@@ -62,7 +62,7 @@ def accuracy_cases(make, shape: str, n: int = 6, seed: int = 7):
             [
                 cls(x, y, f, radius_mm=rr)
                 for (x, y), f, rr in zip(position[i, on], force[i, on], r[i, on], strict=True)
-            ],  # fmt: skip
+            ],
         )
     return spec, batch, fast, today, exact
 
@@ -81,7 +81,7 @@ def accuracy_block() -> tuple[str, tuple]:
     ]
     shown = None
     for make, shape in ((pad16, "sphere"), (pad16, "disc"), (pad12x32, "sphere")):
-        spec, batch, fast, today, exact = accuracy_cases(make, shape)
+        spec, _, fast, today, exact = accuracy_cases(make, shape)
         e_fast, e_today = relative_errors(fast, exact), relative_errors(today, exact)
         what = "1-3 spheres of 1.6 mm, 0.05-3 N (Hertz radius)" if shape == "sphere" else (
             "1-3 discs of radius 1-3 mm, 0.05-3 N")  # fmt: skip
