@@ -437,3 +437,49 @@ def test_view_port_in_use(workspace):
         port = taken.getsockname()[1]
         result = runner.invoke(app, ["view", str(workspace / "rec.h5"), "--port", str(port)])
     _check(result, f"cannot listen on 127.0.0.1:{port}")
+
+
+# ---- the MuJoCo adapter's command (r6-mujoco) ----
+BAD_MUJOCO = [
+    # (command line, what the message must say); MODEL: the example model
+    ("mujoco --seconds 0 --out OUT.h5", "--seconds"),
+    ("mujoco --example bogus --out OUT.h5", "expected one of gripper, fingertip"),
+    ("mujoco --frames-path quick --out OUT.h5", "expected one of auto, fast, reference"),
+    ("mujoco --seconds nan --out OUT.h5", "--seconds"),
+    ("mujoco --seconds 0.001 --out OUT.h5", "shorter than one scan"),
+    ("mujoco --flat-radius-mm 0 --out OUT.h5", "--flat-radius-mm"),
+    ("mujoco --seed -1 --out OUT.h5", "--seed"),
+    ("mujoco --flaws viscoelastic --out OUT.h5", "need the frame sequence"),
+    ("mujoco --flaws bogus --out OUT.h5", "unknown flaw(s) bogus"),
+    ("mujoco --geom nope --out OUT.h5", "--geom nope: the model has no geom"),
+    ("mujoco MODEL --out OUT.h5", "say which geom"),
+    ("mujoco MODEL --geom pad --site pad_grid --out OUT.h5", "give one"),
+    ("mujoco MODEL --site nope --out OUT.h5", "--site nope"),
+    ("mujoco --sensor initial --out OUT.h5", "mount it on a capsule or a cylinder"),
+    ("mujoco MODEL --site pad_grid --sensor initial --out OUT.h5", "mount it on a geom"),
+    ("mujoco --out OUT.csv", "use the extension .h5"),
+    ("mujoco REC --geom pad --out OUT.h5", "MuJoCo cannot load it"),
+    ("mujoco no_such.xml --geom pad --out OUT.h5", "no such model file"),
+    ("mujoco --controls REC --out OUT.h5", "not a text CSV file"),
+    ("mujoco --controls DIR/a_file --out OUT.h5", "expected a CSV with a header"),
+    ("mujoco --controls DIR/bad_controls.csv --out OUT.h5", "no actuator named wrist"),
+]
+
+
+@pytest.mark.parametrize("line, names", BAD_MUJOCO, ids=[line for line, _ in BAD_MUJOCO])
+def test_bad_mujoco_input(workspace, line, names):
+    pytest.importorskip("mujoco")
+    from tactsense.interop.mujoco import example_model_path
+
+    (workspace / "bad_controls.csv").write_text("time_s,wrist\n0,0\n1,0.1\n")
+    out = workspace / "never_written"
+    args = (
+        line.replace("MODEL", str(example_model_path()))
+        .replace("REC", str(workspace / "rec.h5"))
+        .replace("OUT", str(out))
+        .replace("DIR", str(workspace))
+        .split()
+    )
+    result = _invoke_with_deadline(args)
+    _check(result, names)
+    assert not list(workspace.glob("never_written*"))

@@ -53,6 +53,10 @@ app.add_typer(interop.app)
 app.add_typer(imports.app)
 app.add_typer(model.sensor_app, name="sensor")
 app.add_typer(design.app, name="design")
+# ---- the MuJoCo adapter (r6-mujoco) ----
+from tactsense.cli import _mujoco  # noqa: E402
+
+app.add_typer(_mujoco.app)
 
 
 def _show_usage_error(self, file=None) -> None:

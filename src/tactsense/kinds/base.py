@@ -263,6 +263,37 @@ class Kind:
         """
         raise self.unsupported(spec, "a contact response")
 
+    # ---- frames from contacts (r6-fast) ----------------------------------------
+    senses_shear: ClassVar[bool] = False
+    """Whether the kind's forward model takes a contact's tangential force (the finger:
+    its axial part); False: a :class:`~tactsense.simulate.ContactBatch`'s tangential
+    forces are ignored, and :func:`~tactsense.simulate.frames_from_contacts` says so."""
+
+    def contact_state(self, spec: Any, contacts: list[dict]) -> tuple:
+        """One frame's contacts as the kind's own contact objects (what ``layer_strain``
+        and ``elastic_batch`` take), from the dicts of ``ContactBatch.frame`` (position
+        [mm] in the kind's surface coordinates, forces [N], radius [mm], shape). Default
+        (a layer kind): a :class:`~tactsense.physics.indenters.SphereProbe` (Hertz
+        pressure) or a :class:`~tactsense.physics.indenters.DiscProbe` at (x, y)."""
+        from tactsense.physics.indenters import DiscProbe, SphereProbe
+
+        made = []
+        for c in contacts:
+            cls = SphereProbe if c["shape"] == "sphere" else DiscProbe
+            x, y = c["position_mm"]
+            made.append(cls(x, y, c["normal_force_n"], radius_mm=c["radius_mm"]))
+        return tuple(made)
+
+    def contact_forward(self, spec: Any) -> Any:
+        """The kind's fast forward for ``frames_from_contacts``, or None (the default:
+        ``elastic_batch`` frame by frame, slow but any kind works). An object whose
+        ``prepare(contacts)`` (a :class:`~tactsense.simulate.ContactBatch`) returns a
+        function ``(first, last) -> (last - first, rows * cols)`` (float32 or float64):
+        every taxel's
+        fractional deflection [-] (what ``elastic_batch`` gives, before gains) in those
+        frames."""
+        return None
+
 
 RESPONSE_PROBE_N = 0.49
 """The load of the probe whose response :meth:`Kind.contact_response` tabulates: the

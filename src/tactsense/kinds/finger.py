@@ -105,5 +105,37 @@ class FingerKind(Kind):
 
     # ---- estimation (r5-estimate) ----------------------------------------------
 
+    # ---- frames from contacts (r6-fast) ----------------------------------------
+    senses_shear = True
+
+    def contact_state(self, spec, contacts):
+        """Each contact as the paper's probe (:class:`~tactsense.physics.contact.Probe`,
+        a parabolic pressure across its contact diameter) or, for a disc, a uniform
+        :class:`~tactsense.physics.contact.FlatContact` of the disc's diameter: the
+        position (axial [mm], arc around the skin [mm]), the total force and its angle
+        from the normal from the normal and the axial tangential force [N] (the
+        tangential force around the finger is not modelled); a sphere's contact diameter
+        is twice its Hertz radius on the skin's rubber (at most its diameter)."""
+        from tactsense.physics.contact import FlatContact, Probe
+
+        e = spec.elastic
+        modulus_star = e.youngs_modulus_pa / (1.0 - e.poisson_ratio**2)
+        made = []
+        for c in contacts:
+            axial, around = c["position_mm"]
+            angle = math.degrees(around / spec.radius_mm)
+            normal, shear = c["normal_force_n"], c["tangential_force_n"][0]
+            force = math.hypot(normal, shear)
+            alpha = math.degrees(math.atan2(shear, normal))
+            radius = c["radius_mm"]
+            if c["shape"] == "sphere":
+                hertz = 1e3 * (3.0 * normal * radius * 1e-3 / (4.0 * modulus_star)) ** (1 / 3)
+                made.append(Probe(axial, angle, force, 2.0 * min(hertz, radius), alpha))
+            else:
+                made.append(
+                    FlatContact(axial, angle, force, 2.0 * radius, 2.0 * radius, "uniform", alpha)
+                )
+        return tuple(made)
+
 
 KIND: Any = FingerKind()

@@ -19,6 +19,7 @@ a point set's are in :mod:`tactsense.flat_scenarios`), :mod:`~tactsense.simulate
 (the time loop) and :mod:`~tactsense.simulate.write` (to a file as frames are made).
 """
 
+from tactsense.simulate.contact_frames import ContactBatch, frames_from_contacts
 from tactsense.simulate.run import simulate
 from tactsense.simulate.scenario import Scenario, Step
 from tactsense.simulate.scenarios import (
@@ -35,12 +36,14 @@ from tactsense.simulate.scenarios import (
 from tactsense.simulate.write import simulate_to_file
 
 __all__ = [
+    "ContactBatch",
     "Scenario",
     "Step",
     "calibration_sweep",
     "default_col",
     "default_row",
     "force_steps",
+    "frames_from_contacts",
     "knife_edge_sweep",
     "load_series",
     "probe_sweep",

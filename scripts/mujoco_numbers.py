@@ -1,0 +1,243 @@
+"""The numbers and the figure of docs/mujoco.md: the example model's frames beside MuJoCo's
+own touch sensor and touch grid, and the adapter's checks (force with the sensor's
+calibration, contact centroid, slip onset) measured on it.
+
+Run: ``python scripts/mujoco_numbers.py`` (about a minute) rewrites the block between
+``<!-- begin mujoco numbers -->`` and ``<!-- end mujoco numbers -->`` in docs/mujoco.md
+and writes ``docs/images/mujoco_side_by_side.png``.
+
+How the numbers are made (seeded, so a run repeats them):
+
+* **The example**: ``tactsense mujoco --out ex.h5 --seed 2`` (the example model, its
+  controls, pad16 with all its per-frame flaws). The figure's frames are the same frames
+  (``frame_blocks`` with the same seed), with MuJoCo's ``touch`` sensor and touch grid
+  read at each frame's instant (``on_read``).
+* **Calibration**: twelve presses of the finger on the ball (``PRESS_DEPTHS_M``) recorded
+  the same way (seed 1), MuJoCo's force on each press's plateau as the weights log,
+  ``tactsense calibrate weights.h5 --force-log weights.csv`` (the weight curve); then
+  ``tactsense locate ex.h5 --calibration cal.json``: each frame's summed contact force
+  against MuJoCo's normal force sum, per phase of the motion.
+* **Centroid**: ``tactsense locate ex.h5 --method fit`` (uncalibrated): the located
+  contacts' force-weighted centroid against MuJoCo's (the truth's ``step_x_mm``,
+  ``step_y_mm``).
+* **Slip**: MuJoCo's onset (the first frame with a contact at the friction cone's limit
+  after the ball press) against the first frame of the slide that ``locate`` flags
+  ``slip`` (a contact moving under a steady force).
+* **The finger** (``tactsense mujoco --example fingertip --seed 3``: the paper's finger
+  slid along its axis over a ball; it takes the axial shear): ``tactsense locate``'s skew
+  index per frame turned into ``tan(alpha)`` (``skew / k(nu)``, section 9 of the paper,
+  ``angle_from_skew``) against MuJoCo's friction over normal force, in the stick before
+  the onset and while sliding.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import mujoco
+import numpy as np
+import pandas as pd
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from docblock import replace_block, save_figure
+
+from tactsense.interop import mujoco as adapter
+from tactsense.io.recording import read_recording
+from tactsense.sensor import load_sensor
+
+ROOT = Path(__file__).resolve().parents[1]
+DOC = ROOT / "docs" / "mujoco.md"
+FIGURE = ROOT / "docs" / "images" / "mujoco_side_by_side.png"
+PHASES = {
+    "ball, held (1.5-1.8 s)": range(150, 180),
+    "ball, sliding (2.3-3.7 s)": range(230, 370),
+    "rod, held (6.7-7.1 s)": range(670, 710),
+    "rod, sliding (7.4-9.0 s)": range(740, 900),
+}
+SHOWN = {"ball, held": 165, "ball, sliding": 300, "rod, sliding": 850}
+PRESS_DEPTHS_M = np.linspace(-0.0305, -0.0375, 12)
+PITCH_MM = 2.5
+
+
+def _tactsense(*args: str) -> None:
+    subprocess.run([sys.executable, "-m", "tactsense", *args], check=True, capture_output=True)
+
+
+def _side_by_side(spec):
+    """Frames and MuJoCo's own sensors at every frame of the example (seed 2)."""
+    model = adapter.load_model(adapter.example_model_path())
+    controls = adapter.read_controls(adapter.example_controls_path(), model)
+    sensor = adapter.MujocoSensor(model, spec, geom="pad")
+    ids = {
+        name: mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SENSOR, name)
+        for name in ("pad_touch", "pad_grid")
+    }
+    touch, grid, contacts = {}, {}, {}
+
+    def read(j, data):
+        a = model.sensor_adr[ids["pad_touch"]]
+        touch[j] = float(data.sensordata[a])
+        a, n = model.sensor_adr[ids["pad_grid"]], model.sensor_dim[ids["pad_grid"]]
+        image = data.sensordata[a : a + n].reshape(3, 16, 16)[0]
+        grid[j] = np.flipud(image).T.copy()  # the plugin's [i, j] is the pad's (row j, col 15 - i)
+        contacts[j] = sensor.read(data)
+
+    n = adapter.frame_count(spec, 10.0)
+    data = mujoco.MjData(model)
+    frames = np.concatenate(
+        [c for _, _, c, _ in adapter.frame_blocks(
+            sensor, data, n_frames=n, controls=controls, rng=2, on_read=read)]
+    )  # fmt: skip
+    return frames, touch, grid, contacts
+
+
+def _figure(spec, frames, touch, grid, contacts) -> None:
+    baseline = frames[:50].mean(axis=0)
+    fig, axes = plt.subplots(len(SHOWN), 3, figsize=(10.5, 3.2 * len(SHOWN)))
+    extent = (-PITCH_MM / 2, 16 * PITCH_MM - PITCH_MM / 2) * 2
+    for row, (label, j) in enumerate(SHOWN.items()):
+        c = contacts[j]
+        panels = (
+            (frames[j] - baseline, "tactsense pad16 [counts above rest]"),
+            (grid[j], "MuJoCo touch grid, normal [N]"),
+        )
+        for col, (image, title) in enumerate(panels):
+            ax = axes[row, col]
+            shown = ax.imshow(image.T, origin="lower", extent=extent, cmap="magma")
+            ax.plot(*c.position_mm.T, "c+", ms=12, mew=2)
+            ax.set_title(f"{label}: {title}", fontsize=8)
+            ax.set_xlabel("x [mm] (rows)", fontsize=8)
+            ax.set_ylabel("y [mm] (columns)", fontsize=8)
+            fig.colorbar(shown, ax=ax, fraction=0.046)
+        ax = axes[row, 2]
+        ax.axis("off")
+        lines = [
+            f"frame {j} ({(j + 0.5) * spec.scan_period_s:.3f} s)",
+            f"MuJoCo touch sensor: {touch[j]:.3f} N (one number)",
+            f"touch grid, sum of normal: {grid[j].sum():.3f} N",
+            f"contacts read ({len(c)}):",
+        ]
+        for p, f, t, s in zip(
+            c.position_mm, c.normal_force_n, c.tangential_force_n, c.slipping, strict=True
+        ):
+            lines.append(f"  ({p[0]:.1f}, {p[1]:.1f}) mm, {f:.3f} N" + (", sliding" if s else ""))
+            lines.append(f"    friction ({t[0]:+.3f}, {t[1]:+.3f}) N")
+        ax.text(0, 0.95, "\n".join(lines), va="top", family="monospace", fontsize=7.5)
+    fig.tight_layout()
+    save_figure(fig, FIGURE)
+
+
+def _numbers(folder: Path, spec, touch, grid) -> str:
+    ex = folder / "ex.h5"
+    _tactsense("mujoco", "--out", str(ex), "--seed", "2", "-q")
+    truth = read_recording(ex).truth
+    force, centre = truth["step_force_n"], np.c_[truth["step_x_mm"], truth["step_y_mm"]]
+    # the calibration: presses on the ball, MuJoCo's plateau forces as the weights
+    controls = folder / "presses.csv"
+    rows, t = [(0.0, 0.0, 0.0, 0.0)], 0.0
+    for z in PRESS_DEPTHS_M:
+        rows += [(t + 0.3, 0, 0, -0.028), (t + 0.6, 0, 0, z), (t + 1.4, 0, 0, z),
+                 (t + 1.7, 0, 0, -0.028)]  # fmt: skip
+        t += 1.7
+    rows.append((t + 0.3, 0.0, 0.0, 0.0))
+    controls.write_text("time_s,x,y,z\n" + "".join(",".join(map(str, r)) + "\n" for r in rows))
+    weights = folder / "weights.h5"
+    _tactsense("mujoco", "--controls", str(controls), "--out", str(weights), "--seed", "1", "-q")
+    pressed = read_recording(weights).truth["step_force_n"]
+    edges = np.flatnonzero(np.diff((pressed > 0.05).astype(int)))
+    loads = [np.median(pressed[s + (e - s) // 2 : e - (e - s) // 10])
+             for s, e in zip(edges[::2] + 1, edges[1::2] + 1, strict=True)]  # fmt: skip
+    log = folder / "weights.csv"
+    log.write_text("press,force_n\n" + "".join(f"{i + 1},{f:.6f}\n" for i, f in enumerate(loads)))
+    cal = folder / "cal.json"
+    _tactsense("calibrate", str(weights), "--force-log", str(log), "--out", str(cal))
+    _tactsense("locate", str(ex), "--calibration", str(cal), "--out", str(folder / "cal.csv"))
+    _tactsense("locate", str(ex), "--method", "fit", "--out", str(folder / "fit.csv"))
+    calibrated = pd.read_csv(folder / "cal.csv")
+    fitted = pd.read_csv(folder / "fit.csv")
+    total = calibrated.groupby("frame").force_n.sum()
+    weighted = fitted.assign(wx=fitted.x_mm * fitted.force_n, wy=fitted.y_mm * fitted.force_n)
+    sums = weighted.groupby("frame")[["wx", "wy", "force_n"]].sum()
+    located = np.c_[sums.wx / sums.force_n, sums.wy / sums.force_n]
+    located = pd.DataFrame(located, index=sums.index)
+    out = [
+        "| phase | MuJoCo force [N] | force error, calibrated: median, largest [%] | "
+        "centroid error (fit): median, largest [mm] (pitch) |",
+        "|---|---|---|---|",
+    ]
+    for label, frames in PHASES.items():
+        frames = list(frames)
+        error = 100 * (total.reindex(frames).fillna(0).to_numpy() / force[frames] - 1)
+        gap = np.hypot(*(located.reindex(frames).to_numpy() - centre[frames]).T)
+        out.append(
+            f"| {label} | {force[frames].mean():.3f} | {np.median(error):+.2f}, "
+            f"{error[np.argmax(np.abs(error))]:+.2f} | {np.nanmedian(gap):.3f}, "
+            f"{np.nanmax(gap):.3f} ({np.nanmax(gap) / PITCH_MM:.2f}) |"
+        )
+    onset = 180 + int(np.argmax(truth["mujoco_slip"][180:]))
+    flagged = fitted[(fitted.frame >= 180) & (fitted.frame < 420) & fitted.slip]
+    first_flag = int(flagged.frame.min()) if len(flagged) else None
+    ours = np.array([force[j] for j in sorted(touch)])
+    touch_gap = np.max(np.abs(ours - np.array([touch[j] for j in sorted(touch)])))
+    grid_gap = np.max(np.abs(ours - np.array([grid[j].sum() for j in sorted(grid)])))
+    lag = "never" if first_flag is None else f"frame {first_flag} ({first_flag - onset:+d} frames)"
+    out += [
+        "",
+        f"* Slip on the ball: MuJoCo's onset (friction at the cone's limit) at frame {onset} "
+        f"({(onset + 0.5) * spec.scan_period_s:.3f} s); `locate`'s `slip` flag first at {lag}.",
+        f"* Normal force read by the adapter against MuJoCo's `touch` sensor, every frame: "
+        f"largest difference {touch_gap:.1e} N; against the touch grid's summed normal "
+        f"channel: {grid_gap:.1e} N.",
+        f"* Calibration: {len(loads)} presses, {min(loads):.3f}-{max(loads):.3f} N.",
+        _fingertip(folder),
+    ]
+    return "\n".join(out)
+
+
+def _fingertip(folder: Path) -> str:
+    """The finger's slip onset in MuJoCo against the force angle its frames give."""
+    from tactsense.physics.halfplane import line_load_skew_coefficient
+
+    rec, table = folder / "fingertip.h5", folder / "fingertip.csv"
+    _tactsense("mujoco", "--example", "fingertip", "--out", str(rec), "--seed", "3", "-q")
+    _tactsense("locate", str(rec), "--out", str(table))
+    recording = read_recording(rec)
+    truth, period = recording.truth, recording.sensor.scan_period_s
+    true_ratio = truth["mujoco_tangential_force_n"][:, 0] / np.maximum(truth["step_force_n"], 1e-12)
+    estimate = pd.read_csv(table).set_index("frame")["skew"].reindex(range(len(true_ratio)))
+    estimated = estimate.to_numpy() / line_load_skew_coefficient(0.5)
+    slip = truth["mujoco_slip"]
+    onset = int(np.argmax(slip))
+    sliding = np.flatnonzero(slip)
+    stick = np.flatnonzero((true_ratio > 0.01) & ~slip & (np.arange(len(slip)) < onset))
+    return (
+        f"* The finger (`--example fingertip`, {1 / period:g} Hz): MuJoCo's onset at frame "
+        f"{onset} ({(onset + 0.5) * period:.2f} s), friction over normal force rising "
+        f"{true_ratio[stick].min():.3f}-{true_ratio[stick].max():.3f} in the {len(stick)} "
+        f"frames of stick before it; the frames' skew gives tan(alpha) "
+        f"{np.nanmin(estimated[stick]):+.3f} to {np.nanmax(estimated[stick]):+.3f} there, "
+        f"and {np.nanmin(estimated[sliding]):+.3f} to {np.nanmax(estimated[sliding]):+.3f} "
+        f"over the {len(sliding)} sliding frames (MuJoCo: {true_ratio[sliding].mean():.3f})."
+    )
+
+
+def main() -> None:
+    spec = load_sensor("pad16")
+    frames, touch, grid, contacts = _side_by_side(spec)
+    _figure(spec, frames, touch, grid, contacts)
+    with tempfile.TemporaryDirectory() as folder:
+        text = _numbers(Path(folder), spec, touch, grid)
+    begin, end = "<!-- begin mujoco numbers -->", "<!-- end mujoco numbers -->"
+    replace_block(DOC, begin, end, f"{begin}\n{text}\n{end}")
+    print(text)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,322 @@
+"""The MuJoCo adapter (tactsense.interop.mujoco) on its example model: MuJoCo's contacts
+read in the sensor's frame, frames from them, a recording the other commands read, and
+the issue's checks (force with the sensor's calibration within 2 %, contact centroid
+within a quarter pitch, slip onset)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+from typer.testing import CliRunner
+
+mujoco = pytest.importorskip("mujoco")
+
+from tactsense.cli import app  # noqa: E402
+from tactsense.interop import mujoco as adapter  # noqa: E402
+from tactsense.io.recording import read_recording  # noqa: E402
+from tactsense.sensor import load_sensor  # noqa: E402
+
+runner = CliRunner()
+
+HOLD_BALL = range(150, 180)
+"""Frames of the example's steady press on the ball (1.3-1.8 s of its controls) [-]."""
+HOLD_ROD = range(670, 710)
+"""Frames of the example's steady press on the rod (6.7-7.1 s) [-]."""
+
+
+@pytest.fixture(scope="module")
+def example():
+    """The example model stepped over its controls: per MuJoCo step the reading, the
+    touch sensor, the time."""
+    spec = load_sensor("pad16")
+    model = adapter.load_model(adapter.example_model_path())
+    controls = adapter.read_controls(adapter.example_controls_path(), model)
+    sensor = adapter.MujocoSensor(model, spec, geom="pad")
+    data = mujoco.MjData(model)
+    touch = model.sensor_adr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SENSOR, "pad_touch")]
+    steps = []
+    while data.time < 9.5:
+        data.ctrl[:] = controls.at(data.time)
+        mujoco.mj_step(model, data)
+        steps.append((float(data.time), sensor.read(data), float(data.sensordata[touch])))
+    return spec, steps
+
+
+def test_normal_force_is_mujocos_touch_sensor(example):
+    # MuJoCo's own touch sensor on a site covering the pad sums the contacts' normal
+    # forces: an evaluation independent of the adapter's frame arithmetic
+    _, steps = example
+    ours = np.array([r.normal_force_n.sum() for _, r, _ in steps])
+    touch = np.array([t for _, _, t in steps])
+    assert ours.max() > 1.5
+    np.testing.assert_allclose(ours, touch, atol=1e-9)
+
+
+def test_contact_position_in_the_pads_surface_coordinates(example):
+    spec, steps = example
+    centre = (np.array(spec.shape) - 1) / 2 * 2.5  # the ball under the pad's centre [mm]
+    held = [r for t, r, _ in steps if 1.5 < t < 1.8]
+    assert all(len(r) == 1 for r in held)
+    for r in held:
+        np.testing.assert_allclose(r.position_mm[0], centre, atol=1e-6)
+        assert r.radius_mm[0] == pytest.approx(8.0)  # the ball's radius [mm]
+    # the pad moves +x over the fixed ball: the contact moves to -x on the pad, by what
+    # the finger moved (the pad's x axis is the world's; its y the world's -y)
+    at_end = [r for t, r, _ in steps if 3.9 < t < 4.0]
+    assert all(r.position_mm[0, 0] < centre[0] - 12.0 for r in at_end)
+    rod = [r for t, r, _ in steps if 6.8 < t < 7.0]
+    assert all(len(r) == 2 for r in rod)  # a capsule on a box: its two ends
+    assert all(r.radius_mm == pytest.approx(4.0) for r in rod)
+
+
+def test_friction_opposes_sliding_and_slip_is_the_cone_limit(example):
+    _, steps = example
+    sliding = [r for t, r, _ in steps if 2.5 < t < 3.7]
+    for r in sliding:
+        assert r.slipping.all()
+        assert np.all(r.tangential_force_n[:, 0] < 0)  # the pad moves +x: friction -x
+        ratio = np.hypot(*r.tangential_force_n.T) / r.normal_force_n
+        np.testing.assert_allclose(ratio, 0.5, rtol=2e-3)  # friction="0.5 ..." in the model
+    stuck = [r for t, r, _ in steps if 1.5 < t < 1.8]
+    assert not any(r.slipping.any() for r in stuck)
+
+
+def test_slip_onset_is_where_friction_reaches_the_cone(example):
+    # the onset the adapter reports is the first step where |f_t| / f_n reaches mu, and
+    # the finger starts to move relative to the ball there (not before)
+    _, steps = example
+    times = np.array([t for t, _, _ in steps])
+    slip = np.array([bool(r.slipping.any()) for _, r, _ in steps])
+    ratio = np.array(
+        [np.hypot(*r.tangential_force_n.sum(0)) / max(r.normal_force_n.sum(), 1e-12)
+         for _, r, _ in steps]
+    )  # fmt: skip
+    onset = int(np.argmax(slip & (times > 1.8)))
+    assert 1.9 < times[onset] < 2.5  # the slide's servo needs time to pull mu f_n
+    assert np.all(ratio[(times > 1.8) & (times < times[onset])] < 0.5 * (1 - 1e-3))
+    assert ratio[onset] == pytest.approx(0.5, rel=2e-3)
+
+
+@pytest.fixture(scope="module")
+def recording(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("mujoco")
+    out = folder / "example.h5"
+    result = runner.invoke(app, ["mujoco", "--out", str(out), "--quiet", "--seed", "2"])
+    assert result.exit_code == 0, result.output
+    return folder, out
+
+
+def test_the_recording_carries_mujocos_contacts_as_truth(recording):
+    _, out = recording
+    rec = read_recording(out)
+    assert rec.frames.shape == (1000, 16, 16)
+    assert rec.flaws == ("gain_spread", "noise", "quantization", "nonlinearity", "dead",
+                         "crosstalk")  # fmt: skip
+    truth = rec.truth
+    np.testing.assert_array_equal(truth["frame_step"], np.arange(1000))
+    held = truth["step_force_n"][HOLD_BALL]
+    assert np.all((held > 1.5) & (held < 2.5))
+    assert np.all(truth["step_n_contacts"][:50] == 0)  # the approach: nothing touches
+    assert len(rec.baseline_frames) > 300
+    assert truth["mujoco_slip"][250:370].all() and not truth["mujoco_slip"][HOLD_BALL].any()
+    # the frames see the press where MuJoCo has it: the ball under the pad's centre
+    peak = np.unravel_index(np.argmax(rec.frames[HOLD_BALL].mean(0)), (16, 16))
+    assert peak in {(7, 7), (7, 8), (8, 7), (8, 8)}
+
+
+def _locate(folder, out, name, *extra):
+    table = folder / f"{name}.csv"
+    args = ["locate", str(out), "--out", str(table), *extra]
+    result = runner.invoke(app, args)
+    assert result.exit_code == 0, result.output
+    return pd.read_csv(table)
+
+
+def test_contact_centroid_within_a_quarter_pitch(recording):
+    folder, out = recording
+    truth = read_recording(out).truth
+    table = _locate(folder, out, "fit", "--method", "fit")
+    largest = table[table.contact == 0].set_index("frame")
+    frames = list(HOLD_BALL)
+    error = np.hypot(
+        largest.loc[frames, "x_mm"] - truth["step_x_mm"][frames],
+        largest.loc[frames, "y_mm"] - truth["step_y_mm"][frames],
+    )
+    assert error.max() < 0.25 * 2.5, error.max()  # a quarter of pad16's pitch [mm]
+
+
+def _presses(path, depths_m):
+    """A controls table: the finger pressed on the ball to each depth in turn."""
+    rows, t = [(0.0, 0.0, 0.0, 0.0)], 0.0
+    for z in depths_m:
+        rows += [(t + 0.3, 0, 0, -0.028), (t + 0.6, 0, 0, z), (t + 1.4, 0, 0, z),
+                 (t + 1.7, 0, 0, -0.028)]  # fmt: skip
+        t += 1.7
+    rows.append((t + 0.3, 0.0, 0.0, 0.0))
+    path.write_text("time_s,x,y,z\n" + "".join(",".join(map(str, r)) + "\n" for r in rows))
+
+
+def test_force_with_the_sensors_calibration_within_two_percent(recording):
+    # the pad calibrated as a lab would, with known loads (here MuJoCo's press forces
+    # on the same ball, as a load cell would log them), then locate on the example:
+    # the held presses' total force within 2 % of MuJoCo's normal force sum
+    folder, out = recording
+    controls = folder / "presses.csv"
+    _presses(controls, np.linspace(-0.0305, -0.0375, 12))
+    weights_rec = folder / "weights.h5"
+    args = ["mujoco", "--controls", str(controls), "--out", str(weights_rec), "-q"]
+    assert runner.invoke(app, [*args, "--seed", "1"]).exit_code == 0
+    truth = read_recording(weights_rec).truth["step_force_n"]
+    on = truth > 0.05
+    edges = np.flatnonzero(np.diff(on.astype(int)))
+    loads = [np.median(truth[s + (e - s) // 2 : e - (e - s) // 10])
+             for s, e in zip(edges[::2] + 1, edges[1::2] + 1, strict=True)]  # fmt: skip
+    assert len(loads) == 12
+    log = folder / "weights.csv"
+    log.write_text("press,force_n\n" + "".join(f"{i + 1},{f:.6f}\n" for i, f in enumerate(loads)))
+    calibration = folder / "cal.json"
+    result = runner.invoke(
+        app, ["calibrate", str(weights_rec), "--force-log", str(log), "--out", str(calibration)]
+    )
+    assert result.exit_code == 0, result.output
+    table = _locate(folder, out, "calibrated", "--calibration", str(calibration))
+    total = table.groupby("frame").force_n.sum()
+    mujoco_sum = read_recording(out).truth["step_force_n"]
+    for frames in (HOLD_BALL,):
+        frames = list(frames)
+        ratio = total.reindex(frames).to_numpy() / mujoco_sum[frames]
+        assert np.all(np.abs(ratio - 1) < 0.02), ratio
+
+
+def test_the_view_plays_the_recording_and_export_reads_it(recording):
+    import json
+    import time
+
+    from tactsense.estimate.finger.deflection import baseline_from
+    from tactsense.view import RecordingFeed
+    from tactsense.view.locators import view_locator
+
+    folder, out = recording
+
+    def locator(spec, file):
+        return view_locator(spec, baseline=baseline_from(file.frames(0, 5)))  # as 'view' does
+
+    feed = RecordingFeed(out, locator, speed=1000.0)
+    contacts = []
+
+    def publish(text):
+        message = json.loads(text)
+        if message["type"] == "frame":
+            contacts.append(len((message["estimate"] or {}).get("contacts") or []))
+
+    feed.start(publish)
+    try:
+        deadline = time.monotonic() + 60
+        while feed.status != "ended":
+            assert time.monotonic() < deadline, "the view did not play the recording"
+            time.sleep(0.01)
+    finally:
+        feed.stop()
+    assert feed.n_frames == 1000 and feed.position == 999
+    assert contacts and max(contacts) >= 1  # the view shows the located contacts
+    mcap = folder / "example.mcap"
+    result = runner.invoke(app, ["export", str(out), "--out", str(mcap), "--quiet"])
+    assert result.exit_code == 0, result.output
+    assert mcap.stat().st_size > 0
+
+
+RESTING_BLOCK = """
+<mujoco>
+  <option timestep="0.001" cone="elliptic"/>
+  <worldbody>
+    <body name="palm" pos="0 0 0.1">
+      <geom name="pad" type="box" size="0.02 0.02 0.002"/>
+      <site name="palm_site" pos="0 0 0.002" size="0.02 0.02 0.001" type="box"/>
+    </body>
+    <body name="block" pos="0.005 -0.004 0.108">
+      <freejoint/>
+      <geom name="block" type="box" size="0.004 0.003 0.006" mass="0.05"/>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+"""A 50-g block resting on a pad that faces up (+z, the sensing face, up as declared):
+the pad is ``geom1`` of every contact (declared first), the block's face gives four
+contact points at its corners."""
+
+
+@pytest.mark.parametrize("mount", [{"geom": "pad"}, {"site": "palm_site"}])
+def test_a_resting_block_weighs_its_weight_at_its_corners(mount):
+    model = mujoco.MjModel.from_xml_string(RESTING_BLOCK)
+    data = mujoco.MjData(model)
+    spec = load_sensor("pad16")
+    sensor = adapter.MujocoSensor(model, spec, **mount)
+    for _ in range(1000):  # settle [1 s]
+        mujoco.mj_step(model, data)
+    reading = sensor.read(data)
+    pad = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, "pad")
+    assert all(data.contact[i].geom1 == pad for i in range(data.ncon))  # the other sign
+    weight = 0.05 * -model.opt.gravity[2]  # [N]
+    assert len(reading) == 4
+    assert reading.normal_force_n.sum() == pytest.approx(weight, rel=1e-6)
+    np.testing.assert_allclose(reading.tangential_force_n, 0.0, atol=1e-6)
+    # the corners, in surface coordinates: the pad's centre is taxel (7.5, 7.5) [mm]
+    centre = 7.5 * 2.5
+    xs, ys = (
+        sorted(set(np.round(reading.position_mm[:, 0], 3))),
+        sorted(set(np.round(reading.position_mm[:, 1], 3))),
+    )
+    np.testing.assert_allclose(xs, [centre + 5.0 - 4.0, centre + 5.0 + 4.0], atol=1e-3)
+    np.testing.assert_allclose(ys, [centre - 4.0 - 3.0, centre - 4.0 + 3.0], atol=1e-3)
+    assert np.all(reading.radius_mm == adapter.DEFAULT_FLAT_RADIUS_MM)  # a flat body
+
+
+def test_controls_interpolate_as_numpy_does():
+    model = adapter.load_model(adapter.example_model_path())
+    controls = adapter.read_controls(adapter.example_controls_path(), model)
+    for t in np.linspace(-1.0, 12.0, 1301):  # before, inside and after the table [s]
+        expected = [np.interp(t, controls.time_s, column) for column in controls.values.T]
+        np.testing.assert_allclose(controls.at(t), expected, rtol=0, atol=1e-15)
+
+
+def test_the_fingers_skin_reads_the_ball_and_its_axial_friction():
+    # the paper's finger as a capsule along world x, its local x down: the ball under
+    # the middle of its cylinder is at axial 12.5 mm (half its 25 mm), angle 0; slid
+    # toward its tip (+x), the ball's friction pulls toward the base (+axial)
+    spec = load_sensor("initial")
+    folder = adapter.fingertip_model_path().parent
+    model = adapter.load_model(adapter.fingertip_model_path())
+    controls = adapter.read_controls(folder / "mujoco_fingertip.csv", model)
+    sensor = adapter.MujocoSensor(model, spec, geom="finger")
+    data = mujoco.MjData(model)
+    readings = {}
+    while data.time < 8.0:
+        data.ctrl[:] = controls.at(data.time)
+        mujoco.mj_step(model, data)
+        if round(data.time * 1e3) in (2500, 7000):
+            readings[round(data.time * 1e3)] = sensor.read(data)
+    held, sliding = readings[2500], readings[7000]
+    np.testing.assert_allclose(held.position_mm[0], [12.5, 0.0], atol=1e-6)
+    assert held.radius_mm[0] == pytest.approx(3.0)
+    assert held.normal_force_n[0] > 0.5
+    assert sliding.slipping.all()
+    assert sliding.position_mm[0, 0] > 14.0  # the ball moved toward the base [mm]
+    ratio = sliding.tangential_force_n[0] / sliding.normal_force_n[0]
+    np.testing.assert_allclose(ratio, [0.5, 0.0], atol=2e-3)  # friction 0.5, along the axis
+    batch = adapter.contact_batch([held, sliding], shear=True)
+    from tactsense.simulate import frames_from_contacts
+
+    frames = frames_from_contacts(spec, batch, flaws="none").reshape(2, *spec.shape)
+    still = frames_from_contacts(
+        spec, adapter.contact_batch([held, sliding], shear=False), flaws="none"
+    ).reshape(2, *spec.shape)
+    assert np.argmax(frames[0, :, 0]) in (3, 4)  # the rows around 12.5 mm, column 0
+    assert not np.allclose(frames[1], still[1])  # the finger's frames carry the shear
+
+
+def test_a_face_that_does_not_fit_the_taxels_is_said():
+    model = adapter.load_model(adapter.example_model_path())
+    assert adapter.MujocoSensor(model, load_sensor("pad16"), geom="pad").size_note() is None
+    note = adapter.MujocoSensor(model, load_sensor("pad12x32"), geom="pad").size_note()
+    assert "40 x 40 mm" in note and "24 x 64 mm" in note
