@@ -76,9 +76,13 @@ def main() -> int:
         f"len(dataset) {len(dataset)}"
     )
     print(f"features {sorted(meta.features)}")
+    # a recording's export has the contact estimates as observation.state; a simulated
+    # data set (tactsense dataset) its ground truth as label.contacts
+    state_key = "observation.state" if "observation.state" in meta.features else "label.contacts"
+    names = meta.features[state_key]["names"]
     print(
         f"observation.tactile shape {meta.features['observation.tactile']['shape']}, "
-        f"state names {meta.features['observation.state']['names']}"
+        f"{state_key} names {names[:10]}{' ...' if len(names) > 10 else ''} ({len(names)})"
     )
     frames = []
     for i in range(len(dataset)):
@@ -89,7 +93,7 @@ def main() -> int:
     frames = np.stack(frames)
     print(
         f"item 0: observation.tactile {tuple(frames[0].shape)} {frames.dtype}, "
-        f"state {dataset[0]['observation.state'].numpy().round(3).tolist()}"
+        f"{state_key} {dataset[0][state_key].numpy().round(3).tolist()[:10]}"
     )
     print(f"item 0 task {dataset[0]['task']!r}")
     history = LeRobotDataset(
