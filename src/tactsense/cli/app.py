@@ -54,6 +54,12 @@ app.add_typer(imports.app)
 app.add_typer(model.sensor_app, name="sensor")
 app.add_typer(design.app, name="design")
 
+# ---- tactsense dataset (r6-data) ----
+from tactsense.cli import _dataset  # noqa: E402
+
+app.add_typer(_dataset.app)
+# ---- /r6-data ----
+
 
 def _show_usage_error(self, file=None) -> None:
     """A usage error (unknown option, value out of range, missing argument) as one line
