@@ -201,6 +201,7 @@ class LeRobotEpisodesWriter:
         )
         self.chunk = self.file = 0
         self.writer = None
+        self.file_written = 0
         self.frames = 0
         self.episode_rows: list[dict] = []
         self.stats = _Merged()
@@ -233,7 +234,9 @@ class LeRobotEpisodesWriter:
             pa.array(np.arange(self.frames, self.frames + n, dtype=np.int64)),
             pa.array(np.full(n, task_index, np.int64)),
         ]
-        self.writer.write_table(pa.Table.from_arrays(arrays, schema=self.schema))
+        table = pa.Table.from_arrays(arrays, schema=self.schema)
+        self.writer.write_table(table)
+        self.file_written += table.nbytes  # in memory, as LeRobot's writer measures a file
         row = {
             "episode_index": ep.index,
             "tasks": [ep.task],
@@ -253,9 +256,9 @@ class LeRobotEpisodesWriter:
         self.episode_rows.append(row)
         self.stats.add(stats)
         self.frames += n
-        if self._path().stat().st_size >= self.file_bytes:  # the next episode: a new file
+        if self.file_written >= self.file_bytes:  # the next episode: a new file
             self.writer.close()
-            self.writer = None
+            self.writer, self.file_written = None, 0
             self.file += 1
             if self.file >= CHUNKS_SIZE:
                 self.chunk, self.file = self.chunk + 1, 0
