@@ -125,15 +125,31 @@ def dataset(
     from tactsense.interop.datasets import write_dataset
     from tactsense.sensor import load_sensor
     from tactsense.simulate.contact_frames import resolve_flaws
-    from tactsense.simulate.dataset import DatasetPlan, surface_area
+    from tactsense.simulate.dataset import TASKS, DatasetPlan, surface_area
 
     try:
+        for option, (low, high), (low_limit, high_limit), unit in (
+            ("--force-n", force_n, (1e-4, 1e3), "N"),
+            ("--radius-mm", radius_mm, (0.05, 100.0), "mm"),
+            ("--speed-mm-s", speed_mm_s, (0.0, 1e4), "mm/s"),
+            ("--friction", friction, (0.01, 10.0), "-"),
+        ):
+            if not low_limit <= low <= high <= high_limit:  # NaN fails too
+                fail(
+                    f"{option} {low:g} {high:g}: need {low_limit:g} <= LOW <= HIGH <= "
+                    f"{high_limit:g} [{unit}]"
+                )
+        names = tuple(t.strip() for t in tasks.split(",") if t.strip())
+        unknown = [t for t in names if t not in TASKS]
+        if unknown or not names:
+            fail(f"--tasks {tasks!r}: choose from {', '.join(TASKS)} (a comma list)")
+        resolve_flaws(flaws)
         spec = load_sensor(sensor)
         surface_area(spec)  # a pad: contacts go on its grid
         plan = DatasetPlan(
             episodes=episodes,
             frames=frames,
-            tasks=tuple(t.strip() for t in tasks.split(",") if t.strip()),
+            tasks=names,
             force_n=force_n,
             radius_mm=radius_mm,
             speed_mm_s=speed_mm_s,
@@ -141,7 +157,6 @@ def dataset(
             seed=seed,
             flaws=flaws,
         )
-        resolve_flaws(flaws)
         parent = out.parent if str(out.parent) else Path(".")
         if not parent.is_dir():
             fail(f"folder {parent} of --out {out} does not exist; create it first")

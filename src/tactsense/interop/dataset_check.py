@@ -17,7 +17,7 @@ the HDF5 recording with h5py) batch by batch and checks:
   least ``min_force_n`` [N] whose centre is ``margin`` pitches inside the grid, the
   position ``locate`` finds (:func:`~tactsense.estimate.contacts.find_contacts`, the
   largest contact, the baseline the median of frames without contact) against the
-  labelled one: the error distribution [mm] is returned.
+  labelled one: the error distribution [mm] and its mean (a bias) are returned.
 """
 
 from __future__ import annotations
@@ -92,7 +92,7 @@ class _Sampler:
         from tactsense.estimate.contacts import find_contacts
 
         if not self.kept or not self.empty_kept:
-            return np.zeros(0)
+            return np.zeros((0, 2))
         frames = np.concatenate(self.frames)
         truth = np.concatenate(self.truth)
         baseline = np.median(np.concatenate(self.empty), axis=0)
@@ -100,7 +100,7 @@ class _Sampler:
         found = np.full((len(frames), 2), np.nan)
         first = table.contact == 0  # the largest contact of each frame
         found[table.frame[first]] = np.column_stack([table.x_mm[first], table.y_mm[first]])
-        return np.linalg.norm(found - truth, axis=1)  # NaN: nothing found
+        return found - truth  # NaN: nothing found
 
 
 def _lerobot(folder: Path, sampler: _Sampler, spec, progress) -> dict:
@@ -202,7 +202,8 @@ def check_dataset(
 
     Returns ``frames``, ``episodes``, ``located`` (frames of the locate check),
     ``missed`` (of those, frames where locate found nothing), ``error_median_mm``,
-    ``error_p95_mm``, ``error_max_mm`` and ``pitch_mm``.
+    ``error_p95_mm``, ``error_max_mm`` (the distance found - labelled), ``bias_x_mm``,
+    ``bias_y_mm`` (its mean along x and y) and ``pitch_mm``.
     """
     from tactsense.sensor import SensorSpec
 
@@ -217,8 +218,10 @@ def check_dataset(
             spec = reader.sensor
     sampler = _Sampler(spec, sample, min_force_n, margin)
     counts = (_lerobot if path.is_dir() else _hdf5)(path, sampler, spec, progress)
-    errors = sampler.errors()
+    signed = sampler.errors()
+    errors = np.linalg.norm(signed, axis=1) if len(signed) else np.zeros(0)
     found = errors[np.isfinite(errors)]
+    bias = np.nanmean(signed, axis=0) if len(found) else np.full(2, np.nan)
     (row_pitch, _), (col_pitch, _) = kind_of(spec).surface_grid(spec)
     return {
         **counts,
@@ -227,5 +230,7 @@ def check_dataset(
         "error_median_mm": float(np.median(found)) if len(found) else float("nan"),
         "error_p95_mm": float(np.quantile(found, 0.95)) if len(found) else float("nan"),
         "error_max_mm": float(found.max()) if len(found) else float("nan"),
+        "bias_x_mm": float(bias[0]),
+        "bias_y_mm": float(bias[1]),
         "pitch_mm": float(min(row_pitch, col_pitch)),
     }

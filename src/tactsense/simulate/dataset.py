@@ -23,7 +23,8 @@ whichever worker makes it and in whatever order). Three tasks:
 
 Labels per frame and contact slot (``(frames, MAX_CONTACTS)``): position [mm] in the
 kind's surface coordinates (a pad: x along rows, y along columns), normal force [N],
-tangential force [N] (x, y), sphere radius [mm], slip (0/1) and the contact's id (its
+tangential force [N] (x, y), sphere radius [mm], slip (1: the contact slides during the
+frame, it is ``speed * period`` further on in the next) and the contact's id (its
 slot, stable over the episode; -1 where the slot carries no force). The frames come
 from :func:`tactsense.simulate.contact_frames.frames_from_contacts` with the plan's flaws
 (its per-frame flaws; the memory flaws need a sequence and are not applied there).
@@ -224,9 +225,10 @@ def episode_labels(spec, plan: DatasetPlan, index: int) -> Episode:
         stick = rng.uniform(0.03, 0.08)  # fraction of the episode the contact sticks
         moving = (t >= held + stick) & (t < off)
         build = np.clip((t - held) / stick, 0.0, 1.0) * (t < held + stick) * (t >= held)
-        duration = max(0.0, off - held - stick) * n * period
+        duration = moving.sum() * period
         speed = _fit_speed(start, direction, rng.uniform(*plan.speed_mm_s), duration, area)
-        travel = np.clip(t - (held + stick), 0.0, off - held - stick) * n * period * speed
+        speed = speed if moving.any() else 0.0
+        travel = np.concatenate([[0.0], np.cumsum(moving[:-1])]) * period * speed
         position[:, 0] = start[0] + travel[:, None] * direction
         drag = np.where(moving, KINETIC_RATIO * mu, build * mu) * normal[:, 0]
         tangential[:, 0] = drag[:, None] * direction
@@ -240,8 +242,7 @@ def episode_labels(spec, plan: DatasetPlan, index: int) -> Episode:
         peak = rng.uniform(0.5, 1.5) * mu * force  # either side of the friction limit
         load = peak * np.clip((t - held) / lift, 0.0, 1.0) * (t >= held) * (envelope > 0)
         slipping = (load >= mu * grip) & (t >= held) & (t < off)
-        first = int(np.argmax(slipping)) if slipping.any() else n
-        duration = max(0.0, off - t[min(first, n - 1)]) * n * period
+        duration = slipping.sum() * period
         speed = _fit_speed(start, direction, rng.uniform(*plan.speed_mm_s), duration, area)
         slid = np.concatenate([[0.0], np.cumsum(slipping[:-1])]) * period * speed
         position[:, :k] = start[None] + slid[:, None, None] * direction
