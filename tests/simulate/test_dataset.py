@@ -160,7 +160,8 @@ def test_the_check_reads_both_formats_and_locate_agrees_with_the_labels(written)
     """Labels against frames: locate's largest contact on single-contact frames within
     half a pitch of the labelled centre (the taxel under it), median within 0.3 pitch,
     no bias beyond 0.1 pitch. pad16 is coarse for its layer (2.5-mm pitch): locate's
-    own error on noiseless single presses is about 0.28 pitch median, 0.45 at most."""
+    own error on noiseless presses at exact positions is of that size (docs/datasets.md,
+    "locate alone")."""
     for path in written[1:]:
         result = check_dataset(path, sample=1)
         pitch = result["pitch_mm"]
