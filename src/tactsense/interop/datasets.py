@@ -113,10 +113,22 @@ def _fps(spec) -> int:
     return int(max(1, round(spec.electronics.scan_rate_hz)))
 
 
+def _frame_dtype(plan: DatasetPlan, fmt: str):
+    """float32 for LeRobot (its ``observation.tactile``); for HDF5 uint16 counts when
+    quantized (as the simulator writes them), else float64."""
+    from tactsense.simulate.contact_frames import resolve_flaws
+
+    if fmt == "lerobot":
+        return np.float32
+    return np.uint16 if "quantization" in resolve_flaws(plan.flaws) else np.float64
+
+
 def make_block(spec, plan: DatasetPlan, first: int, count: int, fmt: str) -> list:
     """One Dask task: episodes ``first`` to ``first + count`` and, for LeRobot, each
     one's statistics (LeRobot's ``compute_episode_stats``)."""
     made = episodes(spec, plan, first, count)
+    for ep in made:  # what the format stores, and a quarter of the bytes back from a worker
+        ep.frames = ep.frames.astype(_frame_dtype(plan, fmt), copy=False)
     if fmt != "lerobot":
         return [(ep, None) for ep in made]
     features = _features(spec)
@@ -357,7 +369,7 @@ class HDF5EpisodesWriter:
 
         self.spec, self.plan = spec, plan
         flaws = resolve_flaws(plan.flaws)
-        self.dtype = np.uint16 if "quantization" in flaws else np.float64
+        self.dtype = _frame_dtype(plan, "hdf5")
         self.h5 = h5 = h5py.File(path, "w", libver=("earliest", "latest"))
         h5.attrs["format"] = FORMAT
         h5.attrs["format_version"] = FORMAT_VERSION
