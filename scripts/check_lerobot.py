@@ -118,6 +118,24 @@ def main() -> int:
     )
     stats = meta.stats["observation.tactile"]
     print(f"stats of observation.tactile: mean shape {tuple(np.shape(stats['mean']))}")
+    # the episodes' statistics merged by LeRobot's own aggregate_stats against stats.json
+    from lerobot.datasets.compute_stats import aggregate_stats
+    from lerobot.datasets.utils import EPISODES_DIR, load_nested_dataset
+
+    prefix = "stats/observation.tactile/"
+    episodes = load_nested_dataset(args.dataset / EPISODES_DIR)  # with the stats columns
+    columns = [c for c in episodes.column_names if c.startswith(prefix)]
+    per_episode = [
+        {"observation.tactile": {c[len(prefix) :]: np.asarray(row[c]) for c in columns}}
+        for row in episodes
+    ]
+    merged = aggregate_stats(per_episode)["observation.tactile"]
+    for name in ("min", "max", "mean", "std", "count"):
+        assert np.allclose(merged[name], np.asarray(stats[name]), rtol=1e-6, atol=1e-6), name
+    print(
+        f"aggregate_stats over the {len(per_episode)} episodes' statistics equals "
+        "stats.json (min, max, mean, std, count)"
+    )
     if args.recording is not None:
         import h5py
 
