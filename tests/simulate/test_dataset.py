@@ -268,3 +268,13 @@ def test_the_command_writes_a_set_the_check_accepts(tmp_path):
     assert check_dataset(out)["frames"] == 120
     with h5py.File(out) as h5:
         assert h5["episodes"].attrs["tasks"] == "press"
+
+
+def test_tactsense_imports_the_lerobot_set_as_the_hdf5_one(written, tmp_path):
+    """``tactsense import`` (LeRobot to a recording) gives the HDF5 set's frames and times."""
+    _, lerobot, hdf5 = written
+    result = CliRunner().invoke(app, ["import", str(lerobot), "--out", str(tmp_path / "in.h5")])
+    assert result.exit_code == 0, result.output
+    imported, direct = read_recording(tmp_path / "in.h5"), read_recording(hdf5)
+    assert np.array_equal(imported.frames, direct.frames)
+    assert np.allclose(imported.time_s, direct.time_s, rtol=0, atol=1e-9)

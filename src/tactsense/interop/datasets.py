@@ -89,12 +89,14 @@ def label_rows(ep) -> np.ndarray:
 
 
 def _columns(ep, spec, fps: int) -> dict:
+    """An episode's LeRobot columns; ``frame_time`` [s] runs on through the set, as the
+    HDF5 set's ``time`` (every episode has the plan's length)."""
     n = len(ep.frames)
     frame_index = np.arange(n, dtype=np.int64)
     return {
         "observation.tactile": np.asarray(ep.frames, dtype=np.float32),
         LABEL_FEATURE: label_rows(ep),
-        "frame_time": frame_index * spec.scan_period_s,
+        "frame_time": (ep.index * n + frame_index) * spec.scan_period_s,
         "timestamp": (frame_index / fps).astype(np.float32),
         "frame_index": frame_index,
     }
