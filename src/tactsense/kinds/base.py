@@ -286,10 +286,11 @@ class Kind:
 
     def contact_forward(self, spec: Any) -> Any:
         """The kind's fast forward for ``frames_from_contacts``, or None (the default:
-        ``elastic_batch`` frame by frame, slow but any kind works). An object with
-        ``deflection(contacts) -> (N, rows * cols)`` float64: every taxel's fractional
-        deflection [-] (what ``elastic_batch`` gives, before gains) for a
-        :class:`~tactsense.simulate.ContactBatch`."""
+        ``elastic_batch`` frame by frame, slow but any kind works). An object whose
+        ``prepare(contacts)`` (a :class:`~tactsense.simulate.ContactBatch`) returns a
+        function ``(first, last) -> (last - first, rows * cols)`` float64: every taxel's
+        fractional deflection [-] (what ``elastic_batch`` gives, before gains) in those
+        frames."""
         return None
 
 

@@ -109,4 +109,13 @@ class PadKind(Kind):
         return kernel
 
 
+    # ---- frames from contacts (r6-fast) ----------------------------------------
+    def contact_forward(self, spec: PadSpec):
+        """The layer's response tabulated once per layer, electrode and shape and
+        superposed per contact (:mod:`tactsense.physics._contact_kernel`)."""
+        from tactsense.physics._contact_kernel import PadContactForward
+
+        return PadContactForward(spec)
+
+
 KIND: Any = PadKind()

@@ -87,7 +87,8 @@ class ContactBatch:
         Radius of each indenter [mm] > 0: a sphere's radius (its contact radius follows
         from its force, Hertz) or a disc's.
     shape : (N, k) ndarray of str, or str
-        ``"sphere"`` or ``"disc"`` (:data:`SHAPES`) for every contact or each.
+        ``"sphere"`` or ``"disc"`` (:data:`SHAPES`) for every contact (kept as the
+        string) or each.
     """
 
     position_mm: np.ndarray
@@ -120,14 +121,18 @@ class ContactBatch:
             ) from None
         if np.any(radius <= 0):
             raise ContactBatchError("radius_mm must be > 0 [mm]")
-        shape = np.asarray(self.shape, dtype=object)
-        try:
-            shape = np.broadcast_to(shape, (n, k))
-        except ValueError:
-            raise ContactBatchError(
-                f"shape has shape {shape.shape}; expected a string or ({n}, {k})"
-            ) from None
-        unknown = sorted({str(s) for s in np.unique(shape.astype(str))} - set(SHAPES))
+        if isinstance(self.shape, str):
+            shape = self.shape
+            unknown = [] if shape in SHAPES else [shape]
+        else:
+            shape = np.asarray(self.shape).astype(str)
+            try:
+                shape = np.broadcast_to(shape, (n, k))
+            except ValueError:
+                raise ContactBatchError(
+                    f"shape has shape {shape.shape}; expected a string or ({n}, {k})"
+                ) from None
+            unknown = sorted(set(np.unique(shape).tolist()) - set(SHAPES))
         if unknown:
             raise ContactBatchError(
                 f"unknown contact shape(s) {', '.join(unknown)}; expected {' or '.join(SHAPES)}"
@@ -168,18 +173,35 @@ class ContactBatch:
                     "normal_force_n": force,
                     "tangential_force_n": tangential,
                     "radius_mm": float(self.radius_mm[index, j]),
-                    "shape": str(self.shape[index, j]),
+                    "shape": str(self.shape if isinstance(self.shape, str) else self.shape[index, j]),
                 }
             )
         return out
 
-    def hertz_radius_mm(self, modulus_star_pa: float) -> np.ndarray:
+    def shape_masks(self, first: int = 0, last: int | None = None):
+        """``(shape, chosen)`` for each shape present in frames ``first`` to ``last``:
+        ``chosen`` a boolean (frames, k) array, or True when every contact has it."""
+        if isinstance(self.shape, str):
+            return [(self.shape, True)]
+        part = self.shape[first:last]
+        return [(name, part == name) for name in SHAPES if np.any(part == name)]
+
+    def pressure_radius_mm(self, modulus_star_pa: float) -> np.ndarray:
         """Radius of each contact's pressure [mm], (N, k): a sphere's Hertz contact radius
-        ``(3 F R / (4 E*))^(1/3)`` at most ``R`` (Johnson 1985, eq. 4.22); a disc's own."""
-        force = self.normal_force_n
-        radius = np.asarray(self.radius_mm, dtype=float)
-        hertz = 1e3 * np.cbrt(3.0 * force * radius * 1e-3 / (4.0 * modulus_star_pa))
-        return np.where(self.shape == "sphere", np.minimum(hertz, radius), radius)
+        ``(3 F R / (4 E*))^(1/3)`` at most ``R`` (Johnson 1985, eq. 4.22, as
+        :class:`~tactsense.physics.indenters.SphereProbe`), a disc's own radius.
+
+        Parameters
+        ----------
+        modulus_star_pa : float
+            Plane-strain modulus ``E / (1 - nu^2)`` of the layer [Pa].
+        """
+        radius = self.radius_mm
+        hertz = 1e3 * np.cbrt(3.0 * self.normal_force_n * radius * 1e-3 / (4.0 * modulus_star_pa))
+        sphere = np.minimum(hertz, radius)
+        if isinstance(self.shape, str):
+            return sphere if self.shape == "sphere" else np.array(radius, dtype=float)
+        return np.where(self.shape == "sphere", sphere, radius)
 
 
 def resolve_flaws(flaws) -> tuple[str, ...]:

@@ -1,0 +1,204 @@
+"""The pad's fast forward for ``frames_from_contacts``: round contacts to taxel strain.
+
+Each contact adds ``F G(a; x_i - x_c, y_j - y_c)`` to taxel (i, j), ``G`` the layer's
+separable table (:mod:`tactsense.physics._hertz_table`): per contact and term r of the
+table, a row vector ``F U_r(a, x_i - x_c)`` (linear in a and in |dx|) and a column vector
+``V_r(y_j - y_c)`` (linear in |dy|), added as their outer product. The loop is compiled
+(Numba); the same sum is an ``einsum`` of gathered factors in any array library
+(:func:`superpose_array`, the check of the compiled loop and the route for an array-API
+backend).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from tactsense._jit import jit
+from tactsense.physics._hertz_table import SeparableResponse, layer_response_table
+
+A_TOP_GRAIN_MM = 0.5
+"""The tables are built for pressure radii up to a multiple of this [mm] (a batch with a
+slightly larger contact reuses the table of the next multiple)."""
+
+
+@jit(inline="always")
+def _cubic_weights(w):
+    """Lagrange weights of the four samples at -1, 0, 1, 2 for a point w in [0, 1)."""
+    return (
+        -w * (w - 1.0) * (w - 2.0) / 6.0,
+        (w + 1.0) * (w - 1.0) * (w - 2.0) / 2.0,
+        -(w + 1.0) * w * (w - 2.0) / 2.0,
+        (w + 1.0) * w * (w - 1.0) / 6.0,
+    )
+
+
+@jit(fastmath=True)
+def superpose(x_taxel, y_taxel, position, force, radius, x_factors, y_factors, step, a_step, out):
+    """Add every contact's response to ``out`` (n, rows, cols) [force times 1/N].
+
+    Parameters
+    ----------
+    x_taxel, y_taxel : float64 (rows,), (cols,)
+        Taxel centres along x (rows) and y (columns) [mm].
+    position : float64 (n, k, 2)
+        Contact centres [mm].
+    force : float64 (n, k)
+        Normal forces [N] (times any scale); 0: no contact.
+    radius : float64 (n, k)
+        Pressure radius a of each contact [mm], at most the table's top.
+    x_factors, y_factors : float64 (n_a, n_x + 3, R), (n_y + 3, R)
+        The table's factors padded for cubic interpolation
+        (:meth:`~tactsense.physics._hertz_table.SeparableResponse.padded`): sample 0 is
+        the mirror of sample 2 (the factors are even), the last two are zero.
+    step, a_step : float
+        The table's steps in offset and in pressure radius [mm].
+    """
+    n, k = force.shape
+    n_a, n_x, terms = x_factors.shape
+    n_y = y_factors.shape[0]
+    rows, cols = x_taxel.size, y_taxel.size
+    ux = np.empty((terms, rows))
+    vy = np.empty((terms, cols))
+    for p in range(n):
+        for c in range(k):
+            f = force[p, c]
+            if f <= 0.0:
+                continue
+            t = radius[p, c] / a_step
+            ia = min(int(t), n_a - 2)
+            wa = min(t - ia, 1.0)
+            for i in range(rows):
+                d = abs(x_taxel[i] - position[p, c, 0]) / step
+                ix = int(d)
+                if ix >= n_x - 3:
+                    for r in range(terms):
+                        ux[r, i] = 0.0
+                    continue
+                w0, w1, w2, w3 = _cubic_weights(d - ix)
+                for r in range(terms):
+                    lo = (
+                        w0 * x_factors[ia, ix, r]
+                        + w1 * x_factors[ia, ix + 1, r]
+                        + w2 * x_factors[ia, ix + 2, r]
+                        + w3 * x_factors[ia, ix + 3, r]
+                    )
+                    hi = (
+                        w0 * x_factors[ia + 1, ix, r]
+                        + w1 * x_factors[ia + 1, ix + 1, r]
+                        + w2 * x_factors[ia + 1, ix + 2, r]
+                        + w3 * x_factors[ia + 1, ix + 3, r]
+                    )
+                    ux[r, i] = f * (lo + wa * (hi - lo))
+            for j in range(cols):
+                d = abs(y_taxel[j] - position[p, c, 1]) / step
+                iy = int(d)
+                if iy >= n_y - 3:
+                    for r in range(terms):
+                        vy[r, j] = 0.0
+                    continue
+                w0, w1, w2, w3 = _cubic_weights(d - iy)
+                for r in range(terms):
+                    vy[r, j] = (
+                        w0 * y_factors[iy, r]
+                        + w1 * y_factors[iy + 1, r]
+                        + w2 * y_factors[iy + 2, r]
+                        + w3 * y_factors[iy + 3, r]
+                    )
+            for r in range(terms):
+                for i in range(rows):
+                    u = ux[r, i]
+                    if u == 0.0:
+                        continue
+                    for j in range(cols):
+                        out[p, i, j] += u * vy[r, j]
+
+
+def _lerp_index(distance, step, size):
+    """Index, weight and inside-mask of a linear interpolation at ``|distance| / step``."""
+    d = np.abs(distance) / step
+    index = np.minimum(d.astype(np.int64), size - 2)
+    inside = d < size - 1
+    return index, d - index, inside
+
+
+def superpose_array(x_taxel, y_taxel, position, force, radius, table: SeparableResponse):
+    """:func:`superpose` as whole-array operations (gathers and one ``einsum``), (n, rows,
+    cols) [-]: the same numbers to round-off; written so that an array-API library (CuPy,
+    JAX) could run it with its own ``take`` and ``einsum``."""
+    xf, yf = table.x_factors, table.y_factors
+    n_a, n_x, _ = xf.shape
+    t = radius / table.a_step_mm
+    ia = np.minimum(t.astype(np.int64), n_a - 2)
+    wa = np.minimum(t - ia, 1.0)[..., None, None]
+    ix, wx, in_x = _lerp_index(x_taxel[None, None, :] - position[..., :1], table.step_mm, n_x)
+    iy, wy, in_y = _lerp_index(y_taxel[None, None, :] - position[..., 1:], table.step_mm, len(yf))
+    ia_ = ia[..., None]
+
+    def at(a_index, x_index):  # (n, k, rows, terms)
+        return xf[a_index, x_index]
+
+    lo = at(ia_, ix) + wa * (at(ia_ + 1, ix) - at(ia_, ix))
+    hi = at(ia_, ix + 1) + wa * (at(ia_ + 1, ix + 1) - at(ia_, ix + 1))
+    u = (lo + wx[..., None] * (hi - lo)) * (in_x[..., None] * force[..., None, None])
+    v = (yf[iy] + wy[..., None] * (yf[iy + 1] - yf[iy])) * in_y[..., None]
+    return np.einsum("nkir,nkjr->nij", u, v)
+
+
+class PadContactForward:
+    """A pad's fast forward (``Kind.contact_forward``): the tabulated layer response.
+
+    The layer is taken as unbounded around the pad (as the twin's own forward takes it
+    within its margin), so a contact beside the pad still presses its edge taxels.
+    """
+
+    def __init__(self, spec):
+        g = spec.grid
+        self.spec = spec
+        self.x_taxel = g.row_pitch_mm * np.arange(g.rows, dtype=float)
+        self.y_taxel = g.col_pitch_mm * np.arange(g.cols, dtype=float)
+        self.electrode = (float(g.electrode_x_mm), float(g.electrode_y_mm))
+        t = spec.transduction
+        self.scale = t.strain_gain if t.kind == "capacitive" else 1.0
+        layer = spec.layer
+        self.modulus_star_pa = layer.youngs_modulus_pa / (1.0 - layer.poisson_ratio**2)
+
+    def table(self, shape: str, a_top_mm: float) -> SeparableResponse:
+        """The layer's table for ``shape`` covering pressure radii up to ``a_top_mm``."""
+        top = A_TOP_GRAIN_MM * max(1, math.ceil(a_top_mm / A_TOP_GRAIN_MM - 1e-9))
+        return layer_response_table(self.spec.layer, self.electrode, shape, top)
+
+    def prepare(self, contacts):
+        """A function ``(first, last) -> (last - first, rows * cols)``: the fractional
+        deflection [-] of every taxel (before gains) for those frames of ``contacts`` (a
+        ContactBatch), with the tables its largest contacts need (chosen once, so a frame
+        reads the same whatever block it is computed in)."""
+        radius = contacts.pressure_radius_mm(self.modulus_star_pa)
+        tables = {}
+        for shape, chosen in contacts.shape_masks():
+            top = float(np.max(radius[chosen] if chosen is not True else radius, initial=0.0))
+            tables[shape] = self.table(shape, top)
+        rows, cols = self.x_taxel.size, self.y_taxel.size
+
+        def block(first: int, last: int) -> np.ndarray:
+            out = np.zeros((last - first, rows, cols))
+            position = np.ascontiguousarray(contacts.position_mm[first:last])
+            force = contacts.normal_force_n[first:last] * self.scale
+            for shape, chosen in contacts.shape_masks(first, last):
+                table = tables[shape]
+                superpose(
+                    self.x_taxel,
+                    self.y_taxel,
+                    position,
+                    force if chosen is True else np.where(chosen, force, 0.0),
+                    np.ascontiguousarray(radius[first:last]),
+                    table.padded_x,
+                    table.padded_y,
+                    table.step_mm,
+                    table.a_step_mm,
+                    out,
+                )
+            return out.reshape(last - first, rows * cols)
+
+        return block

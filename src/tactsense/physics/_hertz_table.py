@@ -1,0 +1,173 @@
+"""A layer's taxel response to round contacts, tabulated once and kept separable.
+
+What a taxel of a flat layer kind reads under one round contact of force F [N] and
+pressure radius a [mm] centred (dx, dy) [mm] from the taxel's centre is
+``F G(a; dx, dy)``: the compressive strain ``-eps_zz`` at the sensing depth averaged over
+the taxel's electrode, per newton. The layer is linear and the same everywhere, so ``G``
+is all a pad needs; it is even in dx and in dy (a rectangular electrode).
+
+``G`` is computed here for a Hertz pressure ``p0 sqrt(1 - r^2/a^2)`` (a sphere) or a
+uniform one (a disc) on a grid of a from 0 to the largest needed, by the bonded layer's
+closed-form transfer function (:func:`tactsense.physics.pad_response.strain_transfer`)
+times the pressure's exact Fourier transform (``3 (sin ka - ka cos ka) / (ka)^3`` for
+Hertz, ``2 J1(ka) / ka`` for a disc, each times F) and the electrode's (a product of
+sincs), on a periodic grid much larger than the response's reach (the field of a layer
+bonded to a rigid base dies out exponentially, about e-fold per 1.2 layer thicknesses).
+No pressure is sampled: the only grid is the offsets'.
+
+The table is then factored (SVD of the (a, dx) x dy matrix) into
+``G(a; dx, dy) = sum_r U_r(a, dx) V_r(dy)`` with as few terms as keep the largest error
+under :data:`RANK_TOLERANCE` of the peak (six for the built-in pads): a frame is then an
+outer product per contact, ``sum_r (F U_r(a, x_i - x_c)) V_r(y_j - y_c)``, interpolated
+linearly in a and in dx, dy.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import special
+
+from tactsense.sensor import Layer
+
+RANK_TOLERANCE = 2e-5
+"""Largest error of the factored table against the full one, relative to its peak [-]."""
+
+REACH_TOLERANCE = 1e-5
+"""The table ends where ``|G|`` stays below this share of its peak beyond [-]."""
+
+SHAPES = ("sphere", "disc")
+
+
+@dataclass(frozen=True, eq=False)
+class SeparableResponse:
+    """``G(a; dx, dy) = sum_r x_factors[a_index, dx_index, r] * y_factors[dy_index, r]``.
+
+    ``x_factors`` (n_a, n_x, R) at a = ``a_step_mm * a_index``, |dx| = ``step_mm *
+    dx_index``; ``y_factors`` (n_y, R) at |dy| = ``step_mm * dy_index``; zero beyond
+    the last index (the reach) [strain per newton: 1/N].
+    """
+
+    x_factors: np.ndarray
+    y_factors: np.ndarray
+    step_mm: float
+    a_step_mm: float
+    peak: float
+    rank_error: float
+
+    @property
+    def a_top_mm(self) -> float:
+        """Largest pressure radius tabulated [mm]."""
+        return self.a_step_mm * (self.x_factors.shape[0] - 1)
+
+    @functools.cached_property
+    def padded_x(self) -> np.ndarray:
+        """``x_factors`` padded for cubic interpolation along dx, (n_a, n_x + 3, R): the
+        mirror of sample 1 first (the factors are even in dx), two zeros last."""
+        f = self.x_factors
+        zeros = np.zeros((f.shape[0], 2, f.shape[2]))
+        return np.ascontiguousarray(np.concatenate([f[:, 1:2], f, zeros], axis=1))
+
+    @functools.cached_property
+    def padded_y(self) -> np.ndarray:
+        """``y_factors`` padded alike, (n_y + 3, R)."""
+        f = self.y_factors
+        return np.ascontiguousarray(np.concatenate([f[1:2], f, np.zeros((2, f.shape[1]))]))
+
+    def full(self, a_index: int) -> np.ndarray:
+        """``G`` at one tabulated a over the quadrant dx, dy >= 0, (n_x, n_y) [1/N]."""
+        return self.x_factors[a_index] @ self.y_factors.T
+
+
+def pressure_transform(shape: str, ka: np.ndarray) -> np.ndarray:
+    """Fourier transform of a round pressure of unit force at ``ka`` = wavenumber [rad/mm]
+    times radius [mm] [-]: Hertz's ``3 (sin x - x cos x) / x^3`` or the disc's
+    ``2 J1(x) / x``; 1 at x = 0."""
+    x = np.asarray(ka, dtype=float)
+    small = x < 1e-3
+    safe = np.where(small, 1.0, x)
+    if shape == "sphere":
+        exact = 3.0 * (np.sin(safe) - safe * np.cos(safe)) / safe**3
+        series = 1.0 - x**2 / 10.0
+    else:
+        exact = 2.0 * special.j1(safe) / safe
+        series = 1.0 - x**2 / 8.0
+    return np.where(small, series, exact)
+
+
+def table_step_mm(layer: Layer, electrode_mm: tuple[float, float]) -> float:
+    """Offset step of the table [mm]: a fortieth of the smallest of the electrode, the
+    layer's thickness and the sensing depth (the narrowest feature of ``G``), at most
+    0.05 mm."""
+    sizes = [*electrode_mm, layer.thickness_mm]
+    if layer.sensing_depth_mm > 0:
+        sizes.append(layer.sensing_depth_mm)
+    return min(0.05, min(sizes) / 40.0)
+
+
+A_STEP_MM = 0.05
+"""Step of the table in the pressure radius a [mm]."""
+
+
+def _spectrum(layer, electrode_mm, step, n):
+    """The strain's transfer times the electrode's on an n x n periodic grid of ``step``
+    [mm] (the half plane of ``rfft2``), and |k| [rad/mm] there."""
+    from tactsense.physics.pad_response import strain_transfer
+
+    fx = np.fft.fftfreq(n, d=step)[:, None]  # [cycles/mm]
+    fy = np.fft.rfftfreq(n, d=step)[None, :]
+    transfer = strain_transfer(fx, fy, layer.sensing_depth_mm, layer)  # [1/Pa]
+    transfer = transfer * np.sinc(fx * electrode_mm[0]) * np.sinc(fy * electrode_mm[1])
+    return transfer, 2.0 * np.pi * np.hypot(fx, fy)
+
+
+def _quadrant(transfer, k, shape, a, step, n, size):
+    """``G`` over the quadrant dx, dy in [0, size * step) for one a, (size, size) [1/N]."""
+    spectrum = transfer * pressure_transform(shape, k * a)  # [m^2] for 1 N
+    field = np.fft.irfft2(spectrum, s=(n, n)) / (step * 1e-3) ** 2
+    return -field[:size, :size]  # compressive strain per newton
+
+
+@functools.lru_cache(maxsize=16)
+def layer_response_table(
+    layer: Layer, electrode_mm: tuple[float, float], shape: str, a_top_mm: float
+) -> SeparableResponse:
+    """The separable table of ``G`` for a layer, an electrode (x, y) [mm] and a contact
+    shape (``"sphere"``: Hertz; ``"disc"``: uniform), for pressure radii 0 to at least
+    ``a_top_mm`` [mm] (cached per process)."""
+    from scipy.fft import next_fast_len
+
+    step = table_step_mm(layer, electrode_mm)
+    n_a = max(2, math.ceil(a_top_mm / A_STEP_MM - 1e-9) + 1)
+    a_values = A_STEP_MM * np.arange(n_a)
+    # a quadrant wide enough for the field to die out (about e-fold per 1.2 layer
+    # thicknesses); the periodic images then lie beyond it as well
+    trial = math.ceil((18.0 * layer.thickness_mm + max(electrode_mm) + a_values[-1]) / step)
+    n = next_fast_len(2 * trial)
+    transfer, k = _spectrum(layer, electrode_mm, step, n)
+    grid = np.stack([_quadrant(transfer, k, shape, a, step, n, trial) for a in a_values])
+    peak = float(np.abs(grid).max())
+    beyond = np.abs(grid).max(axis=(0, 2))  # largest |G| at each dx
+    beyond = np.maximum(beyond, np.abs(grid).max(axis=(0, 1)))  # and each dy
+    tail = np.maximum.accumulate(beyond[::-1])[::-1]
+    size = int(np.argmax(tail < REACH_TOLERANCE * peak)) or trial
+    size = min(trial, size + 2)
+    grid = np.ascontiguousarray(grid[:, :size, :size])
+    grid[:, -1, :] = 0.0  # zero at the reach: the interpolation falls to it
+    grid[:, :, -1] = 0.0
+    matrix = grid.reshape(n_a * size, size)
+    # the dy basis: eigenvectors of the Gram matrix, largest first (its singular values
+    # squared; the terms kept are far above the round-off of the squares)
+    values, vectors = np.linalg.eigh(matrix.T @ matrix)
+    basis = vectors[:, ::-1]
+    for rank in range(1, size + 1):
+        y_factors = np.ascontiguousarray(basis[:, :rank])
+        x_flat = matrix @ y_factors
+        error = float(np.abs(matrix - x_flat @ y_factors.T).max())
+        if error <= RANK_TOLERANCE * peak:
+            break
+    x_factors = np.ascontiguousarray(x_flat.reshape(n_a, size, rank))
+    return SeparableResponse(x_factors, y_factors, step, A_STEP_MM, peak, error / peak)
