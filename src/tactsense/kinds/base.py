@@ -288,7 +288,8 @@ class Kind:
         """The kind's fast forward for ``frames_from_contacts``, or None (the default:
         ``elastic_batch`` frame by frame, slow but any kind works). An object whose
         ``prepare(contacts)`` (a :class:`~tactsense.simulate.ContactBatch`) returns a
-        function ``(first, last) -> (last - first, rows * cols)`` float64: every taxel's
+        function ``(first, last) -> (last - first, rows * cols)`` (float32 or float64):
+        every taxel's
         fractional deflection [-] (what ``elastic_batch`` gives, before gains) in those
         frames."""
         return None

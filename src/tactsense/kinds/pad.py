@@ -108,7 +108,6 @@ class PadKind(Kind):
                 kernel[a, b] = signal_per_strain(spec, strain / newtons, signed=signed)
         return kernel
 
-
     # ---- frames from contacts (r6-fast) ----------------------------------------
     def contact_forward(self, spec: PadSpec):
         """The layer's response tabulated once per layer, electrode and shape and

@@ -48,20 +48,23 @@ def superpose(x_taxel, y_taxel, position, force, radius, x_factors, y_factors, s
         Normal forces [N] (times any scale); 0: no contact.
     radius : float64 (n, k)
         Pressure radius a of each contact [mm], at most the table's top.
-    x_factors, y_factors : float64 (n_a, n_x + 3, R), (n_y + 3, R)
+    x_factors, y_factors : (n_a, n_x + 3, R), (n_y + 3, R), float32 or float64
         The table's factors padded for cubic interpolation
-        (:meth:`~tactsense.physics._hertz_table.SeparableResponse.padded`): sample 0 is
-        the mirror of sample 2 (the factors are even), the last two are zero.
+        (:meth:`~tactsense.physics._hertz_table.SeparableResponse.padded_x`): sample 0
+        is the mirror of sample 2 (the factors are even), the last two are zero. The
+        sums are carried in their precision (float32: 1e-7 of the peak).
     step, a_step : float
         The table's steps in offset and in pressure radius [mm].
+    out : (n, rows, cols) array of the factors' type
     """
     n, k = force.shape
     n_a, n_x, terms = x_factors.shape
     n_y = y_factors.shape[0]
     rows, cols = x_taxel.size, y_taxel.size
-    ux = np.empty((terms, rows))
-    vy = np.empty((terms, cols))
+    ux = np.empty((rows, terms), dtype=x_factors.dtype)
+    vy = np.empty((terms, cols), dtype=x_factors.dtype)
     for p in range(n):
+        frame = out[p]
         for c in range(k):
             f = force[p, c]
             if f <= 0.0:
@@ -69,34 +72,32 @@ def superpose(x_taxel, y_taxel, position, force, radius, x_factors, y_factors, s
             t = radius[p, c] / a_step
             ia = min(int(t), n_a - 2)
             wa = min(t - ia, 1.0)
+            low, high = f * (1.0 - wa), f * wa  # linear in a, the force folded in
+            below, above = x_factors[ia], x_factors[ia + 1]
             for i in range(rows):
                 d = abs(x_taxel[i] - position[p, c, 0]) / step
                 ix = int(d)
                 if ix >= n_x - 3:
-                    for r in range(terms):
-                        ux[r, i] = 0.0
+                    ux[i, :] = 0.0
                     continue
                 w0, w1, w2, w3 = _cubic_weights(d - ix)
                 for r in range(terms):
-                    lo = (
-                        w0 * x_factors[ia, ix, r]
-                        + w1 * x_factors[ia, ix + 1, r]
-                        + w2 * x_factors[ia, ix + 2, r]
-                        + w3 * x_factors[ia, ix + 3, r]
+                    ux[i, r] = low * (
+                        w0 * below[ix, r]
+                        + w1 * below[ix + 1, r]
+                        + w2 * below[ix + 2, r]
+                        + w3 * below[ix + 3, r]
+                    ) + high * (
+                        w0 * above[ix, r]
+                        + w1 * above[ix + 1, r]
+                        + w2 * above[ix + 2, r]
+                        + w3 * above[ix + 3, r]
                     )
-                    hi = (
-                        w0 * x_factors[ia + 1, ix, r]
-                        + w1 * x_factors[ia + 1, ix + 1, r]
-                        + w2 * x_factors[ia + 1, ix + 2, r]
-                        + w3 * x_factors[ia + 1, ix + 3, r]
-                    )
-                    ux[r, i] = f * (lo + wa * (hi - lo))
             for j in range(cols):
                 d = abs(y_taxel[j] - position[p, c, 1]) / step
                 iy = int(d)
                 if iy >= n_y - 3:
-                    for r in range(terms):
-                        vy[r, j] = 0.0
+                    vy[:, j] = 0.0
                     continue
                 w0, w1, w2, w3 = _cubic_weights(d - iy)
                 for r in range(terms):
@@ -106,13 +107,14 @@ def superpose(x_taxel, y_taxel, position, force, radius, x_factors, y_factors, s
                         + w2 * y_factors[iy + 2, r]
                         + w3 * y_factors[iy + 3, r]
                     )
-            for r in range(terms):
-                for i in range(rows):
-                    u = ux[r, i]
+            for i in range(rows):
+                row = frame[i]
+                for r in range(terms):
+                    u = ux[i, r]
                     if u == 0.0:
                         continue
                     for j in range(cols):
-                        out[p, i, j] += u * vy[r, j]
+                        row[j] += u * vy[r, j]
 
 
 def _lerp_index(distance, step, size):
@@ -171,30 +173,36 @@ class PadContactForward:
 
     def prepare(self, contacts):
         """A function ``(first, last) -> (last - first, rows * cols)``: the fractional
-        deflection [-] of every taxel (before gains) for those frames of ``contacts`` (a
+        deflection [-] of every taxel (before gains; float32, 1e-7 of the peak) for
+        those frames of ``contacts`` (a
         ContactBatch), with the tables its largest contacts need (chosen once, so a frame
         reads the same whatever block it is computed in)."""
         radius = contacts.pressure_radius_mm(self.modulus_star_pa)
         tables = {}
         for shape, chosen in contacts.shape_masks():
             top = float(np.max(radius[chosen] if chosen is not True else radius, initial=0.0))
-            tables[shape] = self.table(shape, top)
+            table = self.table(shape, top)
+            tables[shape] = (
+                table,
+                table.padded_x.astype(np.float32),
+                table.padded_y.astype(np.float32),
+            )
         rows, cols = self.x_taxel.size, self.y_taxel.size
 
         def block(first: int, last: int) -> np.ndarray:
-            out = np.zeros((last - first, rows, cols))
+            out = np.zeros((last - first, rows, cols), dtype=np.float32)
             position = np.ascontiguousarray(contacts.position_mm[first:last])
             force = contacts.normal_force_n[first:last] * self.scale
             for shape, chosen in contacts.shape_masks(first, last):
-                table = tables[shape]
+                table, x_factors, y_factors = tables[shape]
                 superpose(
                     self.x_taxel,
                     self.y_taxel,
                     position,
                     force if chosen is True else np.where(chosen, force, 0.0),
                     np.ascontiguousarray(radius[first:last]),
-                    table.padded_x,
-                    table.padded_y,
+                    x_factors,
+                    y_factors,
                     table.step_mm,
                     table.a_step_mm,
                     out,

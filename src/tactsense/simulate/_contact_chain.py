@@ -26,7 +26,7 @@ BLOCK_FRAMES = 1024
 _CAPACITIVE, _RESISTIVE = 0, 1
 
 
-@jit()
+@jit(fastmath=True)
 def _counts_pass(
     values,
     gains,
@@ -47,34 +47,42 @@ def _counts_pass(
     noise_sd,
     quantize,
     full_scale,
-    dead,
+    alive,
+    out,
 ):
-    """Counts in place of ``values`` (frames, taxels): the deflection [-] in, A/D counts
-    out; ``noise`` (frames, taxels) float32 standard normals or an empty array."""
+    """Counts into ``out`` (frames, taxels) from the deflections ``values`` [-];
+    ``noise`` (frames, taxels) float32 standard normals or an empty array; ``alive``
+    1.0 for a taxel that reads, 0.0 for a dead one. The branches on the flaws are taken
+    outside the loops over taxels, which the compiler vectorizes."""
     n, m = values.shape
     with_noise = noise.shape[0] > 0
+    low = -0.5 * saturation
+    sign = -1.0 if falling else 1.0
     for p in range(n):
+        row = out[p]
         for q in range(m):
-            d = values[p, q] * gains[q]
-            if nonlinear:
-                d = max(d, -0.5 * saturation)
-                d = d / (1.0 + d / saturation)
-            if mode == _CAPACITIVE:
-                d = min(d, 0.95)
-                cap = c0[q] / (1.0 - d)
+            row[q] = values[p, q] * gains[q]
+        if nonlinear:
+            for q in range(m):
+                d = max(row[q], low)
+                row[q] = d / (1.0 + d / saturation)
+        if mode == _CAPACITIVE:
+            for q in range(m):
+                cap = c0[q] / (1.0 - min(row[q], 0.95))
                 volts = cap * rc / math.sqrt(1.0 + (rc * (cap + c_load)) ** 2) * drive_v
                 counts = gain_v[q] * volts / adc_full_scale_v * adc_levels
-                if falling:
-                    counts = 2.0 * nominal - counts
-            else:
-                change = counts_per_strain * max(d, 0.0)
-                counts = nominal - change if falling else nominal + change
-            if with_noise:
-                counts = counts + noise_sd * np.float64(noise[p, q])
-            if quantize:
-                counts = np.rint(counts)
-            counts = min(max(counts, 0.0), full_scale)
-            values[p, q] = 0.0 if dead[q] else counts
+                row[q] = 2.0 * nominal - counts if falling else counts
+        else:
+            for q in range(m):
+                row[q] = nominal + sign * (counts_per_strain * max(row[q], 0.0))
+        if with_noise:
+            for q in range(m):
+                row[q] += noise_sd * noise[p, q]
+        if quantize:
+            for q in range(m):
+                row[q] = np.rint(row[q])
+        for q in range(m):
+            row[q] = min(max(row[q], 0.0), full_scale) * alive[q]
 
 
 def _numpy_counts(spec, values, gains, active, noise, first, last):
@@ -128,6 +136,7 @@ def fast_frames(spec, contacts, forward, active, gains, rng) -> np.ndarray:
         for r, c in spec.flaws.dead_tactels:
             dead[r, c] = True
     dead = dead.reshape(taxels)
+    alive = np.where(dead, 0.0, 1.0)
     mode = _compiled_mode(spec, kind, active)
     el, f = spec.electronics, spec.flaws
     with_noise = "noise" in active
@@ -175,7 +184,7 @@ def fast_frames(spec, contacts, forward, active, gains, rng) -> np.ndarray:
             float(f.read_noise_counts),
             "quantization" in active,
             float(2**el.adc_bits - 1),
-            dead,
+            alive,
+            out[first:last],
         )
-        out[first:last] = values
     return out

@@ -173,7 +173,9 @@ class ContactBatch:
                     "normal_force_n": force,
                     "tangential_force_n": tangential,
                     "radius_mm": float(self.radius_mm[index, j]),
-                    "shape": str(self.shape if isinstance(self.shape, str) else self.shape[index, j]),
+                    "shape": str(
+                        self.shape if isinstance(self.shape, str) else self.shape[index, j]
+                    ),
                 }
             )
         return out

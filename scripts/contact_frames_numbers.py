@@ -1,0 +1,168 @@
+"""Regenerate the measured blocks of docs/batch-frames.md and docs/performance.md.
+
+Run from the repository root: ``python scripts/contact_frames_numbers.py [--frames N]``.
+Throughput from ``benchmarks/bench_contact_frames.py`` (this run); accuracy of the fast
+path and of today's path against the layer's exact solution (the Hankel quadrature of
+``tests/simulate/test_contact_frames.py``) on random frames of one to three contacts;
+a figure of one frame (``docs/figures/batch_frames.png``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path[:0] = [str(ROOT), str(ROOT / "benchmarks"), str(ROOT / "scripts")]
+
+from bench_contact_frames import measure  # noqa: E402
+from docblock import replace_block, save_figure  # noqa: E402
+
+from tactsense.kinds import kind_of  # noqa: E402
+from tactsense.physics.indenters import DiscProbe, SphereProbe  # noqa: E402
+from tactsense.sensor.registry import pad12x32, pad16  # noqa: E402
+from tactsense.simulate import ContactBatch  # noqa: E402
+from tests.simulate.test_contact_frames import _exact_frame  # noqa: E402
+
+DOC = ROOT / "docs" / "batch-frames.md"
+PERFORMANCE = ROOT / "docs" / "performance.md"
+FIGURE = ROOT / "docs" / "figures" / "batch_frames.png"
+
+
+def accuracy_cases(make, shape: str, n: int = 6, seed: int = 7):
+    """(spec, batch, fast strain, today's strain, exact strain), each (n, rows, cols)."""
+    spec = make()
+    g = spec.grid
+    rng = np.random.default_rng(seed)
+    extent = np.array([(g.rows - 1) * g.row_pitch_mm, (g.cols - 1) * g.col_pitch_mm])
+    position = rng.uniform(0.0, 1.0, (n, 3, 2)) * extent
+    force = rng.uniform(0.05, 3.0, (n, 3))
+    missing = rng.random((n, 3)) < 1.0 / 3.0
+    missing[:, 0] = False
+    force[missing] = 0.0
+    radius = rng.uniform(1.0, 3.0, (n, 3)) if shape == "disc" else 1.6
+    batch = ContactBatch(position, force, radius_mm=radius, shape=shape)
+    kind = kind_of(spec)
+    fast = kind.contact_forward(spec).prepare(batch)(0, n).reshape(n, g.rows, g.cols)
+    layer = spec.layer
+    a = batch.pressure_radius_mm(layer.youngs_modulus_pa / (1 - layer.poisson_ratio**2))
+    exact = np.empty_like(fast)
+    today = np.empty_like(fast)
+    cls = SphereProbe if shape == "sphere" else DiscProbe
+    for i in range(n):
+        on = force[i] > 0
+        contacts = zip(position[i, on, 0], position[i, on, 1], force[i, on], a[i, on], strict=True)
+        exact[i] = _exact_frame(spec, contacts, shape)
+        r = np.broadcast_to(np.asarray(radius, dtype=float), (n, 3))
+        today[i] = kind.layer_strain(
+            spec,
+            [
+                cls(x, y, f, radius_mm=rr)
+                for (x, y), f, rr in zip(position[i, on], force[i, on], r[i, on], strict=True)
+            ],  # fmt: skip
+        )
+    return spec, batch, fast, today, exact
+
+
+def relative_errors(estimate, exact) -> np.ndarray:
+    """Largest error of each frame over the exact frame's peak [-]."""
+    peak = np.abs(exact).max(axis=(1, 2))
+    return np.abs(estimate - exact).max(axis=(1, 2)) / peak
+
+
+def accuracy_block() -> tuple[str, tuple]:
+    lines = [
+        "| sensor | contacts | frames | fast path: largest error / exact peak | "
+        "today's path (`layer_strain`, 0.5-mm pressure grid) |",
+        "|---|---|---|---|---|",
+    ]
+    shown = None
+    for make, shape in ((pad16, "sphere"), (pad16, "disc"), (pad12x32, "sphere")):
+        spec, batch, fast, today, exact = accuracy_cases(make, shape)
+        e_fast, e_today = relative_errors(fast, exact), relative_errors(today, exact)
+        what = "1-3 spheres of 1.6 mm, 0.05-3 N (Hertz radius)" if shape == "sphere" else (
+            "1-3 discs of radius 1-3 mm, 0.05-3 N")  # fmt: skip
+        lines.append(
+            f"| {spec.name} | {what} | {len(fast)} | max {e_fast.max():.1e} "
+            f"(median {np.median(e_fast):.1e}) | max {e_today.max():.1e} "
+            f"(median {np.median(e_today):.1e}) |"
+        )
+        if shown is None:
+            shown = (spec, fast[0], today[0], exact[0])
+    return "\n".join(lines), shown
+
+
+def figure(shown) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    spec, fast, today, exact = shown
+    fig, axes = plt.subplots(1, 4, figsize=(13, 3.2), constrained_layout=True)
+    peak = np.abs(exact).max()
+    panels = [
+        (exact, "exact layer (Hankel) [-]", "viridis"),
+        (fast, "frames_from_contacts [-]", "viridis"),
+        ((fast - exact) / peak, "fast - exact [peak]", "coolwarm"),
+        ((today - exact) / peak, "today's layer_strain - exact [peak]", "coolwarm"),
+    ]
+    for ax, (image, title, cmap) in zip(axes, panels, strict=True):
+        limit = np.abs(image).max() if cmap == "coolwarm" else None
+        shown_image = ax.imshow(image, cmap=cmap, vmin=-limit if limit else None, vmax=limit)
+        ax.set_title(title, fontsize=9)
+        ax.set_xlabel("column")
+        ax.set_ylabel("row")
+        fig.colorbar(shown_image, ax=ax, shrink=0.8)
+    fig.suptitle(f"{spec.name}: compressive strain of one frame (contacts of the first case)")
+    save_figure(fig, FIGURE)
+
+
+def throughput_block(rows) -> str:
+    lines = [
+        "| sensor | taxels | flaws | frames/s (CPU time, one core) | readings/s | "
+        "today's path (`simulate`, one step per frame) | ratio |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        path = "" if r["fast_path"] else " (no fast forward: the reference)"
+        lines.append(
+            f"| {r['sensor']}{path} | {r['taxels']} | {r['flaws']} | "
+            f"**{r['frames_per_s']:,.0f}** (wall {r['wall_frames_per_s']:,.0f}) | "
+            f"{r['readings_per_s']:,.0f} | {r['reference_frames_per_s']:,.0f} frames/s | "
+            f"{r['ratio']:,.0f}x |"
+        )
+    return "\n".join(lines)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--frames", type=int, default=200_000, help="frames per run [-]")
+    args = parser.parse_args()
+    rows = measure(args.frames)
+    table = throughput_block(rows)
+    accuracy, shown = accuracy_block()
+    figure(shown)
+    for path in (DOC, PERFORMANCE):
+        replace_block(
+            path,
+            "<!-- begin contact-frames throughput -->",
+            "<!-- end contact-frames throughput -->",
+            f"<!-- begin contact-frames throughput -->\n{table}\n"
+            "<!-- end contact-frames throughput -->",
+        )
+    replace_block(
+        DOC,
+        "<!-- begin contact-frames accuracy -->",
+        "<!-- end contact-frames accuracy -->",
+        f"<!-- begin contact-frames accuracy -->\n{accuracy}\n<!-- end contact-frames accuracy -->",
+    )
+    print(table)
+    print(accuracy)
+
+
+if __name__ == "__main__":
+    main()
