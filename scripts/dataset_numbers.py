@@ -304,7 +304,7 @@ def _perf_block(args, total, results) -> str:
     return "\n".join(
         [
             PERF_BEGIN,
-            "### Labelled data sets (`tactsense dataset`)",
+            "## Labelled data sets: `tactsense dataset` (issue 38, item 3)",
             "",
             f"{total:,} pad16 frames with labels ({args.episodes:,} episodes), "
             f"{args.workers} Dask workers, `scripts/dataset_numbers.py` (docs/datasets.md): "
