@@ -18,14 +18,14 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT), str(ROOT / "benchmarks"), str(ROOT / "scripts")]
 
-from bench_contact_frames import measure  # noqa: E402
 from docblock import replace_block, save_figure  # noqa: E402
+from tests.simulate.test_contact_frames import _exact_frame  # noqa: E402
 
+from bench_contact_frames import measure  # noqa: E402
 from tactsense.kinds import kind_of  # noqa: E402
 from tactsense.physics.indenters import DiscProbe, SphereProbe  # noqa: E402
 from tactsense.sensor.registry import pad12x32, pad16  # noqa: E402
 from tactsense.simulate import ContactBatch  # noqa: E402
-from tests.simulate.test_contact_frames import _exact_frame  # noqa: E402
 
 DOC = ROOT / "docs" / "batch-frames.md"
 PERFORMANCE = ROOT / "docs" / "performance.md"
@@ -62,7 +62,7 @@ def accuracy_cases(make, shape: str, n: int = 6, seed: int = 7):
             [
                 cls(x, y, f, radius_mm=rr)
                 for (x, y), f, rr in zip(position[i, on], force[i, on], r[i, on], strict=True)
-            ],  # fmt: skip
+            ],
         )
     return spec, batch, fast, today, exact
 
@@ -81,7 +81,7 @@ def accuracy_block() -> tuple[str, tuple]:
     ]
     shown = None
     for make, shape in ((pad16, "sphere"), (pad16, "disc"), (pad12x32, "sphere")):
-        spec, batch, fast, today, exact = accuracy_cases(make, shape)
+        spec, _, fast, today, exact = accuracy_cases(make, shape)
         e_fast, e_today = relative_errors(fast, exact), relative_errors(today, exact)
         what = "1-3 spheres of 1.6 mm, 0.05-3 N (Hertz radius)" if shape == "sphere" else (
             "1-3 discs of radius 1-3 mm, 0.05-3 N")  # fmt: skip
@@ -121,6 +121,64 @@ def figure(shown) -> None:
     save_figure(fig, FIGURE)
 
 
+def table_block() -> str:
+    """What the one-off table of each built-in pad is: steps, reach, terms, build time."""
+    import time
+
+    from bench_contact_frames import pad32
+    from tactsense.physics._hertz_table import layer_response_table
+
+    lines = [
+        "| sensor | shape | offset step [mm] | radius step [mm] | radii tabulated [mm] | "
+        "reach [mm] | terms | factoring error / peak | build [s, CPU] |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    for make in (pad16, pad32, pad12x32):
+        spec = make()
+        forward = kind_of(spec).contact_forward(spec)
+        for shape in ("sphere", "disc"):
+            layer_response_table.cache_clear()
+            start = time.process_time()
+            table = forward.table(shape, 1.6)
+            build = time.process_time() - start
+            _, n_x, terms = table.x_factors.shape
+            lines.append(
+                f"| {spec.name} | {shape} | {table.step_mm:g} | {table.a_step_mm:g} | "
+                f"0-{table.a_top_mm:g} | {table.step_mm * n_x:.1f} | {terms} | "
+                f"{table.rank_error:.1e} | {build:.1f} |"
+            )
+    return "\n".join(lines)
+
+
+def components_line(n: int = 100_000) -> str:
+    """pad16 per frame: the superposition alone and the noise alone [us], best of 3."""
+    import time
+
+    from bench_contact_frames import random_contacts
+
+    spec = pad16()
+    batch = random_contacts(spec, n)
+    block = kind_of(spec).contact_forward(spec).prepare(batch)
+    rng = np.random.default_rng(0)
+
+    def best(function):
+        times = []
+        for _ in range(3):
+            start = time.process_time()
+            function()
+            times.append(time.process_time() - start)
+        return 1e6 * min(times) / n
+
+    superposition = best(lambda: [block(lo, min(n, lo + 1024)) for lo in range(0, n, 1024)])
+    noise = best(lambda: [rng.standard_normal((1024, 256), dtype=np.float32)
+                          for _ in range(0, n, 1024)])  # fmt: skip
+    return (
+        f"Of a pad16 frame (this run, CPU time, best of three): the superposition of its "
+        f"contacts {superposition:.2f} us, its 256 float32 normals for the read noise "
+        f"{noise:.2f} us."
+    )
+
+
 def throughput_block(rows) -> str:
     lines = [
         "| sensor | taxels | flaws | frames/s (CPU time, one core) | readings/s | "
@@ -144,6 +202,8 @@ def main() -> None:
     args = parser.parse_args()
     rows = measure(args.frames)
     table = throughput_block(rows)
+    components = components_line()
+    tables = table_block()
     accuracy, shown = accuracy_block()
     figure(shown)
     for path in (DOC, PERFORMANCE):
@@ -156,11 +216,26 @@ def main() -> None:
         )
     replace_block(
         DOC,
+        "<!-- begin contact-frames components -->",
+        "<!-- end contact-frames components -->",
+        f"<!-- begin contact-frames components -->\n{components}\n"
+        "<!-- end contact-frames components -->",
+    )
+    replace_block(
+        DOC,
+        "<!-- begin contact-frames tables -->",
+        "<!-- end contact-frames tables -->",
+        f"<!-- begin contact-frames tables -->\n{tables}\n<!-- end contact-frames tables -->",
+    )
+    replace_block(
+        DOC,
         "<!-- begin contact-frames accuracy -->",
         "<!-- end contact-frames accuracy -->",
         f"<!-- begin contact-frames accuracy -->\n{accuracy}\n<!-- end contact-frames accuracy -->",
     )
     print(table)
+    print(components)
+    print(tables)
     print(accuracy)
 
 
