@@ -121,6 +121,64 @@ def figure(shown) -> None:
     save_figure(fig, FIGURE)
 
 
+def table_block() -> str:
+    """What the one-off table of each built-in pad is: steps, reach, terms, build time."""
+    import time
+
+    from bench_contact_frames import pad32
+    from tactsense.physics._hertz_table import layer_response_table
+
+    lines = [
+        "| sensor | shape | offset step [mm] | radius step [mm] | radii tabulated [mm] | "
+        "reach [mm] | terms | factoring error / peak | build [s, CPU] |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    for make in (pad16, pad32, pad12x32):
+        spec = make()
+        forward = kind_of(spec).contact_forward(spec)
+        for shape in ("sphere", "disc"):
+            layer_response_table.cache_clear()
+            start = time.process_time()
+            table = forward.table(shape, 1.6)
+            build = time.process_time() - start
+            _, n_x, terms = table.x_factors.shape
+            lines.append(
+                f"| {spec.name} | {shape} | {table.step_mm:g} | {table.a_step_mm:g} | "
+                f"0-{table.a_top_mm:g} | {table.step_mm * n_x:.1f} | {terms} | "
+                f"{table.rank_error:.1e} | {build:.1f} |"
+            )
+    return "\n".join(lines)
+
+
+def components_line(n: int = 100_000) -> str:
+    """pad16 per frame: the superposition alone and the noise alone [us], best of 3."""
+    import time
+
+    from bench_contact_frames import random_contacts
+
+    spec = pad16()
+    batch = random_contacts(spec, n)
+    block = kind_of(spec).contact_forward(spec).prepare(batch)
+    rng = np.random.default_rng(0)
+
+    def best(function):
+        times = []
+        for _ in range(3):
+            start = time.process_time()
+            function()
+            times.append(time.process_time() - start)
+        return 1e6 * min(times) / n
+
+    superposition = best(lambda: [block(lo, min(n, lo + 1024)) for lo in range(0, n, 1024)])
+    noise = best(lambda: [rng.standard_normal((1024, 256), dtype=np.float32)
+                          for _ in range(0, n, 1024)])  # fmt: skip
+    return (
+        f"Of a pad16 frame (this run, CPU time, best of three): the superposition of its "
+        f"contacts {superposition:.2f} us, its 256 float32 normals for the read noise "
+        f"{noise:.2f} us."
+    )
+
+
 def throughput_block(rows) -> str:
     lines = [
         "| sensor | taxels | flaws | frames/s (CPU time, one core) | readings/s | "
@@ -144,6 +202,8 @@ def main() -> None:
     args = parser.parse_args()
     rows = measure(args.frames)
     table = throughput_block(rows)
+    components = components_line()
+    tables = table_block()
     accuracy, shown = accuracy_block()
     figure(shown)
     for path in (DOC, PERFORMANCE):
@@ -156,11 +216,26 @@ def main() -> None:
         )
     replace_block(
         DOC,
+        "<!-- begin contact-frames components -->",
+        "<!-- end contact-frames components -->",
+        f"<!-- begin contact-frames components -->\n{components}\n"
+        "<!-- end contact-frames components -->",
+    )
+    replace_block(
+        DOC,
+        "<!-- begin contact-frames tables -->",
+        "<!-- end contact-frames tables -->",
+        f"<!-- begin contact-frames tables -->\n{tables}\n<!-- end contact-frames tables -->",
+    )
+    replace_block(
+        DOC,
         "<!-- begin contact-frames accuracy -->",
         "<!-- end contact-frames accuracy -->",
         f"<!-- begin contact-frames accuracy -->\n{accuracy}\n<!-- end contact-frames accuracy -->",
     )
     print(table)
+    print(components)
+    print(tables)
     print(accuracy)
 
 

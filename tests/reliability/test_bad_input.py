@@ -483,3 +483,40 @@ def test_bad_mujoco_input(workspace, line, names):
     result = _invoke_with_deadline(args)
     _check(result, names)
     assert not list(workspace.glob("never_written*"))
+# ---- tactsense dataset (r6-data) ----
+DATASET_BAD_OPTIONS = [
+    ("dataset --episodes 0 --out OUT", "--episodes"),
+    ("dataset --frames 5 --out OUT", "--frames"),
+    ("dataset --force-n 1 0.5 --out OUT", "--force-n"),
+    ("dataset --force-n nan 1 --out OUT", "--force-n"),
+    ("dataset --radius-mm 0 1 --out OUT", "--radius-mm"),
+    ("dataset --speed-mm-s -1 2 --out OUT", "--speed-mm-s"),
+    ("dataset --friction 0.5 20 --out OUT", "--friction"),
+    ("dataset --tasks poke --out OUT", "--tasks"),
+    ("dataset --flaws bogus --out OUT", "unknown flaw(s) bogus"),
+    ("dataset --sensor initial --out OUT", "has none (use a pad)"),
+    ("dataset --sensor bogus --out OUT", "bogus"),
+    ("dataset --format hdf5 --out OUT", "a file named .h5"),
+    ("dataset --format xml --out OUT", "--format"),
+    ("dataset --workers -1 --out OUT", "--workers"),
+    ("dataset --episodes-per-task 0 --out OUT", "--episodes-per-task"),
+    ("dataset --scheduler localhost:1 --out OUT", "--scheduler"),
+    ("dataset --out no_such_folder/set", "does not exist"),
+    ("dataset --out REC", "is never replaced"),
+    ("dataset --out REC.h5", "a LeRobot dataset is a folder"),
+]
+
+
+@pytest.mark.parametrize(
+    "line, names", DATASET_BAD_OPTIONS, ids=[line for line, _ in DATASET_BAD_OPTIONS]
+)
+def test_dataset_bad_options(workspace, line, names):
+    out = workspace / "never_written"
+    args = line.replace("REC", str(workspace / "rec.h5")).replace("OUT", str(out)).split()
+    result = runner.invoke(app, args)
+    _check(result, names)
+    assert not out.exists()
+    assert not [p for p in workspace.iterdir() if ".partial" in p.name]
+
+
+# ---- /r6-data ----

@@ -58,6 +58,12 @@ from tactsense.cli import _mujoco  # noqa: E402
 
 app.add_typer(_mujoco.app)
 
+# ---- tactsense dataset (r6-data) ----
+from tactsense.cli import _dataset  # noqa: E402
+
+app.add_typer(_dataset.app)
+# ---- /r6-data ----
+
 
 def _show_usage_error(self, file=None) -> None:
     """A usage error (unknown option, value out of range, missing argument) as one line

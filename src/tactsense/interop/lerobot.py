@@ -153,8 +153,8 @@ def _stats(values: np.ndarray, scalar: bool) -> dict:
         "std": values.std(axis=0),
         "count": np.array([frames]),
     }
-    for q in QUANTILES:
-        stats[f"q{round(q * 100):02d}"] = np.quantile(values, q, axis=0)
+    for q, value in zip(QUANTILES, np.quantile(values, QUANTILES, axis=0), strict=True):
+        stats[f"q{round(q * 100):02d}"] = value  # one sort for every quantile
     return {k: (v if k == "count" else v.reshape(-1) if scalar else v) for k, v in stats.items()}
 
 
