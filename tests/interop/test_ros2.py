@@ -309,6 +309,11 @@ def test_the_subscriber_refuses_to_start_off_loopback(tmp_path, monkeypatch):
         (["--ros2-config", "x.xml"], "--ros2-config applies to --ros2"),
         (["--ros2", "--namespace", "/1a"], "a ROS 2 namespace is"),
         (["--ros2", "--namespace", "/a b"], "a ROS 2 namespace is"),
+        (["--ros2", "--namespace", "/" + "a" * 300], "301 characters; a ROS 2 topic name"),
+        (["--ros2", "--namespace", "/" + "a" * 233], "the namespace of these topics at most 232"),
+        (["--ros2", "--namespace", "/a/"], "--namespace '/a/': it ends with /"),
+        (["--ros2", "--namespace", "a/"], "--namespace 'a/': it ends with /"),
+        (["--ros2", "--namespace", "/a//b"], "it has //"),
         (["--ros2", "--ros2-config", "/nonexistent/c.xml"], "cannot read it"),
         (["--ros2", "--ros2-config", "<a/>"], "root element <CycloneDDS>"),
         (["--ros2", "--ros2-config", "<CycloneDDS"], "not XML"),
@@ -411,3 +416,48 @@ def test_a_participant_off_the_loopback_fails_the_test(monkeypatch):
             config=LOOPBACK_XML.replace("<AllowMulticast>false", "<AllowMulticast>true"),
         )
     publisher_module.started_configs.pop()  # the refused one, for the fixture's check
+
+
+# ---- names within ROS 2's bounds (r6-fix37) ----
+def test_namespaces_follow_rcl():
+    """rcl_node_init: '' is '/', a relative namespace gets a leading '/'; then
+    rmw_validate_namespace (no trailing '/', no '//', tokens not starting with a digit)."""
+    from tactsense.interop.ros2.publisher import Ros2Error, check_namespace
+
+    assert check_namespace("") == "/"
+    assert check_namespace("foo") == "/foo"
+    assert check_namespace("foo/bar_1") == "/foo/bar_1"
+    assert check_namespace("/") == "/"
+    for bad in ("/a/", "//", "/a//b", "/9a", "/a b", "/a-b", "a/"):
+        with pytest.raises(Ros2Error):
+            check_namespace(bad)
+
+
+def test_the_longest_namespace_and_node_name_publish(store):
+    """A 232-character namespace (the longest whose topics keep within ROS 2's 247) and a
+    255-character node name start and announce themselves; one more character is a
+    one-line Ros2Error before any DDS entity exists (300 crashed in the announcement)."""
+    from tactsense.interop.ros2.publisher import Ros2Error
+
+    sensor = ts.preset("pad16")
+    longest = "/" + "n" * 231
+    publisher = Ros2Publisher(
+        sensor, namespace=longest, node_name="x" * 255, frame_id="f" * 1000
+    )  # fmt: skip  (frame_id: unbounded string)
+    try:
+        assert max(len(t) for t in publisher.ros_topics.values()) == 247
+        node = publisher.discovery_info.node_entities_info_seq[0]
+        assert (node.node_namespace, node.node_name) == (longest, "x" * 255)
+        publisher.publish(_frame(np.zeros(sensor.shape)), None)
+        assert publisher.failed == 0
+    finally:
+        publisher.close()
+    before = len(publisher_module.started_configs)
+    for kwargs in ({"namespace": longest + "n"}, {"namespace": "/" + "a" * 300},
+                   {"namespace": "/a", "node_name": "x" * 256}):  # fmt: skip
+        with pytest.raises(Ros2Error, match="characters"):
+            Ros2Publisher(sensor, **kwargs)
+    assert len(publisher_module.started_configs) == before  # refused before DDS started
+
+
+# ---- /names within ROS 2's bounds (r6-fix37) ----

@@ -431,7 +431,9 @@ def live(
         typer.Option(
             "--namespace",
             help="--ros2: the node's ROS 2 namespace, '/' or /name/... of letters, digits "
-            "and _ [default: /<sensor name>].",
+            "and _ (no trailing /; at most 232 characters); as ROS 2 does with a node's "
+            "namespace, a relative one gets a leading / (foo: /foo; '': /) "
+            "[default: /<sensor name>].",
         ),
     ] = None,
     ros2_config: Annotated[
