@@ -460,4 +460,44 @@ def test_the_longest_namespace_and_node_name_publish(store):
     assert len(publisher_module.started_configs) == before  # refused before DDS started
 
 
+@pytest.mark.parametrize(
+    ("uri", "message"),
+    [
+        ("file:///nonexistent.xml", "CYCLONEDDS_URI file:///nonexistent.xml: cannot read it"),
+        ("/nonexistent.xml", "CYCLONEDDS_URI /nonexistent.xml: cannot read it"),
+        ("TEXT", "CYCLONEDDS_URI TEXT: not XML"),
+        ("file://NOT_CYCLONE", "root element <CycloneDDS>"),
+    ],
+)
+def test_a_bad_cyclonedds_uri_file_is_one_line_before_the_line_opens(
+    tmp_path, monkeypatch, uri, message
+):
+    """A CYCLONEDDS_URI naming a file is checked as --ros2-config is (readable, XML,
+    <CycloneDDS>), named as CYCLONEDDS_URI, before the device is opened (the port named
+    does not exist), not DDS's raw log and 'Non specific error'."""
+    text, other = tmp_path / "plain.txt", tmp_path / "other.xml"
+    text.write_text("vm\n")
+    other.write_text("<Other/>")
+    uri = uri.replace("TEXT", str(text)).replace("NOT_CYCLONE", str(other))
+    message = message.replace("TEXT", str(text))
+    monkeypatch.setenv("CYCLONEDDS_URI", uri)
+    result = runner.invoke(app, ["live", "socket://127.0.0.1:9", "--ros2"])
+    assert result.exit_code == 2
+    output = " ".join(result.output.split())
+    assert message in output and "Traceback" not in output, result.output
+    assert len(result.output.strip().splitlines()) == 1, result.output  # no DDS log line
+
+
+def test_ros2_config_reads_a_file_once(tmp_path):
+    """--ros2-config of a text file that is not XML says so (its text was once taken for
+    a second path)."""
+    from tactsense.interop.ros2.config import Ros2ConfigError, resolve_config
+
+    path = tmp_path / "plain.txt"
+    path.write_text("vm\n")
+    with pytest.raises(Ros2ConfigError, match="not XML"):
+        resolve_config(str(path))
+    assert resolve_config(loopback_config(tmp_path))[0] == LOOPBACK_XML
+
+
 # ---- /names within ROS 2's bounds (r6-fix37) ----
