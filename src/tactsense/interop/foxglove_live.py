@@ -222,9 +222,9 @@ class FoxgloveLive:
         t = float(frame.host_time_s)
         writer = self._encoder
         writer.frame(frame.counts, t, sequence=int(frame.sequence))
-        self.frames += 1
         if estimate is None:
             writer.contacts_at([t], np.zeros(0, int), np.zeros((0, 3)), np.zeros((0, 3)), [])
+            self.frames += 1  # counted once every message of the frame is sent
             return
         if not self._multi:
             force = estimate.get("force_n")
@@ -235,6 +235,7 @@ class FoxgloveLive:
             )
             axial, angle = (_number(estimate.get(k)) for k in ("axial_mm", "angle_deg"))
             writer.contacts_of([t], [axial], [angle], [force if touching else 0.0], [touching])
+            self.frames += 1
             self.contacts += int(touching)
             return
         kept = [c for c in estimate.get("contacts", []) if _located(c)]
@@ -250,6 +251,7 @@ class FoxgloveLive:
         writer.contacts_at(
             [t], np.zeros(len(kept), int), xyz * 1e-3, self._normals[nearest], force, names
         )
+        self.frames += 1
         self.contacts += len(kept)
 
     def _close_channels(self) -> None:
