@@ -501,3 +501,47 @@ def test_ros2_config_reads_a_file_once(tmp_path):
 
 
 # ---- /names within ROS 2's bounds (r6-fix37) ----
+
+
+# ---- one-line summaries (r6-fix37) ----
+def test_live_summaries_are_single_lines_in_a_log(emulator, tmp_path):  # noqa: F811
+    """Redirected (CliRunner: not a terminal, 80 columns), every summary line of live
+    --ros2 --foxglove is one line: rich once broke 'p99 ... ms' and 'not sent' over
+    lines at 80 columns."""
+    url = emulator("--speed", "10", "--seed", "4")
+    result = runner.invoke(
+        app, ["live", url, "--ros2", "--namespace", "/test_ros2/summary", "--foxglove", "0",
+              "--out", str(tmp_path / "live.jsonl"), "--frames", "30"],
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    lines = result.output.splitlines()
+    (estimates,) = [line for line in lines if " estimates from " in line]
+    assert "latency median" in estimates and estimates.endswith(" ms")
+    (ros2,) = [line for line in lines if line.startswith("ROS 2: ")]
+    assert "not sent" in ros2 and ros2.endswith("(best effort)")
+    (sent,) = [line for line in lines if line.startswith("foxglove: sent")]
+    assert sent.endswith(" contacts") and max(map(len, (estimates, ros2))) > 80
+
+
+def test_the_console_keeps_messages_whole_and_tables_laid_out():
+    """The shared console (every command's messages) does not wrap a long message when
+    redirected; a table is still laid out at the console's width."""
+    import io
+
+    from rich.table import Table
+
+    from tactsense.cli._common import _MessageConsole
+
+    out = io.StringIO()
+    console = _MessageConsole(file=out, width=80)
+    message = "wrote out.h5: " + ", ".join(f"{k} frames lost" for k in range(40))
+    console.print(message)
+    assert out.getvalue() == message + "\n"
+    table = Table("a", "b")
+    table.add_row("x " * 60, "y")
+    out.seek(0), out.truncate()
+    console.print(table)
+    assert max(map(len, out.getvalue().splitlines())) <= 80
+
+
+# ---- /one-line summaries (r6-fix37) ----
