@@ -547,3 +547,34 @@ def test_ctrl_c_counts_only_completed_steps(where):
 
 
 # ---- /Ctrl-C counts (r6-fix37) ----
+
+
+# ---- Foxglove bound before the source (r6-fix37) ----
+@pytest.mark.parametrize("command", ["live", "view"])
+def test_a_foxglove_port_in_use_is_refused_before_the_source_opens(command):
+    """The server binds before the source is opened: with a port in use the error is
+    Foxglove's, not the source's (nothing listens on port 9, the discard port), so no
+    device is touched; a source that fails after the bind leaves the port free again."""
+    import socket
+
+    from typer.testing import CliRunner
+
+    from tactsense.cli import app
+
+    source = "socket://127.0.0.1:9"
+    with FoxgloveLive(ts.preset("pad16"), port=0) as taken:
+        result = CliRunner().invoke(app, [command, source, "--foxglove", str(taken.port)])
+    message = " ".join(result.output.split())
+    assert result.exit_code == 2 and "Traceback" not in message, message
+    assert f"cannot serve Foxglove on 127.0.0.1:{taken.port}" in message
+    with socket.socket() as probe:  # a free port, to be taken and given back by the command
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    result = CliRunner().invoke(app, [command, source, "--foxglove", str(port), "--timeout", "1"])
+    message = " ".join(result.output.split())
+    assert result.exit_code == 2 and "cannot serve Foxglove" not in message, message
+    with FoxgloveLive(ts.preset("pad16"), port=port) as again:  # given back
+        assert again.port == port
+
+
+# ---- /Foxglove bound before the source (r6-fix37) ----

@@ -195,21 +195,35 @@ def check_foxglove(address: str | None) -> tuple[str, int] | None:
     return host_port
 
 
-def serve_foxglove(address: tuple[str, int] | None, sensor):
-    """The Foxglove server of ``--foxglove`` (None without it), its address printed on
-    standard error; a warning when it listens beyond this machine."""
+def bind_foxglove(address: tuple[str, int] | None):
+    """The Foxglove server of ``--foxglove`` bound (None without it), before the source
+    is opened: a port in use is one line before any device is touched. Its sensor comes
+    with :func:`serve_foxglove`."""
     if address is None:
         return None
-    from tactsense.cli._common import console
+    from tactsense._validation import TactsenseInputError
     from tactsense.interop.foxglove_live import FoxgloveLive
-    from tactsense.view.server import is_loopback
 
     host, port = address
-    server = FoxgloveLive(sensor, host=host, port=port)  # TactsenseInputError when it cannot
-    if not is_loopback(host):
+    try:
+        return FoxgloveLive(None, host=host, port=port)
+    except TactsenseInputError as error:
+        fail(str(error))
+
+
+def serve_foxglove(server, sensor):
+    """Give the bound server of ``--foxglove`` (None without it) its sensor and print its
+    address on standard error; a warning when it listens beyond this machine."""
+    if server is None:
+        return None
+    from tactsense.cli._common import console
+    from tactsense.view.server import is_loopback
+
+    server.attach(sensor)
+    if not is_loopback(server.host):
         console.print(
-            f"[bold red]warning:[/] Foxglove on {host}, not only on this machine: anyone who "
-            "can reach it sees the sensor (there is no login)."
+            f"[bold red]warning:[/] Foxglove on {server.host}, not only on this machine: "
+            "anyone who can reach it sees the sensor (there is no login)."
         )
     console.print(
         f"foxglove: {server.url} (Foxglove: Open connection, Foxglove WebSocket)",
