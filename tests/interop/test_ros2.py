@@ -545,3 +545,23 @@ def test_the_console_keeps_messages_whole_and_tables_laid_out():
 
 
 # ---- /one-line summaries (r6-fix37) ----
+
+
+# ---- the .msg texts in docs/ros2.md (r6-fix37) ----
+def test_the_doc_gives_every_published_msg_text(store):
+    """docs/ros2.md holds the upstream .msg text of every tactile type published (the
+    texts the independent subscriber is built from, character for character), and of
+    sensor_msgs/ChannelFloat32 with the fields of ROS 2's own definition (rosbags')."""
+    import re
+
+    from rosbags.typesys import get_types_from_msg
+
+    from .ros2_subscriber import TACTILE_MSGS
+
+    doc = (Path(__file__).parents[2] / "docs" / "ros2.md").read_text()
+    blocks = dict(re.findall(r"`([\w/]+)\.msg`[^`]*?:\n\n```\n(.*?)```", doc, flags=re.S))
+    for name, text in TACTILE_MSGS.items():
+        assert blocks.get(name) == text, name
+    name = "sensor_msgs/msg/ChannelFloat32"
+    parsed = get_types_from_msg(blocks[name], name)[name]
+    assert parsed == store.fielddefs[name]
