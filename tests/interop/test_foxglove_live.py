@@ -455,3 +455,134 @@ def test_view_foxglove_port_in_use(finger_recording):
     message = " ".join(result.output.split())
     assert result.exit_code == 2 and "Traceback" not in message
     assert f"cannot serve Foxglove on 127.0.0.1:{taken.port}" in message
+
+
+# ---- Ctrl-C counts (r6-fix37) ----
+class _Frames:
+    """A reader of ``n`` frames of ``sensor`` (zeros)."""
+
+    def __init__(self, sensor, n):
+        self.sensor, self.n = sensor, n
+
+    def frames(self, max_frames=None, duration_s=None):
+        for i in range(self.n):
+            yield StreamFrame(i, i, 0.001 * i, 1.7e9 + 0.001 * i, time.perf_counter(),
+                              np.zeros(self.sensor.shape))  # fmt: skip
+
+
+class _Locator:
+    """No estimate for the first ``baseline`` frames, then a finger's contact."""
+
+    def __init__(self, baseline):
+        self.baseline, self.seen = baseline, 0
+
+    def __call__(self, frame):
+        self.seen += 1
+        if self.seen <= self.baseline:
+            return None
+        return {"sequence": int(frame.sequence), "latency_ms": 0.5 + self.seen,
+                "force_n": 1.0, "flags": 0, "axial_mm": 5.0, "angle_deg": 0.0}  # fmt: skip
+
+
+class _Interrupt:
+    """An outlet (or a stream) that sends this process SIGINT on its ``at``-th call: the
+    signal arrives in the middle of a frame's steps."""
+
+    def __init__(self, at, inner=None):
+        self.at, self.calls, self.inner = at, 0, inner
+
+    def push(self, frame, estimate):
+        self._tick()
+
+    def write(self, text):
+        self._tick()
+        self.inner.write(text)
+
+    def flush(self):
+        self.inner.flush()
+
+    def _tick(self):
+        self.calls += 1
+        if self.calls == self.at:
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.01)  # the handler runs here, in the main thread
+
+
+@pytest.mark.parametrize("where", ["before foxglove", "after foxglove", "writing the line"])
+def test_ctrl_c_counts_only_completed_steps(where):
+    """A SIGINT between a frame's steps (estimate, publish, write) leaves every count
+    equal to what was done: frames given to the locator and published, estimates and
+    lines written, the baseline's frames (once counted 6 for a baseline of 5, 307
+    estimates for 306 lines, Foxglove 135 frames for 136)."""
+    import io
+    import threading
+
+    from tactsense import _signals
+    from tactsense.cli._live_outputs import LiveFormat, Outlets, write_estimates
+
+    sensor = ts.preset("initial")
+    server = FoxgloveLive(sensor, port=0)
+    interrupt = _Interrupt(9)
+    stream = io.StringIO()
+    if where == "before foxglove":
+        outlets, out = Outlets(interrupt, server), stream
+    elif where == "after foxglove":
+        outlets, out = Outlets(server, interrupt), stream
+    else:
+        outlets, out = Outlets(server), _Interrupt(4, stream)
+    latencies, used = [], [0]
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            write_estimates(out, _Frames(sensor, 50), _Locator(5), output_format=LiveFormat.jsonl,
+                            multi=False, frames=None, duration=None, rezero=threading.Event(),
+                            outlets=outlets, latencies=latencies, used=used)  # fmt: skip
+    finally:
+        server.close()
+        _signals.remove_gate()
+    lines = stream.getvalue().splitlines()
+    assert used[0] == 9  # the interrupted frame completed, and no frame after it began
+    assert server.frames == used[0]
+    assert len(lines) == len(latencies) == used[0] - 5
+    assert [json.loads(line)["latency_ms"] for line in lines] == latencies
+
+
+# ---- /Ctrl-C counts (r6-fix37) ----
+
+
+# ---- Foxglove bound before the source (r6-fix37) ----
+@pytest.mark.parametrize("command", ["live", "view"])
+def test_a_foxglove_port_in_use_is_refused_before_the_source_opens(command):
+    """The server binds before the source is opened: with a port in use the error is
+    Foxglove's, not the source's (nothing listens on port 9, the discard port), so no
+    device is touched; a source that fails after the bind leaves the port free again."""
+    import socket
+
+    from typer.testing import CliRunner
+
+    from tactsense.cli import app
+
+    source = "socket://127.0.0.1:9"
+    with FoxgloveLive(ts.preset("pad16"), port=0) as taken:
+        result = CliRunner().invoke(app, [command, source, "--foxglove", str(taken.port)])
+    message = " ".join(result.output.split())
+    assert result.exit_code == 2 and "Traceback" not in message, message
+    assert f"cannot serve Foxglove on 127.0.0.1:{taken.port}" in message
+    with socket.socket() as probe:  # a free port, to be taken and given back by the command
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    result = CliRunner().invoke(app, [command, source, "--foxglove", str(port), "--timeout", "1"])
+    message = " ".join(result.output.split())
+    assert result.exit_code == 2 and "cannot serve Foxglove" not in message, message
+    deadline = time.monotonic() + 5.0  # the SDK's stop releases the port a moment later
+    while True:
+        try:
+            with FoxgloveLive(ts.preset("pad16"), port=port) as again:  # given back
+                assert again.port == port
+            break
+        except TactsenseInputError:
+            if time.monotonic() > deadline:
+                raise
+            time.sleep(0.05)
+
+
+# ---- /Foxglove bound before the source (r6-fix37) ----

@@ -309,6 +309,11 @@ def test_the_subscriber_refuses_to_start_off_loopback(tmp_path, monkeypatch):
         (["--ros2-config", "x.xml"], "--ros2-config applies to --ros2"),
         (["--ros2", "--namespace", "/1a"], "a ROS 2 namespace is"),
         (["--ros2", "--namespace", "/a b"], "a ROS 2 namespace is"),
+        (["--ros2", "--namespace", "/" + "a" * 300], "301 characters; a ROS 2 topic name"),
+        (["--ros2", "--namespace", "/" + "a" * 233], "the namespace of these topics at most 232"),
+        (["--ros2", "--namespace", "/a/"], "--namespace '/a/': it ends with /"),
+        (["--ros2", "--namespace", "a/"], "--namespace 'a/': it ends with /"),
+        (["--ros2", "--namespace", "/a//b"], "it has //"),
         (["--ros2", "--ros2-config", "/nonexistent/c.xml"], "cannot read it"),
         (["--ros2", "--ros2-config", "<a/>"], "root element <CycloneDDS>"),
         (["--ros2", "--ros2-config", "<CycloneDDS"], "not XML"),
@@ -411,3 +416,152 @@ def test_a_participant_off_the_loopback_fails_the_test(monkeypatch):
             config=LOOPBACK_XML.replace("<AllowMulticast>false", "<AllowMulticast>true"),
         )
     publisher_module.started_configs.pop()  # the refused one, for the fixture's check
+
+
+# ---- names within ROS 2's bounds (r6-fix37) ----
+def test_namespaces_follow_rcl():
+    """rcl_node_init: '' is '/', a relative namespace gets a leading '/'; then
+    rmw_validate_namespace (no trailing '/', no '//', tokens not starting with a digit)."""
+    from tactsense.interop.ros2.publisher import Ros2Error, check_namespace
+
+    assert check_namespace("") == "/"
+    assert check_namespace("foo") == "/foo"
+    assert check_namespace("foo/bar_1") == "/foo/bar_1"
+    assert check_namespace("/") == "/"
+    for bad in ("/a/", "//", "/a//b", "/9a", "/a b", "/a-b", "a/"):
+        with pytest.raises(Ros2Error):
+            check_namespace(bad)
+
+
+def test_the_longest_namespace_and_node_name_publish(store):
+    """A 232-character namespace (the longest whose topics keep within ROS 2's 247) and a
+    255-character node name start and announce themselves; one more character is a
+    one-line Ros2Error before any DDS entity exists (300 crashed in the announcement)."""
+    from tactsense.interop.ros2.publisher import Ros2Error
+
+    sensor = ts.preset("pad16")
+    longest = "/" + "n" * 231
+    publisher = Ros2Publisher(
+        sensor, namespace=longest, node_name="x" * 255, frame_id="f" * 1000
+    )  # fmt: skip  (frame_id: unbounded string)
+    try:
+        assert max(len(t) for t in publisher.ros_topics.values()) == 247
+        node = publisher.discovery_info.node_entities_info_seq[0]
+        assert (node.node_namespace, node.node_name) == (longest, "x" * 255)
+        publisher.publish(_frame(np.zeros(sensor.shape)), None)
+        assert publisher.failed == 0
+    finally:
+        publisher.close()
+    before = len(publisher_module.started_configs)
+    for kwargs in ({"namespace": longest + "n"}, {"namespace": "/" + "a" * 300},
+                   {"namespace": "/a", "node_name": "x" * 256}):  # fmt: skip
+        with pytest.raises(Ros2Error, match="characters"):
+            Ros2Publisher(sensor, **kwargs)
+    assert len(publisher_module.started_configs) == before  # refused before DDS started
+
+
+@pytest.mark.parametrize(
+    ("uri", "message"),
+    [
+        ("file:///nonexistent.xml", "CYCLONEDDS_URI file:///nonexistent.xml: cannot read it"),
+        ("/nonexistent.xml", "CYCLONEDDS_URI /nonexistent.xml: cannot read it"),
+        ("TEXT", "CYCLONEDDS_URI TEXT: not XML"),
+        ("file://NOT_CYCLONE", "root element <CycloneDDS>"),
+    ],
+)
+def test_a_bad_cyclonedds_uri_file_is_one_line_before_the_line_opens(
+    tmp_path, monkeypatch, uri, message
+):
+    """A CYCLONEDDS_URI naming a file is checked as --ros2-config is (readable, XML,
+    <CycloneDDS>), named as CYCLONEDDS_URI, before the device is opened (the port named
+    does not exist), not DDS's raw log and 'Non specific error'."""
+    text, other = tmp_path / "plain.txt", tmp_path / "other.xml"
+    text.write_text("vm\n")
+    other.write_text("<Other/>")
+    uri = uri.replace("TEXT", str(text)).replace("NOT_CYCLONE", str(other))
+    message = message.replace("TEXT", str(text))
+    monkeypatch.setenv("CYCLONEDDS_URI", uri)
+    result = runner.invoke(app, ["live", "socket://127.0.0.1:9", "--ros2"])
+    assert result.exit_code == 2
+    output = " ".join(result.output.split())
+    assert message in output and "Traceback" not in output, result.output
+    assert len(result.output.strip().splitlines()) == 1, result.output  # no DDS log line
+
+
+def test_ros2_config_reads_a_file_once(tmp_path):
+    """--ros2-config of a text file that is not XML says so (its text was once taken for
+    a second path)."""
+    from tactsense.interop.ros2.config import Ros2ConfigError, resolve_config
+
+    path = tmp_path / "plain.txt"
+    path.write_text("vm\n")
+    with pytest.raises(Ros2ConfigError, match="not XML"):
+        resolve_config(str(path))
+    assert resolve_config(loopback_config(tmp_path))[0] == LOOPBACK_XML
+
+
+# ---- /names within ROS 2's bounds (r6-fix37) ----
+
+
+# ---- one-line summaries (r6-fix37) ----
+def test_live_summaries_are_single_lines_in_a_log(emulator, tmp_path):  # noqa: F811
+    """Redirected (CliRunner: not a terminal, 80 columns), every summary line of live
+    --ros2 --foxglove is one line: rich once broke 'p99 ... ms' and 'not sent' over
+    lines at 80 columns."""
+    url = emulator("--speed", "10", "--seed", "4")
+    result = runner.invoke(
+        app, ["live", url, "--ros2", "--namespace", "/test_ros2/summary", "--foxglove", "0",
+              "--out", str(tmp_path / "live.jsonl"), "--frames", "30"],
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    lines = result.output.splitlines()
+    (estimates,) = [line for line in lines if " estimates from " in line]
+    assert "latency median" in estimates and estimates.endswith(" ms")
+    (ros2,) = [line for line in lines if line.startswith("ROS 2: ")]
+    assert "not sent" in ros2 and ros2.endswith("(best effort)")
+    (sent,) = [line for line in lines if line.startswith("foxglove: sent")]
+    assert sent.endswith(" contacts") and max(map(len, (estimates, ros2))) > 80
+
+
+def test_the_console_keeps_messages_whole_and_tables_laid_out():
+    """The shared console (every command's messages) does not wrap a long message when
+    redirected; a table is still laid out at the console's width."""
+    import io
+
+    from rich.table import Table
+
+    from tactsense.cli._common import _MessageConsole
+
+    out = io.StringIO()
+    console = _MessageConsole(file=out, width=80)
+    message = "wrote out.h5: " + ", ".join(f"{k} frames lost" for k in range(40))
+    console.print(message)
+    assert out.getvalue() == message + "\n"
+    table = Table("a", "b")
+    table.add_row("x " * 60, "y")
+    out.seek(0), out.truncate()
+    console.print(table)
+    assert max(map(len, out.getvalue().splitlines())) <= 80
+
+
+# ---- /one-line summaries (r6-fix37) ----
+
+
+# ---- the .msg texts in docs/ros2.md (r6-fix37) ----
+def test_the_doc_gives_every_published_msg_text(store):
+    """docs/ros2.md holds the upstream .msg text of every tactile type published (the
+    texts the independent subscriber is built from, character for character), and of
+    sensor_msgs/ChannelFloat32 with the fields of ROS 2's own definition (rosbags')."""
+    import re
+
+    from rosbags.typesys import get_types_from_msg
+
+    from .ros2_subscriber import TACTILE_MSGS
+
+    doc = (Path(__file__).parents[2] / "docs" / "ros2.md").read_text()
+    blocks = dict(re.findall(r"`([\w/]+)\.msg`[^`]*?:\n\n```\n(.*?)```", doc, flags=re.S))
+    for name, text in TACTILE_MSGS.items():
+        assert blocks.get(name) == text, name
+    name = "sensor_msgs/msg/ChannelFloat32"
+    parsed = get_types_from_msg(blocks[name], name)[name]
+    assert parsed == store.fielddefs[name]

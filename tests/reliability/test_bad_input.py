@@ -129,6 +129,10 @@ BAD_OPTIONS = [
     ("live loop:// --ros2 --ros2-config no_such.xml", "--ros2-config no_such.xml: cannot read"),
     ("live loop:// --ros2 --ros2-config REC", "--ros2-config"),
     # ---- /live --ros2 (r6-ros2) ----
+    # ---- fix37 (r6-fix37) ----
+    ("live loop:// --ros2 --namespace /a/", "--namespace '/a/': it ends with /"),
+    ("live loop:// --ros2 --namespace /" + "a" * 300, "301 characters"),
+    # ---- /fix37 (r6-fix37) ----
 ]
 
 

@@ -20,7 +20,20 @@ from rich.markup import escape
 
 from tactsense._validation import TactsenseInputError
 
-console = Console(stderr=True)
+
+class _MessageConsole(Console):
+    """A console whose text messages are never hard-wrapped: a summary printed to a log
+    or a pipe stays one line (rich would otherwise break it at 80 columns there, and at
+    the terminal's width on a terminal, where the terminal wraps it anyway). Tables and
+    other renderables are laid out at the console's width as before."""
+
+    def print(self, *objects, soft_wrap=None, **kwargs) -> None:
+        if soft_wrap is None and all(isinstance(o, str) for o in objects):
+            soft_wrap = True
+        super().print(*objects, soft_wrap=soft_wrap, **kwargs)
+
+
+console = _MessageConsole(stderr=True)
 """Messages, progress and tables meant for a person go to standard error."""
 
 

@@ -90,12 +90,45 @@ def _listen_for_rezero(event, signal) -> None:
 RECORDING_SUFFIXES = (".h5", ".hdf5")
 
 
+class _FrameSteps:
+    """Ctrl-C (or SIGTERM) between frames, never inside one: while a frame is being
+    estimated, published and written, a press is held (``tactsense._signals``' gate, as
+    around compiled code) and delivered once the frame is complete, so that every count
+    kept is of steps completed. Waiting for the next frame, it interrupts at once. Off
+    the main thread it changes nothing."""
+
+    __slots__ = ("outer",)
+
+    def __enter__(self):
+        from tactsense import _signals
+
+        self.outer = None
+        if _signals.gate_ready():
+            self.outer = _signals._inside_compiled
+            _signals._inside_compiled = True
+        return self
+
+    def __exit__(self, *exc) -> None:
+        from tactsense import _signals
+
+        if self.outer is not None:
+            _signals._inside_compiled = self.outer
+            if not self.outer:
+                _signals.deliver()
+
+
 def write_estimates(stream, reader, locator, *, output_format, multi, frames, duration,
                     rezero, outlets, latencies, used) -> None:  # fmt: skip
     """Estimate the frames of ``reader`` with ``locator`` and write them to ``stream``:
     one JSON object per frame, or CSV rows (one per contact where ``multi``); the
-    latencies and the frames used are appended to ``latencies`` and counted in
-    ``used[0]``; ``rezero`` (an Event) re-zeroes the locator before the next frame."""
+    latencies of the estimates written are appended to ``latencies`` and the frames
+    done counted in ``used[0]``; ``rezero`` (an Event) re-zeroes the locator before the
+    next frame.
+
+    Every count is of steps completed: a frame is counted once its estimate is made,
+    given to ``outlets`` and its line written (a frame in the baseline: once given to
+    ``outlets``), an estimate once its line is written; Ctrl-C during a frame takes
+    effect when the frame is complete (:class:`_FrameSteps`)."""
     from tactsense.stream.live import CONTACT_FIELDS, FIELDS
 
     writer = None
@@ -103,32 +136,39 @@ def write_estimates(stream, reader, locator, *, output_format, multi, frames, du
         fields = LIVE_CONTACT_COLUMNS if multi else FIELDS
         writer = csv.DictWriter(stream, fieldnames=fields, lineterminator="\n")
         writer.writeheader()
+    steps = _FrameSteps()
     for frame in reader.frames(max_frames=frames, duration_s=duration):
-        used[0] += 1
-        if rezero.is_set():
-            rezero.clear()
-            locator.rezero()
-            print("re-zeroing: the baseline from the next frames", file=sys.stderr)
-        estimate = locator(frame)
-        if outlets is not None:
-            outlets.push(frame, estimate)
-        if estimate is None:
-            continue
-        latencies.append(estimate["latency_ms"])
-        if writer is None:
-            clean = {
-                k: (None if isinstance(v, float) and not np.isfinite(v) else v)
-                for k, v in estimate.items()
-            }
-            stream.write(json.dumps(clean) + "\n")
-        elif multi:
-            for row in _contact_rows(estimate, CONTACT_FIELDS):
-                writer.writerow(row)
-        else:
-            writer.writerow(
-                {k: repr(v) if isinstance(v, float) else v for k, v in estimate.items()}
-            )
-        stream.flush()
+        with steps:
+            _one_frame(frame, stream, writer, locator, outlets, rezero, multi, latencies,
+                       CONTACT_FIELDS)  # fmt: skip
+            used[0] += 1
+
+
+def _one_frame(frame, stream, writer, locator, outlets, rezero, multi, latencies, fields):
+    """Estimate one frame, give it to ``outlets``, write its line; its latency goes to
+    ``latencies`` once the line is written."""
+    if rezero.is_set():
+        rezero.clear()
+        locator.rezero()
+        print("re-zeroing: the baseline from the next frames", file=sys.stderr)
+    estimate = locator(frame)
+    if outlets is not None:
+        outlets.push(frame, estimate)
+    if estimate is None:
+        return
+    if writer is None:
+        clean = {
+            k: (None if isinstance(v, float) and not np.isfinite(v) else v)
+            for k, v in estimate.items()
+        }
+        stream.write(json.dumps(clean) + "\n")
+    elif multi:
+        for row in _contact_rows(estimate, fields):
+            writer.writerow(row)
+    else:
+        writer.writerow({k: repr(v) if isinstance(v, float) else v for k, v in estimate.items()})
+    stream.flush()
+    latencies.append(estimate["latency_ms"])
 
 
 # ---- foxglove live (r6-fox) ----
@@ -155,21 +195,35 @@ def check_foxglove(address: str | None) -> tuple[str, int] | None:
     return host_port
 
 
-def serve_foxglove(address: tuple[str, int] | None, sensor):
-    """The Foxglove server of ``--foxglove`` (None without it), its address printed on
-    standard error; a warning when it listens beyond this machine."""
+def bind_foxglove(address: tuple[str, int] | None):
+    """The Foxglove server of ``--foxglove`` bound (None without it), before the source
+    is opened: a port in use is one line before any device is touched. Its sensor comes
+    with :func:`serve_foxglove`."""
     if address is None:
         return None
-    from tactsense.cli._common import console
+    from tactsense._validation import TactsenseInputError
     from tactsense.interop.foxglove_live import FoxgloveLive
-    from tactsense.view.server import is_loopback
 
     host, port = address
-    server = FoxgloveLive(sensor, host=host, port=port)  # TactsenseInputError when it cannot
-    if not is_loopback(host):
+    try:
+        return FoxgloveLive(None, host=host, port=port)
+    except TactsenseInputError as error:
+        fail(str(error))
+
+
+def serve_foxglove(server, sensor):
+    """Give the bound server of ``--foxglove`` (None without it) its sensor and print its
+    address on standard error; a warning when it listens beyond this machine."""
+    if server is None:
+        return None
+    from tactsense.cli._common import console
+    from tactsense.view.server import is_loopback
+
+    server.attach(sensor)
+    if not is_loopback(server.host):
         console.print(
-            f"[bold red]warning:[/] Foxglove on {host}, not only on this machine: anyone who "
-            "can reach it sees the sensor (there is no login)."
+            f"[bold red]warning:[/] Foxglove on {server.host}, not only on this machine: "
+            "anyone who can reach it sees the sensor (there is no login)."
         )
     console.print(
         f"foxglove: {server.url} (Foxglove: Open connection, Foxglove WebSocket)",

@@ -20,6 +20,7 @@ from tactsense.cli._common import (
 from tactsense.cli._live_outputs import (
     FOXGLOVE_HELP,
     RECORDING_SUFFIXES,
+    bind_foxglove,
     check_foxglove,
     close_foxglove,
     serve_foxglove,
@@ -111,6 +112,7 @@ def view(
         fail("--timeout applies to a device, not to a recording")
     if not is_recording and speed != 1.0:
         fail("--speed applies to recordings; a device sends at its own rate")
+    foxglove_server = bind_foxglove(foxglove_address)  # r6-fox: before the source opens
     try:
         cal = None if calibration is None else load_calibration(calibration)
         if is_recording:
@@ -152,20 +154,21 @@ def view(
                 reader.close()
                 raise
             feed = LiveFeed(reader, locator)
-    except TactsenseInputError as error:
-        fail(str(error))
+    except BaseException as error:
+        if foxglove_server is not None:  # r6-fox: bound before the source; nothing sent
+            foxglove_server.close()
+        if isinstance(error, TactsenseInputError):
+            fail(str(error))
+        raise
     try:
         server = ViewServer(feed, host=listen, port=port)
     except OSError as error:
         feed.stop()
+        if foxglove_server is not None:  # r6-fox
+            foxglove_server.close()
         fail(f"cannot listen on {listen}:{port}: {error.strerror or error}")
     # ---- foxglove live (r6-fox): the page's frames and estimates, to Foxglove too ----
-    try:
-        foxglove_server = serve_foxglove(foxglove_address, feed.sensor)
-    except TactsenseInputError as error:
-        server.socket.close()
-        feed.stop()
-        fail(str(error))
+    serve_foxglove(foxglove_server, feed.sensor)
     if foxglove_server is not None:
         from tactsense.interop.foxglove_live import PublishingLocator
 

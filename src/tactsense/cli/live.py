@@ -36,6 +36,7 @@ from tactsense.cli._live_outputs import (
     _check_record_suffix,
     _check_ros2_options,
     _listen_for_rezero,
+    bind_foxglove,
     check_foxglove,
     close_foxglove,
     serve_foxglove,
@@ -431,7 +432,9 @@ def live(
         typer.Option(
             "--namespace",
             help="--ros2: the node's ROS 2 namespace, '/' or /name/... of letters, digits "
-            "and _ [default: /<sensor name>].",
+            "and _ (no trailing /; at most 232 characters); as ROS 2 does with a node's "
+            "namespace, a relative one gets a leading / (foo: /foo; '': /) "
+            "[default: /<sensor name>].",
         ),
     ] = None,
     ros2_config: Annotated[
@@ -466,6 +469,7 @@ def live(
     if out is not None:
         check_output(out, force, inputs=[calibration, *sensor_file(sensor), *_source_file(source)])
     _check_ros2_options(ros2, namespace, ros2_config)  # r6-ros2
+    foxglove_server = bind_foxglove(foxglove_address)  # r6-fox: before the source opens
     try:
         cal = None if calibration is None else load_calibration(calibration)
         from tactsense.estimate.contacts import METHODS
@@ -484,7 +488,7 @@ def live(
             rate = 1.0 / reader.frame_period_s if reader.frame_period_s else 0.0
             outlets = LslOutlets(reader.sensor, reader.identity, rate)
         # ---- foxglove live (r6-fox) ----
-        foxglove_server = serve_foxglove(foxglove_address, reader.sensor)
+        serve_foxglove(foxglove_server, reader.sensor)
         if foxglove_server is not None:
             outlets = Outlets(outlets, foxglove_server)
         # ---- /foxglove live (r6-fox) ----
@@ -496,8 +500,12 @@ def live(
             publisher.wait_for_subscribers(1.0)  # those already listening get the first frame
             outlets = Outlets(outlets, publisher)
         reader.start()
-    except TactsenseInputError as error:
-        fail(str(error))
+    except BaseException as error:
+        if foxglove_server is not None:  # r6-fox: bound before the source; nothing sent
+            foxglove_server.close()
+        if isinstance(error, TactsenseInputError):
+            fail(str(error))
+        raise
     latencies: list[float] = []
     used = [0]  # frames given to the locator
     multi = kind_of(reader.sensor).multi_contact

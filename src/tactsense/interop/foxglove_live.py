@@ -139,7 +139,9 @@ class FoxgloveLive:
 
     Parameters
     ----------
-    sensor : SensorSpec, PadSpec or PointsSpec
+    sensor : SensorSpec, PadSpec or PointsSpec, optional
+        The sensor of the frames; None binds the server now and takes the sensor later
+        (:meth:`attach`), as ``live`` and ``view`` do before they open their source.
     host : str
         Address to bind; 127.0.0.1 (this machine only) by default.
     port : int
@@ -158,7 +160,7 @@ class FoxgloveLive:
 
     def __init__(
         self,
-        sensor,
+        sensor=None,
         *,
         host: str = DEFAULT_HOST,
         port: int = DEFAULT_PORT,
@@ -169,12 +171,9 @@ class FoxgloveLive:
 
         foxglove = _sdk()
         self._no_contact = int(Flag.NO_CONTACT)
-        self.sensor = sensor
+        self.sensor = None
         self.host = host
-        self._multi = kind_of(sensor).multi_contact
-        if self._multi:
-            self._positions = np.asarray(sensor.taxel_positions_mm(), dtype=float)
-            self._normals = np.asarray(sensor.taxel_normals(), dtype=float)
+        self._frame_id = frame_id
         self._context = foxglove.Context()
         self.channels = {
             topic: foxglove.Channel(
@@ -187,10 +186,9 @@ class FoxgloveLive:
             )
             for topic, schema, definition in CHANNELS
         }
-        self._encoder = _LiveEncoder(sensor, self.channels, frame_id)
         try:
             self._server = foxglove.start_server(
-                name=name or f"tactsense {sensor.name}",
+                name=name or ("tactsense" if sensor is None else f"tactsense {sensor.name}"),
                 host=host,
                 port=int(port),
                 context=self._context,
@@ -201,6 +199,18 @@ class FoxgloveLive:
         self.port = int(self._server.port)
         self.frames = 0
         self.contacts = 0
+        if sensor is not None:
+            self.attach(sensor)
+
+    def attach(self, sensor) -> None:
+        """Say which sensor the frames come from (a server bound before its source was
+        opened: ``sensor`` None at construction); before the first :meth:`push`."""
+        self.sensor = sensor
+        self._multi = kind_of(sensor).multi_contact
+        if self._multi:
+            self._positions = np.asarray(sensor.taxel_positions_mm(), dtype=float)
+            self._normals = np.asarray(sensor.taxel_normals(), dtype=float)
+        self._encoder = _LiveEncoder(sensor, self.channels, self._frame_id)
 
     @property
     def url(self) -> str:
@@ -222,9 +232,9 @@ class FoxgloveLive:
         t = float(frame.host_time_s)
         writer = self._encoder
         writer.frame(frame.counts, t, sequence=int(frame.sequence))
-        self.frames += 1
         if estimate is None:
             writer.contacts_at([t], np.zeros(0, int), np.zeros((0, 3)), np.zeros((0, 3)), [])
+            self.frames += 1  # counted once every message of the frame is sent
             return
         if not self._multi:
             force = estimate.get("force_n")
@@ -235,6 +245,7 @@ class FoxgloveLive:
             )
             axial, angle = (_number(estimate.get(k)) for k in ("axial_mm", "angle_deg"))
             writer.contacts_of([t], [axial], [angle], [force if touching else 0.0], [touching])
+            self.frames += 1
             self.contacts += int(touching)
             return
         kept = [c for c in estimate.get("contacts", []) if _located(c)]
@@ -250,6 +261,7 @@ class FoxgloveLive:
         writer.contacts_at(
             [t], np.zeros(len(kept), int), xyz * 1e-3, self._normals[nearest], force, names
         )
+        self.frames += 1
         self.contacts += len(kept)
 
     def _close_channels(self) -> None:

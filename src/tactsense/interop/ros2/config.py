@@ -64,8 +64,9 @@ def loopback_config(folder: str | Path | None = None) -> Path:
     return path
 
 
-def _text(config: str) -> str:
-    """The XML of a configuration given as XML, as ``file://PATH`` or as a path."""
+def _text(config: str, origin: str = "--ros2-config ") -> str:
+    """The XML of a configuration given as XML, as ``file://PATH`` or as a path
+    (``origin``: how an error names where it came from)."""
     stripped = config.strip()
     if stripped.startswith("<"):
         return stripped
@@ -74,11 +75,11 @@ def _text(config: str) -> str:
         return path.read_text()
     except OSError as error:
         raise Ros2ConfigError(
-            f"--ros2-config {config}: cannot read it ({error.strerror or error})"
+            f"{origin}{config}: cannot read it ({error.strerror or error})"
         ) from None
     except UnicodeDecodeError:
         raise Ros2ConfigError(
-            f"--ros2-config {config}: not a text file (a Cyclone DDS XML configuration)"
+            f"{origin}{config}: not a text file (a Cyclone DDS XML configuration)"
         ) from None
 
 
@@ -108,17 +109,31 @@ def is_loopback_only(config: str) -> bool:
     )
 
 
-def _parse(config: str):
+def _parse(config: str, origin: str = "--ros2-config"):
     try:
-        root = ET.fromstring(_text(config))
+        root = ET.fromstring(_text(config, origin + " "))
     except ET.ParseError as error:
-        raise Ros2ConfigError(f"--ros2-config: not XML ({error})") from None
+        where = "" if config.lstrip().startswith("<") else f" {config}"
+        raise Ros2ConfigError(f"{origin}{where}: not XML ({error})") from None
     if root.tag.rpartition("}")[2] != "CycloneDDS":
         raise Ros2ConfigError(
-            f"--ros2-config: a Cyclone DDS configuration has the root element <CycloneDDS>; "
+            f"{origin}{'' if config.lstrip().startswith('<') else ' ' + config}: a Cyclone DDS "
+            "configuration has the root element <CycloneDDS>; "
             f"this one has <{root.tag.rpartition('}')[2]}>"
         )
     return root
+
+
+def _check_environment(uri: str) -> None:
+    """Check each file a ``CYCLONEDDS_URI`` names (``file://PATH`` or a path; several
+    separated by commas, as Cyclone DDS reads them) as ``--ros2-config`` is checked:
+    readable, XML, root ``<CycloneDDS>``. XML given in the variable itself (starting
+    with ``<``) is left to Cyclone DDS."""
+    if uri.startswith("<"):
+        return
+    for item in (part.strip() for part in uri.split(",")):
+        if item and not item.startswith("<"):
+            _parse(item, CONFIG_ENV)
 
 
 def resolve_config(config: str | Path | None) -> tuple[str, str]:
@@ -126,7 +141,8 @@ def resolve_config(config: str | Path | None) -> tuple[str, str]:
 
     ``config`` (XML, ``file://PATH`` or a path; checked to be Cyclone DDS XML) first;
     else the environment's ``CYCLONEDDS_URI`` (as a ROS 2 node on this machine would use
-    it; passed to Cyclone DDS as it stands); else tactsense's loopback-only
+    it; each file it names checked as ``config`` is, then passed to Cyclone DDS as it
+    stands); else tactsense's loopback-only
     :data:`LOOPBACK_XML`, never Cyclone DDS's own default (multicast on every interface).
 
     Returns
@@ -136,10 +152,11 @@ def resolve_config(config: str | Path | None) -> tuple[str, str]:
         ``CYCLONEDDS_URI`` or ``loopback``.
     """
     if config is not None:
+        _parse(str(config))
         text = _text(str(config))
-        _parse(text)
         return text, "option"
     environment = os.environ.get(CONFIG_ENV, "").strip()
     if environment:
+        _check_environment(environment)
         return environment, CONFIG_ENV
     return LOOPBACK_XML, "loopback"

@@ -78,18 +78,75 @@ def ros_token(name: str) -> str:
     return token if _NAME.match(token) else "_" + token
 
 
-def check_namespace(namespace: str) -> str:
-    """A ROS 2 namespace, absolute (``/`` or ``/a/b``), checked; a relative one gets ``/``."""
-    namespace = namespace if namespace.startswith("/") else "/" + namespace
-    namespace = namespace.rstrip("/") or "/"
-    tokens = namespace.strip("/").split("/") if namespace != "/" else []
-    bad = [t for t in tokens if not _NAME.match(t)]
-    if bad or "//" in namespace:
+TOPIC_MAX_LENGTH = 255 - 8
+"""Longest fully qualified ROS 2 topic name (``RMW_TOPIC_MAX_NAME_LENGTH``)."""
+NAMESPACE_MAX_LENGTH = TOPIC_MAX_LENGTH - 2
+"""Longest ROS 2 namespace (``RMW_NAMESPACE_MAX_LENGTH``)."""
+NODE_NAME_MAX_LENGTH = 255
+"""Longest ROS 2 node name (``RMW_NODE_NAME_MAX_NAME_LENGTH``); ``ros_discovery_info``
+holds it in a ``string<=256``."""
+NAMESPACE_RULE = (
+    "a ROS 2 namespace is '/' or /name/name... of letters, digits and _ (a name not "
+    "starting with a digit; no trailing /)"
+)
+
+
+def check_namespace(namespace: str, option: str = "--namespace") -> str:
+    """A node's ROS 2 namespace, checked by ROS 2's own rule, or a one-line
+    :class:`Ros2Error`.
+
+    As ``rcl_node_init`` does with a node's namespace, an empty one becomes ``/`` and a
+    relative one (``foo``) gets a leading ``/``; then ``rmw_validate_namespace``'s rule:
+    absolute, no trailing ``/`` (except ``/`` itself), no ``//``, tokens
+    ``[A-Za-z_][A-Za-z0-9_]*``, at most :data:`NAMESPACE_MAX_LENGTH` characters; and
+    short enough that every topic under it (``<namespace>/tactile_states``) keeps within
+    :data:`TOPIC_MAX_LENGTH`.
+    """
+    given = namespace
+    if not namespace.startswith("/"):
+        namespace = "/" + namespace  # rcl: "" -> "/", "foo" -> "/foo"
+    problem = None
+    if namespace != "/" and namespace.endswith("/"):
+        problem = "it ends with /"
+    elif "//" in namespace:
+        problem = "it has //"
+    elif namespace != "/" and not all(_NAME.match(t) for t in namespace[1:].split("/")):
+        problem = NAMESPACE_RULE
+    if problem is not None:
+        if problem != NAMESPACE_RULE:
+            problem += "; " + NAMESPACE_RULE
+        raise Ros2Error(f"{option} {_short(given)}: {problem}")
+    longest = max(len(_topic(namespace, t)) for t in TOPICS)
+    if len(namespace) > NAMESPACE_MAX_LENGTH or longest > TOPIC_MAX_LENGTH:
+        limit = TOPIC_MAX_LENGTH - (longest - len(namespace))
         raise Ros2Error(
-            f"--namespace {namespace!r}: a ROS 2 namespace is '/' or /name/name... of "
-            "letters, digits and _ (not starting with a digit)"
+            f"{option} {_short(given)}: {len(namespace)} characters; a ROS 2 topic name has at "
+            f"most {TOPIC_MAX_LENGTH}, so the namespace of these topics at most {limit}"
         )
     return namespace
+
+
+def check_node_name(node_name: str) -> str:
+    """A ROS 2 node name (``rmw_validate_node_name``), or a one-line :class:`Ros2Error`."""
+    if not _NAME.match(node_name):
+        raise Ros2Error(
+            f"node name {_short(node_name)}: letters, digits and _ only, not starting with a digit"
+        )
+    if len(node_name) > NODE_NAME_MAX_LENGTH:
+        raise Ros2Error(
+            f"node name {_short(node_name)}: {len(node_name)} characters; a ROS 2 node name "
+            f"has at most {NODE_NAME_MAX_LENGTH}"
+        )
+    return node_name
+
+
+def _topic(namespace: str, topic: str) -> str:
+    return ("" if namespace == "/" else namespace) + "/" + topic
+
+
+def _short(text: str) -> str:
+    """A name quoted for an error line, its middle cut when long."""
+    return repr(text) if len(text) <= 40 else repr(text[:20] + "..." + text[-12:])
 
 
 def domain_id_from_environment() -> int:
@@ -172,12 +229,12 @@ class Ros2Publisher:
 
         self.sensor = sensor
         self.frame_id = frame_id
-        self.namespace = check_namespace(
-            namespace if namespace is not None else "/" + ros_token(sensor.name)
+        self.namespace = (
+            check_namespace(namespace)
+            if namespace is not None
+            else check_namespace("/" + ros_token(sensor.name), "the namespace of the sensor's name")
         )
-        if not _NAME.match(node_name):
-            raise Ros2Error(f"node name {node_name!r}: letters, digits and _ only")
-        self.node_name = node_name
+        self.node_name = check_node_name(node_name)
         self.domain_id = domain_id_from_environment() if domain_id is None else int(domain_id)
         if not 0 <= self.domain_id <= 232:
             raise Ros2Error(f"DDS domain {self.domain_id}: expected 0-232")
@@ -222,7 +279,7 @@ class Ros2Publisher:
         self._write_bytes = ddspy_write
 
     def _ros_name(self, topic: str) -> str:
-        return ("" if self.namespace == "/" else self.namespace) + "/" + topic
+        return _topic(self.namespace, topic)
 
     def _gid(self, entity) -> list[int]:
         guid = entity.get_guid().bytes
