@@ -285,7 +285,7 @@ def test_the_fast_chain_is_the_scan_loops(make, flaws):
     active = resolve_flaws(flaws)
     gains = check_gains(spec, None, active)
     ref = reference_frames(spec, batch, active, gains, np.random.default_rng(0))
-    fast = fast_frames(spec, batch, _ReferenceForward(spec), active, gains, None)
+    fast = fast_frames(spec, batch, _ReferenceForward(spec).prepare(batch), active, gains, None)
     if "quantization" in active:  # a count apart only where the value sits on an edge
         assert np.abs(fast - ref).max() <= 1.0
         assert np.mean(fast != ref) < 0.01
@@ -313,3 +313,13 @@ def test_fast_and_reference_agree_on_a_pad_within_the_twins_grid_error():
     ref = frames_from_contacts(spec, batch, flaws="none", fast=False)
     rest = spec.electronics.nominal_counts
     assert np.abs(fast - ref).max() <= 0.05 * (ref - rest).max()
+
+
+def test_a_contact_beyond_the_tables_runs_the_reference():
+    spec = _pad()
+    batch = ContactBatch(np.array([[[18.0, 18.0]]]), np.array([[0.5]]), radius_mm=6.0, shape="disc")
+    assert kind_of(spec).contact_forward(spec).prepare(batch) is None
+    np.testing.assert_array_equal(
+        frames_from_contacts(spec, batch, flaws="none"),
+        frames_from_contacts(spec, batch, flaws="none", fast=False),
+    )

@@ -287,11 +287,10 @@ class Kind:
     def contact_forward(self, spec: Any) -> Any:
         """The kind's fast forward for ``frames_from_contacts``, or None (the default:
         ``elastic_batch`` frame by frame, slow but any kind works). An object whose
-        ``prepare(contacts)`` (a :class:`~tactsense.simulate.ContactBatch`) returns a
-        function ``(first, last) -> (last - first, rows * cols)`` (float32 or float64):
-        every taxel's
-        fractional deflection [-] (what ``elastic_batch`` gives, before gains) in those
-        frames."""
+        ``prepare(contacts)`` (a :class:`~tactsense.simulate.ContactBatch`) returns None
+        (a batch it does not take: the reference runs) or a function ``(first, last) ->
+        (last - first, rows * cols)`` (float32 or float64): every taxel's fractional
+        deflection [-] (what ``elastic_batch`` gives, before gains) in those frames."""
         return None
 
 

@@ -16,7 +16,11 @@ import math
 import numpy as np
 
 from tactsense._jit import jit
-from tactsense.physics._hertz_table import SeparableResponse, layer_response_table
+from tactsense.physics._hertz_table import (
+    A_TOP_LIMIT_MM,
+    SeparableResponse,
+    layer_response_table,
+)
 
 A_TOP_GRAIN_MM = 0.5
 """The tables are built for pressure radii up to a multiple of this [mm] (a batch with a
@@ -176,8 +180,12 @@ class PadContactForward:
         deflection [-] of every taxel (before gains; float32, 1e-7 of the peak) for
         those frames of ``contacts`` (a
         ContactBatch), with the tables its largest contacts need (chosen once, so a frame
-        reads the same whatever block it is computed in)."""
+        reads the same whatever block it is computed in); None when a contact's pressure
+        radius exceeds :data:`~tactsense.physics._hertz_table.A_TOP_LIMIT_MM` (the
+        caller runs the reference path)."""
         radius = contacts.pressure_radius_mm(self.modulus_star_pa)
+        if np.any(radius[contacts.normal_force_n > 0] > A_TOP_LIMIT_MM):
+            return None
         tables = {}
         for shape, chosen in contacts.shape_masks():
             top = float(np.max(radius[chosen] if chosen is not True else radius, initial=0.0))

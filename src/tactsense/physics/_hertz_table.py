@@ -113,6 +113,10 @@ def table_step_mm(layer: Layer, electrode_mm: tuple[float, float]) -> float:
 A_STEP_MM = 0.05
 """Step of the table in the pressure radius a [mm]."""
 
+A_TOP_LIMIT_MM = 5.0
+"""Largest pressure radius a table covers [mm] (its memory grows with the square of its
+reach): a batch with a larger contact runs the kind's reference path."""
+
 
 def _spectrum(layer, electrode_mm, step, n):
     """The strain's transfer times the electrode's on an n x n periodic grid of ``step``
@@ -150,14 +154,15 @@ def layer_response_table(
     trial = math.ceil((18.0 * layer.thickness_mm + max(electrode_mm) + a_values[-1]) / step)
     n = next_fast_len(2 * trial)
     transfer, k = _spectrum(layer, electrode_mm, step, n)
-    grid = np.stack([_quadrant(transfer, k, shape, a, step, n, trial) for a in a_values])
-    peak = float(np.abs(grid).max())
-    beyond = np.abs(grid).max(axis=(0, 2))  # largest |G| at each dx
-    beyond = np.maximum(beyond, np.abs(grid).max(axis=(0, 1)))  # and each dy
+    # the reach from the smallest and the largest pressure (the field widens with a)
+    ends = np.stack([_quadrant(transfer, k, shape, a, step, n, trial) for a in a_values[[0, -1]]])
+    peak = float(np.abs(ends).max())
+    beyond = np.maximum(np.abs(ends).max(axis=(0, 2)), np.abs(ends).max(axis=(0, 1)))
     tail = np.maximum.accumulate(beyond[::-1])[::-1]
     size = int(np.argmax(tail < REACH_TOLERANCE * peak)) or trial
     size = min(trial, size + 2)
-    grid = np.ascontiguousarray(grid[:, :size, :size])
+    grid = np.stack([_quadrant(transfer, k, shape, a, step, n, size) for a in a_values])
+    peak = float(np.abs(grid).max())
     grid[:, -1, :] = 0.0  # zero at the reach: the interpolation falls to it
     grid[:, :, -1] = 0.0
     matrix = grid.reshape(n_a * size, size)

@@ -121,15 +121,15 @@ def _compiled_mode(spec, kind, active) -> int | None:
     return None
 
 
-def fast_frames(spec, contacts, forward, active, gains, rng) -> np.ndarray:
-    """Frames (N, taxels) [counts] from the kind's fast forward and the per-frame flaws."""
+def fast_frames(spec, contacts, block, active, gains, rng) -> np.ndarray:
+    """Frames (N, taxels) [counts] from the kind's fast forward (``block(first, last)``,
+    what its ``prepare(contacts)`` returned) and the per-frame flaws."""
     from tactsense.kinds import kind_of
     from tactsense.physics.transduction import amplifier_gain
 
     kind = kind_of(spec)
     n, taxels = contacts.n_frames, math.prod(spec.shape)
     out = np.empty((n, taxels))
-    block = forward.prepare(contacts)
     gains = np.ascontiguousarray(np.asarray(gains, dtype=float).reshape(taxels))
     dead = np.zeros(spec.shape, dtype=bool)
     if "dead" in active:

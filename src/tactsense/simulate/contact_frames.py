@@ -255,8 +255,9 @@ def frames_from_contacts(
     gains : (rows, cols) ndarray, optional
         Per-taxel gains [-] instead of the sensor's own (``gain_spread``).
     fast : bool
-        Use the kind's fast forward (:meth:`Kind.contact_forward`) where it has one;
-        False: its ``elastic_batch`` frame by frame (the reference).
+        Use the kind's fast forward (:meth:`Kind.contact_forward`) where it has one and
+        it takes the batch (a pad's: pressure radii up to 5 mm); False: the kind's
+        ``elastic_batch`` frame by frame (the reference).
 
     Returns
     -------
@@ -288,10 +289,11 @@ def frames_from_contacts(
             stacklevel=2,
         )
     forward = kind.contact_forward(spec) if fast else None
-    if forward is not None:
+    block = forward.prepare(contacts) if forward is not None else None
+    if block is not None:
         from tactsense.simulate._contact_chain import fast_frames
 
-        return fast_frames(spec, contacts, forward, active, gains, rng)
+        return fast_frames(spec, contacts, block, active, gains, rng)
     return reference_frames(spec, contacts, active, gains, rng)
 
 
