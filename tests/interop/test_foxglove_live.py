@@ -531,6 +531,9 @@ def test_ctrl_c_counts_only_completed_steps(where):
     else:
         outlets, out = Outlets(server), _Interrupt(4, stream)
     latencies, used = [], [0]
+    # Python's own SIGINT handler, whatever an earlier test in this process left there
+    # (in the full suite one left SIGINT without KeyboardInterrupt)
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     try:
         with pytest.raises(KeyboardInterrupt):
             write_estimates(out, _Frames(sensor, 50), _Locator(5), output_format=LiveFormat.jsonl,
@@ -539,6 +542,7 @@ def test_ctrl_c_counts_only_completed_steps(where):
     finally:
         server.close()
         _signals.remove_gate()
+        signal.signal(signal.SIGINT, previous)
     lines = stream.getvalue().splitlines()
     assert used[0] == 9  # the interrupted frame completed, and no frame after it began
     assert server.frames == used[0]
