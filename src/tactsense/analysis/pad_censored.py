@@ -212,7 +212,7 @@ def cell_prior_information(pitch_mm: float) -> float:
     return (2.0 * math.pi / pitch_mm) ** 2
 
 
-def bayesian_bound(
+def bayesian_information(
     spec,
     force_n: float,
     *,
@@ -221,18 +221,17 @@ def bayesian_bound(
     noise_counts: float | None = None,
     radius_mm: float = PROBE_RADIUS_MM,
     nodes: int = BAYES_NODES,
-) -> dict:
-    """Hybrid Van Trees bound on ``(x, y, F)`` with the position random over the cell of
-    ``taxel`` (row, col; default the middle one) under a ``cos^2`` prior per axis and
-    the force fixed: root mean square errors as :func:`point_bound`'s keys (never
-    singular: the prior alone gives the position a finite bound; the force's is
-    ``inf`` only if no position in the cell informs it), plus ``nodes``."""
+) -> np.ndarray:
+    """The prior mean of the Fisher information over the cell of ``taxel`` (row, col;
+    default the middle one), ``cos^2`` prior per axis, by ``nodes`` x ``nodes``
+    Gauss-Legendre quadrature, (3, 3) (without the prior's own information)."""
     g = spec.grid
     r, c = (g.rows // 2, g.cols // 2) if taxel is None else taxel
     u, weights = np.polynomial.legendre.leggauss(int(nodes))
+    # the prior (2/L) cos^2(pi s / L) ds at s = u L / 2 is cos^2(pi u / 2) du on [-1, 1]
+    w1 = weights * np.cos(0.5 * np.pi * u) ** 2
+    w1 = w1 / w1.sum()
     information = np.zeros((3, 3))
-    density = np.cos(0.5 * np.pi * u) ** 2  # cos^2(pi s / L) at s = u L / 2; mean 1/2 over [-1, 1]
-    w1 = weights * density / np.sum(weights * density)
     for i, ui in enumerate(u):
         for j, uj in enumerate(u):
             a = whitened_jacobian(
@@ -245,11 +244,34 @@ def bayesian_bound(
                 radius_mm=radius_mm,
             )
             information += w1[i] * w1[j] * (a.T @ a)
+    return information
+
+
+def bayesian_bound(
+    spec,
+    force_n: float,
+    *,
+    taxel: tuple[int, int] | None = None,
+    model: str = "censored",
+    noise_counts: float | None = None,
+    radius_mm: float = PROBE_RADIUS_MM,
+    nodes: int = BAYES_NODES,
+) -> dict:
+    """Hybrid Van Trees bound on ``(x, y, F)`` with the position random over the cell of
+    ``taxel`` (row, col; default the middle one) under a ``cos^2`` prior per axis and
+    the force fixed: root mean square errors as :func:`point_bound`'s keys (the prior
+    alone keeps the position's finite; the force's is ``inf`` where no position in the
+    cell informs it), plus ``nodes``. It is at most the cell's mean of the point bound
+    (Jensen): a bound on the average error, not on the typical one."""
+    g = spec.grid
+    information = bayesian_information(
+        spec, force_n, taxel=taxel, model=model, noise_counts=noise_counts,
+        radius_mm=radius_mm, nodes=nodes,
+    )  # fmt: skip
     information[0, 0] += cell_prior_information(g.row_pitch_mm)
     information[1, 1] += cell_prior_information(g.col_pitch_mm)
     if information[2, 2] <= 0:
-        inverse = np.linalg.inv(information[:2, :2])
-        std = np.sqrt(np.diag(inverse))
+        std = np.sqrt(np.diag(np.linalg.inv(information[:2, :2])))
         return {"x_mm": float(std[0]), "y_mm": float(std[1]),
                 "position_mm": float(np.sqrt(0.5 * (std @ std))), "force_n": math.inf,
                 "force_relative": math.inf, "x_pitch": float(std[0] / g.row_pitch_mm),
