@@ -43,13 +43,18 @@ import numpy as np
 from scipy import special
 
 from tactsense._validation import TactsenseInputError, check_positive
-from tactsense.analysis.pad_bound import PROBE_RADIUS_MM, _check_pad, counts_from_strain
+from tactsense.analysis.pad_bound import (
+    PROBE_RADIUS_MM,
+    _check_pad,
+    counts_from_strain,
+    rank_test,
+)
+from tactsense.analysis.pad_bound import (
+    RANK_TOLERANCE as RANK_TOLERANCE,  # re-exported
+)
 from tactsense.physics.indenters import SphereProbe
 from tactsense.physics.pad_response import pad_strain
 
-RANK_TOLERANCE = 1e-6
-"""Smallest singular value of the scaled whitened Jacobian over its largest below which
-the Fisher matrix is called singular [-]."""
 BAYES_NODES = 8
 """Gauss-Legendre nodes per axis of the Bayesian bound's average over a taxel cell."""
 REALISTIC_NOISE_FS_PCT = 1.0
@@ -153,19 +158,6 @@ def whitened_jacobian(
     else:
         w = censored_weight((rest - mu) / sigma)
     return g * np.sqrt(w)[:, None] / sigma
-
-
-def rank_test(a: np.ndarray, tolerance: float = RANK_TOLERANCE) -> dict:
-    """Rank of ``J = A^T A`` from the singular values of ``A`` with its columns scaled to
-    unit length: ``rank``, ``smallest_ratio`` (smallest over largest singular value)
-    and ``singular`` (``smallest_ratio < tolerance``)."""
-    norms = np.linalg.norm(a, axis=0)
-    if not np.all(np.isfinite(a)) or np.any(norms == 0):
-        return {"rank": int(np.sum(norms > 0)), "smallest_ratio": 0.0, "singular": True}
-    s = np.linalg.svd(a / norms, compute_uv=False)
-    ratio = float(s[-1] / s[0])
-    return {"rank": int(np.sum(s > tolerance * s[0])), "smallest_ratio": ratio,
-            "singular": ratio < tolerance}  # fmt: skip
 
 
 def _stds(information: np.ndarray, spec, force_n: float) -> dict:
