@@ -253,3 +253,27 @@ def test_noise_from_full_scale_and_bad_values():
             pc.noise_from_full_scale(spec, bad)
     with pytest.raises(pc.TactsenseInputError):
         pc.point_bound(spec, 20.0, 20.0, F50, model="bogus")
+
+
+def test_design_bound_on_a_centred_probe_reports_singular_and_the_other_bounds():
+    import json
+
+    from typer.testing import CliRunner
+
+    from tactsense.cli import app
+
+    result = CliRunner().invoke(
+        app,
+        ["design", "bound", "--sensor", "pad16", "--x-mm", "20", "--y-mm", "20",
+         "--noise-fs", "2", "--json"],
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    data = json.loads(result.output)
+    assert data["bound"] is None  # the classic bound: singular
+    rows = {(r["noise"], r["bound"]): r for r in data["bounds"]}
+    assert rows[("preset", "classic")]["singular"] is True
+    assert rows[("preset", "classic")]["x_mm"] is None  # strict JSON: null, not Infinity
+    assert "Infinity" not in result.output
+    assert rows[("2 % FS", "censored")]["noise_counts"] == pytest.approx(81.9)
+    assert math.isfinite(rows[("2 % FS", "censored")]["x_mm"])
+    assert rows[("2 % FS", "bayesian")]["x_mm"] < rows[("2 % FS", "censored")]["x_mm"]

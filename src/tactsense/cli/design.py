@@ -266,7 +266,11 @@ def _pad_bound(spec, x_mm, y_mm, force_g, diameter, as_json, noise_fs=1.0) -> No
     if as_json:
         inputs = {"x_mm": x, "y_mm": y, "force_n": force, "probe_diameter_mm": diameter,
                   "sensor": spec.name, "noise_counts": noise, "noise_fs_pct": noise_fs}  # fmt: skip
-        typer.echo(json.dumps({"inputs": inputs, "bound": bound, "bounds": rows}, indent=2))
+        finite = [  # strict JSON: a singular bound's infinities as null
+            {k: (None if isinstance(v, float) and not np.isfinite(v) else v) for k, v in r.items()}
+            for r in rows
+        ]
+        typer.echo(json.dumps({"inputs": inputs, "bound": bound, "bounds": finite}, indent=2))
         return
     table = Table(
         title=f"Cramer-Rao bound, {force_g:g} g ({diameter:g}-mm sphere) at ({x:g}, {y:g}) mm "
