@@ -101,14 +101,19 @@ def _check_pad(spec, x_mm: float, y_mm: float) -> None:
             )
 
 
-def rank_test(a: np.ndarray, tolerance: float = RANK_TOLERANCE) -> dict:
-    """Rank of ``J = A^T A`` from the singular values of ``A`` with its columns scaled to
-    unit length: ``rank``, ``smallest_ratio`` (smallest over largest singular value)
-    and ``singular`` (``smallest_ratio < tolerance``)."""
-    norms = np.linalg.norm(a, axis=0)
-    if not np.all(np.isfinite(a)) or np.any(norms == 0):
-        return {"rank": int(np.sum(norms > 0)), "smallest_ratio": 0.0, "singular": True}
-    s = np.linalg.svd(a / norms, compute_uv=False)
+def rank_test(a: np.ndarray, scales, tolerance: float = RANK_TOLERANCE) -> dict:
+    """Rank of ``J = A^T A`` from the singular values of ``A`` with each column times its
+    parameter's physical scale (``scales``: a pitch for a position [mm], the load for a
+    force [N]), so a singular value is the readings' change, in noise units, for a move
+    of one pitch or a change of the whole load: ``rank``, ``smallest_ratio`` (smallest
+    over largest singular value) and ``singular`` (``smallest_ratio < tolerance``).
+
+    Not scaled by the columns' own lengths: a parameter no reading depends on has a
+    column of rounding, which scaled to unit length would look independent."""
+    scaled = np.asarray(a, dtype=float) * np.asarray(scales, dtype=float)
+    if not np.all(np.isfinite(scaled)) or not np.any(scaled):
+        return {"rank": 0, "smallest_ratio": 0.0, "singular": True}
+    s = np.linalg.svd(scaled, compute_uv=False)
     ratio = float(s[-1] / s[0])
     return {"rank": int(np.sum(s > tolerance * s[0])), "smallest_ratio": ratio,
             "singular": ratio < tolerance}  # fmt: skip
@@ -177,12 +182,13 @@ def cramer_rao_bound(
         :mod:`tactsense.analysis.pad_censored` for the censored and Bayesian bounds.
     """
     information = fisher_information(spec, x_mm, y_mm, force_n, radius_mm=radius_mm)
-    # the rank test on J = A^T A: A's columns scaled, its singular values are the
-    # square roots of the scaled J's eigenvalues
-    scale = np.sqrt(np.abs(np.diag(information)))
-    singular = not np.all(np.isfinite(information)) or np.any(scale == 0)
+    # the rank test on J = A^T A (A's singular values: the square roots of J's
+    # eigenvalues), in units of a pitch and the load
+    g = spec.grid
+    scale = np.array([g.row_pitch_mm, g.col_pitch_mm, force_n])
+    singular = not np.all(np.isfinite(information))
     if not singular:
-        eigen = np.linalg.eigvalsh(information / np.outer(scale, scale))
+        eigen = np.linalg.eigvalsh(information * np.outer(scale, scale))
         singular = eigen[0] <= (RANK_TOLERANCE**2) * eigen[-1]
     if singular:
         raise TactsenseInputError(

@@ -20,11 +20,11 @@ above rest (the unclipped Gaussian's), 0.82 at rest, falling as ``alpha phi(alph
 below it -- not zero and not 1. ``J = sum_i w_i g_i g_i^T / sigma^2`` with ``g_i`` the
 latent reading's derivatives (central differences, as the classic bound's).
 
-Singular Fisher matrices are reported by a rank test: the singular values of the
-whitened Jacobian with its columns scaled to unit length (units drop out), the matrix
-singular when the smallest is below ``RANK_TOLERANCE`` times the largest (eigenvalue
-ratio ``RANK_TOLERANCE^2``). The tolerance sits far above the central differences'
-rounding (about 1e-10 relative) and far below any identifiable case measured here.
+Singular Fisher matrices are reported by a rank test
+(:func:`tactsense.analysis.pad_bound.rank_test`): the singular values of the whitened
+Jacobian in units of a pitch and of the load, the matrix singular when the smallest is
+below ``RANK_TOLERANCE`` (1e-6) times the largest (eigenvalue ratio 1e-12): a move of a
+pitch changes the readings by less than a millionth of what doubling the load does.
 
 The Bayesian bound is the hybrid Cramer-Rao bound (Van Trees for the random part, Rockah
 and Schultz 1987): the position uniform-ish within one taxel cell, a ``cos^2`` prior
@@ -191,7 +191,8 @@ def point_bound(
     a = whitened_jacobian(
         spec, x_mm, y_mm, force_n, model=model, noise_counts=noise_counts, radius_mm=radius_mm
     )
-    test = rank_test(a)
+    g = spec.grid
+    test = rank_test(a, (g.row_pitch_mm, g.col_pitch_mm, force_n))
     if test["singular"]:
         keys = ("x_mm", "y_mm", "position_mm", "force_n", "force_relative", "x_pitch", "y_pitch")
         return {**test, **dict.fromkeys(keys, math.inf)}

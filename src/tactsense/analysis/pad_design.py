@@ -134,7 +134,7 @@ def design_point(
     # a position no compressed taxel's reading depends on is not observable: the bound
     # is unbounded, inf (the rank test of pad_bound, not an absolute condition cut-off)
     position = force_pct = float("inf")
-    if not rank_test(jacobian / np.sqrt(noise))["singular"]:
+    if not rank_test(jacobian / np.sqrt(noise), (pitch_mm, pitch_mm, force))["singular"]:
         bound = np.linalg.inv(fisher)
         if bound[0, 0] > 0 and bound[1, 1] > 0 and bound[2, 2] > 0:
             position = float(np.sqrt(0.5 * (bound[0, 0] + bound[1, 1])))
