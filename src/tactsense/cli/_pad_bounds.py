@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 
+from rich.markup import escape
 from rich.table import Table
 
 from tactsense.analysis.pad_censored import (
@@ -57,10 +58,10 @@ def bounds_table(rows: list[dict], name: str) -> Table:
         title=f"Bounds on {name}: classic (noise after the clip), censored (noise before "
         "it), unclipped (a two-sided transducer), bayesian (hybrid Van Trees, cos^2 prior "
         f"over the taxel cell); singular: rank test, tolerance {RANK_TOLERANCE:g} on the "
-        "scaled singular values"
+        "singular values in units of a pitch and the load"
     )
     for column in ("noise", "read noise [counts]", "bound", "x [um]", "y [um]", "force [%]"):
-        table.add_column(column)
+        table.add_column(escape(column), no_wrap=True)
     for r in rows:
         force = "singular" if not math.isfinite(r["force_relative"]) else (
             f"{100 * r['force_relative']:.3g}")  # fmt: skip
