@@ -242,7 +242,7 @@ def test_bayesian_bound_lies_under_the_posterior_mean_error():
         ]
     )
     mean_point_bound = float(np.sum(prior[::4] / j_grid) / np.sum(prior[::4]))
-    assert 5 * bound < mse < mean_point_bound
+    assert 15 * bound < mse < mean_point_bound  # docs/accuracy.md: "21 times" above the bound
 
 
 def test_noise_from_full_scale_and_bad_values():
