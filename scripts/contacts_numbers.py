@@ -39,6 +39,7 @@ from pathlib import Path
 import numpy as np
 
 import tactsense as ts
+from tactsense.analysis.pad_bound import rank_test
 from tactsense.estimate.contacts import find_contacts
 from tactsense.physics.contact import grams_force
 from tactsense.physics.indenters import SphereProbe
@@ -134,7 +135,11 @@ def two_contact_bound(spec, separation_mm: float, centre_offset_mm: float = 0.0)
         columns.append(((f_up - f_down) / (0.02 * FORCE_N)).ravel())
     jac = np.column_stack(columns) / _noise_sigma(spec)
     fisher = jac.T @ jac
-    if np.linalg.cond(fisher) > 1e14:
+    # a pitch and the load on a pad; the finger's columns (mm, deg, N) at their own size
+    scales = (_pitch(spec), _pitch(spec), FORCE_N) * 2
+    if spec.kind != "pad":
+        scales = 1.0 / np.linalg.norm(jac, axis=0)
+    if rank_test(jac, scales)["singular"]:  # tolerance 1e-6 (pad_bound.rank_test)
         return float("inf")
     return float(np.sqrt(max(np.linalg.inv(fisher)[0, 0], 0.0)))
 
@@ -352,7 +357,8 @@ def one_contact_bound(spec, x_mm: float, y_mm: float, force_n: float) -> float:
     columns.append(((up - down) / (0.02 * force_n)).ravel())
     jac = np.column_stack(columns) / _noise_sigma(spec)
     fisher = jac.T @ jac
-    if np.linalg.cond(fisher) > 1e14:
+    scales = (_pitch(spec), _pitch(spec), force_n)  # a pitch, the load
+    if rank_test(jac, scales)["singular"]:  # tolerance 1e-6 (pad_bound.rank_test)
         return float("inf")
     cov = np.linalg.inv(fisher)
     return float(np.sqrt(max(cov[0, 0], cov[1, 1], 0.0)))

@@ -133,6 +133,13 @@ BAD_OPTIONS = [
     ("live loop:// --ros2 --namespace /a/", "--namespace '/a/': it ends with /"),
     ("live loop:// --ros2 --namespace /" + "a" * 300, "301 characters"),
     # ---- /fix37 (r6-fix37) ----
+    # ---- design bound --noise-fs (r6-bounds) ----
+    ("design bound --sensor pad16 --noise-fs 0", "--noise-fs"),
+    ("design bound --sensor pad16 --noise-fs -1", "--noise-fs"),
+    ("design bound --sensor pad16 --noise-fs 51", "--noise-fs"),
+    ("design bound --sensor pad16 --noise-fs nan", "--noise-fs"),
+    ("design bound --sensor initial --noise-fs 1", "--noise-fs is for pads"),
+    # ---- /design bound --noise-fs (r6-bounds) ----
 ]
 
 

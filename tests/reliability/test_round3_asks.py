@@ -50,7 +50,6 @@ BAD = [
     ("design bound --sensor pad4 --angle 3", "--angle is for fingers; 'pad4' is a pad"),
     ("design bound --sensor initial --x-mm 3", "--x-mm is for pads"),
     ("design bound --sensor initial --y-mm 3", "--y-mm is for pads"),
-    ("design bound --sensor pad16 --x-mm 5 --y-mm 5", "is not identifiable on 'pad16'"),
     ("design bound --sensor pad4 --x-mm nan", "'--x-mm': NaN is not a number"),
     ("sensor check DIR/pad16.toml --probe-g 0", "Invalid value for '--probe-g'"),
     ("sensor check DIR/pad16.toml --probe-g nan", "'--probe-g': NaN is not a number"),

@@ -31,6 +31,10 @@ from tactsense.physics.transduction import amplifier_gain, divider_voltage, volt
 PARAMETERS = ("x_mm", "y_mm", "force_n")
 PROBE_RADIUS_MM = 1.6
 """The paper's probe: a 3.2-mm hemisphere (section 3) [mm]."""
+RANK_TOLERANCE = 1e-6
+"""Smallest singular value of the scaled whitened Jacobian over its largest below which
+the Fisher matrix is called singular [-] (eigenvalue ratio 1e-12): far above the central
+differences' rounding, far below any identifiable case measured (``docs/accuracy.md``)."""
 
 
 def noise_variance(spec) -> float:
@@ -97,6 +101,24 @@ def _check_pad(spec, x_mm: float, y_mm: float) -> None:
             )
 
 
+def rank_test(a: np.ndarray, scales, tolerance: float = RANK_TOLERANCE) -> dict:
+    """Rank of ``J = A^T A`` from the singular values of ``A`` with each column times its
+    parameter's physical scale (``scales``: a pitch for a position [mm], the load for a
+    force [N]), so a singular value is the readings' change, in noise units, for a move
+    of one pitch or a change of the whole load: ``rank``, ``smallest_ratio`` (smallest
+    over largest singular value) and ``singular`` (``smallest_ratio < tolerance``).
+
+    Not scaled by the columns' own lengths: a parameter no reading depends on has a
+    column of rounding, which scaled to unit length would look independent."""
+    scaled = np.asarray(a, dtype=float) * np.asarray(scales, dtype=float)
+    if not np.all(np.isfinite(scaled)) or not np.any(scaled):
+        return {"rank": 0, "smallest_ratio": 0.0, "singular": True}
+    s = np.linalg.svd(scaled, compute_uv=False)
+    ratio = float(s[-1] / s[0])
+    return {"rank": int(np.sum(s > tolerance * s[0])), "smallest_ratio": ratio,
+            "singular": ratio < tolerance}  # fmt: skip
+
+
 def fisher_information(
     spec,
     x_mm: float,
@@ -154,20 +176,28 @@ def cramer_rao_bound(
     Raises
     ------
     TactsenseInputError
-        Where the contact is not identifiable (singular Fisher information): the probe
-        moves too few taxels (on a thin incompressible layer, a probe centred on a taxel
-        moves no neighbour).
+        Where the contact is not identifiable (singular Fisher information by the rank
+        test of :data:`RANK_TOLERANCE`): on a thin incompressible layer a probe centred
+        on a resistive taxel stretches its neighbours, which read tension as rest; see
+        :mod:`tactsense.analysis.pad_censored` for the censored and Bayesian bounds.
     """
     information = fisher_information(spec, x_mm, y_mm, force_n, radius_mm=radius_mm)
-    covariance = None
-    if np.all(np.isfinite(information)) and np.linalg.cond(information) < 1e12:
-        covariance = np.linalg.inv(information)
-    if covariance is None or np.any(np.diag(covariance) <= 0):
+    # the rank test on J = A^T A (A's singular values: the square roots of J's
+    # eigenvalues), in units of a pitch and the load
+    g = spec.grid
+    scale = np.array([g.row_pitch_mm, g.col_pitch_mm, force_n])
+    singular = not np.all(np.isfinite(information))
+    if not singular:
+        eigen = np.linalg.eigvalsh(information * np.outer(scale, scale))
+        singular = eigen[0] <= (RANK_TOLERANCE**2) * eigen[-1]
+    if singular:
         raise TactsenseInputError(
             f"a {force_n:g}-N probe at ({x_mm:g}, {y_mm:g}) mm is not identifiable on "
-            f"{spec.name!r} (singular Fisher information): too few taxels respond to a "
-            "move of it; try a point between taxels"
+            f"{spec.name!r} (singular Fisher information: rank test, tolerance "
+            f"{RANK_TOLERANCE:g}): no compressed taxel's reading moves with it; try a "
+            "point between taxels"
         )
+    covariance = np.linalg.inv(information)
     std = np.sqrt(np.diag(covariance))
     g = spec.grid
     return {

@@ -12,17 +12,20 @@ taxels ``pitch_mm`` apart along both axes (electrodes scaled with the pitch):
 * ``crb_position_mm`` and ``crb_force_pct``: the Cramer-Rao bound on the position
   (root mean square over x and y) and on the force of a probe a quarter pitch off a
   taxel along both axes, with the pad's read noise and quantization (what any estimator
-  could reach) [mm], [%]; ``inf`` where the position is not observable (the probe's
-  neighbours do not respond: no overlap between taxels). The bound is for that one
-  position: on a thin incompressible layer a probe centred on a taxel moves no neighbour
-  (the bound there is infinite), while a quarter pitch off it two neighbours respond and
-  the bound is small; a map of the bound over positions within a taxel is still to do.
+  could reach) [mm], [%]; ``inf`` where the Fisher matrix is singular by the rank test
+  of :func:`tactsense.analysis.pad_bound.rank_test`. The bound is for that one
+  position: on a thin incompressible layer a probe centred on a resistive taxel
+  stretches its neighbours, which read tension as rest (the classic bound there is
+  infinite), while a quarter pitch off it two neighbours are compressed and the bound is
+  small; :mod:`tactsense.analysis.pad_censored` gives the censored bound and the
+  Bayesian one over the cell.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from tactsense.analysis.pad_bound import rank_test
 from tactsense.kinds import kind_of
 from tactsense.physics.contact import grams_force
 from tactsense.physics.indenters import SphereProbe
@@ -128,10 +131,10 @@ def design_point(
     noise = spec.flaws.read_noise_counts**2 + 1.0 / 12.0  # read noise and quantization
     jacobian = np.column_stack([d_x, d_y, d_f])
     fisher = jacobian.T @ jacobian / noise
-    # a position no taxel's reading depends on (no overlap between taxels) is not
-    # observable: the bound is unbounded, inf
+    # a position no compressed taxel's reading depends on is not observable: the bound
+    # is unbounded, inf (the rank test of pad_bound, not an absolute condition cut-off)
     position = force_pct = float("inf")
-    if np.linalg.cond(fisher) < 1e12:
+    if not rank_test(jacobian / np.sqrt(noise), (pitch_mm, pitch_mm, force))["singular"]:
         bound = np.linalg.inv(fisher)
         if bound[0, 0] > 0 and bound[1, 1] > 0 and bound[2, 2] > 0:
             position = float(np.sqrt(0.5 * (bound[0, 0] + bound[1, 1])))

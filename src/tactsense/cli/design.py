@@ -135,9 +135,22 @@ def design_bound(
     as_json: Annotated[
         bool, typer.Option("--json", help="Print the result as JSON instead of a table.")
     ] = False,
+    noise_fs: Annotated[
+        float | None,
+        typer.Option(
+            "--noise-fs",
+            min=0.001,
+            max=50.0,
+            help="Pads: the realistic read noise the bounds are also given at, in % of the "
+            "converter's full scale, 0.001-50 [default: 1, the lower end of 1-2 % for "
+            "piezoresistive arrays; Interlink FSR 400 data sheet: +-2 % repeatability].",
+        ),
+    ] = None,
 ) -> None:
     """Cramer-Rao lower bound on contact position and force at the sensor's reading noise
-    (a finger, or a pad: a sphere at --x-mm, --y-mm)."""
+    (a finger, or a pad: a sphere at --x-mm, --y-mm; pads also give the censored
+    (one-sided) bound and the Bayesian bound over the taxel cell, at the preset's noise
+    and at --noise-fs)."""
     try:
         spec = load_sensor(sensor)
         kind = kind_of(spec)
@@ -147,13 +160,13 @@ def design_bound(
                     fail(f"{flag} is for fingers; {spec.name!r} is a {kind.label}: give "
                          "--x-mm, --y-mm")  # fmt: skip
             _pad_bound(spec, x_mm, y_mm, force_g, 3.2 if diameter is None else diameter,
-                       as_json)  # fmt: skip
+                       as_json, 1.0 if noise_fs is None else noise_fs)  # fmt: skip
             return
         if kind.design_model != "paper":
             bounded = " and ".join(f"{k.name} sensors" for k in kinds().values() if k.design_model)
             raise KindNotSupported(f"design bound works on {bounded}; {spec.name!r} is a "
                                    f"{kind.label}")  # fmt: skip
-        for flag, value in (("--x-mm", x_mm), ("--y-mm", y_mm)):
+        for flag, value in (("--x-mm", x_mm), ("--y-mm", y_mm), ("--noise-fs", noise_fs)):
             if value is not None:
                 fail(f"{flag} is for pads; {spec.name!r} is a {kind.label}: give --axial, --angle")
     except TactsenseInputError as error:
@@ -218,7 +231,7 @@ def _finger_bound(spec, axial, angle, force_g, diameter, as_json) -> None:
     print_table(table)
 
 
-def _pad_bound(spec, x_mm, y_mm, force_g, diameter, as_json) -> None:
+def _pad_bound(spec, x_mm, y_mm, force_g, diameter, as_json, noise_fs=1.0) -> None:
     """``design bound`` on a pad: a sphere of ``diameter`` mm at (x_mm, y_mm)."""
     import json
 
@@ -241,13 +254,23 @@ def _pad_bound(spec, x_mm, y_mm, force_g, diameter, as_json) -> None:
     force = grams_force(force_g)
     try:
         bound = cramer_rao_bound(spec, x, y, force, radius_mm=0.5 * diameter)
+    except TactsenseInputError:
+        bound = None  # singular: the censored and Bayesian bounds below say more
+    from tactsense.cli._pad_bounds import pad_bound_rows
+
+    try:
+        rows = pad_bound_rows(spec, x, y, force, 0.5 * diameter, noise_fs)
     except TactsenseInputError as error:
         fail(str(error))
     noise = float(np.sqrt(noise_variance(spec)))
     if as_json:
         inputs = {"x_mm": x, "y_mm": y, "force_n": force, "probe_diameter_mm": diameter,
-                  "sensor": spec.name, "noise_counts": noise}  # fmt: skip
-        typer.echo(json.dumps({"inputs": inputs, "bound": bound}, indent=2))
+                  "sensor": spec.name, "noise_counts": noise, "noise_fs_pct": noise_fs}  # fmt: skip
+        finite = [  # strict JSON: a singular bound's infinities as null
+            {k: (None if isinstance(v, float) and not np.isfinite(v) else v) for k, v in r.items()}
+            for r in rows
+        ]
+        typer.echo(json.dumps({"inputs": inputs, "bound": bound, "bounds": finite}, indent=2))
         return
     table = Table(
         title=f"Cramer-Rao bound, {force_g:g} g ({diameter:g}-mm sphere) at ({x:g}, {y:g}) mm "
@@ -255,12 +278,18 @@ def _pad_bound(spec, x_mm, y_mm, force_g, diameter, as_json) -> None:
         show_header=False,
     )
     table.add_row("reading noise", f"{noise:.3f} counts RMS (read noise and quantization)")
-    table.add_row("along x", f"{1e3 * bound['x_mm']:.3g} um ({bound['x_pitch']:.3g} pitch)")
-    table.add_row("along y", f"{1e3 * bound['y_mm']:.3g} um ({bound['y_pitch']:.3g} pitch)")
-    table.add_row(
-        "force", f"{1e3 * bound['force_n']:.3g} mN ({100 * bound['force_relative']:.3g} %)"
-    )
+    if bound is None:
+        table.add_row("classic bound", "singular Fisher information (see the rank test below)")
+    else:
+        table.add_row("along x", f"{1e3 * bound['x_mm']:.3g} um ({bound['x_pitch']:.3g} pitch)")
+        table.add_row("along y", f"{1e3 * bound['y_mm']:.3g} um ({bound['y_pitch']:.3g} pitch)")
+        table.add_row(
+            "force", f"{1e3 * bound['force_n']:.3g} mN ({100 * bound['force_relative']:.3g} %)"
+        )
     print_table(table)
+    from tactsense.cli._pad_bounds import bounds_table
+
+    print_table(bounds_table(rows, spec.name))
 
 
 class ElasticModel(StrEnum):
