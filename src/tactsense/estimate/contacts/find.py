@@ -245,12 +245,19 @@ def _grid_contacts(
         peak = seg["value"]
         if method == "fit":
             row, col, force = pad_fit(signal, labels, seg, sensor)
+            model = kind.contact_model(sensor)
+            if model is not None:  # each contact's size fitted too (r6-padfit)
+                from tactsense.estimate.contacts._joint import joint_fit
+
+                row, col, force, radius = joint_fit(signal, seg, row, col, force, sensor, model)
+                extra["contact_radius_mm"] = radius
             x = row * g.row_pitch_mm
             y = col * g.col_pitch_mm
         else:
             force = pad_contact_force(signal, labels, seg, sensor)
-        pad_merged_force(signal, labels, seg, row, col, sensor, threshold, force)
-        if seg["wide"].any():
+        if "contact_radius_mm" not in extra:  # the joint fit sizes each contact itself
+            pad_merged_force(signal, labels, seg, row, col, sensor, threshold, force)
+        if seg["wide"].any() and "contact_radius_mm" not in extra:
             # an extended contact (a stamp's rim): no point load explains it; its summed
             # signal over a point load's summed response per newton
             force = np.where(seg["wide"], seg["total"] / _kernel_total(sensor), force)
