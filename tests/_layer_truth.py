@@ -18,7 +18,8 @@ def hankel_hertz_strain(spec, x_mm, y_mm, force_n, radius_mm=1.6, sub=12, shape=
     a direct Navier solve in ``tests/physics/test_layer.py``), by 16-point Gauss-Legendre
     panels, on 1500 radii joined by a cubic spline (smooth in the probe's position),
     averaged over each electrode on ``sub`` x ``sub`` points. ``shape="disc"``: a flat
-    disc of radius ``radius_mm`` (uniform pressure, transform ``2 F J1(q) / q``). Against the FFT grid: 0.56 %
+    disc of radius ``radius_mm`` (uniform pressure, transform ``2 F J1(q) / q``).
+    Against the FFT grid: 0.56 %
     of the peak on a 6-mm pad16; 8 vs 16 electrode points change it by 0.09 %."""
     lay = spec.layer
     h, z = 1e-3 * lay.thickness_mm, 1e-3 * lay.sensing_depth_mm
