@@ -246,11 +246,15 @@ def _grid_contacts(
         if method == "fit":
             row, col, force = pad_fit(signal, labels, seg, sensor)
             model = kind.contact_model(sensor)
-            if model is not None:  # each contact's size fitted too (r6-padfit)
-                from tactsense.estimate.contacts._joint import joint_fit
+            if model is not None:  # each contact's size; more contacts (r6-padfit)
+                from tactsense.estimate.contacts._joint import fit_sizes
 
-                row, col, force, radius = joint_fit(signal, seg, row, col, force, sensor, model)
+                seg, row, col, force, radius = fit_sizes(
+                    signal, seg, row, col, force, sensor, model, max_contacts
+                )
                 extra["contact_radius_mm"] = radius
+                n = len(seg["frame"])
+                flags, z, peak = np.zeros(n, np.int64), np.zeros(n), seg["value"]
             x = row * g.row_pitch_mm
             y = col * g.col_pitch_mm
         else:
