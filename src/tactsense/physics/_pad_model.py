@@ -50,8 +50,9 @@ def sphere_radius_mm(force_n, contact_radius_mm, modulus_star_pa):
 
 
 class PadContactModel:
-    """A pad's signal [-] under round Hertzian contacts at (x, y) [mm], force [N] and
-    contact radius a [mm]: what ``find_contacts``' ``fit`` method fits."""
+    """A pad's signal [-] under round contacts at (x, y) [mm], force [N], contact radius
+    a [mm] and flat share (a Hertzian sphere's pressure, a flat disc's, or a mix): what
+    ``find_contacts``' ``fit`` method fits."""
 
     def __init__(self, spec):
         g = spec.grid
@@ -63,10 +64,13 @@ class PadContactModel:
         )
         self.a_top_mm = FIT_A_STEP_MM * math.ceil(top / FIT_A_STEP_MM + 1e-9)
         electrode = (float(g.electrode_x_mm), float(g.electrode_y_mm))
-        table = layer_response_table(layer, electrode, "sphere", self.a_top_mm, FIT_A_STEP_MM)
-        self.table = table
-        self.x_factors = table.padded_x
-        self.y_factors = table.padded_y
+        self.tables = {
+            shape: layer_response_table(layer, electrode, shape, self.a_top_mm, FIT_A_STEP_MM)
+            for shape in ("sphere", "disc")
+        }
+        self.factors = {
+            shape: (table.padded_x, table.padded_y) for shape, table in self.tables.items()
+        }
         self.x_taxel = g.row_pitch_mm * np.arange(g.rows, dtype=float)
         self.y_taxel = g.col_pitch_mm * np.arange(g.cols, dtype=float)
         self.pitch_mm = (float(g.row_pitch_mm), float(g.col_pitch_mm))
@@ -74,19 +78,27 @@ class PadContactModel:
         self.capacitive = t.kind == "capacitive"
         self.scale = t.strain_gain if self.capacitive else 1.0
 
-    def signal(self, position_mm, force_n, radius_mm, *, signed=False) -> np.ndarray:
+    def signal(self, position_mm, force_n, radius_mm, flat=None, *, signed=False) -> np.ndarray:
         """The frame's signal (rows, cols) [-] under contacts at ``position_mm`` (k, 2),
-        forces (k,) [N] and contact radii (k,) [mm] (clipped to the table); a resistive
-        taxel's strain clipped at zero unless ``signed``."""
+        forces (k,) [N] and contact radii (k,) [mm] (clipped to the table), each a share
+        ``flat`` (k,) [-] (default 0) of its force as a flat disc's uniform pressure and
+        the rest as a Hertzian sphere's; a resistive taxel's strain clipped at zero unless
+        ``signed``."""
         position = np.ascontiguousarray(np.reshape(position_mm, (1, -1, 2)), dtype=float)
-        force = np.reshape(np.asarray(force_n, float), (1, -1)) * self.scale
+        force = np.maximum(np.reshape(np.asarray(force_n, float), (1, -1)) * self.scale, 0.0)
         radius = np.clip(np.reshape(np.asarray(radius_mm, float), (1, -1)), 0.0, self.a_top_mm)
+        radius = np.ascontiguousarray(radius)
+        share = 0.0 if flat is None else np.clip(np.reshape(flat, (1, -1)), 0.0, 1.0)
         out = np.zeros((1, self.x_taxel.size, self.y_taxel.size))
-        superpose(
-            self.x_taxel, self.y_taxel, position, np.maximum(force, 0.0),
-            np.ascontiguousarray(radius), self.x_factors, self.y_factors,
-            self.table.step_mm, self.table.a_step_mm, out,
-        )  # fmt: skip
+        for shape, part in (("sphere", 1.0 - share), ("disc", share)):
+            if np.all(np.asarray(part) == 0.0):
+                continue
+            table = self.tables[shape]
+            x_factors, y_factors = self.factors[shape]
+            superpose(
+                self.x_taxel, self.y_taxel, position, np.ascontiguousarray(force * part),
+                radius, x_factors, y_factors, table.step_mm, table.a_step_mm, out,
+            )  # fmt: skip
         if self.capacitive or signed:
             return out[0]
         return np.maximum(out[0], 0.0)

@@ -20,6 +20,11 @@ from tactsense.estimate.reading import signal_noise_variance
 SEED_RADIUS_MM = 1.0
 """Contact radius the fit starts from [mm]."""
 
+NP = 5
+"""Parameters per contact: x, y [mm], force [N], contact radius a [mm], flat share [-]
+(the share of the force pressed as a flat disc's uniform pressure, the rest as a Hertzian
+sphere's)."""
+
 
 PRIOR_RADIUS_MM = 1.6
 """The prior's sphere: the scenarios' probe [mm]. Where a frame cannot tell a contact's
@@ -30,37 +35,41 @@ PRIOR_WIDTH = 0.7
 """Width of the prior on ln a [-] (spheres 1-10 mm at 10-500 g span ln a by 2.1)."""
 
 
-def _fit_frame(model, frame, x0, y0, f0, a0, sigma=None):
-    """Least-squares (x, y [mm], force [N], a [mm]) of k contacts on one frame, and the
-    residual sum of squares [-^2]. With ``sigma`` [-] (the noise's standard deviation)
-    each ln a is drawn toward the prior's (:data:`PRIOR_RADIUS_MM`, :data:`PRIOR_WIDTH`):
-    a maximum a posteriori fit, the prior weighing one noise's worth per width."""
+def _fit_frame(model, frame, x0, y0, f0, a0, w0=None, sigma=None):
+    """Least-squares (x, y [mm], force [N], a [mm], flat share w [-]) of k contacts on
+    one frame (k, 5), and the residual sum of squares [-^2]. With ``sigma`` [-] (the
+    noise's standard deviation) each ln a is drawn toward the prior's
+    (:data:`PRIOR_RADIUS_MM`, :data:`PRIOR_WIDTH`): a maximum a posteriori fit, the
+    prior weighing one noise's worth per width."""
     k = len(x0)
     px, py = model.pitch_mm
     rows, cols = frame.shape
-    p0 = np.column_stack([x0, y0, np.maximum(f0, 1e-6), np.clip(a0, 0.0, model.a_top_mm)])
-    lo = np.tile([-2.0 * px, -2.0 * py, 0.0, 0.0], k)
-    hi = np.tile([(rows + 1) * px, (cols + 1) * py, np.inf, model.a_top_mm], k)
+    w0 = np.full(k, 0.5) if w0 is None else w0
+    p0 = np.column_stack(
+        [x0, y0, np.maximum(f0, 1e-6), np.clip(a0, 0.0, model.a_top_mm), np.clip(w0, 0, 1)]
+    )
+    lo = np.tile([-2.0 * px, -2.0 * py, 0.0, 0.0, 0.0], k)
+    hi = np.tile([(rows + 1) * px, (cols + 1) * py, np.inf, model.a_top_mm, 1.0], k)
     p0 = np.clip(p0.ravel(), lo + 1e-9, hi - 1e-9)
     target = frame.ravel()
 
     def residual(p):
-        q = p.reshape(k, 4)
-        misfit = model.signal(q[:, :2], q[:, 2], q[:, 3]).ravel() - target
+        q = p.reshape(k, NP)
+        misfit = model.signal(q[:, :2], q[:, 2], q[:, 3], q[:, 4]).ravel() - target
         if sigma is None:
             return misfit
         prior = _prior_radius(model, q[:, 2])
         pull = sigma * np.log(np.maximum(q[:, 3], 1e-3) / prior) / PRIOR_WIDTH
         return np.concatenate([misfit, pull])
 
-    scale = np.tile([0.1 * px, 0.1 * py, max(float(np.max(f0)), 1e-3) * 0.05, 0.1], k)
+    scale = np.tile([0.1 * px, 0.1 * py, max(float(np.max(f0)), 1e-3) * 0.05, 0.1, 0.1], k)
     with warnings.catch_warnings(), np.errstate(all="ignore"):
         warnings.simplefilter("ignore")
         out = least_squares(
             residual, p0, bounds=(lo, hi), x_scale=scale, method="trf",
             diff_step=1e-6, xtol=1e-10, ftol=1e-12, gtol=1e-12, max_nfev=200 * (k + 1),
         )  # fmt: skip
-    q = out.x.reshape(k, 4)
+    q = out.x.reshape(k, NP)
     return q, float(np.sum(out.fun[: target.size] ** 2))
 
 
@@ -100,15 +109,16 @@ def _split_seed(q, c, moments, pitch):
     two[:2] -= step
     one[2] = two[2] = q[c, 2] / 2.0
     one[3] = two[3] = SEED_RADIUS_MM
+    one[4] = two[4] = 0.5
     return np.vstack([np.delete(q, c, axis=0), one, two])
 
 
 def _order(model, frame, q, rss, moments, noise_var, max_contacts):
     """More contacts where a likelihood criterion asks for them: the contact whose
     region's residual is largest split in two and the frame refitted jointly; kept when
-    the Bayesian information criterion falls (4 more parameters: ``rss / sigma^2`` must
-    fall by more than ``4 ln n``). Returns the fitted contacts (k', 4), the index among
-    the originals each came from, and the RSS."""
+    the Bayesian information criterion falls (:data:`NP` more parameters: ``rss /
+    sigma^2`` must fall by more than ``NP ln n``). Returns the fitted contacts (k', NP),
+    the index among the originals each came from, and the RSS."""
     n = frame.size
     parents = list(range(len(q)))
     while len(q) < max_contacts:
@@ -124,7 +134,7 @@ def _order(model, frame, q, rss, moments, noise_var, max_contacts):
             gain = (rss - rss2) / noise_var
             if apart < SPLIT_MIN_PITCH or share < SPLIT_MIN_SHARE:
                 continue
-            if gain > 4.0 * math.log(n) and (best is None or rss2 < best[1]):
+            if gain > NP * math.log(n) and (best is None or rss2 < best[1]):
                 order = [p for i, p in enumerate(parents) if i != c] + [parents[c]] * 2
                 best = (q2, rss2, order)
         if best is None:
@@ -134,7 +144,8 @@ def _order(model, frame, q, rss, moments, noise_var, max_contacts):
 
 
 def joint_fit(signal, seg, row, col, force, sensor, model, noise_var=None, max_contacts=0):
-    """Each contact's row, column [taxel], force [N] and contact radius [mm], fitted
+    """Each contact's row, column [taxel], force [N], contact radius [mm] and flat share
+    [-], fitted
     jointly with the other contacts of its frame, starting from ``row``, ``col``
     [taxel] and ``force`` [N] (the fixed-shape fit). Contacts whose seed force is not
     finite keep their seed.
@@ -146,9 +157,10 @@ def joint_fit(signal, seg, row, col, force, sensor, model, noise_var=None, max_c
     n = len(seg["frame"])
     row, col, force = (np.array(v, float, copy=True) for v in (row, col, force))
     radius = np.full(n, np.nan)
+    flat = np.full(n, np.nan)
     added = []
     if n == 0:
-        return row, col, force, radius, added
+        return row, col, force, radius, flat, added
     px, py = model.pitch_mm
     frames = np.asarray(seg["frame"])
     order = np.argsort(frames, kind="stable")
@@ -162,7 +174,7 @@ def joint_fit(signal, seg, row, col, force, sensor, model, noise_var=None, max_c
         sigma = math.sqrt(signal_noise_variance(sensor))
         q, rss = _fit_frame(
             model, frame, row[good] * px, col[good] * py,
-            force[good], np.full(len(good), SEED_RADIUS_MM), sigma,
+            force[good], np.full(len(good), SEED_RADIUS_MM), sigma=sigma,
         )  # fmt: skip
         parents = np.arange(len(good))
         if noise_var is not None and max_contacts > len(good):
@@ -172,16 +184,16 @@ def joint_fit(signal, seg, row, col, force, sensor, model, noise_var=None, max_c
         seen = set()
         for j, p in enumerate(parents):
             i = good[p]
-            values = (q[j, 0] / px, q[j, 1] / py, q[j, 2], q[j, 3])
+            values = (q[j, 0] / px, q[j, 1] / py, q[j, 2], q[j, 3], q[j, 4])
             if p in seen:
                 added.append((i, *values))
                 continue
             seen.add(p)
-            row[i], col[i], force[i], radius[i] = values
+            row[i], col[i], force[i], radius[i], flat[i] = values
         missing = set(range(len(good))) - seen
         for p in missing:  # an original replaced by none (cannot happen: splits only add)
             force[good[p]] = np.nan
-    return row, col, force, radius, added
+    return row, col, force, radius, flat, added
 
 
 def information(rss, noise_var, n_taxels, n_params):
@@ -194,13 +206,13 @@ def fit_sizes(signal, seg, row, col, force, sensor, model, max_contacts):
     (:func:`~tactsense.estimate.reading.signal_noise_variance`): the segmentation's rows
     ``seg`` extended by the contacts added (each a copy of its parent's row, numbered
     after the frame's others), sorted by frame and contact, and each row's row, column
-    [taxel], force [N] and contact radius [mm]."""
+    [taxel], force [N], contact radius [mm] and flat share [-]."""
     noise_var = signal_noise_variance(sensor)
-    row, col, force, radius, added = joint_fit(
+    row, col, force, radius, flat, added = joint_fit(
         signal, seg, row, col, force, sensor, model, noise_var, max_contacts
     )
     if not added:
-        return seg, row, col, force, radius
+        return seg, row, col, force, radius, flat
     parent = np.array([a[0] for a in added], np.int64)
     seg = {key: np.concatenate([value, value[parent]]) for key, value in seg.items()}
     n_old = len(row)
@@ -210,6 +222,7 @@ def fit_sizes(signal, seg, row, col, force, sensor, model, max_contacts):
     extra = np.array([a[1:] for a in added], float)
     row, col = np.concatenate([row, extra[:, 0]]), np.concatenate([col, extra[:, 1]])
     force, radius = np.concatenate([force, extra[:, 2]]), np.concatenate([radius, extra[:, 3]])
+    flat = np.concatenate([flat, extra[:, 4]])
     order = np.lexsort((seg["contact"], seg["frame"]))
     seg = {key: value[order] for key, value in seg.items()}
-    return seg, row[order], col[order], force[order], radius[order]
+    return seg, row[order], col[order], force[order], radius[order], flat[order]

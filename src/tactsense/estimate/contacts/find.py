@@ -249,10 +249,10 @@ def _grid_contacts(
             if model is not None:  # each contact's size; more contacts (r6-padfit)
                 from tactsense.estimate.contacts._joint import fit_sizes
 
-                seg, row, col, force, radius = fit_sizes(
+                seg, row, col, force, radius, flat = fit_sizes(
                     signal, seg, row, col, force, sensor, model, max_contacts
                 )
-                extra["contact_radius_mm"] = radius
+                extra["contact_radius_mm"], extra["flat_share"] = radius, flat
                 n = len(seg["frame"])
                 flags, z, peak = np.zeros(n, np.int64), np.zeros(n), seg["value"]
             x = row * g.row_pitch_mm
