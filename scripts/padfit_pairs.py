@@ -39,7 +39,7 @@ END = "<!-- end of scripts/padfit_pairs.py -->"
 PADS = ("pad4", "pad16", "pad12x32")
 SEPARATIONS = (1.0, 1.5, 2.0, 2.5)
 ORIENTATIONS = (0.0, 22.5, 45.0, 67.5, 90.0)
-PHASES = 3
+PHASES = 2
 LOAD_N = 0.49
 NOISE_SHARE = 0.01
 
