@@ -18,8 +18,9 @@ from tactsense.physics._contact_kernel import superpose
 from tactsense.physics._hertz_table import layer_response_table
 
 FIT_A_STEP_MM = 0.1
-"""Step of the fit's table in the pressure radius a [mm] (linear between: the force it
-reads moves by under 0.2 % against a step of 0.05 mm; tests/estimate/test_pad_model.py)."""
+"""Step of the fit's table in the pressure radius a [mm], linear between (the model
+within 2e-3 of the peak of an exact Hankel-transform solution between steps:
+tests/estimate/test_pad_model.py)."""
 
 SPHERE_RADII_MM = (1.0, 10.0)
 """Sphere radii the fit's table covers at :data:`LOADS_N` [mm] (issue 34 item 1)."""
