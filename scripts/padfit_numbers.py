@@ -1,4 +1,4 @@
-"""Issue 34 item 1: the pad fit (``find_contacts(method="fit")``) on frames it does not
+"""Issue 34 item 1: the pad fit (``find_contacts(method="joint")``) on frames it does not
 share: a Hankel-transform solution of the bonded layer (tests/_layer_truth.py) under
 Hertzian spheres (1, 3, 10 mm; Hertz radius of the half space) and flat discs (radius
 0.5, 1, 1.5 pitches: 1-3 pitches across) at 10, 50 and 500 g, each at a random sub-taxel
@@ -55,7 +55,7 @@ def measure(spec, rng):
                 y = (g.cols / 2 - 0.5 + rng.uniform()) * g.col_pitch_mm
                 strain = hankel_hertz_strain(spec, x, y, load, radius_mm=radius, shape=shape)
                 t0 = time.perf_counter()
-                fit = find_contacts(_signal(spec, strain), spec, counts=False, method="fit")
+                fit = find_contacts(_signal(spec, strain), spec, counts=False, method="joint")
                 times.append(time.perf_counter() - t0)
                 if len(fit) != 1:
                     out.append((shape, size, load, np.nan, np.nan, len(fit)))

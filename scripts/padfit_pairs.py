@@ -10,7 +10,7 @@ pair's midpoint at ``PHASES`` random sub-taxel offsets from the middle of the pa
 seeded draw per cell). Noise-free and quantized to one A/D count; and with Gaussian read
 noise of 1 % of the A/D's full scale (the estimator told that noise: the sensor's
 ``read_noise_counts`` set to it). A frame *resolves* the pair when
-``find_contacts(..., method="fit")`` reports exactly two contacts and each true contact
+``find_contacts(..., method="joint")`` reports exactly two contacts and each true contact
 has its own estimate within half the separation; the position error of a resolved pair
 is the RMS over its two contacts.
 
@@ -70,7 +70,7 @@ def pair_case(spec, estimator_spec, sep, angle_deg, rng, noise_counts):
     truth = np.array([centre + half, centre - half])
     strain = sum(hankel_hertz_strain(spec, x, y, LOAD_N) for x, y in truth)
     signal = _signal(spec, strain, noise_counts, rng)
-    fit = find_contacts(signal, estimator_spec, counts=False, method="fit")
+    fit = find_contacts(signal, estimator_spec, counts=False, method="joint")
     if len(fit) != 2:
         return False, np.nan
     est = np.column_stack([fit.x_mm, fit.y_mm])

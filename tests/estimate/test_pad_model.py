@@ -53,7 +53,7 @@ def test_force_position_and_size_of_any_indenter(thick, shape, size, load):
     g = thick.grid
     x, y = 7.3 * g.row_pitch_mm, 8.7 * g.col_pitch_mm
     strain = np.maximum(hankel_hertz_strain(thick, x, y, load, radius_mm=size, shape=shape), 0)
-    fit = find_contacts(strain, thick, counts=False, method="fit", threshold=1e-4)
+    fit = find_contacts(strain, thick, counts=False, method="joint", threshold=1e-4)
     assert len(fit) == 1
     assert fit.force_n[0] == pytest.approx(load, rel=0.02)
     assert np.hypot(fit.x_mm[0] - x, fit.y_mm[0] - y) < 0.05 * g.row_pitch_mm
@@ -74,7 +74,7 @@ def test_two_contacts_one_and_a_half_pitches_apart_are_two(thick, angle):
     truth = np.array([centre + half, centre - half])
     strain = sum(hankel_hertz_strain(thick, x, y, 0.49) for x, y in truth)
     signal = np.round(np.maximum(strain, 0) * 20000) / 20000  # quantized
-    fit = find_contacts(signal, thick, counts=False, method="fit")
+    fit = find_contacts(signal, thick, counts=False, method="joint")
     assert len(fit) == 2
     est = np.column_stack([fit.x_mm, fit.y_mm])
     d = np.hypot(*(truth[:, None, :] - est[None, :, :]).transpose(2, 0, 1))
