@@ -296,7 +296,7 @@ class Kind:
 
     # ---- contacts of any size (r6-padfit) ----------------------------------------
     def contact_model(self, spec: Any) -> Any:
-        """The model the ``fit`` method of ``find_contacts`` fits jointly to a frame's
+        """The model the ``joint`` method of ``find_contacts`` fits jointly to a frame's
         contacts, or None (the default: the kind has none). An object with
         ``signal(position_mm (k, 2), force_n (k,), radius_mm (k,))`` -> the frame's
         signal [-] under k round contacts of contact radius a [mm], ``a_top_mm`` (the

@@ -3,7 +3,7 @@
 The layer is linear and the same everywhere: a frame under k round contacts is
 ``sum_c F_c G(a_c; x_i - x_c, y_j - y_c)``, ``G`` the layer's taxel response per newton
 to a round pressure of radius a (:mod:`tactsense.physics._hertz_table`, exact transfer
-function, no sampled pressure). The estimator fits (x_c, y_c, F_c, a_c) of every contact
+function, no sampled pressure). The ``joint`` method fits (x_c, y_c, F_c, a_c) of every contact
 of a frame jointly through :class:`PadContactModel` (a pad kind's ``contact_model``).
 """
 
@@ -53,7 +53,7 @@ def sphere_radius_mm(force_n, contact_radius_mm, modulus_star_pa):
 class PadContactModel:
     """A pad's signal [-] under round contacts at (x, y) [mm], force [N], contact radius
     a [mm] and flat share (a Hertzian sphere's pressure, a flat disc's, or a mix): what
-    ``find_contacts``' ``fit`` method fits."""
+    ``find_contacts``' ``joint`` method fits."""
 
     def __init__(self, spec):
         g = spec.grid
