@@ -46,8 +46,8 @@ def timed(spec, data, method="joint"):
 
 def main(n=200):
     rng = np.random.default_rng(0)
-    print(f"| pad | contacts per frame | fit before [ms per contact] | fit now [ms per contact] "
-          f"| ratio | (median of {n} frames' mean) |")  # fmt: skip
+    print(f"| pad | contacts per frame | fit [ms per contact] | joint [ms per contact] "
+          f"| ratio | ({n} frames) |")  # fmt: skip
     print("|---|---|---|---|---|---|")
     for name in ("pad16", "pad4"):
         spec = load_sensor(name)
