@@ -81,3 +81,12 @@ def test_two_contacts_one_and_a_half_pitches_apart_are_two(thick, angle):
     pair = min(max(d[0, 0], d[1, 1]), max(d[0, 1], d[1, 0]))
     assert pair < 0.1 * g.row_pitch_mm
     np.testing.assert_allclose(fit.force_n, 0.49, rtol=0.05)
+
+
+def test_joint_on_a_kind_without_a_response_table():
+    """A one-line error, not a traceback, on a finger."""
+    from tactsense._validation import TactsenseInputError
+
+    finger = load_sensor("initial")
+    with pytest.raises(TactsenseInputError, match="method 'joint' works on pads"):
+        find_contacts(np.zeros((1, *finger.shape)), finger, counts=False, method="joint")
