@@ -149,7 +149,8 @@ def test_pad_round_trip_from_an_independent_layer_solution(thick, offset, load):
 @pytest.mark.xfail(
     strict=True,
     reason="finding (issue 34 item 1): the fit's table is one 0.49-N contact's shape; "
-    "at 20 g and 100 g its force misses by +2.7 % and -2.5 % on independent frames",
+    "at 20 g and 100 g its force misses by +2.7 % and -2.5 % on independent frames "
+    "(method 'joint' meets it: test_joint_force_within_two_percent_at_any_load)",
 )
 @pytest.mark.parametrize("load", [0.2, 0.98])
 def test_pad_fit_force_within_two_percent_at_any_load(thick, load):
@@ -158,6 +159,17 @@ def test_pad_fit_force_within_two_percent_at_any_load(thick, load):
     x, y = 7.3 * g.row_pitch_mm, 8.7 * g.col_pitch_mm
     strain = np.maximum(hankel_hertz_strain(thick, x, y, load), 0.0)
     fit = find_contacts(strain, thick, counts=False, method="fit")
+    np.testing.assert_allclose(fit.force_n, load, rtol=0.02)
+
+
+@pytest.mark.parametrize("load", [0.2, 0.98])
+def test_joint_force_within_two_percent_at_any_load(thick, load):
+    """Issue 34 item 1's goal, met by method 'joint' (each contact's size fitted):
+    noise-free force within 2 % at 20 and 100 g on independent frames."""
+    g = thick.grid
+    x, y = 7.3 * g.row_pitch_mm, 8.7 * g.col_pitch_mm
+    strain = np.maximum(hankel_hertz_strain(thick, x, y, load), 0.0)
+    fit = find_contacts(strain, thick, counts=False, method="joint")
     np.testing.assert_allclose(fit.force_n, load, rtol=0.02)
 
 

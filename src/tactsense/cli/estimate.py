@@ -118,7 +118,9 @@ def locate(
             help="Long table: how a contact's position is found: 'interpolate' (the "
             "paper's windowed sinc and Newton, on the grid), 'cop' (centre of pressure) or "
             "'fit' (pads: maximum likelihood on the layer's response, the most accurate, "
-            "about 300 us a contact; docs/accuracy.md)."
+            "about 300 us a contact; docs/accuracy.md) or 'joint' (pads: every contact of "
+            "a frame fitted jointly with its size and indenter shape, contacts added by a "
+            "likelihood criterion; tens of ms a frame; docs/contacts.md)."
         ),
     ] = "interpolate",
     drift_s: Annotated[

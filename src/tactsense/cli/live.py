@@ -391,7 +391,7 @@ def live(
         str,
         typer.Option(
             help="Pads and point sets: how a contact's position is found, as for 'locate' "
-            "('interpolate', 'cop' or 'fit')."
+            "('interpolate', 'cop', 'fit' or 'joint')."
         ),
     ] = "interpolate",
     max_contacts: Annotated[

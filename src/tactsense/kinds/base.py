@@ -293,6 +293,15 @@ class Kind:
         deflection [-] (what ``elastic_batch`` gives, before gains) in those frames."""
         return None
 
+    # ---- contacts of any size (r6-padfit) ----------------------------------------
+    def contact_model(self, spec: Any) -> Any:
+        """The model the ``joint`` method of ``find_contacts`` fits jointly to a frame's
+        contacts, or None (the default: the kind has none). An object with
+        ``signal(position_mm (k, 2), force_n (k,), radius_mm (k,))`` -> the frame's
+        signal [-] under k round contacts of contact radius a [mm], ``a_top_mm`` (the
+        largest a it covers), ``pitch_mm`` and ``modulus_star_pa`` [Pa]."""
+        return None
+
 
 RESPONSE_PROBE_N = 0.49
 """The load of the probe whose response :meth:`Kind.contact_response` tabulates: the

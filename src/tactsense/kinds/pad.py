@@ -116,5 +116,13 @@ class PadKind(Kind):
 
         return PadContactForward(spec)
 
+    # ---- contacts of any size (r6-padfit) ----------------------------------------
+    def contact_model(self, spec: PadSpec):
+        """The layer's response to Hertzian contacts of any radius, superposed
+        (:class:`tactsense.physics._pad_model.PadContactModel`)."""
+        from tactsense.physics._pad_model import pad_contact_model
+
+        return pad_contact_model(spec)
+
 
 KIND: Any = PadKind()

@@ -139,16 +139,22 @@ def _quadrant(transfer, k, shape, a, step, n, size):
 
 @functools.lru_cache(maxsize=16)
 def layer_response_table(
-    layer: Layer, electrode_mm: tuple[float, float], shape: str, a_top_mm: float
+    layer: Layer,
+    electrode_mm: tuple[float, float],
+    shape: str,
+    a_top_mm: float,
+    a_step_mm: float | None = None,
 ) -> SeparableResponse:
     """The separable table of ``G`` for a layer, an electrode (x, y) [mm] and a contact
     shape (``"sphere"``: Hertz; ``"disc"``: uniform), for pressure radii 0 to at least
-    ``a_top_mm`` [mm] (cached per process)."""
+    ``a_top_mm`` [mm] every ``a_step_mm`` [mm] (default :data:`A_STEP_MM`; cached per
+    process)."""
+    a_step = A_STEP_MM if a_step_mm is None else float(a_step_mm)
     from scipy.fft import next_fast_len
 
     step = table_step_mm(layer, electrode_mm)
-    n_a = max(2, math.ceil(a_top_mm / A_STEP_MM - 1e-9) + 1)
-    a_values = A_STEP_MM * np.arange(n_a)
+    n_a = max(2, math.ceil(a_top_mm / a_step - 1e-9) + 1)
+    a_values = a_step * np.arange(n_a)
     # a quadrant wide enough for the field to die out (about e-fold per 1.2 layer
     # thicknesses); the periodic images then lie beyond it as well
     trial = math.ceil((18.0 * layer.thickness_mm + max(electrode_mm) + a_values[-1]) / step)
@@ -177,4 +183,4 @@ def layer_response_table(
         if error <= RANK_TOLERANCE * peak:
             break
     x_factors = np.ascontiguousarray(x_flat.reshape(n_a, size, rank))
-    return SeparableResponse(x_factors, y_factors, step, A_STEP_MM, peak, error / peak)
+    return SeparableResponse(x_factors, y_factors, step, a_step, peak, error / peak)

@@ -102,8 +102,10 @@ def find_contacts(
         :class:`~tactsense.estimate.contacts.baseline.DriftBaseline` started from its baseline.
     max_contacts : int
         At most this many contacts per frame, the largest kept (1-64).
-    method : {"interpolate", "cop"}
-        How a contact's position is found (:data:`METHODS`).
+    method : {"interpolate", "cop", "fit", "joint"}
+        How a contact's position is found (:data:`METHODS`); ``"joint"`` (pads): every
+        contact of a frame fitted jointly with its size, contacts added by a likelihood
+        criterion (docs/contacts.md).
     first_frame : int
         Added to the ``frame`` column (pieces of a longer recording).
     saddle : float
@@ -222,8 +224,10 @@ def _grid_contacts(
     signal, sensor, threshold, saddle, max_contacts, method, ring=RING_RATIO
 ) -> ContactTable:
     kind = kind_of(sensor)
-    if method == "fit" and not kind.response_fit:
-        raise TactsenseInputError(f"method 'fit' works on pads; {sensor.name!r} is a {kind.label}")
+    if method in ("fit", "joint") and not kind.response_fit:
+        raise TactsenseInputError(
+            f"method {method!r} works on pads; {sensor.name!r} is a {kind.label}"
+        )
     periodic = kind.periodic(sensor)
     refine = method == "interpolate" and kind.response_fit
     floor = dip_floor(sensor, threshold)
@@ -243,14 +247,25 @@ def _grid_contacts(
         y = col * g.col_pitch_mm
         z = np.zeros(n)
         peak = seg["value"]
-        if method == "fit":
+        if method in ("fit", "joint"):
             row, col, force = pad_fit(signal, labels, seg, sensor)
+            model = kind.contact_model(sensor) if method == "joint" else None
+            if model is not None:  # each contact's size; more contacts (r6-padfit)
+                from tactsense.estimate.contacts._joint import fit_sizes
+
+                seg, row, col, force, radius, flat = fit_sizes(
+                    signal, seg, row, col, force, sensor, model, max_contacts
+                )
+                extra["contact_radius_mm"], extra["flat_share"] = radius, flat
+                n = len(seg["frame"])
+                flags, z, peak = np.zeros(n, np.int64), np.zeros(n), seg["value"]
             x = row * g.row_pitch_mm
             y = col * g.col_pitch_mm
         else:
             force = pad_contact_force(signal, labels, seg, sensor)
-        pad_merged_force(signal, labels, seg, row, col, sensor, threshold, force)
-        if seg["wide"].any():
+        if "contact_radius_mm" not in extra:  # the joint fit sizes each contact itself
+            pad_merged_force(signal, labels, seg, row, col, sensor, threshold, force)
+        if seg["wide"].any() and "contact_radius_mm" not in extra:
             # an extended contact (a stamp's rim): no point load explains it; its summed
             # signal over a point load's summed response per newton
             force = np.where(seg["wide"], seg["total"] / _kernel_total(sensor), force)

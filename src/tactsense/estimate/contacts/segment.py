@@ -42,7 +42,7 @@ are joined by a ridge of at least this share of their summed heights are one con
 that far apart read less than 0.1 of each one's peak between them, 0.15 with a taxel's
 gain half as high again)."""
 
-METHODS = ("interpolate", "cop", "fit")
+METHODS = ("interpolate", "cop", "fit", "joint")
 """``interpolate``: the paper's method on the grid (Hann-windowed sinc over 3 taxels on
 each side of the maximum, Newton to 0.01 taxel); ``cop``: the centre of pressure (the
 signal-weighted mean position of the contact's taxels); ``fit`` (pads): the maximum-

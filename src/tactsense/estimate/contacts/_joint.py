@@ -1,0 +1,228 @@
+"""A pad frame's contacts fitted jointly, each with its own size (issue 34 item 1).
+
+The layer is linear: a frame under k round contacts is the sum of their responses
+(:meth:`~tactsense.kinds.Kind.contact_model`). Seeded by the watershed's contacts and the
+fixed-shape fit, the positions [mm], forces [N] and contact radii [mm] of all contacts of
+a frame are fitted together by least squares over every taxel of the frame (the taxels'
+noise is independent and equal: the maximum-likelihood fit under Gaussian noise).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from tactsense.estimate.reading import signal_noise_variance
+
+SEED_RADIUS_MM = 1.0
+"""Contact radius the fit starts from [mm]."""
+
+NP = 5
+"""Parameters per contact: x, y [mm], force [N], contact radius a [mm], flat share [-]
+(the share of the force pressed as a flat disc's uniform pressure, the rest as a Hertzian
+sphere's)."""
+
+
+PRIOR_RADIUS_MM = 1.6
+"""The prior's sphere: the scenarios' probe [mm]. Where a frame cannot tell a contact's
+size (a few taxels read: a wider, stronger contact gives the same readings), the fit
+takes the Hertz radius of this sphere at the contact's force."""
+
+PRIOR_WIDTH = 0.7
+"""Width of the prior on ln a [-] (spheres 1-10 mm at 10-500 g span ln a by 2.1)."""
+
+
+def _fit_frame(model, frame, x0, y0, f0, a0, w0=None, sigma=None):
+    """Least-squares (x, y [mm], force [N], a [mm], flat share w [-]) of k contacts on
+    one frame (k, 5), and the residual sum of squares [-^2]. With ``sigma`` [-] (the
+    noise's standard deviation) each ln a is drawn toward the prior's
+    (:data:`PRIOR_RADIUS_MM`, :data:`PRIOR_WIDTH`): a maximum a posteriori fit, the
+    prior weighing one noise's worth per width."""
+    k = len(x0)
+    px, py = model.pitch_mm
+    rows, cols = frame.shape
+    w0 = np.full(k, 0.5) if w0 is None else w0
+    p0 = np.column_stack(
+        [x0, y0, np.maximum(f0, 1e-6), np.clip(a0, 0.0, model.a_top_mm), np.clip(w0, 0, 1)]
+    )
+    lo = np.tile([-2.0 * px, -2.0 * py, 0.0, 0.0, 0.0], k)
+    hi = np.tile([(rows + 1) * px, (cols + 1) * py, np.inf, model.a_top_mm, 1.0], k)
+    p0 = np.clip(p0.ravel(), lo + 1e-9, hi - 1e-9)
+    target = frame.ravel()
+
+    def residual(p):
+        q = p.reshape(k, NP)
+        misfit = model.signal(q[:, :2], q[:, 2], q[:, 3], q[:, 4]).ravel() - target
+        if sigma is None:
+            return misfit
+        prior = _prior_radius(model, q[:, 2])
+        pull = sigma * np.log(np.maximum(q[:, 3], 1e-3) / prior) / PRIOR_WIDTH
+        return np.concatenate([misfit, pull])
+
+    scale = np.tile([0.1 * px, 0.1 * py, max(float(np.max(f0)), 1e-3) * 0.05, 0.1, 0.1], k)
+    with warnings.catch_warnings(), np.errstate(all="ignore"):
+        warnings.simplefilter("ignore")
+        out = least_squares(
+            residual, p0, bounds=(lo, hi), x_scale=scale, method="trf",
+            diff_step=1e-6, xtol=1e-10, ftol=1e-12, gtol=1e-12, max_nfev=200 * (k + 1),
+        )  # fmt: skip
+    q = out.x.reshape(k, NP)
+    return q, float(np.sum(out.fun[: target.size] ** 2))
+
+
+def _prior_radius(model, force):
+    """Hertz radius [mm] of :data:`PRIOR_RADIUS_MM`'s sphere under ``force`` [N]."""
+    f = np.maximum(force, 1e-4) * 1e-3
+    a = (3.0 * f * PRIOR_RADIUS_MM / (4.0 * model.modulus_star_pa)) ** (1.0 / 3.0) * 1e3
+    return np.minimum(a, PRIOR_RADIUS_MM)
+
+
+SPLIT_MIN_PITCH = 0.3
+"""Two contacts found by a split must lie at least this far apart [pitch] (closer, the
+pair is one contact's shape fitted by two)."""
+
+MODEL_ERROR = 2e-3
+"""The model's own error against an exact solution of the layer, as a share of the
+frame's largest signal [-] (the table: 1e-3 against the Hankel transform,
+tests/_layer_truth.py), added to the noise's standard deviation when the criterion
+weighs a fit's residual."""
+
+SPLIT_MIN_SHARE = 0.1
+"""Each of two contacts found by a split carries at least this share of their force."""
+
+
+def _split_seed(q, c, moments, pitch):
+    """Seeds (k + 1, 4) with contact ``c`` replaced by two along its major axis: a pair
+    d apart widens a contact's signal by (d/2)^2 along it, so the half separation is
+    the square root of the major minus the minor second moment (at least 0.4 taxel)."""
+    rr, cc, rc = moments
+    lam = np.linalg.eigh(np.array([[rr, rc], [rc, cc]]))
+    (minor, major), vectors = lam
+    u = vectors[:, 1]
+    h = max(0.4, math.sqrt(max(major - minor, 0.0)))  # [taxel]
+    step = np.array([u[0] * h * pitch[0], u[1] * h * pitch[1]])
+    one, two = q[c].copy(), q[c].copy()
+    one[:2] += step
+    two[:2] -= step
+    one[2] = two[2] = q[c, 2] / 2.0
+    one[3] = two[3] = SEED_RADIUS_MM
+    one[4] = two[4] = 0.5
+    return np.vstack([np.delete(q, c, axis=0), one, two])
+
+
+def _order(model, frame, q, rss, moments, noise_var, max_contacts):
+    """More contacts where a likelihood criterion asks for them: the contact whose
+    region's residual is largest split in two and the frame refitted jointly; kept when
+    the Bayesian information criterion falls (:data:`NP` more parameters: ``rss /
+    sigma^2`` must fall by more than ``NP ln n``). Returns the fitted contacts (k', NP),
+    the index among the originals each came from, and the RSS."""
+    n = frame.size
+    parents = list(range(len(q)))
+    while len(q) < max_contacts:
+        if rss / noise_var < n + 3.0 * math.sqrt(2.0 * n):  # consistent with noise alone
+            break
+        best = None
+        for c in range(len(q)):  # try each contact's split, keep the best
+            seed = _split_seed(q, c, moments[parents[c]], model.pitch_mm)
+            q2, rss2 = _fit_frame(model, frame, *seed.T, sigma=math.sqrt(noise_var))
+            pair = q2[-2:]
+            apart = np.hypot(*((pair[0, :2] - pair[1, :2]) / model.pitch_mm))
+            share = pair[:, 2].min() / max(pair[:, 2].sum(), 1e-30)
+            gain = (rss - rss2) / noise_var
+            if apart < SPLIT_MIN_PITCH or share < SPLIT_MIN_SHARE:
+                continue
+            if gain > NP * math.log(n) and (best is None or rss2 < best[1]):
+                order = [p for i, p in enumerate(parents) if i != c] + [parents[c]] * 2
+                best = (q2, rss2, order)
+        if best is None:
+            break
+        q, rss, parents = best
+    return q, np.asarray(parents), rss
+
+
+def joint_fit(signal, seg, row, col, force, sensor, model, noise_var=None, max_contacts=0):
+    """Each contact's row, column [taxel], force [N], contact radius [mm] and flat share
+    [-], fitted
+    jointly with the other contacts of its frame, starting from ``row``, ``col``
+    [taxel] and ``force`` [N] (the fixed-shape fit). Contacts whose seed force is not
+    finite keep their seed.
+
+    With ``noise_var`` [-^2] and ``max_contacts`` > 0, a frame may hold more contacts
+    than the watershed found (:func:`_order`): returns also ``added``, a list of
+    ``(parent index, row, col, force, radius)`` for each contact added (it shares its
+    parent's region)."""
+    n = len(seg["frame"])
+    row, col, force = (np.array(v, float, copy=True) for v in (row, col, force))
+    radius = np.full(n, np.nan)
+    flat = np.full(n, np.nan)
+    added = []
+    if n == 0:
+        return row, col, force, radius, flat, added
+    px, py = model.pitch_mm
+    frames = np.asarray(seg["frame"])
+    order = np.argsort(frames, kind="stable")
+    bounds = np.flatnonzero(np.diff(frames[order])) + 1
+    for group in np.split(order, bounds):
+        good = group[np.isfinite(force[group]) & np.isfinite(row[group])]
+        if len(good) == 0:
+            continue
+        f = int(frames[good[0]])
+        frame = np.asarray(signal[f], float)
+        sigma = math.sqrt(signal_noise_variance(sensor))
+        q, rss = _fit_frame(
+            model, frame, row[good] * px, col[good] * py,
+            force[good], np.full(len(good), SEED_RADIUS_MM), sigma=sigma,
+        )  # fmt: skip
+        parents = np.arange(len(good))
+        if noise_var is not None and max_contacts > len(good):
+            sigma = sigma + MODEL_ERROR * float(np.abs(frame).max())
+            moments = [(seg["rr"][i], seg["cc"][i], seg["rc"][i]) for i in good]
+            q, parents, rss = _order(model, frame, q, rss, moments, sigma**2, max_contacts)
+        seen = set()
+        for j, p in enumerate(parents):
+            i = good[p]
+            values = (q[j, 0] / px, q[j, 1] / py, q[j, 2], q[j, 3], q[j, 4])
+            if p in seen:
+                added.append((i, *values))
+                continue
+            seen.add(p)
+            row[i], col[i], force[i], radius[i], flat[i] = values
+        missing = set(range(len(good))) - seen
+        for p in missing:  # an original replaced by none (cannot happen: splits only add)
+            force[good[p]] = np.nan
+    return row, col, force, radius, flat, added
+
+
+def information(rss, noise_var, n_taxels, n_params):
+    """Bayesian information criterion of a fit [-]: ``rss / sigma^2 + p ln n``."""
+    return rss / noise_var + n_params * math.log(n_taxels)
+
+
+def fit_sizes(signal, seg, row, col, force, sensor, model, max_contacts):
+    """:func:`joint_fit` with model-order selection under the sensor's noise
+    (:func:`~tactsense.estimate.reading.signal_noise_variance`): the segmentation's rows
+    ``seg`` extended by the contacts added (each a copy of its parent's row, numbered
+    after the frame's others), sorted by frame and contact, and each row's row, column
+    [taxel], force [N], contact radius [mm] and flat share [-]."""
+    noise_var = signal_noise_variance(sensor)
+    row, col, force, radius, flat, added = joint_fit(
+        signal, seg, row, col, force, sensor, model, noise_var, max_contacts
+    )
+    if not added:
+        return seg, row, col, force, radius, flat
+    parent = np.array([a[0] for a in added], np.int64)
+    seg = {key: np.concatenate([value, value[parent]]) for key, value in seg.items()}
+    n_old = len(row)
+    for j, p in enumerate(parent):  # numbered after the frame's others
+        same = seg["frame"] == seg["frame"][p]
+        seg["contact"][n_old + j] = seg["contact"][same].max() + 1
+    extra = np.array([a[1:] for a in added], float)
+    row, col = np.concatenate([row, extra[:, 0]]), np.concatenate([col, extra[:, 1]])
+    force, radius = np.concatenate([force, extra[:, 2]]), np.concatenate([radius, extra[:, 3]])
+    flat = np.concatenate([flat, extra[:, 4]])
+    order = np.lexsort((seg["contact"], seg["frame"]))
+    seg = {key: value[order] for key, value in seg.items()}
+    return seg, row[order], col[order], force[order], radius[order], flat[order]
