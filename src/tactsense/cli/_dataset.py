@@ -10,7 +10,7 @@ import typer
 
 from tactsense._validation import TactsenseInputError
 from tactsense.cli._common import console, fail, new_group, progress_bar, remove_stale_partials
-from tactsense.cli._scenario import FlawsOption
+from tactsense.simulate.dataset import PER_FRAME_FLAWS
 
 app = new_group("Labelled data sets of simulated episodes.")
 
@@ -86,7 +86,15 @@ def dataset(
         tuple[float, float],
         _pair("--friction", "-, 0.01 to 10", "0.3 1", "Static friction coefficient"),
     ] = (0.3, 1.0),
-    flaws: FlawsOption = "all",
+    flaws: Annotated[
+        str,
+        typer.Option(
+            help="Per-frame flaws to switch on: 'all' (all of these), 'none' or a comma list "
+            f"of {', '.join(PER_FRAME_FLAWS)}. Their sizes come from the sensor description; "
+            "the flaws with memory (viscoelastic, hysteresis, drift) and jitter need a frame "
+            "sequence and are refused.",
+        ),
+    ] = "all",
     seed: Annotated[
         int, typer.Option(min=0, help="Seed of every random draw [-]: the same set again.")
     ] = 0,
