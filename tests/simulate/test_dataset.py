@@ -278,3 +278,56 @@ def test_tactsense_imports_the_lerobot_set_as_the_hdf5_one(written, tmp_path):
     imported, direct = read_recording(tmp_path / "in.h5"), read_recording(hdf5)
     assert np.array_equal(imported.frames, direct.frames)
     assert np.allclose(imported.time_s, direct.time_s, rtol=0, atol=1e-9)
+
+
+# ---- fix38 (r6-fix38) ----
+def _ignore_sigint():  # what a non-interactive shell does to a job started with '&'
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+@pytest.mark.parametrize(
+    "workers, when",
+    [(0, "writing"), (2, "writing"), (2, "starting")],
+    ids=["workers0-writing", "workers2-writing", "workers2-cluster-starting"],
+)
+def test_fix38_one_sigint_stops_a_dataset_run(tmp_path, workers, when):
+    """One SIGINT to the process alone (``kill -INT PID``) stops the run: one line, exit
+    status 1, no data set and no partial folder; also when the command was started with
+    SIGINT ignored (in the background of a script), and when the signal lands while the
+    Dask cluster starts (then held until it has started, and the cluster closed)."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "ds"
+    cli = [sys.executable, "-m", "tactsense_launcher", "dataset", "--out", str(out),
+           "--episodes", "2000", "--frames", "500", "--workers", str(workers), "-q"]  # fmt: skip
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    process = subprocess.Popen(
+        cli, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
+        cwd=tmp_path, preexec_fn=_ignore_sigint,
+    )  # fmt: skip
+    deadline = time.monotonic() + 120
+    if when == "writing":  # the temporary folder is there: the episodes are being written
+        while not any(".partial" in p for p in os.listdir(tmp_path)):
+            assert process.poll() is None and time.monotonic() < deadline
+            time.sleep(0.05)
+        time.sleep(0.5)
+    else:
+        time.sleep(2.5)  # after the imports (about 1-2 s), while the workers spawn
+    process.send_signal(signal.SIGINT)
+    _, err = process.communicate(timeout=120)
+    assert process.returncode == 1, err
+    assert err.strip().splitlines()[-1] == (
+        "error: interrupted; no output was left half-written"
+    ), err
+    assert "Traceback" not in err and "Exception ignored" not in err, err
+    assert not out.exists()
+    assert not [p for p in os.listdir(tmp_path) if ".partial" in p]
+
+
+# ---- /r6-fix38 ----

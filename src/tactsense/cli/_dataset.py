@@ -29,6 +29,27 @@ def _pair(name: str, unit: str, default: str, what: str):
     )
 
 
+def _start_cluster(scheduler, workers: int, log_level: int):
+    """(local cluster or None, client): a local Dask cluster of ``workers`` processes, or
+    a client of the scheduler at ``scheduler``."""
+    from dask.distributed import Client, LocalCluster
+
+    if scheduler is not None:
+        return None, Client(scheduler, timeout=10)
+    local = LocalCluster(
+        n_workers=workers,
+        threads_per_worker=1,
+        processes=True,
+        dashboard_address="127.0.0.1:0",
+        silence_logs=log_level,
+    )
+    try:
+        return local, Client(local)
+    except BaseException:
+        local.close()
+        raise
+
+
 @app.command("dataset")
 def dataset(
     out: Annotated[
@@ -178,21 +199,17 @@ def dataset(
             fail(f"--scheduler {scheduler!r} is not a scheduler address (tcp://HOST:PORT)")
         remove_stale_partials(parent)
         client = local = None
-        if scheduler is not None or workers > 0:
-            from dask.distributed import Client, LocalCluster
+        try:  # the cluster is closed on an interrupt while it starts too
+            if scheduler is not None or workers > 0:
+                from tactsense._signals import deferred_interrupts
 
-            if scheduler is None:
-                local = LocalCluster(
-                    n_workers=workers,
-                    threads_per_worker=1,
-                    processes=True,
-                    dashboard_address="127.0.0.1:0",
-                    silence_logs=logging.ERROR,
-                )
-                client = Client(local)
-            else:
-                client = Client(scheduler, timeout=10)
-        try:
+                # a Ctrl-C while the cluster starts is held until it has started (an
+                # interrupted LocalCluster is left to Dask's exit hook, which fails)
+                with deferred_interrupts():
+                    # the workers' own logs stay quiet (a task's error reaches this
+                    # process as the task's exception; a worker closed mid-task on
+                    # Ctrl-C would print heartbeat tracebacks)
+                    local, client = _start_cluster(scheduler, workers, logging.CRITICAL)
             with progress_bar("frames", quiet=quiet) as bar:
                 task = bar.add_task("dataset", total=plan.total_frames)
                 summary = write_dataset(
