@@ -330,4 +330,24 @@ def test_fix38_one_sigint_stops_a_dataset_run(tmp_path, workers, when):
     assert not [p for p in os.listdir(tmp_path) if ".partial" in p]
 
 
+@pytest.mark.parametrize("fmt, name", [("lerobot", "set"), ("hdf5", "set.h5")])
+def test_fix38_the_final_name_appears_only_when_complete(pad16, tmp_path, fmt, name):
+    """While the episodes are written, nothing is at the final name (a folder with
+    data/ but no meta/ was reported once); the work is under a hidden .partial name,
+    moved into place whole at the end."""
+    out = tmp_path / name
+    seen = []
+
+    def look(done, total):
+        assert not out.exists()
+        seen.append([p.name for p in tmp_path.iterdir()])
+
+    ds.write_dataset(pad16, DatasetPlan(episodes=4, frames=20), out, fmt=fmt,
+                     episodes_per_task=1, progress=look)  # fmt: skip
+    assert len(seen) == 4 and all(len(n) == 1 and ".partial" in n[0] for n in seen), seen
+    assert [p.name for p in tmp_path.iterdir()] == [name]
+    if fmt == "lerobot":
+        assert (out / "meta" / "info.json").is_file() and (out / "data").is_dir()
+
+
 # ---- /r6-fix38 ----
