@@ -557,4 +557,16 @@ def test_fix38_dataset_help_lists_only_the_flaws_that_apply():
     assert "jitter" not in PER_FRAME_FLAWS and "viscoelastic" not in PER_FRAME_FLAWS
 
 
+def test_fix38_mujoco_seconds_help_range_is_the_one_checked(workspace):
+    """--help's declared range of --seconds is the one enforced: (0, 1e6], no '0.0<=x'."""
+    help_text = " ".join(
+        runner.invoke(app, ["mujoco", "--help"], terminal_width=400).output.split()
+    )
+    assert "(0, 1e6]" in help_text and "0.0<=x" not in help_text
+    out = workspace / "never.h5"
+    for value, names in (("-1", "--seconds -1"), ("0", "--seconds 0"), ("2e6", "--seconds")):
+        _check(runner.invoke(app, ["mujoco", "--seconds", value, "--out", str(out)]), names)
+    assert not out.exists()
+
+
 # ---- /r6-fix38 ----

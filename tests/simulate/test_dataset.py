@@ -350,4 +350,24 @@ def test_fix38_the_final_name_appears_only_when_complete(pad16, tmp_path, fmt, n
         assert (out / "meta" / "info.json").is_file() and (out / "data").is_dir()
 
 
+def test_fix38_the_summary_counts_the_tasks_drawn(tmp_path):
+    """The summary line gives the episodes of each task as drawn (not the tasks asked
+    for), the counts the file's task_index holds."""
+    import re
+
+    out = tmp_path / "drawn.h5"
+    result = CliRunner().invoke(app, ["dataset", "--out", str(out), "--format", "hdf5",
+                                      "--episodes", "12", "--frames", "20", "--workers", "0",
+                                      "--quiet"])  # fmt: skip
+    assert result.exit_code == 0, result.output
+    text = " ".join(result.output.split())
+    printed = {task: int(n) for n, task in re.findall(r"(\d+) (press|slide|grasp)", text)}
+    with h5py.File(out) as h5:
+        index = h5["episodes/task_index"][:]
+        names = h5["episodes"].attrs["tasks"].split(",")
+    counts = {name: int(np.sum(index == i)) for i, name in enumerate(names)}
+    assert printed == counts and sum(printed.values()) == 12, (text, counts)
+    assert "12 episodes (" in text
+
+
 # ---- /r6-fix38 ----

@@ -230,7 +230,8 @@ def dataset(
         fail(str(error))
     except OSError as error:
         fail(f"cannot write the data set or reach the scheduler: {error}")
+    drawn = ", ".join(f"{n:,} {task}" for task, n in summary["episodes_per_task"].items())
     console.print(
-        f"wrote {out}: {summary['frames']:,} frames in {summary['episodes']:,} episodes of "
-        f"{', '.join(plan.tasks)} at {summary['fps']} fps ({spec.name}, {format.value})"
+        f"wrote {out}: {summary['frames']:,} frames in {summary['episodes']:,} episodes "
+        f"({drawn}) at {summary['fps']} fps ({spec.name}, {format.value})"
     )
