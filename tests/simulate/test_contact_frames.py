@@ -368,4 +368,30 @@ def test_fix38_huge_contacts_cost_bounded_work(monkeypatch, radius_mm, force_n, 
                 frames_from_contacts(pad16(), batch, flaws="none", rng=1)
 
 
+def test_fix38_docs_clip_force_and_error_import():
+    """docs/batch-frames.md: ContactBatchError comes from tactsense.simulate; one 1.6-mm
+    sphere on a pad16 taxel clips at 4095 counts from about 0.8 N (the doc's figure,
+    within 0.05 N), above the example's largest force (0.5 N)."""
+    import re
+    from pathlib import Path
+
+    from tactsense.simulate import ContactBatchError as exported
+
+    assert exported is ContactBatchError
+    doc = (Path(__file__).parents[2] / "docs" / "batch-frames.md").read_text()
+    assert "from tactsense.simulate import\nContactBatchError" in doc
+    stated = float(re.search(r"from about ([0-9.]+) N with `flaws=\"none\"`", doc).group(1))
+    largest = float(re.search(r"normal_force_n=rng.uniform\(0, ([0-9.]+),", doc).group(1))
+    forces = np.arange(0.30, 1.20, 0.005)
+    batch = ContactBatch(
+        position_mm=np.tile([[[7.5, 7.5]]], (forces.size, 1, 1)),  # on taxel (3, 3)
+        normal_force_n=forces[:, None],
+        radius_mm=1.6,
+    )
+    peak = frames_from_contacts(pad16(), batch, flaws="none", rng=1).max(axis=1)
+    clip = forces[np.argmax(peak >= 4095)]
+    assert abs(clip - stated) <= 0.05, clip
+    assert largest < clip and peak[0] < 4095
+
+
 # ---- /r6-fix38 ----
