@@ -370,4 +370,32 @@ def test_fix38_the_summary_counts_the_tasks_drawn(tmp_path):
     assert "12 episodes (" in text
 
 
+def test_fix38_below_baseline_warning_says_what_is_true(pad16, tmp_path):
+    """A data set's first frames are untouched (the first press starts at frame 6), yet
+    locate warned "the first frames, which make the baseline, were probably touched":
+    its baseline follows a slow unload as the creep after a lift, and the unload's end
+    reads below that moved baseline. Now the warning says so, and keeps "probably
+    touched" for frames below the first frames' own baseline (a baseline taken under
+    the press: --baseline-frames 40)."""
+    rec = tmp_path / "set.h5"
+    ds.write_dataset(pad16, DatasetPlan(episodes=2, frames=200, seed=0), rec, fmt="hdf5")
+    frames = read_recording(rec).frames.reshape(400, -1).astype(float)
+    assert np.ptp(frames[:5] - frames[0], axis=1).max() <= 5  # untouched: noise only
+    assert np.ptp(frames[30] - frames[0]) > 100  # pressed by frame 30
+
+    def locate(*extra):
+        out = tmp_path / f"est{len(extra)}.csv"
+        result = CliRunner().invoke(app, ["locate", str(rec), "--method", "fit", "--out",
+                                          str(out), "-q", *extra])  # fmt: skip
+        assert result.exit_code == 0, result.output
+        return " ".join(result.output.split())
+
+    untouched = locate()
+    assert "below the baseline" in untouched  # the moved baseline: still flagged
+    assert "none below the first frames' own" in untouched
+    assert "probably touched" not in untouched
+    touched = locate("--baseline-frames", "40")
+    assert "probably touched" in touched and "below the first frames' own)" in touched
+
+
 # ---- /r6-fix38 ----
