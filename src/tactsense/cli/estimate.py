@@ -83,7 +83,8 @@ def _locate_contacts(recording, out, force, quiet, **options) -> None:
             f"warning: {below} frames read below the baseline by more than the threshold "
             "(flag BELOW_BASELINE), none below the first frames' own: the baseline "
             "followed a falling reading it took for the creep after a lift (a slow "
-            "unload) and the reading fell further; the forces there read low"
+            "unload, or a contact sliding off the taxel) and the reading fell further; "
+            "the forces there read low"
         )
 
 
