@@ -388,6 +388,7 @@ def contacts_file(
         "most": most,
         **counts,
         "below_baseline": 0 if baseline is None else baseline.below_frames,
+        "below_first_baseline": 0 if baseline is None else baseline.below_first_frames,
         "saturated": saturated,
         "beyond_calibration": beyond,
         "force_mean_n": force_sum / force_count if force_count else float("nan"),

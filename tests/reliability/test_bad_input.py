@@ -494,6 +494,8 @@ def test_bad_mujoco_input(workspace, line, names):
     result = _invoke_with_deadline(args)
     _check(result, names)
     assert not list(workspace.glob("never_written*"))
+
+
 # ---- tactsense dataset (r6-data) ----
 DATASET_BAD_OPTIONS = [
     ("dataset --episodes 0 --out OUT", "--episodes"),
@@ -531,3 +533,47 @@ def test_dataset_bad_options(workspace, line, names):
 
 
 # ---- /r6-data ----
+
+
+# ---- fix38 (r6-fix38) ----
+FIX38_DATASET_FLAWS = [
+    # a flaw a data set's frames never have is refused, not recorded in meta unapplied
+    ("dataset --flaws viscoelastic --out OUT", "viscoelastic need the frame sequence"),
+    ("dataset --flaws noise,jitter --out OUT", "jitter need the frame sequence"),
+    ("dataset --flaws hysteresis,drift --out OUT", "hysteresis, drift need the frame"),
+]
+
+
+@pytest.mark.parametrize(
+    "line, names", FIX38_DATASET_FLAWS, ids=[line for line, _ in FIX38_DATASET_FLAWS]
+)
+def test_fix38_dataset_refuses_flaws_it_never_applies(workspace, line, names):
+    out = workspace / "never_written"
+    result = runner.invoke(app, line.replace("OUT", str(out)).split())
+    _check(result, names)
+    assert not out.exists()
+
+
+def test_fix38_dataset_help_lists_only_the_flaws_that_apply():
+    from tactsense.simulate.dataset import PER_FRAME_FLAWS
+
+    result = runner.invoke(app, ["dataset", "--help"], terminal_width=400)
+    text = " ".join(result.output.split())
+    assert "'all' (all of these)" in text
+    assert ", ".join(PER_FRAME_FLAWS) in text
+    assert "jitter" not in PER_FRAME_FLAWS and "viscoelastic" not in PER_FRAME_FLAWS
+
+
+def test_fix38_mujoco_seconds_help_range_is_the_one_checked(workspace):
+    """--help's declared range of --seconds is the one enforced: (0, 1e6], no '0.0<=x'."""
+    help_text = " ".join(
+        runner.invoke(app, ["mujoco", "--help"], terminal_width=400).output.split()
+    )
+    assert "(0, 1e6]" in help_text and "0.0<=x" not in help_text
+    out = workspace / "never.h5"
+    for value, names in (("-1", "--seconds -1"), ("0", "--seconds 0"), ("2e6", "--seconds")):
+        _check(runner.invoke(app, ["mujoco", "--seconds", value, "--out", str(out)]), names)
+    assert not out.exists()
+
+
+# ---- /r6-fix38 ----

@@ -323,3 +323,75 @@ def test_a_contact_beyond_the_tables_runs_the_reference():
         frames_from_contacts(spec, batch, flaws="none"),
         frames_from_contacts(spec, batch, flaws="none", fast=False),
     )
+
+
+# ---- fix38 (r6-fix38) ----
+@pytest.mark.parametrize(
+    "radius_mm, force_n, position_mm, shape",
+    [
+        (1e6, 1.0, 0.0, "sphere"),  # the trial's case: Hertz radius ~131 mm
+        (1e6, 1.0, 0.0, "disc"),
+        (1.6, 1e6, 0.0, "sphere"),  # a huge force: the contact radius stops at R
+        (1.6, 1.0, 1e9, "sphere"),  # a contact far off the pad
+    ],
+)
+def test_fix38_huge_contacts_cost_bounded_work(monkeypatch, radius_mm, force_n, position_mm, shape):
+    """A huge radius, force or position never asks for a response table beyond
+    A_TOP_LIMIT_MM (the table's memory grows with the square of its reach: a table built
+    up to the batch's largest radius of 1e6 mm ran 10 minutes and 19 GB); the batch
+    beyond it runs the reference path and reads finite counts."""
+    from tactsense.physics import _contact_kernel
+    from tactsense.physics._hertz_table import A_TOP_LIMIT_MM
+
+    asked = []
+    real = _contact_kernel.layer_response_table
+
+    def spy(layer, electrode, kind, top):
+        asked.append(top)  # checked before the build: a failing case fails fast
+        assert top <= A_TOP_LIMIT_MM + _contact_kernel.A_TOP_GRAIN_MM, top
+        return real(layer, electrode, kind, top)
+
+    monkeypatch.setattr(_contact_kernel, "layer_response_table", spy)
+    batch = ContactBatch(
+        position_mm=np.full((1, 1, 2), position_mm),
+        normal_force_n=[[force_n]],
+        radius_mm=radius_mm,
+        shape=shape,
+    )
+    frames = frames_from_contacts(pad16(), batch, flaws="none", rng=1)
+    assert frames.shape == (1, 256) and np.all(np.isfinite(frames))
+    assert all(top <= A_TOP_LIMIT_MM + _contact_kernel.A_TOP_GRAIN_MM for top in asked), asked
+    with monkeypatch.context() as patched:  # without the limit the test fails
+        patched.setattr(_contact_kernel, "A_TOP_LIMIT_MM", 1e12)
+        if radius_mm > 100:
+            with pytest.raises(AssertionError):
+                frames_from_contacts(pad16(), batch, flaws="none", rng=1)
+
+
+def test_fix38_docs_clip_force_and_error_import():
+    """docs/batch-frames.md: ContactBatchError comes from tactsense.simulate; one 1.6-mm
+    sphere on a pad16 taxel clips at 4095 counts from about 0.8 N (the doc's figure,
+    within 0.05 N), above the example's largest force (0.5 N)."""
+    import re
+    from pathlib import Path
+
+    from tactsense.simulate import ContactBatchError as exported
+
+    assert exported is ContactBatchError
+    doc = (Path(__file__).parents[2] / "docs" / "batch-frames.md").read_text()
+    assert "from tactsense.simulate import\nContactBatchError" in doc
+    stated = float(re.search(r"from about ([0-9.]+) N with `flaws=\"none\"`", doc).group(1))
+    largest = float(re.search(r"normal_force_n=rng.uniform\(0, ([0-9.]+),", doc).group(1))
+    forces = np.arange(0.30, 1.20, 0.005)
+    batch = ContactBatch(
+        position_mm=np.tile([[[7.5, 7.5]]], (forces.size, 1, 1)),  # on taxel (3, 3)
+        normal_force_n=forces[:, None],
+        radius_mm=1.6,
+    )
+    peak = frames_from_contacts(pad16(), batch, flaws="none", rng=1).max(axis=1)
+    clip = forces[np.argmax(peak >= 4095)]
+    assert abs(clip - stated) <= 0.05, clip
+    assert largest < clip and peak[0] < 4095
+
+
+# ---- /r6-fix38 ----

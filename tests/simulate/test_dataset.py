@@ -278,3 +278,124 @@ def test_tactsense_imports_the_lerobot_set_as_the_hdf5_one(written, tmp_path):
     imported, direct = read_recording(tmp_path / "in.h5"), read_recording(hdf5)
     assert np.array_equal(imported.frames, direct.frames)
     assert np.allclose(imported.time_s, direct.time_s, rtol=0, atol=1e-9)
+
+
+# ---- fix38 (r6-fix38) ----
+def _ignore_sigint():  # what a non-interactive shell does to a job started with '&'
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+@pytest.mark.parametrize(
+    "workers, when",
+    [(0, "writing"), (2, "writing"), (2, "starting")],
+    ids=["workers0-writing", "workers2-writing", "workers2-cluster-starting"],
+)
+def test_fix38_one_sigint_stops_a_dataset_run(tmp_path, workers, when):
+    """One SIGINT to the process alone (``kill -INT PID``) stops the run: one line, exit
+    status 1, no data set and no partial folder; also when the command was started with
+    SIGINT ignored (in the background of a script), and when the signal lands while the
+    Dask cluster starts (then held until it has started, and the cluster closed)."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "ds"
+    cli = [sys.executable, "-m", "tactsense_launcher", "dataset", "--out", str(out),
+           "--episodes", "2000", "--frames", "500", "--workers", str(workers), "-q"]  # fmt: skip
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    process = subprocess.Popen(
+        cli, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
+        cwd=tmp_path, preexec_fn=_ignore_sigint,
+    )  # fmt: skip
+    deadline = time.monotonic() + 120
+    if when == "writing":  # the temporary folder is there: the episodes are being written
+        while not any(".partial" in p for p in os.listdir(tmp_path)):
+            assert process.poll() is None and time.monotonic() < deadline
+            time.sleep(0.05)
+        time.sleep(0.5)
+    else:
+        time.sleep(2.5)  # after the imports (about 1-2 s), while the workers spawn
+    process.send_signal(signal.SIGINT)
+    _, err = process.communicate(timeout=120)
+    assert process.returncode == 1, err
+    assert err.strip().splitlines()[-1] == (
+        "error: interrupted; no output was left half-written"
+    ), err
+    assert "Traceback" not in err and "Exception ignored" not in err, err
+    assert not out.exists()
+    assert not [p for p in os.listdir(tmp_path) if ".partial" in p]
+
+
+@pytest.mark.parametrize("fmt, name", [("lerobot", "set"), ("hdf5", "set.h5")])
+def test_fix38_the_final_name_appears_only_when_complete(pad16, tmp_path, fmt, name):
+    """While the episodes are written, nothing is at the final name (a folder with
+    data/ but no meta/ was reported once); the work is under a hidden .partial name,
+    moved into place whole at the end."""
+    out = tmp_path / name
+    seen = []
+
+    def look(done, total):
+        assert not out.exists()
+        seen.append([p.name for p in tmp_path.iterdir()])
+
+    ds.write_dataset(pad16, DatasetPlan(episodes=4, frames=20), out, fmt=fmt,
+                     episodes_per_task=1, progress=look)  # fmt: skip
+    assert len(seen) == 4 and all(len(n) == 1 and ".partial" in n[0] for n in seen), seen
+    assert [p.name for p in tmp_path.iterdir()] == [name]
+    if fmt == "lerobot":
+        assert (out / "meta" / "info.json").is_file() and (out / "data").is_dir()
+
+
+def test_fix38_the_summary_counts_the_tasks_drawn(tmp_path):
+    """The summary line gives the episodes of each task as drawn (not the tasks asked
+    for), the counts the file's task_index holds."""
+    import re
+
+    out = tmp_path / "drawn.h5"
+    result = CliRunner().invoke(app, ["dataset", "--out", str(out), "--format", "hdf5",
+                                      "--episodes", "12", "--frames", "20", "--workers", "0",
+                                      "--quiet"])  # fmt: skip
+    assert result.exit_code == 0, result.output
+    text = " ".join(result.output.split())
+    printed = {task: int(n) for n, task in re.findall(r"(\d+) (press|slide|grasp)", text)}
+    with h5py.File(out) as h5:
+        index = h5["episodes/task_index"][:]
+        names = h5["episodes"].attrs["tasks"].split(",")
+    counts = {name: int(np.sum(index == i)) for i, name in enumerate(names)}
+    assert printed == counts and sum(printed.values()) == 12, (text, counts)
+    assert "12 episodes (" in text
+
+
+def test_fix38_below_baseline_warning_says_what_is_true(pad16, tmp_path):
+    """A data set's first frames are untouched (the first press starts at frame 6), yet
+    locate warned "the first frames, which make the baseline, were probably touched":
+    its baseline follows a slow unload as the creep after a lift, and the unload's end
+    reads below that moved baseline. Now the warning says so, and keeps "probably
+    touched" for frames below the first frames' own baseline (a baseline taken under
+    the press: --baseline-frames 40)."""
+    rec = tmp_path / "set.h5"
+    ds.write_dataset(pad16, DatasetPlan(episodes=2, frames=200, seed=0), rec, fmt="hdf5")
+    frames = read_recording(rec).frames.reshape(400, -1).astype(float)
+    assert np.ptp(frames[:5] - frames[0], axis=1).max() <= 5  # untouched: noise only
+    assert np.ptp(frames[30] - frames[0]) > 100  # pressed by frame 30
+
+    def locate(*extra):
+        out = tmp_path / f"est{len(extra)}.csv"
+        result = CliRunner().invoke(app, ["locate", str(rec), "--method", "fit", "--out",
+                                          str(out), "-q", *extra])  # fmt: skip
+        assert result.exit_code == 0, result.output
+        return " ".join(result.output.split())
+
+    untouched = locate()
+    assert "below the baseline" in untouched  # the moved baseline: still flagged
+    assert "none below the first frames' own" in untouched
+    assert "probably touched" not in untouched
+    touched = locate("--baseline-frames", "40")
+    assert "probably touched" in touched and "below the first frames' own)" in touched
+
+
+# ---- /r6-fix38 ----

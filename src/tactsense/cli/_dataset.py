@@ -10,7 +10,7 @@ import typer
 
 from tactsense._validation import TactsenseInputError
 from tactsense.cli._common import console, fail, new_group, progress_bar, remove_stale_partials
-from tactsense.cli._scenario import FlawsOption
+from tactsense.simulate.dataset import PER_FRAME_FLAWS
 
 app = new_group("Labelled data sets of simulated episodes.")
 
@@ -27,6 +27,27 @@ def _pair(name: str, unit: str, default: str, what: str):
         help=f"{what}: each episode draws it uniformly between LOW and HIGH [{unit}] "
         f"(default {default}).",
     )
+
+
+def _start_cluster(scheduler, workers: int, log_level: int):
+    """(local cluster or None, client): a local Dask cluster of ``workers`` processes, or
+    a client of the scheduler at ``scheduler``."""
+    from dask.distributed import Client, LocalCluster
+
+    if scheduler is not None:
+        return None, Client(scheduler, timeout=10)
+    local = LocalCluster(
+        n_workers=workers,
+        threads_per_worker=1,
+        processes=True,
+        dashboard_address="127.0.0.1:0",
+        silence_logs=log_level,
+    )
+    try:
+        return local, Client(local)
+    except BaseException:
+        local.close()
+        raise
 
 
 @app.command("dataset")
@@ -86,7 +107,15 @@ def dataset(
         tuple[float, float],
         _pair("--friction", "-, 0.01 to 10", "0.3 1", "Static friction coefficient"),
     ] = (0.3, 1.0),
-    flaws: FlawsOption = "all",
+    flaws: Annotated[
+        str,
+        typer.Option(
+            help="Per-frame flaws to switch on: 'all' (all of these), 'none' or a comma list "
+            f"of {', '.join(PER_FRAME_FLAWS)}. Their sizes come from the sensor description; "
+            "the flaws with memory (viscoelastic, hysteresis, drift) and jitter need a frame "
+            "sequence and are refused.",
+        ),
+    ] = "all",
     seed: Annotated[
         int, typer.Option(min=0, help="Seed of every random draw [-]: the same set again.")
     ] = 0,
@@ -170,21 +199,17 @@ def dataset(
             fail(f"--scheduler {scheduler!r} is not a scheduler address (tcp://HOST:PORT)")
         remove_stale_partials(parent)
         client = local = None
-        if scheduler is not None or workers > 0:
-            from dask.distributed import Client, LocalCluster
+        try:  # the cluster is closed on an interrupt while it starts too
+            if scheduler is not None or workers > 0:
+                from tactsense._signals import deferred_interrupts
 
-            if scheduler is None:
-                local = LocalCluster(
-                    n_workers=workers,
-                    threads_per_worker=1,
-                    processes=True,
-                    dashboard_address="127.0.0.1:0",
-                    silence_logs=logging.ERROR,
-                )
-                client = Client(local)
-            else:
-                client = Client(scheduler, timeout=10)
-        try:
+                # a Ctrl-C while the cluster starts is held until it has started (an
+                # interrupted LocalCluster is left to Dask's exit hook, which fails)
+                with deferred_interrupts():
+                    # the workers' own logs stay quiet (a task's error reaches this
+                    # process as the task's exception; a worker closed mid-task on
+                    # Ctrl-C would print heartbeat tracebacks)
+                    local, client = _start_cluster(scheduler, workers, logging.CRITICAL)
             with progress_bar("frames", quiet=quiet) as bar:
                 task = bar.add_task("dataset", total=plan.total_frames)
                 summary = write_dataset(
@@ -205,7 +230,8 @@ def dataset(
         fail(str(error))
     except OSError as error:
         fail(f"cannot write the data set or reach the scheduler: {error}")
+    drawn = ", ".join(f"{n:,} {task}" for task, n in summary["episodes_per_task"].items())
     console.print(
-        f"wrote {out}: {summary['frames']:,} frames in {summary['episodes']:,} episodes of "
-        f"{', '.join(plan.tasks)} at {summary['fps']} fps ({spec.name}, {format.value})"
+        f"wrote {out}: {summary['frames']:,} frames in {summary['episodes']:,} episodes "
+        f"({drawn}) at {summary['fps']} fps ({spec.name}, {format.value})"
     )

@@ -74,8 +74,7 @@ def mujoco_command(
         float | None,
         typer.Option(
             "--seconds",
-            min=0.0,
-            max=1e6,
+            max=1e6,  # above 0: checked with the others (click has no open bound here)
             help="Simulated time to record [s], (0, 1e6]. Default: the controls table's "
             "last time (10 s for the example), else 1 s.",
         ),

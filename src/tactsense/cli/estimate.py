@@ -70,11 +70,21 @@ def _locate_contacts(recording, out, force, quiet, **options) -> None:
             console.print(
                 f"warning: {line}", soft_wrap=True, markup=False, highlight=False, emoji=False
             )
-    if summary["below_baseline"]:
+    below, first = summary["below_baseline"], summary.get("below_first_baseline", 0)
+    if below and first:
         console.print(
-            f"warning: {summary['below_baseline']} frames read below the baseline by more "
-            "than the threshold (flag BELOW_BASELINE): the first frames, which make the "
-            "baseline, were probably touched; record untouched frames first"
+            f"warning: {below} frames read below the baseline by more than the threshold "
+            f"(flag BELOW_BASELINE; {first} below the first frames' own): the first "
+            "frames, which make the baseline, were probably touched; record untouched "
+            "frames first"
+        )
+    elif below:  # below a baseline that moved, never below the first frames'
+        console.print(
+            f"warning: {below} frames read below the baseline by more than the threshold "
+            "(flag BELOW_BASELINE), none below the first frames' own: the baseline "
+            "followed a falling reading it took for the creep after a lift (a slow "
+            "unload, or a contact sliding off the taxel) and the reading fell further; "
+            "the forces there read low"
         )
 
 

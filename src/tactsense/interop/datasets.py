@@ -491,7 +491,8 @@ def write_dataset(
     this process). ``episodes_per_task``: episodes per Dask task (default: about 20,000
     frames a task). ``window``: tasks in flight (default: twice the workers, at least
     4), which bounds memory. ``progress(done_frames, total_frames)`` after each task.
-    Returns ``frames``, ``episodes``, ``fps`` and the format's counts.
+    Returns ``frames``, ``episodes``, ``fps``, ``episodes_per_task`` (the episodes of
+    each task as drawn) and the format's counts.
     """
     if fmt not in FORMATS:
         raise DatasetError(f"format {fmt!r}: choose from {', '.join(FORMATS)}")
@@ -514,10 +515,12 @@ def write_dataset(
         else:
             writer = HDF5EpisodesWriter(temporary, spec, plan)
         done = 0
+        drawn = dict.fromkeys(plan.tasks, 0)  # episodes of each task, as drawn
         for block in _ordered_results(client, spec, plan, fmt, per_task, window):
             for ep, stats in block:
                 writer.add(ep, stats)
                 done += len(ep.frames)
+                drawn[ep.task] += 1
             if progress is not None:
                 progress(done, plan.total_frames)
         summary = writer.close()
@@ -528,7 +531,7 @@ def write_dataset(
             writer.abort()
         _remove(temporary)
         raise
-    return {**summary, "format": fmt, "tasks": list(plan.tasks)}
+    return {**summary, "format": fmt, "tasks": list(plan.tasks), "episodes_per_task": drawn}
 
 
 def _remove(path: Path) -> None:

@@ -19,7 +19,7 @@ a point set's are in :mod:`tactsense.flat_scenarios`), :mod:`~tactsense.simulate
 (the time loop) and :mod:`~tactsense.simulate.write` (to a file as frames are made).
 """
 
-from tactsense.simulate.contact_frames import ContactBatch, frames_from_contacts
+from tactsense.simulate.contact_frames import ContactBatch, ContactBatchError, frames_from_contacts
 from tactsense.simulate.run import simulate
 from tactsense.simulate.scenario import Scenario, Step
 from tactsense.simulate.scenarios import (
@@ -37,6 +37,7 @@ from tactsense.simulate.write import simulate_to_file
 
 __all__ = [
     "ContactBatch",
+    "ContactBatchError",
     "Scenario",
     "Step",
     "calibration_sweep",

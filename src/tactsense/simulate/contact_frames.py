@@ -45,6 +45,17 @@ LEFT_OUT_FLAWS = (*MEMORY_FLAWS, "jitter")
 the contacts applied)."""
 
 
+def named_left_out_flaws(flaws) -> list[str]:
+    """The flaws of :data:`LEFT_OUT_FLAWS` that ``flaws`` names one by one (a comma
+    string or names; none for "all" or "none", which mean the per-frame flaws that
+    apply): a caller that must not accept a flaw it never applies raises on them."""
+    from tactsense.simulate.run import _resolve_flaws
+
+    if flaws is None or (isinstance(flaws, str) and flaws.strip() in ("all", "none")):
+        return []
+    return [name for name in _resolve_flaws(flaws) if name in LEFT_OUT_FLAWS]
+
+
 class ShearIgnoredWarning(UserWarning):
     """Tangential forces were given to a kind whose forward model does not take them."""
 

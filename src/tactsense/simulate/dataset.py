@@ -49,6 +49,17 @@ KINETIC_RATIO = 0.8
 """Kinetic over static friction coefficient of a sliding contact [-]."""
 
 
+def _per_frame_flaws() -> tuple[str, ...]:
+    from tactsense.physics.flaws import FLAW_NAMES
+    from tactsense.simulate.contact_frames import LEFT_OUT_FLAWS
+
+    return tuple(name for name in FLAW_NAMES if name not in LEFT_OUT_FLAWS)
+
+
+PER_FRAME_FLAWS = _per_frame_flaws()
+"""The flaws a data set's frames can have (``--flaws all``: all of these)."""
+
+
 class DatasetError(TactsenseInputError):
     """A data set plan that cannot be generated."""
 
@@ -86,6 +97,16 @@ class DatasetPlan:
                 f"{', '.join(TASKS)}"
             )
         object.__setattr__(self, "tasks", tasks)
+        from tactsense.simulate.contact_frames import named_left_out_flaws, resolve_flaws
+
+        left_out = named_left_out_flaws(self.flaws)
+        if left_out:
+            raise DatasetError(
+                f"flaw(s) {', '.join(left_out)} need the frame sequence (memory or jitter); "
+                "a data set's frames take the per-frame flaws only "
+                f"({', '.join(PER_FRAME_FLAWS)})"
+            )
+        resolve_flaws(self.flaws)  # an unknown name: a one-line error
         for name, low_limit, high_limit, unit in (
             ("force_n", 1e-4, 1e3, "N"),
             ("radius_mm", 0.05, 100.0, "mm"),

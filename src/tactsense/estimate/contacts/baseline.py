@@ -59,7 +59,7 @@ from tactsense.estimate.contacts.health import (  # noqa: F401  (their old path)
 )
 from tactsense.estimate.creep import CreepCompensator
 from tactsense.estimate.finger._fast import taxel_signal
-from tactsense.estimate.reading import reading_mode, unusable_baseline
+from tactsense.estimate.reading import at_rail, reading_mode, unusable_baseline
 from tactsense.estimate.results import Flag
 
 TIME_CONSTANT_S = 2.0
@@ -386,6 +386,14 @@ class DriftBaseline:
         self.rezero_frames = int(rezero_frames)
         self.below_frames = 0
         """Frames so far flagged ``BELOW_BASELINE`` (:func:`below_baseline`)."""
+        self.first_baseline = self.baseline.copy()
+        """The baseline the frames started from (the first frames' median, or the last
+        re-zero's) [counts]: not moved by drift or a release."""
+        self.below_first_frames = 0
+        """Of :attr:`below_frames`, those that read below :attr:`first_baseline` by the
+        same rule: only these say the first frames were touched (the others read below
+        a baseline that followed the reading, e.g. a slow unload taken for the creep
+        after a lift)."""
         self.frames_seen = 0
         self.last_signal: np.ndarray | None = None
         """The signal of the frames last given to :meth:`signal` (a caller that scales
@@ -464,10 +472,35 @@ class DriftBaseline:
                 RELEASE_FRAMES, self._block, self.releasing, self._low, self._peaks,
                 self._phase, self._below,
             )  # fmt: skip
-        self.below_frames += int(np.count_nonzero(flags & int(Flag.BELOW_BASELINE)))
+        below = np.flatnonzero(flags & int(Flag.BELOW_BASELINE))
+        self.below_frames += below.size
+        if below.size:
+            self.below_first_frames += self._below_first(source[below], unusable)
         self.frames_seen += len(frames)
         self.last_signal = signal
         return signal, flags
+
+    def _below_first(self, frames: np.ndarray, unusable: np.ndarray) -> int:
+        """How many of ``frames`` read below :attr:`first_baseline` by the rule of
+        :func:`below_baseline` (the signal as :func:`taxel_signal` takes it, without
+        creep compensation or saturated and unusable taxels)."""
+        v = frames.astype(float)
+        base = self.first_baseline
+        sign = -1.0 if self._falling else 1.0
+        with np.errstate(all="ignore"):
+            if self._resistive:
+                d = sign * (v - base) * self._per_count
+            elif self._falling:  # an open junction (w <= 0 or v <= 0): no signal
+                d = np.where(2.0 * base - v > 0, (base - v) / (2.0 * base - v), np.nan)
+            else:
+                d = np.where(v > 0, (v - base) / v, np.nan)
+        usable = np.isfinite(d) & ~unusable & ~at_rail(frames, self.sensor)
+        d = np.where(usable, d, 0.0).reshape(len(frames), -1)
+        lowest, highest = np.minimum(d.min(axis=1), 0.0), np.maximum(d.max(axis=1), 0.0)
+        return sum(
+            bool(below_baseline(lo, hi, self.threshold, self._resistive))
+            for lo, hi in zip(lowest.tolist(), highest.tolist(), strict=True)
+        )
 
     def _take_rezero(self, frames: np.ndarray) -> np.ndarray:
         # frames collected for the new baseline still get a signal against the old one
@@ -475,6 +508,7 @@ class DriftBaseline:
         self._collect.extend(np.asarray(frames[:need], dtype=float))
         if len(self._collect) >= self.rezero_frames:
             self.baseline = np.ascontiguousarray(np.nanmedian(np.stack(self._collect), axis=0))
+            self.first_baseline = self.baseline.copy()
             self._collect = None
             self.creep_memory[:] = 0.0  # the new baseline holds whatever creep is left
             self._reset_release()
