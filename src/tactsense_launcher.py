@@ -52,13 +52,6 @@ def main() -> None:
         from tactsense._signals import install_sigterm
         from tactsense.cli.app import main as run
     finally:
-        # a command started in the background of a script (``tactsense ... &`` in a
-        # non-interactive shell) inherits SIGINT ignored, and Python leaves it so: a
-        # ``kill -INT`` then did nothing and a long run wrote its output regardless.
-        # Every command stops cleanly on SIGINT (nothing is left half-written), so it
-        # takes SIGINT back, as Python does when it is not ignored.
-        if previous == signal.SIG_IGN:
-            previous = signal.default_int_handler
         signal.signal(signal.SIGINT, previous)
     install_sigterm()
     if pressed or terms:
