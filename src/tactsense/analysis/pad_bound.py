@@ -197,8 +197,13 @@ def cramer_rao_bound(
             f"{RANK_TOLERANCE:g}): no compressed taxel's reading moves with it; try a "
             "point between taxels"
         )
-    covariance = np.linalg.inv(information)
-    std = np.sqrt(np.diag(covariance))
+    return bound_stds(information, spec, force_n)
+
+
+def bound_stds(information: np.ndarray, spec, force_n: float) -> dict:
+    """The bound's standard deviations from a Fisher matrix over (x, y, force): x, y and
+    their RMS [mm], force [N] and relative to ``force_n`` [-], x and y in pitches [-]."""
+    std = np.sqrt(np.diag(np.linalg.inv(information)))
     g = spec.grid
     return {
         "x_mm": float(std[0]),

@@ -46,6 +46,7 @@ from tactsense._validation import TactsenseInputError, check_positive
 from tactsense.analysis.pad_bound import (
     PROBE_RADIUS_MM,
     _check_pad,
+    bound_stds,
     counts_from_strain,
     rank_test,
 )
@@ -160,20 +161,6 @@ def whitened_jacobian(
     return g * np.sqrt(w)[:, None] / sigma
 
 
-def _stds(information: np.ndarray, spec, force_n: float) -> dict:
-    std = np.sqrt(np.diag(np.linalg.inv(information)))
-    g = spec.grid
-    return {
-        "x_mm": float(std[0]),
-        "y_mm": float(std[1]),
-        "position_mm": float(np.sqrt(0.5 * (std[0] ** 2 + std[1] ** 2))),
-        "force_n": float(std[2]),
-        "force_relative": float(std[2] / force_n),
-        "x_pitch": float(std[0] / g.row_pitch_mm),
-        "y_pitch": float(std[1] / g.col_pitch_mm),
-    }
-
-
 def point_bound(
     spec,
     x_mm: float,
@@ -196,7 +183,7 @@ def point_bound(
     if test["singular"]:
         keys = ("x_mm", "y_mm", "position_mm", "force_n", "force_relative", "x_pitch", "y_pitch")
         return {**test, **dict.fromkeys(keys, math.inf)}
-    return {**test, **_stds(a.T @ a, spec, force_n)}
+    return {**test, **bound_stds(a.T @ a, spec, force_n)}
 
 
 def cell_prior_information(pitch_mm: float) -> float:
@@ -269,4 +256,4 @@ def bayesian_bound(
                 "position_mm": float(np.sqrt(0.5 * (std @ std))), "force_n": math.inf,
                 "force_relative": math.inf, "x_pitch": float(std[0] / g.row_pitch_mm),
                 "y_pitch": float(std[1] / g.col_pitch_mm), "nodes": int(nodes)}  # fmt: skip
-    return {**_stds(information, spec, force_n), "nodes": int(nodes)}
+    return {**bound_stds(information, spec, force_n), "nodes": int(nodes)}

@@ -46,6 +46,7 @@ from tactsense.interop.lerobot import (
     _stats,
     _write_json,
     features_of,
+    write_tasks_parquet,
 )
 from tactsense.simulate.dataset import MAX_CONTACTS, TASKS, DatasetError, DatasetPlan, episodes
 
@@ -287,7 +288,7 @@ class LeRobotEpisodesWriter:
         episodes_file.parent.mkdir(parents=True, exist_ok=True)
         pq.write_table(pa.Table.from_pylist(self.episode_rows), episodes_file)
         _write_json(self.folder / "meta" / "stats.json", _listed(self.stats.result()))
-        _write_tasks(self.folder / "meta" / "tasks.parquet", list(self.plan.tasks))
+        write_tasks_parquet(self.folder / "meta" / "tasks.parquet", list(self.plan.tasks))
         info = {
             "codebase_version": CODEBASE_VERSION,
             "fps": self.fps,
@@ -322,35 +323,6 @@ class LeRobotEpisodesWriter:
         files = len(list((self.folder / "data").glob("*/*.parquet")))
         return {"frames": self.frames, "episodes": len(self.episode_rows), "fps": self.fps,
                 "data_files": files}  # fmt: skip
-
-
-def _write_tasks(path: Path, tasks: list[str]) -> None:
-    """``meta/tasks.parquet`` as pandas writes a frame indexed by ``task`` (LeRobot reads
-    it with ``pandas.read_parquet``), as :mod:`tactsense.interop.lerobot` writes it."""
-    import pyarrow as pa
-    import pyarrow.parquet as pq
-
-    pandas_meta = {
-        "index_columns": ["task"],
-        "column_indexes": [
-            {"name": None, "field_name": None, "pandas_type": "unicode",
-             "numpy_type": "object", "metadata": {"encoding": "UTF-8"}}
-        ],
-        "columns": [
-            {"name": "task_index", "field_name": "task_index", "pandas_type": "int64",
-             "numpy_type": "int64", "metadata": None},
-            {"name": "task", "field_name": "task", "pandas_type": "unicode",
-             "numpy_type": "object", "metadata": None},
-        ],
-        "creator": {"library": "pyarrow", "version": pa.__version__},
-    }  # fmt: skip
-    table = pa.table(
-        {
-            "task_index": pa.array(range(len(tasks)), pa.int64()),
-            "task": pa.array(tasks, pa.string()),
-        }
-    ).replace_schema_metadata({"pandas": json.dumps(pandas_meta)})
-    pq.write_table(table, path)
 
 
 class HDF5EpisodesWriter:

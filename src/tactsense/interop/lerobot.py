@@ -297,26 +297,7 @@ def write_dataset(
     stats = {k: _stats(columns[k], features[k]["shape"] == [1]) for k in numeric}
     _write_json(folder / "meta" / "stats.json", _listed(stats))
 
-    # meta/tasks.parquet as pandas writes a frame indexed by "task" (LeRobot reads it with
-    # pandas.read_parquet): the metadata that makes "task" the index, without pandas here
-    pandas_meta = {
-        "index_columns": ["task"],
-        "column_indexes": [
-            {"name": None, "field_name": None, "pandas_type": "unicode",
-             "numpy_type": "object", "metadata": {"encoding": "UTF-8"}}
-        ],
-        "columns": [
-            {"name": "task_index", "field_name": "task_index", "pandas_type": "int64",
-             "numpy_type": "int64", "metadata": None},
-            {"name": "task", "field_name": "task", "pandas_type": "unicode",
-             "numpy_type": "object", "metadata": None},
-        ],
-        "creator": {"library": "pyarrow", "version": pa.__version__},
-    }  # fmt: skip
-    tasks = pa.table(
-        {"task_index": pa.array([0], pa.int64()), "task": pa.array([task], pa.string())}
-    ).replace_schema_metadata({"pandas": json.dumps(pandas_meta)})
-    pq.write_table(tasks, folder / "meta" / "tasks.parquet")
+    write_tasks_parquet(folder / "meta" / "tasks.parquet", [task])
 
     info = {
         "codebase_version": CODEBASE_VERSION,
@@ -505,3 +486,33 @@ def import_lerobot(folder: str | Path, *, sensor=None):
         spec, list(np.concatenate(frames)), np.concatenate(times), source=str(folder),
         description=f"imported from the LeRobot dataset {folder}", losses=losses,
     )  # fmt: skip
+
+
+def write_tasks_parquet(path: Path, tasks: list[str]) -> None:
+    """``meta/tasks.parquet`` as pandas writes a frame indexed by ``task`` (LeRobot reads
+    it with ``pandas.read_parquet``): the metadata that makes ``task`` the index, without
+    pandas here; task ``i`` has ``task_index`` i."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    pandas_meta = {
+        "index_columns": ["task"],
+        "column_indexes": [
+            {"name": None, "field_name": None, "pandas_type": "unicode",
+             "numpy_type": "object", "metadata": {"encoding": "UTF-8"}}
+        ],
+        "columns": [
+            {"name": "task_index", "field_name": "task_index", "pandas_type": "int64",
+             "numpy_type": "int64", "metadata": None},
+            {"name": "task", "field_name": "task", "pandas_type": "unicode",
+             "numpy_type": "object", "metadata": None},
+        ],
+        "creator": {"library": "pyarrow", "version": pa.__version__},
+    }  # fmt: skip
+    table = pa.table(
+        {
+            "task_index": pa.array(range(len(tasks)), pa.int64()),
+            "task": pa.array(tasks, pa.string()),
+        }
+    ).replace_schema_metadata({"pandas": json.dumps(pandas_meta)})
+    pq.write_table(table, path)
