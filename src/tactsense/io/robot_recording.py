@@ -1,0 +1,200 @@
+"""A recording of a robot's skin: one stream per patch, in one folder.
+
+Layout (format ``tactsense-robot-recording``, version 1)::
+
+    NAME/                      the recording (a folder)
+      robot.json               manifest: format, version, skin name, streams, devices
+      skin.toml                the robot skin (tactsense.robot's TOML form)
+      streams/PATCH.h5         one tactsense recording per patch, as every command reads
+
+Each stream is an ordinary recording (:mod:`tactsense.io.recording`): its own rate, its
+device clock (``device_time_us``), host stamps, losses, crash-safe on its own, so
+``tactsense info``, ``locate`` and the rest read a single patch's file as they read any.
+The manifest says which device read which patches, each device's clock fit to the host
+clock and whether the device dropped out (and when). It is written first (so a
+recording killed while capturing still says what it holds) and again at the end.
+
+Whole recordings (simulations) are written to ``NAME.partial`` and moved into place when
+complete.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from tactsense.io._layout import Recording, RecordingError, write_recording
+from tactsense.io.recording import read_recording
+from tactsense.robot import RobotSkin, RobotSkinError, skin_from_toml, skin_to_toml_string
+
+ROBOT_FORMAT = "tactsense-robot-recording"
+ROBOT_FORMAT_VERSION = 1
+MANIFEST = "robot.json"
+SKIN = "skin.toml"
+STREAMS = "streams"
+
+
+@dataclass
+class RobotRecording:
+    """Streams of several patches of one robot skin.
+
+    Attributes
+    ----------
+    skin : RobotSkin
+    streams : dict of str -> Recording
+        One recording per patch (patch name -> frames on that patch's own clock and rate);
+        a patch missing here recorded nothing.
+    devices : dict of str -> dict
+        Per device (board): ``patches`` (names), ``source`` (URL), ``clock`` (fit of the
+        device clock to the host: ``offset_s``, ``drift_ppm``, ``residual_s``; empty for a
+        simulation), ``status`` (``"ok"`` or ``"dropped"``), ``dropped_at_s`` (host time
+        of its last frame when it dropped out, else None).
+    description : str
+        What was recorded (a simulation's scenario, or the sources).
+    closed_cleanly : bool
+        False when the manifest says capture never finished (the writer was killed).
+    """
+
+    skin: RobotSkin
+    streams: dict[str, Recording]
+    devices: dict[str, dict[str, Any]] = field(default_factory=dict)
+    description: str = ""
+    closed_cleanly: bool = True
+
+    def __post_init__(self) -> None:
+        for name, recording in self.streams.items():
+            patch = self.skin.patch(name)
+            if recording.sensor.shape != patch.sensor.shape:
+                raise RecordingError(
+                    f"stream {name!r} has frames of shape {recording.sensor.shape}; the skin's "
+                    f"patch {name!r} has {patch.sensor.shape}"
+                )
+        if not self.devices:
+            self.devices = {
+                device: {"patches": list(names), "source": "", "clock": {}, "status": "ok",
+                         "dropped_at_s": None}
+                for device, names in self.skin.devices.items()
+            }  # fmt: skip
+
+
+def stream_path(path: str | Path, patch: str) -> Path:
+    """Where a patch's stream lies in a robot recording."""
+    return Path(path) / STREAMS / f"{patch}.h5"
+
+
+def is_robot_recording(path: str | Path) -> bool:
+    """Whether ``path`` is a robot recording's folder (it holds the manifest)."""
+    return (Path(path) / MANIFEST).is_file()
+
+
+def manifest(recording: RobotRecording, *, closed_cleanly: bool = True) -> dict[str, Any]:
+    """The manifest's content for ``recording``."""
+    return {
+        "format": ROBOT_FORMAT,
+        "format_version": ROBOT_FORMAT_VERSION,
+        "skin": recording.skin.name,
+        "description": recording.description,
+        "streams": sorted(recording.streams),
+        "devices": recording.devices,
+        "closed_cleanly": closed_cleanly,
+    }
+
+
+def write_manifest(folder: str | Path, content: dict[str, Any]) -> None:
+    """Write ``robot.json`` atomically (a temporary name, then moved into place)."""
+    folder = Path(folder)
+    partial = folder / (MANIFEST + ".partial")
+    partial.write_text(json.dumps(content, indent=2, sort_keys=True) + "\n", encoding="utf-8")
+    os.replace(partial, folder / MANIFEST)
+
+
+def write_robot_recording(
+    path: str | Path, recording: RobotRecording, *, overwrite: bool = False
+) -> Path:
+    """Write a whole robot recording; nothing is left behind if interrupted.
+
+    An existing folder is refused unless ``overwrite``; even then only a robot recording is
+    replaced (a folder that is not one is never removed).
+    """
+    path = Path(path)
+    if not path.parent.is_dir():
+        raise RecordingError(f"folder {path.parent} does not exist")
+    if path.exists():
+        if not overwrite:
+            raise FileExistsError(f"{path} exists; pass overwrite=True (--force) to replace it")
+        if not is_robot_recording(path):
+            raise RecordingError(
+                f"{path} exists and is not a robot recording; it is not replaced, whatever "
+                "--force says"
+            )
+    partial = path.with_name(path.name + ".partial")
+    if partial.exists():
+        shutil.rmtree(partial)
+    try:
+        (partial / STREAMS).mkdir(parents=True)
+        (partial / SKIN).write_text(skin_to_toml_string(recording.skin), encoding="utf-8")
+        for name, stream in recording.streams.items():
+            write_recording(stream_path(partial, name), stream)
+        write_manifest(partial, manifest(recording))
+    except BaseException:
+        shutil.rmtree(partial, ignore_errors=True)
+        raise
+    if path.exists():
+        shutil.rmtree(path)
+    partial.replace(path)
+    return path
+
+
+def read_manifest(path: str | Path) -> dict[str, Any]:
+    """The manifest of a robot recording, checked, or RecordingError saying what is wrong."""
+    path = Path(path)
+    if not path.is_dir():
+        raise RecordingError(f"{path} is not a robot recording (expected a folder)")
+    try:
+        content = json.loads((path / MANIFEST).read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise RecordingError(f"{path} is not a robot recording: it has no {MANIFEST}") from None
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
+        raise RecordingError(f"{path / MANIFEST}: unreadable ({error})") from None
+    if not isinstance(content, dict) or content.get("format") != ROBOT_FORMAT:
+        raise RecordingError(f"{path / MANIFEST}: not a {ROBOT_FORMAT} manifest")
+    version = content.get("format_version")
+    if version != ROBOT_FORMAT_VERSION:
+        raise RecordingError(
+            f"{path}: robot recording format version {version!r}; this tactsense reads "
+            f"version {ROBOT_FORMAT_VERSION}"
+        )
+    return content
+
+
+def read_robot_skin(path: str | Path) -> RobotSkin:
+    """The skin a robot recording was made with."""
+    try:
+        return skin_from_toml(Path(path) / SKIN)
+    except RobotSkinError as error:
+        raise RecordingError(f"{path}: {error}") from None
+
+
+def read_robot_recording(path: str | Path) -> RobotRecording:
+    """A robot recording whole (every stream in memory; use the per-patch files' readers,
+    :class:`tactsense.io.recording.RecordingReader`, for long ones)."""
+    path = Path(path)
+    content = read_manifest(path)
+    skin = read_robot_skin(path)
+    streams = {}
+    for name in content.get("streams", []):
+        skin.patch(name)
+        file = stream_path(path, name)
+        if file.exists():
+            streams[name] = read_recording(file)
+    return RobotRecording(
+        skin=skin,
+        streams=streams,
+        devices=dict(content.get("devices", {})),
+        description=str(content.get("description", "")),
+        closed_cleanly=bool(content.get("closed_cleanly", False)),
+    )
