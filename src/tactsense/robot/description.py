@@ -254,16 +254,16 @@ class RobotSkin:
         if not problems:
             unreached = links - set(self._order())
             if unreached:
-                problems.append(
-                    "links not joined to the base: " + ", ".join(sorted(unreached))
-                )
+                problems.append("links not joined to the base: " + ", ".join(sorted(unreached)))
         patch_names: set[str] = set()
         for patch in self.patches:
             if patch.name in patch_names:
                 problems.append(f"patch {patch.name!r} is named twice")
             patch_names.add(patch.name)
             if patch.link not in links:
-                problems.append(f"patch {patch.name!r}: link {patch.link!r} is not one of the links")
+                problems.append(
+                    f"patch {patch.name!r}: link {patch.link!r} is not one of the links"
+                )
         if not self.patches:
             problems.append("no sensors: a skin holds at least one")
         return problems
@@ -288,7 +288,9 @@ class RobotSkin:
         """Names of the joints that move (not fixed), in description order."""
         return tuple(j.name for j in self.joints if j.type != "fixed")
 
-    def link_poses(self, joint_positions: Mapping[str, float] | None = None) -> dict[str, np.ndarray]:
+    def link_poses(
+        self, joint_positions: Mapping[str, float] | None = None
+    ) -> dict[str, np.ndarray]:
         """Every link's frame in the base frame, 4 x 4, for a joint state.
 
         Parameters
@@ -322,7 +324,9 @@ class RobotSkin:
                 poses[link] = np.eye(4)
                 continue
             poses[link] = (
-                poses[joint.parent] @ joint.origin.matrix() @ joint.motion(positions.get(joint.name, 0.0))
+                poses[joint.parent]
+                @ joint.origin.matrix()
+                @ joint.motion(positions.get(joint.name, 0.0))
             )
         return poses
 

@@ -63,7 +63,8 @@ def hand4() -> RobotSkin:
         )
         parent = base
         offset = 0.0
-        for j, (segment, length) in enumerate(zip(("proximal", "middle", "distal"), lengths_m)):
+        segments = zip(("proximal", "middle", "distal"), lengths_m, strict=True)
+        for j, (segment, length) in enumerate(segments):
             link = f"{finger}_{segment}"
             links.append(link)
             joints.append(
@@ -104,7 +105,10 @@ def hand4() -> RobotSkin:
                 name=f"palm_{k}",
                 sensor=palm,
                 link="palm",
-                origin=Pose((0.02 + 0.037 * (k // 2), -0.04 + 0.037 * (k % 2) * 2, -0.01), (math.pi, 0.0, 0.0)),
+                origin=Pose(
+                    (0.02 + 0.037 * (k // 2), -0.04 + 0.037 * (k % 2) * 2, -0.01),
+                    (math.pi, 0.0, 0.0),
+                ),
                 device="board_palm",
             )
         )

@@ -50,7 +50,8 @@ def _unknown(table: dict, allowed: set[str], where: str) -> None:
     extra = sorted(set(table) - allowed)
     if extra:
         raise RobotSkinError(
-            f"{where}: unknown key(s) {', '.join(extra)}; expected some of {', '.join(sorted(allowed))}"
+            f"{where}: unknown key(s) {', '.join(extra)}; "
+            f"expected some of {', '.join(sorted(allowed))}"
         )
 
 
