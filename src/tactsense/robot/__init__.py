@@ -16,6 +16,7 @@ from tactsense.robot.description import (
     RobotSkin,
     RobotSkinError,
     rotation_matrix,
+    rpy_from_matrix,
 )
 from tactsense.robot.presets import SKIN_PRESETS, skin_preset
 from tactsense.robot.toml_form import (
@@ -51,6 +52,7 @@ __all__ = [
     "RobotSkinError",
     "load_skin",
     "rotation_matrix",
+    "rpy_from_matrix",
     "skin_from_dict",
     "skin_from_toml",
     "skin_preset",

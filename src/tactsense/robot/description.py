@@ -65,6 +65,20 @@ def rotation_matrix(rpy_rad: tuple[float, float, float]) -> np.ndarray:
     )
 
 
+def rpy_from_matrix(rotation: np.ndarray) -> tuple[float, float, float]:
+    """URDF roll-pitch-yaw [rad] of a rotation matrix (the inverse of :func:`rotation_matrix`).
+
+    At pitch = +-pi/2 (gimbal lock) roll is taken as 0 and yaw carries the whole turn.
+    """
+    r = np.asarray(rotation, dtype=float)
+    pitch = -math.asin(max(-1.0, min(1.0, float(r[2, 0]))))
+    if abs(math.cos(pitch)) < 1e-9:
+        return 0.0, pitch, math.atan2(-float(r[0, 1]), float(r[1, 1]))
+    roll = math.atan2(float(r[2, 1]), float(r[2, 2]))
+    yaw = math.atan2(float(r[1, 0]), float(r[0, 0]))
+    return roll, pitch, yaw
+
+
 def axis_rotation(axis: np.ndarray, angle_rad: float) -> np.ndarray:
     """Rotation by ``angle_rad`` about the unit vector ``axis`` (Rodrigues)."""
     x, y, z = axis
