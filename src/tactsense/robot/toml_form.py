@@ -119,7 +119,18 @@ def _sensor(value: Any, where: str, folder: Path | None):
 def skin_from_dict(
     data: dict[str, Any], *, source: str = "robot skin", folder: Path | None = None
 ) -> RobotSkin:
-    """A skin from the TOML form's tables (``folder``: where relative sensor paths start)."""
+    """A skin from the TOML form's tables (``folder``: where relative sensor paths start).
+
+    Every error is a :class:`RobotSkinError` that starts with ``source``."""
+    try:
+        return _skin_from_dict(data, source, folder)
+    except RobotSkinError as error:
+        if str(error).startswith(source):
+            raise
+        raise RobotSkinError(f"{source}: {error}") from None
+
+
+def _skin_from_dict(data: dict[str, Any], source: str, folder: Path | None) -> RobotSkin:
     if not isinstance(data, dict):
         raise RobotSkinError(f"{source}: expected a table, got {type(data).__name__}")
     _unknown(data, _TOP, source)
