@@ -270,8 +270,7 @@ def robot_skin_to_urdf(skin: RobotSkin) -> str:
         ET.SubElement(
             element, "origin", xyz=_xyz(joint.origin.xyz_m), rpy=_xyz(joint.origin.rpy_rad)
         )
-        if joint.type != "fixed":
-            ET.SubElement(element, "axis", xyz=_xyz(joint.axis))
+        ET.SubElement(element, "axis", xyz=_xyz(joint.axis))  # a fixed joint ignores it
         if joint.type in ("revolute", "prismatic"):
             ET.SubElement(
                 element,
