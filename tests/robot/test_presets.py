@@ -91,3 +91,31 @@ def test_icub_hand_fingertips_sit_on_the_distal_links_as_published():
     flexed = skin.taxels_in_base({"r_hand_index_1_joint": math.pi / 2})["index_tip"][0]
     straight = skin.taxels_in_base()["index_tip"][0]
     assert np.linalg.norm(flexed.mean(0) - straight.mean(0)) > 0.02
+
+
+def test_rest_state_is_within_every_limit():
+    skin = skin_preset("hand4")
+    rest = skin.rest_joint_positions()
+    assert rest["thumb_abduction"] == 0.263  # Allegro's lower limit: 0 is outside
+    assert rest["index_joint1"] == 0.0
+    assert set(rest) == set(skin.movable_joints)
+    skin.link_poses(rest)  # every value within its limits, or this raises
+
+
+def test_the_docs_preset_tables_are_current():
+    """docs/robot.md's tables are scripts/robot_skin_numbers.py's: each row is found."""
+    import importlib.util
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    spec = importlib.util.spec_from_file_location(
+        "robot_skin_numbers", root / "scripts" / "robot_skin_numbers.py"
+    )
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    doc = (root / "docs" / "robot.md").read_text()
+    for name in ("hand4", "icub_hand"):
+        skin = skin_preset(name)
+        for row in script._patch_rows(skin):
+            assert row in doc, row
+        assert f"**`{name}`**: {len(skin.patches)} patches, {skin.n_taxels} taxels" in doc

@@ -159,3 +159,17 @@ def test_extends_must_fit_the_form(tmp_path):
         read_robot_urdf(path, extends="pad99")
     skin = read_robot_urdf(path, extends={"pad": "fsr16"})
     assert skin.patch("pad").sensor.transduction.kind == "piezoresistive"
+
+
+def test_load_robot_skin_reads_every_form(tmp_path):
+    from tactsense.interop.robot_urdf import load_robot_skin
+    from tactsense.robot import skin_to_toml_string
+
+    skin = skin_preset("icub_hand")
+    (tmp_path / "s.toml").write_text(skin_to_toml_string(skin))
+    write_robot_urdf(skin, tmp_path / "s.urdf")
+    assert load_robot_skin("icub_hand") == skin == load_robot_skin(tmp_path / "s.toml")
+    from_urdf = load_robot_skin(tmp_path / "s.urdf", extends="icub_fingertip")
+    assert from_urdf.joints == skin.joints
+    with pytest.raises(UrdfError, match="does not exist"):
+        load_robot_skin(tmp_path / "none.urdf")

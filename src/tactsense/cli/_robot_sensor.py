@@ -18,8 +18,6 @@ from tactsense.kinds import kind_of
 from tactsense.robot import (
     SKIN_PRESETS,
     RobotSkin,
-    RobotSkinError,
-    load_skin,
     skin_from_dict,
     skin_to_toml_string,
 )
@@ -72,14 +70,9 @@ def skin_inputs(value: str | Path) -> list[Path]:
 
 def read_skin(value: str | Path) -> RobotSkin:
     """A skin from a preset's name, a skin TOML or a URDF file."""
-    text = str(value)
-    if text not in SKIN_PRESETS and Path(text).suffix.lower() == ".urdf":
-        from tactsense.interop.robot_urdf import read_robot_urdf
+    from tactsense.interop.robot_urdf import load_robot_skin
 
-        if not Path(text).is_file():
-            raise RobotSkinError(f"URDF file {text} does not exist")
-        return read_robot_urdf(text)
-    return load_skin(text)
+    return load_robot_skin(value)
 
 
 def _rate(patch) -> str:

@@ -32,10 +32,25 @@ from pathlib import Path
 from tactsense.interop.urdf import read_tactile_arrays, read_tactile_taxels, sensor_to_urdf
 from tactsense.kinds import kind_of
 from tactsense.kinds.urdf import UrdfError
-from tactsense.robot import JOINT_TYPES, Joint, Patch, Pose, RobotSkin, RobotSkinError
+from tactsense.robot import (
+    JOINT_TYPES,
+    SKIN_PRESETS,
+    Joint,
+    Patch,
+    Pose,
+    RobotSkin,
+    RobotSkinError,
+    load_skin,
+)
 from tactsense.sensor import PRESETS, preset
 
-__all__ = ["TACTSENSE_URDF_NS", "read_robot_urdf", "robot_skin_to_urdf", "write_robot_urdf"]
+__all__ = [
+    "TACTSENSE_URDF_NS",
+    "load_robot_skin",
+    "read_robot_urdf",
+    "robot_skin_to_urdf",
+    "write_robot_urdf",
+]
 
 TACTSENSE_URDF_NS = "https://github.com/tactsense/urdf"
 """XML namespace of tactsense's own URDF attributes (``tactsense:device``)."""
@@ -306,3 +321,21 @@ def write_robot_urdf(skin: RobotSkin, path: str | Path) -> Path:
         temporary.unlink(missing_ok=True)
         raise
     return path
+
+
+def load_robot_skin(
+    source: str | Path | RobotSkin, *, extends: str | Mapping[str, str] | None = None
+) -> RobotSkin:
+    """A skin from a preset's name, a skin TOML or a URDF file (``*.urdf``), or one built.
+
+    :func:`tactsense.robot.load_skin` reads presets and TOML; this adds URDF (``extends``:
+    as :func:`read_robot_urdf`'s). Commands that take a ``SKIN`` argument read it here.
+    """
+    if isinstance(source, RobotSkin):
+        return source
+    text = str(source)
+    if text not in SKIN_PRESETS and Path(text).suffix.lower() == ".urdf":
+        if not Path(text).is_file():
+            raise UrdfError(f"robot skin file {text} does not exist")
+        return read_robot_urdf(text, extends=extends)
+    return load_skin(text)

@@ -360,6 +360,13 @@ class RobotSkin:
         """Names of the joints that move (not fixed), in description order."""
         return tuple(j.name for j in self.joints if j.type != "fixed")
 
+    def rest_joint_positions(self) -> dict[str, float]:
+        """Each movable joint at 0, or at its nearer limit when 0 is outside its limits
+        (Allegro's thumb rotation, for one) [rad or m]: a valid state to start from."""
+        return {
+            j.name: float(min(max(0.0, j.lower), j.upper)) for j in self.joints if j.type != "fixed"
+        }
+
     def link_poses(
         self, joint_positions: Mapping[str, float] | None = None
     ) -> dict[str, np.ndarray]:
