@@ -173,3 +173,82 @@ def test_load_robot_skin_reads_every_form(tmp_path):
     assert from_urdf.joints == skin.joints
     with pytest.raises(UrdfError, match="does not exist"):
         load_robot_skin(tmp_path / "none.urdf")
+
+
+def _toolbox_taxels_in_link(sensor) -> tuple[np.ndarray, np.ndarray]:
+    """Each taxel's position [m] and normal in its link's frame by the tactile toolbox's
+    rule (urdf_tactile's TaxelInfoIterator, ubi-agni/tactile_toolbox commit b46718d9),
+    written out from the XML alone: an <array>'s taxel (row, col) at origin + R (row *
+    spacing.x - offset.x, col * spacing.y - offset.y, 0), normal R z; a <taxel>'s at
+    origin + R xyz, normal R R_taxel z. (Upstream's compose() for <taxel> lists adds the
+    origin's x to all three coordinates; the rule here is the one its README states, the
+    URDF convention.)"""
+    from scipy.spatial.transform import Rotation
+
+    def numbers(element, attribute, default):
+        return np.array([float(v) for v in element.get(attribute, default).split()])
+
+    origin = sensor.find("origin")
+    t = numbers(origin, "xyz", "0 0 0")
+    r = Rotation.from_euler("xyz", numbers(origin, "rpy", "0 0 0")).as_matrix()
+    array = sensor.find("tactile/array")
+    if array is not None:
+        rows, cols = int(array.get("rows")), int(array.get("cols"))
+        spacing, offset = numbers(array, "spacing", ""), numbers(array, "offset", "0 0")
+        assert array.get("order", "row-major") == "row-major"
+        local = np.array(
+            [
+                (row * spacing[0] - offset[0], col * spacing[1] - offset[1], 0.0)
+                for row in range(rows)
+                for col in range(cols)
+            ]
+        )
+        return local @ r.T + t, np.tile(r[:, 2], (len(local), 1))
+    positions, normals = [], []
+    for taxel in sensor.findall("tactile/taxel"):
+        own = Rotation.from_euler("xyz", numbers(taxel, "rpy", "0 0 0")).as_matrix()
+        positions.append(r @ numbers(taxel, "xyz", "0 0 0") + t)
+        normals.append((r @ own)[:, 2])
+    return np.array(positions), np.array(normals)
+
+
+@pytest.mark.parametrize("name", ["hand4", "icub_hand"])
+def test_every_taxel_is_where_the_toolbox_and_yourdfpy_put_it(tmp_path, name):
+    """An independent evaluation of the whole placement: the written URDF read with the
+    toolbox's taxel rule (from the XML) and yourdfpy's forward kinematics, against
+    ``skin.taxels_in_base`` at a random joint state; within 1e-12 m (15-digit file)."""
+    import xml.etree.ElementTree as ET
+
+    import yourdfpy
+
+    skin = skin_preset(name)
+    path = write_robot_urdf(skin, tmp_path / "skin.urdf")
+    robot = yourdfpy.URDF.load(str(path), load_meshes=False, build_collision_scene_graph=False)
+    rng = np.random.default_rng(11)
+    state = {j.name: float(rng.uniform(j.lower, j.upper)) for j in skin.joints if j.type != "fixed"}
+    robot.update_cfg(state)
+    placed = skin.taxels_in_base(state)
+    sensors = ET.parse(path).getroot().findall("sensor")
+    assert [s.get("name") for s in sensors] == [p.name for p in skin.patches]
+    for sensor in sensors:
+        link = robot.get_transform(frame_to=sensor.find("parent").get("link"))
+        positions, normals = _toolbox_taxels_in_link(sensor)
+        ours_p, ours_n = placed[sensor.get("name")]
+        np.testing.assert_allclose(positions @ link[:3, :3].T + link[:3, 3], ours_p, atol=1e-12)
+        np.testing.assert_allclose(normals @ link[:3, :3].T, ours_n, atol=1e-12)
+
+
+def test_an_array_offset_moves_the_taxels_as_the_toolbox_does(tmp_path):
+    import xml.etree.ElementTree as ET
+
+    text = TOOLBOX_HAND.replace(
+        'spacing="0.003 0.003"/>', 'spacing="0.003 0.003" offset="0.004 -0.001"/>'
+    )
+    path = tmp_path / "offset.urdf"
+    path.write_text(text)
+    skin = read_robot_urdf(path)
+    sensor = next(s for s in ET.parse(path).getroot().findall("sensor") if s.get("name") == "pad")
+    expected, _ = _toolbox_taxels_in_link(sensor)
+    np.testing.assert_allclose(skin.patch("pad").taxels_in_link()[0], expected, atol=1e-15)
+    # taxel (0, 0) at (0.02 - 0.004, 0 + 0.001, 0) in the finger's frame
+    np.testing.assert_allclose(expected[0], [0.016, 0.001, 0.0], atol=1e-15)

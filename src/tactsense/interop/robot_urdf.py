@@ -29,6 +29,8 @@ import xml.etree.ElementTree as ET
 from collections.abc import Mapping
 from pathlib import Path
 
+import numpy as np
+
 from tactsense.interop.urdf import read_tactile_arrays, read_tactile_taxels, sensor_to_urdf
 from tactsense.kinds import kind_of
 from tactsense.kinds.urdf import UrdfError
@@ -41,6 +43,7 @@ from tactsense.robot import (
     RobotSkin,
     RobotSkinError,
     load_skin,
+    rotation_matrix,
 )
 from tactsense.sensor import PRESETS, preset
 
@@ -145,6 +148,17 @@ def _joint(element, source: str) -> Joint:
         raise UrdfError(f"{source}: {error}") from None
 
 
+def _shifted(origin: Pose, offset_m: tuple[float, float]) -> Pose:
+    """The sensor frame of an ``<array>`` with an ``offset``: the toolbox puts taxel (row,
+    col) at (row * spacing.x - offset.x, col * spacing.y - offset.y, 0) in the sensor's
+    frame (``TaxelInfoIterator``), a sensor description at (row * pitch, col * pitch), so
+    the frame moves by -offset."""
+    if not any(offset_m):
+        return origin
+    shift = rotation_matrix(origin.rpy_rad) @ np.array([-offset_m[0], -offset_m[1], 0.0])
+    return Pose(tuple(float(v) for v in np.asarray(origin.xyz_m) + shift), origin.rpy_rad)
+
+
 def _preset_for(extends, name: str, form: str) -> str:
     if isinstance(extends, Mapping):
         chosen = extends.get(name)
@@ -227,12 +241,15 @@ def read_robot_urdf(
                 f"extend preset {chosen!r} (a {base.kind}); name a preset of a kind that fits"
             )
         try:
+            origin = _pose(element, where)
+            if form == "array":
+                origin = _shifted(origin, arrays[name].offset_m)
             patches.append(
                 Patch(
                     name=name,
                     sensor=spec,
                     link=_link_of(element, "parent", where),
-                    origin=_pose(element, where),
+                    origin=origin,
                     device=element.get(_DEVICE, ""),
                 )
             )
