@@ -139,3 +139,43 @@ def test_taxels_in_base_are_the_patch_pose_applied_to_the_sensor_frame():
 def test_bad_joint_states_are_refused(state, message):
     with pytest.raises(RobotSkinError, match=message):
         _arm().link_poses(state)
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_random_trees_agree_with_yourdfpy(tmp_path, seed):
+    """Random trees (every joint type, random origins, axes, limits) against yourdfpy."""
+    rng = np.random.default_rng(seed)
+    links, joints = ["l0"], []
+    for i in range(1, 12):
+        kind = ("fixed", "revolute", "continuous", "prismatic")[int(rng.integers(4))]
+        low = float(rng.uniform(-2, 0))
+        joints.append(
+            Joint(
+                f"j{i}",
+                kind,
+                links[int(rng.integers(len(links)))],
+                f"l{i}",
+                Pose(tuple(rng.uniform(-0.1, 0.1, 3)), tuple(rng.uniform(-3, 3, 3))),
+                tuple(rng.normal(size=3)),
+                lower=low if kind in ("revolute", "prismatic") else -math.inf,
+                upper=low + 2.5 if kind in ("revolute", "prismatic") else math.inf,
+            )
+        )
+        links.append(f"l{i}")
+    skin = RobotSkin(
+        name="random",
+        base_link="l0",
+        links=tuple(links),
+        joints=tuple(joints),
+        patches=(Patch("pad", preset("pad4"), links[-1]),),
+    )
+    path = tmp_path / "random.urdf"
+    path.write_text(robot_skin_to_urdf(skin))
+    robot = yourdfpy.URDF.load(str(path), load_meshes=False, build_collision_scene_graph=False)
+    for _ in range(10):
+        state = _random_state(skin, rng)
+        robot.update_cfg(state)
+        ours = skin.link_poses(state)
+        for link in links:
+            theirs = robot.get_transform(frame_to=link, frame_from="l0")
+            np.testing.assert_allclose(ours[link], theirs, atol=1e-12, err_msg=link)
