@@ -577,3 +577,54 @@ def test_fix38_mujoco_seconds_help_range_is_the_one_checked(workspace):
 
 
 # ---- /r6-fix38 ----
+
+
+# ---- robot skins in the sensor commands (r7-skin) ----
+SKIN_BAD_INPUT = [
+    # (command line, what the message must say); DIR: the workspace
+    ("sensor export --sensor hand4 --out OUT", "say which format, --format toml|urdf"),
+    ("sensor export --sensor hand4 --format png --out OUT", "--format 'png'"),
+    ("sensor export --sensor pad4 --format toml --out OUT", "--format 'toml': one sensor"),
+    ("sensor export --sensor DIR/skin.toml --format toml --out DIR/skin.toml", "input"),
+    ("sensor export --sensor DIR/no_such.urdf --format toml --out OUT", "does not exist"),
+    ("sensor show --sensor DIR/skin_loop.toml", "close a loop"),
+    ("sensor show --sensor DIR/a_file.urdf", "not XML"),
+    ("sensor check DIR/skin_loop.toml", "the joints close a loop: b -> c -> b"),
+    ("sensor check DIR/skin_badsensor.toml", "sensors[0]"),
+    ("sensor check hand4 --probe-g 50", "--probe-g maps the blind spots of one pad"),
+]
+
+
+def _skin_files(folder):
+    good = (
+        'name = "s"\nbase_link = "a"\nlinks = ["a", "b"]\n'
+        '[[joints]]\nname = "j"\ntype = "revolute"\nparent = "a"\nchild = "b"\n'
+        "lower = -1.0\nupper = 1.0\n"
+        '[[sensors]]\nname = "p"\nlink = "b"\nsensor = "pad4"\n'
+    )
+    (folder / "skin.toml").write_text(good)
+    (folder / "skin_loop.toml").write_text(
+        'name = "s"\nbase_link = "a"\nlinks = ["a", "b", "c"]\n'
+        '[[joints]]\nname = "j1"\ntype = "fixed"\nparent = "b"\nchild = "c"\n'
+        '[[joints]]\nname = "j2"\ntype = "fixed"\nparent = "c"\nchild = "b"\n'
+        '[[sensors]]\nname = "p"\nlink = "a"\nsensor = "pad4"\n'
+    )
+    (folder / "skin_badsensor.toml").write_text(
+        'name = "s"\nbase_link = "a"\n[[sensors]]\nname = "p"\nlink = "a"\n'
+        'sensor = {kind = "pad", grid = {rows = 0}}\n'
+    )
+    (folder / "a_file.urdf").write_text("x")
+
+
+@pytest.mark.parametrize("line, names", SKIN_BAD_INPUT, ids=[line for line, _ in SKIN_BAD_INPUT])
+def test_skin_bad_input(workspace, line, names):
+    _skin_files(workspace)
+    out = workspace / "never_written.out"
+    args = line.replace("OUT", str(out)).replace("DIR", str(workspace)).split()
+    result = runner.invoke(app, args)
+    _check(result, names)
+    assert not out.exists()
+    assert (workspace / "skin.toml").read_text().startswith('name = "s"')
+
+
+# ---- /r7-skin ----

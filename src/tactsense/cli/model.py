@@ -10,6 +10,7 @@ import typer
 from rich.table import Table
 
 from tactsense._validation import TactsenseInputError
+from tactsense.cli import _robot_sensor  # r7-skin
 from tactsense.cli._common import (
     SensorOption,
     atomic_output,
@@ -280,7 +281,15 @@ def sensor_show(
     ] = None,
     force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
 ) -> None:
-    """Print a sensor description as TOML: a starting point for describing your own finger."""
+    """Print a sensor description as TOML: a starting point for describing your own finger.
+
+    A robot skin (a skin preset such as hand4, a skin TOML or a URDF with several sensors):
+    a table of its patches (link, kind, taxels, rate, device) and totals; --out writes its
+    TOML."""
+    # ---- robot skins (r7-skin) ----
+    if _robot_sensor.is_skin(sensor):
+        return _robot_sensor.show_skin(sensor, out, force)
+    # ---- /r7-skin ----
     try:
         spec = load_sensor(sensor)
         if out is None:
@@ -312,11 +321,20 @@ def sensor_list() -> None:
     for name, make in PRESETS.items():
         table.add_row(*_preset_row(name, make()))
     print_table(table)
+    # ---- robot skins (r7-skin) ----
+    print_table(_robot_sensor.skin_list_table())
+    # ---- /r7-skin ----
 
 
 @sensor_app.command("check")
 def sensor_check(
-    path: Annotated[Path, typer.Argument(help="Sensor TOML file to validate.")],
+    path: Annotated[
+        Path,
+        typer.Argument(
+            help="Sensor TOML file to validate, or a robot skin (a skin preset such as hand4, "
+            "a skin TOML or a URDF with several sensors)."
+        ),
+    ],
     probe_g: Annotated[
         float | None,
         typer.Option(
@@ -330,7 +348,15 @@ def sensor_check(
 ) -> None:
     """Validate a sensor TOML file (finger, pad or point set) and print its derived
     quantities; on a pad, warn of blind spots: places where a --probe-g press moves no
-    taxel's reading by more than three times its noise (read noise and quantization)."""
+    taxel's reading by more than three times its noise (read noise and quantization).
+    A robot skin: the skin's problems and each sensor's, then warnings (a board reading
+    patches at different rates, taxels of two patches on top of each other)."""
+    # ---- robot skins (r7-skin) ----
+    if _robot_sensor.is_skin(path):
+        if probe_g is not None:
+            fail("--probe-g maps the blind spots of one pad; give a pad, not a robot skin")
+        return _robot_sensor.check_skin(path)
+    # ---- /r7-skin ----
     try:
         spec = load_sensor(path) if path.suffix.lower() == ".toml" else SensorSpec.from_toml(path)
     except TactsenseInputError as error:
@@ -508,15 +534,39 @@ def sensor_export(
         "finger"
     ),
     force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
+    # ---- robot skins (r7-skin) ----
+    fmt: Annotated[
+        str | None,
+        typer.Option(
+            "--format",
+            help="What to write: 'urdf' (as --urdf) or, for a robot skin (a skin preset such "
+            "as hand4, a skin TOML or a URDF), 'toml' (the skin's TOML, every sensor whole) or "
+            "'urdf' (every link, joint and sensor). Required for a robot skin.",
+        ),
+    ] = None,
+    # ---- /r7-skin ----
 ) -> None:
     """Write a sensor as a URDF tactile description for ROS (RViz's tactile display).
 
     A pad as an <array> (rows along x, columns along y); a finger or a point set as a
     <taxel idx xyz rpy> list, each taxel on the skin at its real position and normal (a
-    finger: x along it); metres; the data vector is a tactsense frame, row-major.
+    finger: x along it); metres; the data vector is a tactsense frame, row-major. A robot
+    skin: --format toml or urdf (its links, joints and every sensor).
     """
     from tactsense.interop.urdf import sensor_to_urdf
 
+    # ---- robot skins (r7-skin) ----
+    if _robot_sensor.is_skin(sensor):
+        return _robot_sensor.export_skin(
+            sensor, "urdf" if urdf and fmt is None else fmt, out, force
+        )
+    if fmt is not None and fmt != "urdf":
+        fail(
+            f"--format {fmt!r}: one sensor is exported as urdf ('tactsense sensor show' "
+            "prints its TOML)"
+        )
+    urdf = urdf or fmt == "urdf"
+    # ---- /r7-skin ----
     if not urdf:
         fail("say which format: --urdf (for TOML use 'tactsense sensor show')")
     if not link.strip():

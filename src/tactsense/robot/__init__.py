@@ -1,7 +1,10 @@
 """A robot's skin: many tactile sensors of any kind on the links of one robot.
 
 :class:`RobotSkin` describes them once (sensors, links, poses, the kinematic tree);
-:func:`load_skin` reads one from a preset's name or a TOML file.
+:func:`load_skin` reads one from a preset's name or a TOML file;
+:func:`tactsense.interop.robot_urdf.load_robot_skin` also from a URDF file. Presets:
+``hand4`` (the Allegro Hand's kinematics, 20 patches, 4,000 taxels) and ``icub_hand``
+(iCub's right hand and its five fingertips); sources in :mod:`tactsense.robot.presets`.
 """
 
 from __future__ import annotations
@@ -16,6 +19,7 @@ from tactsense.robot.description import (
     RobotSkin,
     RobotSkinError,
     rotation_matrix,
+    rpy_from_matrix,
 )
 from tactsense.robot.presets import SKIN_PRESETS, skin_preset
 from tactsense.robot.toml_form import (
@@ -51,6 +55,7 @@ __all__ = [
     "RobotSkinError",
     "load_skin",
     "rotation_matrix",
+    "rpy_from_matrix",
     "skin_from_dict",
     "skin_from_toml",
     "skin_preset",

@@ -35,6 +35,8 @@ JOINT_TYPES = ("fixed", "revolute", "continuous", "prismatic")
 
 
 _NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,63}")
+_FRAME_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.:/+-]{0,127}")
+"""A link's or joint's name: URDF/ROS frame names without spaces or XML's special signs."""
 
 
 class RobotSkinError(TactsenseInputError):
@@ -65,11 +67,29 @@ def rotation_matrix(rpy_rad: tuple[float, float, float]) -> np.ndarray:
     )
 
 
+def rpy_from_matrix(rotation: np.ndarray) -> tuple[float, float, float]:
+    """URDF roll-pitch-yaw [rad] of a rotation matrix (the inverse of :func:`rotation_matrix`).
+
+    At pitch = +-pi/2 (gimbal lock) roll is taken as 0 and yaw carries the whole turn.
+    """
+    r = np.asarray(rotation, dtype=float)
+    pitch = -math.asin(max(-1.0, min(1.0, float(r[2, 0]))))
+    if abs(math.cos(pitch)) < 1e-9:
+        return 0.0, pitch, math.atan2(-float(r[0, 1]), float(r[1, 1]))
+    roll = math.atan2(float(r[2, 1]), float(r[2, 2]))
+    yaw = math.atan2(float(r[1, 0]), float(r[0, 0]))
+    return roll, pitch, yaw
+
+
 def axis_rotation(axis: np.ndarray, angle_rad: float) -> np.ndarray:
     """Rotation by ``angle_rad`` about the unit vector ``axis`` (Rodrigues)."""
     x, y, z = axis
     k = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
     return np.eye(3) + math.sin(angle_rad) * k + (1.0 - math.cos(angle_rad)) * (k @ k)
+
+
+def _frame_name(name: object) -> bool:
+    return isinstance(name, str) and _FRAME_NAME.fullmatch(name) is not None
 
 
 @dataclass(frozen=True)
@@ -128,6 +148,18 @@ class Joint:
             raise RobotSkinError(f"joint {self.name!r}: axis is zero; expected a direction")
         if norm > 0:
             object.__setattr__(self, "axis", tuple(float(v) for v in axis / norm))
+        for which in ("lower", "upper"):
+            value = getattr(self, which)
+            try:
+                value = float(value)
+            except (TypeError, ValueError):
+                value = math.nan
+            if math.isnan(value):
+                raise RobotSkinError(
+                    f"joint {self.name!r}: {which} limit {getattr(self, which)!r} is not a "
+                    "number [rad or m]"
+                )
+            object.__setattr__(self, which, value)
         if not self.lower <= self.upper:
             raise RobotSkinError(
                 f"joint {self.name!r}: lower limit {self.lower} is above upper limit {self.upper}"
@@ -181,6 +213,11 @@ class Patch:
             )
         if not self.device:
             object.__setattr__(self, "device", self.name)
+        if not isinstance(self.device, str) or not _NAME.fullmatch(self.device):
+            raise RobotSkinError(
+                f"patch {self.name!r}: device name {self.device!r}: expected letters, digits, "
+                "'_', '-' or '.', starting with a letter or digit"
+            )
 
     @property
     def n_taxels(self) -> int:
@@ -231,7 +268,15 @@ class RobotSkin:
         problems: list[str] = []
         links = set(self.links)
         if len(links) != len(self.links):
-            problems.append("a link is named twice")
+            twice = sorted({name for name in self.links if self.links.count(name) > 1})
+            problems.append(f"link(s) named twice: {', '.join(map(repr, twice))}")
+        bad = [name for name in self.links if not _frame_name(name)]
+        bad += [j.name for j in self.joints if not _frame_name(j.name)]
+        for name in bad:
+            problems.append(
+                f"name {name!r}: a link or joint name is letters, digits and _ . : / + -, "
+                "without spaces (at most 128)"
+            )
         if self.base_link not in links:
             problems.append(f"base_link {self.base_link!r} is not one of the links")
         children: dict[str, str] = {}
@@ -251,6 +296,9 @@ class RobotSkin:
             children[joint.child] = joint.name
         if self.base_link in children:
             problems.append(f"base_link {self.base_link!r} is a joint's child")
+        cycle = self._cycle()
+        if cycle:
+            problems.append("the joints close a loop: " + " -> ".join(cycle) + "; a tree has none")
         if not problems:
             unreached = links - set(self._order())
             if unreached:
@@ -269,6 +317,30 @@ class RobotSkin:
         return problems
 
     # ---- the tree --------------------------------------------------------------
+    def _cycle(self) -> list[str]:
+        """Links on a loop of joints (parent -> child), the first found; [] when none."""
+        children: dict[str, list[str]] = {}
+        for joint in self.joints:
+            children.setdefault(joint.parent, []).append(joint.child)
+        state: dict[str, int] = {}  # 1: on the current path, 2: done
+        for start in children:
+            if state.get(start):
+                continue
+            path, stack = [start], [iter(children.get(start, []))]
+            state[start] = 1
+            while stack:
+                child = next(stack[-1], None)
+                if child is None:
+                    state[path.pop()] = 2
+                    stack.pop()
+                elif state.get(child) == 1:
+                    return [*path[path.index(child) :], child]
+                elif not state.get(child):
+                    state[child] = 1
+                    path.append(child)
+                    stack.append(iter(children.get(child, [])))
+        return []
+
     def _order(self) -> list[str]:
         """Links from the base outwards (each after its parent)."""
         by_parent: dict[str, list[Joint]] = {}
@@ -287,6 +359,13 @@ class RobotSkin:
     def movable_joints(self) -> tuple[str, ...]:
         """Names of the joints that move (not fixed), in description order."""
         return tuple(j.name for j in self.joints if j.type != "fixed")
+
+    def rest_joint_positions(self) -> dict[str, float]:
+        """Each movable joint at 0, or at its nearer limit when 0 is outside its limits
+        (Allegro's thumb rotation, for one) [rad or m]: a valid state to start from."""
+        return {
+            j.name: float(min(max(0.0, j.lower), j.upper)) for j in self.joints if j.type != "fixed"
+        }
 
     def link_poses(
         self, joint_positions: Mapping[str, float] | None = None

@@ -61,6 +61,36 @@ def _required(table: dict, key: str, where: str) -> Any:
     return table[key]
 
 
+def _number(table: dict, key: str, default: float, where: str) -> float:
+    value = table.get(key, default)
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise RobotSkinError(f"{where}: {key} = {value!r}; expected a number")
+    return float(value)
+
+
+def _pose(table: dict, where: str) -> Pose:
+    try:
+        return Pose(table.get("xyz_m", (0, 0, 0)), table.get("rpy_rad", (0, 0, 0)))
+    except RobotSkinError as error:
+        raise RobotSkinError(f"{where}: {error}") from None
+
+
+def _text(table: dict, key: str, where: str, default: str | None = None) -> str:
+    value = _required(table, key, where) if default is None else table.get(key, default)
+    if not isinstance(value, str):
+        raise RobotSkinError(f"{where}: {key} = {value!r}; expected a string")
+    return value
+
+
+def _tables(data: dict, key: str, source: str) -> list:
+    value = data.get(key, [])
+    if not isinstance(value, list):
+        raise RobotSkinError(
+            f"{source}: {key} is a {type(value).__name__}; expected an array of tables ([[{key}]])"
+        )
+    return value
+
+
 def _sensor(value: Any, where: str, folder: Path | None):
     try:
         if isinstance(value, dict):
@@ -89,53 +119,67 @@ def _sensor(value: Any, where: str, folder: Path | None):
 def skin_from_dict(
     data: dict[str, Any], *, source: str = "robot skin", folder: Path | None = None
 ) -> RobotSkin:
-    """A skin from the TOML form's tables (``folder``: where relative sensor paths start)."""
+    """A skin from the TOML form's tables (``folder``: where relative sensor paths start).
+
+    Every error is a :class:`RobotSkinError` that starts with ``source``."""
+    try:
+        return _skin_from_dict(data, source, folder)
+    except RobotSkinError as error:
+        if str(error).startswith(source):
+            raise
+        raise RobotSkinError(f"{source}: {error}") from None
+
+
+def _skin_from_dict(data: dict[str, Any], source: str, folder: Path | None) -> RobotSkin:
     if not isinstance(data, dict):
         raise RobotSkinError(f"{source}: expected a table, got {type(data).__name__}")
     _unknown(data, _TOP, source)
     joints = []
-    for i, table in enumerate(data.get("joints", [])):
+    for i, table in enumerate(_tables(data, "joints", source)):
         where = f"{source}: joints[{i}]"
         if not isinstance(table, dict):
             raise RobotSkinError(f"{where}: expected a table")
         _unknown(table, _JOINT, where)
         joints.append(
             Joint(
-                name=str(_required(table, "name", where)),
-                type=str(_required(table, "type", where)),
-                parent=str(_required(table, "parent", where)),
-                child=str(_required(table, "child", where)),
-                origin=Pose(table.get("xyz_m", (0, 0, 0)), table.get("rpy_rad", (0, 0, 0))),
-                axis=tuple(table.get("axis", (1.0, 0.0, 0.0))),
-                lower=float(table.get("lower", -math.inf)),
-                upper=float(table.get("upper", math.inf)),
+                name=_text(table, "name", where),
+                type=_text(table, "type", where),
+                parent=_text(table, "parent", where),
+                child=_text(table, "child", where),
+                origin=_pose(table, where),
+                axis=table.get("axis", (1.0, 0.0, 0.0)),
+                lower=_number(table, "lower", -math.inf, where),
+                upper=_number(table, "upper", math.inf, where),
             )
         )
     patches = []
-    for i, table in enumerate(data.get("sensors", [])):
+    for i, table in enumerate(_tables(data, "sensors", source)):
         where = f"{source}: sensors[{i}]"
         if not isinstance(table, dict):
             raise RobotSkinError(f"{where}: expected a table")
         _unknown(table, _SENSOR, where)
-        name = str(_required(table, "name", where))
+        name = _text(table, "name", where)
         patches.append(
             Patch(
                 name=name,
                 sensor=_sensor(_required(table, "sensor", where), f"{where} ({name})", folder),
-                link=str(_required(table, "link", where)),
-                origin=Pose(table.get("xyz_m", (0, 0, 0)), table.get("rpy_rad", (0, 0, 0))),
-                device=str(table.get("device", "")),
+                link=_text(table, "link", where),
+                origin=_pose(table, where),
+                device=_text(table, "device", where, default=""),
             )
         )
+    base_link = _text(data, "base_link", source)
     links = data.get("links")
     if links is None:  # the base and every joint's child
-        links = [str(_required(data, "base_link", source))]
+        links = [base_link]
         links += [j.child for j in joints if j.child not in links]
+    if not isinstance(links, list) or not all(isinstance(v, str) for v in links):
+        raise RobotSkinError(f"{source}: links = {links!r}; expected an array of names")
     return RobotSkin(
-        name=str(_required(data, "name", source)),
-        description=str(data.get("description", "")),
-        base_link=str(_required(data, "base_link", source)),
-        links=tuple(str(v) for v in links),
+        name=_text(data, "name", source),
+        description=_text(data, "description", source, default=""),
+        base_link=base_link,
+        links=tuple(links),
         joints=tuple(joints),
         patches=tuple(patches),
     )

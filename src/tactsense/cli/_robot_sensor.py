@@ -1,0 +1,241 @@
+"""``tactsense sensor show|check|export|list`` for a robot skin (many sensors on one robot).
+
+The sensor commands hand a ``--sensor`` value (or ``check``'s path) here when it names a
+robot skin: a skin preset (``hand4``, ``icub_hand``), a skin TOML (one with a
+``base_link``) or a URDF file (links, joints and any number of tactile sensors).
+"""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+from rich.table import Table
+
+from tactsense._validation import TactsenseInputError
+from tactsense.cli._common import atomic_output, check_output, console, fail, print_table
+from tactsense.kinds import kind_of
+from tactsense.robot import (
+    SKIN_PRESETS,
+    RobotSkin,
+    skin_from_dict,
+    skin_to_toml_string,
+)
+
+SKIN_FORMATS = ("toml", "urdf")
+"""What ``sensor export --format`` writes a skin as."""
+
+OVERLAP_M = 0.5e-3
+"""``sensor check`` warns of taxels of two patches closer than this [m] (0.5 mm)."""
+
+
+def _read_toml(path: Path) -> dict | None:
+    try:
+        return tomllib.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        return None
+
+
+def is_skin(value: str | Path | None) -> bool:
+    """Whether a ``--sensor`` value names a robot skin rather than one sensor."""
+    if value is None:
+        return False
+    text = str(value)
+    if text in SKIN_PRESETS:
+        return True
+    path = Path(text)
+    if path.suffix.lower() == ".urdf":
+        return True
+    if path.suffix.lower() == ".toml" and path.is_file():
+        data = _read_toml(path)
+        return isinstance(data, dict) and "base_link" in data
+    return False
+
+
+def skin_inputs(value: str | Path) -> list[Path]:
+    """The files a skin is read from: its own and the sensor TOML files it names."""
+    path = Path(str(value))
+    if not path.is_file():
+        return []
+    found = [path]
+    data = _read_toml(path) if path.suffix.lower() == ".toml" else None
+    for table in (data or {}).get("sensors", []) if isinstance(data, dict) else []:
+        sensor = table.get("sensor") if isinstance(table, dict) else None
+        if isinstance(sensor, str):
+            candidate = Path(sensor) if Path(sensor).is_absolute() else path.parent / sensor
+            if candidate.is_file():
+                found.append(candidate)
+    return found
+
+
+def read_skin(value: str | Path) -> RobotSkin:
+    """A skin from a preset's name, a skin TOML or a URDF file."""
+    from tactsense.interop.robot_urdf import load_robot_skin
+
+    return load_robot_skin(value)
+
+
+def _rate(patch) -> str:
+    return f"{patch.sensor.electronics.scan_rate_hz:g} Hz"
+
+
+def patch_table(skin: RobotSkin) -> Table:
+    """One row per patch (link, kind, taxels, rate, device) and a row of totals."""
+    table = Table(title=f"{skin.name}: {skin.description}".rstrip(": "))
+    for column in ("patch", "link", "kind", "sensor", "taxels", "rate", "device"):
+        table.add_column(column, justify="right" if column == "taxels" else "left")
+    for patch in skin.patches:
+        table.add_row(
+            patch.name,
+            patch.link,
+            kind_of(patch.sensor).label,
+            patch.sensor.name,
+            str(patch.n_taxels),
+            _rate(patch),
+            patch.device,
+        )
+    rates = sorted({p.sensor.electronics.scan_rate_hz for p in skin.patches})
+    table.add_section()
+    table.add_row(
+        f"{len(skin.patches)} patches",
+        f"{len(skin.links)} links, {len(skin.movable_joints)} moving joints",
+        "",
+        "",
+        str(skin.n_taxels),
+        " / ".join(f"{r:g}" for r in rates) + " Hz",
+        f"{len(skin.devices)} devices",
+    )
+    return table
+
+
+def show_skin(value: str, out: Path | None, force: bool) -> None:
+    """``sensor show`` for a skin: the patch table, or its TOML written to ``out``."""
+    if out is not None:
+        check_output(out, force, inputs=skin_inputs(value))
+    try:
+        skin = read_skin(value)
+        if out is None:
+            print_table(patch_table(skin))
+            return
+        text = skin_to_toml_string(skin)
+        with atomic_output(out) as temporary:
+            Path(temporary).write_text(text, encoding="utf-8")
+        console.print(f"wrote {out}: {skin.name}, {len(skin.patches)} sensors")
+    except (TactsenseInputError, FileExistsError) as error:
+        fail(str(error))
+
+
+def export_skin(value: str, fmt: str | None, out: Path | None, force: bool) -> None:
+    """``sensor export --format toml|urdf`` for a skin (to ``out`` or standard output)."""
+    if fmt is None:
+        fail(f"{value!r} is a robot skin: say which format, --format {'|'.join(SKIN_FORMATS)}")
+    if fmt not in SKIN_FORMATS:
+        fail(f"--format {fmt!r}: a robot skin is written as {' or '.join(SKIN_FORMATS)}")
+    if out is not None:
+        check_output(out, force, inputs=skin_inputs(value))
+    try:
+        skin = read_skin(value)
+        if fmt == "urdf":
+            from tactsense.interop.robot_urdf import robot_skin_to_urdf
+
+            text = robot_skin_to_urdf(skin)
+        else:
+            text = skin_to_toml_string(skin)
+        if out is None:
+            import typer
+
+            typer.echo(text, nl=False)
+            return
+        with atomic_output(out) as temporary:
+            Path(temporary).write_text(text, encoding="utf-8")
+        console.print(f"wrote {out}: {skin.name}, {len(skin.patches)} sensors as {fmt.upper()}")
+    except (TactsenseInputError, FileExistsError) as error:
+        fail(str(error))
+
+
+def _sensor_problems(path: Path) -> list[str]:
+    """Each sensor's problems of a skin TOML, one sensor at a time (all of them, not the
+    first)."""
+    data = _read_toml(path)
+    if not isinstance(data, dict) or not isinstance(data.get("sensors"), list):
+        return []
+    problems = []
+    for i, table in enumerate(data["sensors"]):
+        if not isinstance(table, dict):
+            continue
+        one = {
+            "name": "check",
+            "base_link": "base",
+            "links": ["base"],
+            "sensors": [{**table, "link": "base", "name": str(table.get("name", i))}],
+        }
+        try:
+            skin_from_dict(one, source=f"sensors[{i}]", folder=path.parent)
+        except TactsenseInputError as error:
+            problems.append(str(error))
+    return problems
+
+
+def skin_warnings(skin: RobotSkin) -> list[str]:
+    """What is valid but probably not meant: a board reading patches at different rates,
+    taxels of two patches on top of each other (at the zero joint state)."""
+    warnings = []
+    for device, names in skin.devices.items():
+        rates = {skin.patch(n).sensor.electronics.scan_rate_hz for n in names}
+        if len(rates) > 1:
+            listed = ", ".join(f"{r:g}" for r in sorted(rates))
+            warnings.append(
+                f"device {device!r} reads its patches at different rates ({listed} Hz); a board "
+                "scans all its patches at one rate"
+            )
+    from scipy.spatial import cKDTree
+
+    placed = skin.taxels_in_base()
+    names = list(placed)
+    trees = {name: cKDTree(placed[name][0]) for name in names}
+    for i, first in enumerate(names):
+        for second in names[i + 1 :]:
+            close = trees[first].count_neighbors(trees[second], OVERLAP_M)
+            if close:
+                warnings.append(
+                    f"patches {first!r} and {second!r}: {close} pair(s) of taxels closer than "
+                    f"{OVERLAP_M * 1e3:g} mm at the zero joint state (placed on top of each "
+                    "other?)"
+                )
+    return warnings
+
+
+def check_skin(path: str | Path) -> None:
+    """``sensor check`` for a skin: the skin's problems and each sensor's, then warnings."""
+    text = str(path)
+    problems = [] if text in SKIN_PRESETS else _sensor_problems(Path(text))
+    try:
+        skin = read_skin(text)
+    except TactsenseInputError as error:
+        message = str(error)
+        for problem in problems:
+            if problem not in message:
+                message += f"\n  - {problem}"
+        fail(message)
+    table = patch_table(skin)
+    table.title = f"{skin.name}: valid ({len(skin.patches)} sensors, {skin.n_taxels} taxels)"
+    print_table(table)
+    for patch in skin.patches:
+        for problem in patch.sensor.problems():
+            console.print(f"warning: patch {patch.name!r}: {problem}", markup=False)
+    for warning in skin_warnings(skin):
+        console.print(f"warning: {warning}", soft_wrap=True, markup=False, highlight=False)
+
+
+def skin_list_table() -> Table:
+    """The skin presets: name, patches, taxels, devices, what each is."""
+    table = Table(title="robot skins (tactsense sensor show --sensor NAME lists a skin's patches)")
+    for column in ("name", "patches", "taxels", "devices", "description"):
+        table.add_column(column)
+    for name, make in SKIN_PRESETS.items():
+        skin = make()
+        first = skin.description.split(". ")[0].rstrip(".")
+        table.add_row(
+            name, str(len(skin.patches)), str(skin.n_taxels), str(len(skin.devices)), first
+        )
+    return table

@@ -1,0 +1,97 @@
+"""``tactsense sensor show|check|export|list`` on a robot skin."""
+
+from typer.testing import CliRunner
+
+from tactsense.cli import app
+from tactsense.interop.robot_urdf import read_robot_urdf
+from tactsense.robot import skin_from_toml, skin_preset
+
+runner = CliRunner()
+
+
+def _run(*args):
+    result = runner.invoke(app, list(args), terminal_width=400)
+    return result, " ".join(result.output.split())
+
+
+def test_show_lists_every_patch_and_the_totals():
+    result, text = _run("sensor", "show", "--sensor", "hand4")
+    assert result.exit_code == 0, text
+    skin = skin_preset("hand4")
+    for patch in skin.patches:
+        assert patch.name in text
+    assert "20 patches" in text and "4000" in text and "4 devices" in text
+    assert "17 links, 16 moving joints" in text and "250 Hz" in text
+
+
+def test_export_urdf_then_show_and_check_it(tmp_path):
+    out = tmp_path / "hand.urdf"
+    result, text = _run("sensor", "export", "--sensor", "hand4", "--format", "urdf", "-o", str(out))
+    assert result.exit_code == 0, text
+    back = read_robot_urdf(out)
+    assert [p.name for p in back.patches] == [p.name for p in skin_preset("hand4").patches]
+    result, text = _run("sensor", "show", "--sensor", str(out))
+    assert result.exit_code == 0 and "4000" in text
+    result, text = _run("sensor", "check", str(out))
+    assert result.exit_code == 0 and "valid (20 sensors, 4000 taxels)" in text, text
+    # never over an input, even with --force
+    before = out.read_text()
+    result, text = _run(
+        "sensor", "export", "--sensor", str(out), "--format", "toml", "-o", str(out), "--force"
+    )
+    assert result.exit_code == 2 and out.read_text() == before
+
+
+def test_export_toml_round_trips_and_show_out_writes_toml(tmp_path):
+    out = tmp_path / "icub.toml"
+    result, text = _run(
+        "sensor", "export", "--sensor", "icub_hand", "--format", "toml", "-o", str(out)
+    )
+    assert result.exit_code == 0, text
+    assert skin_from_toml(out) == skin_preset("icub_hand")
+    again = tmp_path / "again.toml"
+    result, _ = _run("sensor", "show", "--sensor", str(out), "-o", str(again))
+    assert result.exit_code == 0 and skin_from_toml(again) == skin_preset("icub_hand")
+    result, text = _run("sensor", "show", "--sensor", str(out), "-o", str(again))
+    assert result.exit_code == 2 and "--force" in text  # an existing file needs --force
+
+
+def test_check_warns_of_mixed_rates_and_overlapping_patches(tmp_path):
+    path = tmp_path / "skin.toml"
+    path.write_text(
+        'name = "s"\nbase_link = "a"\n'
+        '[[sensors]]\nname = "p"\nlink = "a"\nsensor = "pad4"\ndevice = "board"\n'
+        '[[sensors]]\nname = "q"\nlink = "a"\nsensor = "dome12"\ndevice = "board"\n'
+        "xyz_m = [0.0, 0.0, -0.0075]\n"
+    )
+    result, text = _run("sensor", "check", str(path))
+    assert result.exit_code == 0, text
+    assert "device 'board' reads its patches at different rates (50, 100 Hz)" in text
+    # dome12's apex taxel at (0, 0, 7.5 mm) lands on pad4's taxel (0, 0) at the origin
+    assert "patches 'p' and 'q': 1 pair(s) of taxels closer than 0.5 mm" in text
+
+
+def test_check_reports_every_sensors_problem(tmp_path):
+    path = tmp_path / "skin.toml"
+    path.write_text(
+        'name = "s"\nbase_link = "a"\n'
+        '[[sensors]]\nname = "p"\nlink = "a"\nsensor = "pad99"\n'
+        '[[sensors]]\nname = "q"\nlink = "a"\nsensor = "nothere.toml"\n'
+    )
+    result, text = _run("sensor", "check", str(path))
+    assert result.exit_code == 2
+    assert "sensors[0]" in text and "sensors[1]" in text and "nothere.toml" in text
+
+
+def test_list_shows_the_skin_presets():
+    result, text = _run("sensor", "list")
+    assert result.exit_code == 0
+    text = " ".join(text.replace("│", " ").split())
+    assert "hand4 20 4000 4" in text and "icub_hand 5 60 1" in text
+
+
+def test_single_sensors_still_export_as_before(tmp_path):
+    result, text = _run("sensor", "export", "--sensor", "pad4", "--format", "urdf")
+    assert result.exit_code == 0 and "<array" in text
+    _, text_old = _run("sensor", "export", "--sensor", "pad4", "--urdf")
+    assert text_old == text
