@@ -1,0 +1,544 @@
+"""Simulated grasps: an object pressing several patches of a robot's skin at once.
+
+A :class:`Grasp` is an object (:class:`GraspObject`: a sphere, cylinder or box, its size
+[mm] and pose in the robot's base frame), a joint state, the forces and a time course.
+:func:`simulate_grasp` finds where the object touches each patch (one contact per patch:
+:mod:`tactsense.simulate._grasp_geometry`), gives each contact its normal force, and
+makes every patch's frames at the patch's own scan rate with its own flaws
+(:func:`~tactsense.simulate.frames_from_contacts`), into a
+:class:`~tactsense.io.robot_recording.RobotRecording` with the truth in every stream.
+
+Forces, one of two rules:
+
+* **commanded** (``force_n``): a force [N] per finger (every finger the object touches,
+  when one number; or by name), shared among the finger's touched patches in proportion
+  to their penetration volumes, or a force per patch by the patch's name. A *finger* is
+  the subtree of links under one child link of the base link, named by that child link
+  (patches on the base link itself form the finger named by the base link: a palm).
+* **penetration stiffness** (``force_n`` None): each touched patch pushes back with
+  ``stiffness_n_per_mm`` [N/mm] times the object's deepest penetration into it [mm], a
+  linear spring per patch.
+
+The indenter's radius comes from the object's curvature: a sphere's radius, a cylinder's
+radius across its axis (the contact is taken as a point contact of that radius; the line
+along the axis is not modelled), a box's flat face as uniform pressure on a disc of the
+contact's area. Tangential forces are not simulated (a grasp here holds, it does not
+slip).
+
+Time course (:class:`Timing`): approach (nothing touches), squeeze (every force ramps
+linearly from 0 to its full value), hold (full force), release (linearly back to 0). The
+contacts stay where they are at the given pose: only their forces follow the course.
+Each frame takes the force at the start of its scan (``time_s = i / rate``).
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from tactsense.io.recording import Recording
+from tactsense.io.robot_recording import RobotRecording, write_robot_recording
+from tactsense.kinds import kind_of
+from tactsense.physics.transduction import sample_offsets
+from tactsense.robot import Pose, RobotSkin, RobotSkinError
+from tactsense.simulate._grasp_frames import frame_count, patch_frames, takes_grasp
+from tactsense.simulate._grasp_geometry import (
+    FLAT_BOX_SHAPE,
+    OBJECTS,
+    SIZES,
+    GraspError,
+    GraspObject,
+    PatchContact,
+    patch_contact,
+    surface_sample,
+)
+from tactsense.simulate.contact_frames import named_left_out_flaws, resolve_flaws
+
+PHASES = ("approach", "squeeze", "hold", "release")
+"""The phases of a grasp's time course, in order."""
+
+TRUTH_KEYS = (
+    "contact_position_mm",
+    "contact_position_base_m",
+    "contact_normal",
+    "contact_normal_base",
+    "contact_normal_force_n",
+    "contact_radius_mm",
+    "frame_step",
+    "step_n_contacts",
+)
+"""The truth every stream of a simulated grasp carries, whether touched or not (one
+contact per patch: ``k = 1``): ``contact_position_mm`` (T, 1, 3) [mm] in the patch's
+sensor frame and ``contact_position_base_m`` (T, 1, 3) [m] in the base frame (NaN in a
+frame without contact); ``contact_normal`` / ``contact_normal_base`` (T, 1, 3) the skin's
+outward unit normal there (the force presses along its negative; NaN without contact);
+``contact_normal_force_n`` (T, 1) [N]; ``contact_radius_mm`` (T, 1) [mm] the indenter's
+radius (NaN without contact); ``frame_step`` (T,) the phase of each frame (index into
+:data:`PHASES`) and ``step_n_contacts`` (4,) the contacts the patch has in each phase."""
+
+MAX_PHASE_S = 600.0
+"""Longest phase [s] (the frames of every patch are held in memory until written)."""
+
+
+@dataclass(frozen=True)
+class Timing:
+    """Durations of the grasp's phases [s], each 0 to :data:`MAX_PHASE_S`, more than 0
+    in all."""
+
+    approach_s: float = 0.2
+    squeeze_s: float = 0.3
+    hold_s: float = 0.5
+    release_s: float = 0.3
+
+    def __post_init__(self) -> None:
+        durations = self.durations_s
+        for name, value in zip(PHASES, durations, strict=True):
+            if not (math.isfinite(value) and 0.0 <= value <= MAX_PHASE_S):
+                raise GraspError(f"{name} duration {value!r}: expected 0 to {MAX_PHASE_S:g} [s]")
+        if sum(durations) <= 0:
+            raise GraspError("the grasp's phases last 0 s in all; give a duration > 0 [s]")
+
+    @property
+    def durations_s(self) -> tuple[float, float, float, float]:
+        """(approach, squeeze, hold, release) [s]."""
+        return (
+            float(self.approach_s),
+            float(self.squeeze_s),
+            float(self.hold_s),
+            float(self.release_s),
+        )
+
+    @property
+    def total_s(self) -> float:
+        """The whole course [s]."""
+        return float(sum(self.durations_s))
+
+    def phase(self, time_s: np.ndarray) -> np.ndarray:
+        """The phase (index into :data:`PHASES`) at each time [s]; the end belongs to the
+        release."""
+        bounds = np.cumsum(self.durations_s)
+        return np.minimum(np.searchsorted(bounds, np.asarray(time_s), side="right"), 3)
+
+    def scale(self, time_s: np.ndarray) -> np.ndarray:
+        """The fraction of the full force at each time [s] (0 to 1)."""
+        approach, squeeze, hold, release = self.durations_s
+        t = np.asarray(time_s, float)
+        rise = np.clip((t - approach) / squeeze, 0.0, 1.0) if squeeze > 0 else t >= approach
+        end_hold = approach + squeeze + hold
+        fall = np.clip((t - end_hold) / release, 0.0, 1.0) if release > 0 else t >= end_hold
+        return np.asarray(rise, float) * (1.0 - np.asarray(fall, float))
+
+
+@dataclass(frozen=True)
+class Grasp:
+    """A grasp to simulate.
+
+    Attributes
+    ----------
+    object : GraspObject
+    joints : mapping of str -> float
+        Position of each movable joint [rad or m] (those left out at 0).
+    force_n : float, mapping of str -> float, or None
+        The commanded force [N] > 0: one number for every finger the object touches, or
+        by finger or patch name; None: the penetration-stiffness rule.
+    stiffness_n_per_mm : float
+        The penetration-stiffness rule's spring [N/mm] > 0.
+    timing : Timing
+    flaws : str
+        The per-frame flaws (as ``frames_from_contacts`` takes them: "all", "none" or a
+        comma list); a flaw with memory or jitter named is refused.
+    seed : int
+        Seed of the read noise [-] (each patch draws from its own stream of it).
+    """
+
+    object: GraspObject
+    joints: Mapping[str, float] = field(default_factory=dict)
+    force_n: float | Mapping[str, float] | None = None
+    stiffness_n_per_mm: float = 1.0
+    timing: Timing = field(default_factory=Timing)
+    flaws: str = "all"
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.object, GraspObject):
+            raise GraspError(f"object must be a GraspObject; got {type(self.object).__name__}")
+        if not isinstance(self.timing, Timing):
+            raise GraspError(f"timing must be a Timing; got {type(self.timing).__name__}")
+        object.__setattr__(self, "joints", dict(self.joints))
+        force = self.force_n
+        if isinstance(force, Mapping):
+            force = {str(k): _positive(f"force for {k!r}", v, "N", 1e4) for k, v in force.items()}
+            if not force:
+                raise GraspError("force_n names no finger or patch; give at least one")
+        elif force is not None:
+            force = _positive("force_n", force, "N", 1e4)
+        object.__setattr__(self, "force_n", force)
+        _positive("stiffness_n_per_mm", self.stiffness_n_per_mm, "N/mm", 1e6)
+        resolve_flaws(self.flaws)
+        left_out = named_left_out_flaws(self.flaws)
+        if left_out:
+            raise GraspError(
+                f"flaws {', '.join(left_out)} need a frame sequence (memory or jitter); a "
+                "simulated grasp applies the per-frame flaws only"
+            )
+        if not (isinstance(self.seed, int) and self.seed >= 0):
+            raise GraspError(f"seed {self.seed!r}: expected a whole number >= 0")
+
+
+def _positive(name: str, value: Any, unit: str, most: float) -> float:
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise GraspError(f"{name} = {value!r}: expected a number [{unit}]") from None
+    if not (math.isfinite(number) and 0.0 < number <= most):
+        raise GraspError(f"{name} = {value!r}: expected more than 0 and at most {most:g} [{unit}]")
+    return number
+
+
+def fingers(skin: RobotSkin) -> dict[str, str]:
+    """Each patch's finger: the child link of the base link its link lies under, or the
+    base link for a patch on the base link itself."""
+    parent = {joint.child: joint.parent for joint in skin.joints}
+    out = {}
+    for patch in skin.patches:
+        link = patch.link
+        while link != skin.base_link and parent.get(link) != skin.base_link:
+            link = parent[link]
+        out[patch.name] = link
+    return out
+
+
+def grasp_contacts(skin: RobotSkin, grasp: Grasp) -> dict[str, PatchContact]:
+    """The contact of the object on each patch it touches, in the patch's sensor frame,
+    at the grasp's joint state (patches it does not touch are left out)."""
+    try:
+        poses = skin.link_poses(grasp.joints)
+    except RobotSkinError as error:
+        raise GraspError(str(error)) from None
+    out = {}
+    for patch in skin.patches:
+        if not takes_grasp(patch.sensor):
+            continue
+        pose = poses[patch.link] @ patch.origin.matrix()
+        contact = patch_contact(grasp.object, surface_sample(patch.sensor), pose)
+        if contact is not None:
+            out[patch.name] = contact
+    return out
+
+
+def grasp_forces(
+    skin: RobotSkin, grasp: Grasp, contacts: Mapping[str, PatchContact]
+) -> dict[str, float]:
+    """The full normal force [N] of each touched patch (:func:`grasp_contacts`), by the
+    grasp's rule (module docstring)."""
+    if grasp.force_n is None:
+        return {name: grasp.stiffness_n_per_mm * c.depth_mm for name, c in contacts.items()}
+    finger_of = fingers(skin)
+    by_finger: dict[str, list[str]] = {}
+    for name in contacts:
+        by_finger.setdefault(finger_of[name], []).append(name)
+    if not isinstance(grasp.force_n, Mapping):
+        commanded = dict.fromkeys(by_finger, float(grasp.force_n))
+        by_patch: dict[str, float] = {}
+    else:
+        commanded, by_patch = {}, {}
+        finger_names = set(finger_of.values())
+        for key, value in grasp.force_n.items():
+            if key in finger_names:
+                commanded[key] = value
+            elif key in finger_of:
+                by_patch[key] = value
+            else:
+                raise GraspError(
+                    f"force for {key!r}: not a finger ({', '.join(sorted(finger_names))}) nor a "
+                    f"patch of {skin.name!r}"
+                )
+    out: dict[str, float] = {}
+    for name, value in by_patch.items():
+        if name not in contacts:
+            raise GraspError(f"force for patch {name!r}: the object does not touch it")
+        if finger_of[name] in commanded:
+            raise GraspError(
+                f"force for patch {name!r} and for its finger {finger_of[name]!r}: give one"
+            )
+        out[name] = value
+    for finger, value in commanded.items():
+        touched = by_finger.get(finger, [])
+        if not touched:
+            raise GraspError(f"force for finger {finger!r}: the object touches none of its patches")
+        volume = sum(contacts[name].volume_mm3 for name in touched)
+        for name in touched:
+            out[name] = value * contacts[name].volume_mm3 / volume
+    unforced = sorted(set(contacts) - set(out))
+    if unforced:
+        raise GraspError(
+            "the object touches " + ", ".join(unforced) + " but no force is given for them; "
+            "name their fingers or patches, or give one force for every finger"
+        )
+    return out
+
+
+def simulate_grasp(
+    skin: RobotSkin,
+    grasp: Grasp,
+    *,
+    progress: Callable[[int, int], None] | None = None,
+) -> RobotRecording:
+    """Frames of every patch of ``skin`` under ``grasp``, at each patch's own scan rate.
+
+    Parameters
+    ----------
+    skin : RobotSkin
+    grasp : Grasp
+    progress : callable, optional
+        Called with (patches done, patches) as each patch's frames are made.
+
+    Returns
+    -------
+    RobotRecording
+        One stream per patch, each with :data:`TRUTH_KEYS` in its truth, and the grasp
+        in its scenario.
+
+    Raises
+    ------
+    GraspError
+        The object touches no patch, a force names what it does not touch, a joint
+        state is invalid, or a patch's kind does not take a grasp.
+    """
+    if not isinstance(skin, RobotSkin):
+        raise GraspError(f"skin must be a RobotSkin; got {type(skin).__name__}")
+    for patch in skin.patches:
+        if not takes_grasp(patch.sensor):
+            raise kind_of(patch.sensor).unsupported(
+                patch.sensor, f"a simulated grasp (patch {patch.name!r})"
+            )
+    contacts = grasp_contacts(skin, grasp)
+    if not contacts:
+        raise GraspError(
+            f"the {grasp.object.shape} touches no patch of {skin.name!r} at this pose and "
+            "joint state; move it into the hand"
+        )
+    forces = grasp_forces(skin, grasp, contacts)
+    poses = skin.link_poses(grasp.joints)
+    timing = grasp.timing
+    seeds = np.random.SeedSequence(grasp.seed).spawn(len(skin.patches))
+    scenario = grasp_scenario(skin, grasp, forces)
+    streams = {}
+    for done, (patch, seed) in enumerate(zip(skin.patches, seeds, strict=True)):
+        spec = patch.sensor
+        rate = spec.electronics.scan_rate_hz
+        time_s = np.arange(frame_count(timing.total_s, rate)) / rate
+        contact = contacts.get(patch.name)
+        force = forces.get(patch.name, 0.0) * timing.scale(time_s)
+        radius = 1.0 if contact is None else contact.radius_mm(grasp.object)
+        shape = "sphere" if grasp.object.curvature_radius_mm is not None else FLAT_BOX_SHAPE
+        frames, gains = patch_frames(
+            spec,
+            contact,
+            force,
+            radius_mm=radius,
+            shape=shape,
+            flaws=grasp.flaws,
+            rng=np.random.default_rng(seed),
+        )
+        sensor_in_base = poses[patch.link] @ patch.origin.matrix()
+        streams[patch.name] = Recording(
+            frames=frames,
+            time_s=time_s,
+            sample_offset_s=sample_offsets(spec),
+            sensor=spec,
+            scenario=scenario,
+            flaws=resolve_flaws(grasp.flaws),
+            truth=_truth(patch, contact, force, radius, timing.phase(time_s), sensor_in_base),
+            gains=gains,
+        )
+        if progress is not None:
+            progress(done + 1, len(skin.patches))
+    return RobotRecording(
+        skin=skin,
+        streams=streams,
+        description=(
+            f"simulated grasp: {grasp.object.shape} {_numbers(grasp.object.size_mm)} mm, "
+            f"{len(contacts)} of {len(skin.patches)} patches touched"
+        ),
+    )
+
+
+def _truth(patch, contact, force, radius, phase, sensor_in_base) -> dict[str, Any]:
+    n = len(force)
+    touching = force > 0
+    position = np.full((n, 1, 3), np.nan)
+    base = np.full((n, 1, 3), np.nan)
+    normal = np.full((n, 1, 3), np.nan)
+    normal_base = np.full((n, 1, 3), np.nan)
+    radii = np.full((n, 1), np.nan)
+    if contact is not None:
+        rotation = sensor_in_base[:3, :3]
+        position[touching, 0] = contact.position_mm
+        base[touching, 0] = 1e-3 * (rotation @ contact.position_mm) + sensor_in_base[:3, 3]
+        normal[touching, 0] = contact.normal
+        normal_base[touching, 0] = rotation @ contact.normal
+        radii[touching, 0] = radius
+    n_contacts = np.zeros(len(PHASES), dtype=np.int64)
+    if contact is not None:
+        n_contacts[1:] = 1
+    return {
+        "contact_position_mm": position,
+        "contact_position_base_m": base,
+        "contact_normal": normal,
+        "contact_normal_base": normal_base,
+        "contact_normal_force_n": force[:, None].copy(),
+        "contact_radius_mm": radii,
+        "frame_step": np.asarray(phase, dtype=np.int64),
+        "step_n_contacts": n_contacts,
+        "patch": patch.name,
+        "link": patch.link,
+    }
+
+
+def _numbers(values) -> str:
+    return " x ".join(f"{v:g}" for v in values)
+
+
+def grasp_scenario(skin: RobotSkin, grasp: Grasp, forces: Mapping[str, float]) -> dict:
+    """The grasp as a recording's scenario (plain JSON): the object, joint state, rule,
+    each touched patch's full force [N] and the phases as steps."""
+    g = grasp.object
+    return {
+        "kind": "grasp",
+        "skin": skin.name,
+        "object": {
+            "shape": g.shape,
+            "size_mm": list(g.size_mm),
+            "xyz_m": list(g.pose.xyz_m),
+            "rpy_rad": list(g.pose.rpy_rad),
+        },
+        "joints": {k: float(v) for k, v in grasp.joints.items()},
+        "force_rule": "penetration stiffness" if grasp.force_n is None else "commanded",
+        "stiffness_n_per_mm": grasp.stiffness_n_per_mm,
+        "patch_force_n": {k: float(v) for k, v in forces.items()},
+        "steps": [
+            {"name": name, "duration_s": d}
+            for name, d in zip(PHASES, grasp.timing.durations_s, strict=True)
+        ],
+    }
+
+
+def write_grasp(
+    path: str | Path,
+    skin: RobotSkin,
+    grasp: Grasp,
+    *,
+    overwrite: bool = False,
+    progress: Callable[[int, int], None] | None = None,
+) -> RobotRecording:
+    """Simulate ``grasp`` on ``skin`` and write it as a robot recording folder at
+    ``path`` (written under a temporary name, moved into place when whole)."""
+    recording = simulate_grasp(skin, grasp, progress=progress)
+    write_robot_recording(path, recording, overwrite=overwrite)
+    return recording
+
+
+# ---- the grasp file (TOML) -----------------------------------------------------------
+_KEYS = {
+    "object": {"shape", "size_mm", "xyz_mm", "rpy_deg"},
+    "timing": {"approach_s", "squeeze_s", "hold_s", "release_s"},
+    "": {"object", "joints", "force_n", "stiffness_n_per_mm", "timing", "flaws", "seed"},
+}
+
+
+def grasp_from_dict(data: Mapping[str, Any], *, source: str = "grasp") -> Grasp:
+    """A :class:`Grasp` from the grasp file's content (docs/robot.md, "Simulated grasps"):
+    ``[object]`` shape, size_mm, xyz_mm [mm], rpy_deg [deg]; ``[joints]`` name = rad;
+    ``force_n`` a number or a table of finger/patch = N; ``stiffness_n_per_mm``;
+    ``[timing]`` approach_s, squeeze_s, hold_s, release_s; ``flaws``; ``seed``."""
+    for section, allowed in _KEYS.items():
+        table = data if not section else data.get(section, {})
+        if not isinstance(table, Mapping):
+            raise GraspError(f"{source}: [{section}] must be a table")
+        unknown = sorted(set(table) - allowed)
+        if unknown:
+            where = f"[{section}]" if section else "the top level"
+            raise GraspError(
+                f"{source}: unknown key(s) {', '.join(unknown)} in {where}; expected "
+                + ", ".join(sorted(allowed))
+            )
+    if "object" not in data:
+        raise GraspError(f"{source}: no [object] table (shape, size_mm, xyz_mm, rpy_deg)")
+    item = data["object"]
+    try:
+        pose = Pose(
+            tuple(1e-3 * float(v) for v in item.get("xyz_mm", (0, 0, 0))),
+            tuple(math.radians(float(v)) for v in item.get("rpy_deg", (0, 0, 0))),
+        )
+        size = item.get("size_mm", ())
+        grasped = GraspObject(
+            str(item.get("shape", "")), tuple(size) if isinstance(size, list | tuple) else (size,),
+            pose,
+        )  # fmt: skip
+        joints = data.get("joints", {})
+        if not isinstance(joints, Mapping):
+            raise GraspError("[joints] must be a table of joint = position [rad or m]")
+        force = data.get("force_n")
+        return Grasp(
+            object=grasped,
+            joints={str(k): _finite(f"joint {k!r}", v) for k, v in joints.items()},
+            force_n=dict(force) if isinstance(force, Mapping) else force,
+            stiffness_n_per_mm=data.get("stiffness_n_per_mm", 1.0),
+            timing=Timing(**{k: float(v) for k, v in data.get("timing", {}).items()}),
+            flaws=str(data.get("flaws", "all")),
+            seed=data.get("seed", 0),
+        )
+    except (GraspError, RobotSkinError) as error:
+        raise GraspError(f"{source}: {error}") from None
+    except (TypeError, ValueError) as error:
+        raise GraspError(f"{source}: {error}") from None
+
+
+def _finite(name: str, value: Any) -> float:
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        number = math.nan
+    if not math.isfinite(number):
+        raise GraspError(f"{name} = {value!r}: expected a finite number [rad or m]")
+    return number
+
+
+def grasp_from_toml(path: str | Path) -> Grasp:
+    """A :class:`Grasp` from a grasp file (:func:`grasp_from_dict`)."""
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise GraspError(f"grasp file {path} does not exist") from None
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as error:
+        raise GraspError(f"grasp file {path}: unreadable ({error})") from None
+    return grasp_from_dict(data, source=str(path))
+
+
+__all__ = [
+    "OBJECTS",
+    "PHASES",
+    "SIZES",
+    "TRUTH_KEYS",
+    "Grasp",
+    "GraspError",
+    "GraspObject",
+    "PatchContact",
+    "Timing",
+    "fingers",
+    "grasp_contacts",
+    "grasp_forces",
+    "grasp_from_dict",
+    "grasp_from_toml",
+    "grasp_scenario",
+    "simulate_grasp",
+    "write_grasp",
+]
