@@ -329,6 +329,11 @@ def simulate_grasp(
     timing = grasp.timing
     seeds = np.random.SeedSequence(grasp.seed).spawn(len(skin.patches))
     scenario = grasp_scenario(skin, grasp, forces)
+    scenario["description"] = (
+        f"simulated grasp on {skin.name}: {grasp.object.shape} "
+        f"{_numbers(grasp.object.size_mm)} mm, {scenario['force_rule']} forces, "
+        f"{len(contacts)} of {len(skin.patches)} patches touched"
+    )
     streams = {}
     for done, (patch, seed) in enumerate(zip(skin.patches, seeds, strict=True)):
         spec = patch.sensor
@@ -363,10 +368,7 @@ def simulate_grasp(
     return RobotRecording(
         skin=skin,
         streams=streams,
-        description=(
-            f"simulated grasp: {grasp.object.shape} {_numbers(grasp.object.size_mm)} mm, "
-            f"{len(contacts)} of {len(skin.patches)} patches touched"
-        ),
+        description=scenario["description"],
     )
 
 
