@@ -120,19 +120,23 @@ class Timing:
         return float(sum(self.durations_s))
 
     def phase(self, time_s: np.ndarray) -> np.ndarray:
-        """The phase (index into :data:`PHASES`) at each time [s]; the end belongs to the
-        release."""
-        bounds = np.cumsum(self.durations_s)
+        """The phase (index into :data:`PHASES`) at each time [s]: a time on a boundary
+        (to a nanosecond: the decimal durations' rounding) starts the next phase; the end
+        belongs to the release."""
+        bounds = np.cumsum(self.durations_s) - 1e-9
         return np.minimum(np.searchsorted(bounds, np.asarray(time_s), side="right"), 3)
 
     def scale(self, time_s: np.ndarray) -> np.ndarray:
-        """The fraction of the full force at each time [s] (0 to 1)."""
+        """The fraction of the full force at each time [s] (0 to 1): 0 in the approach,
+        a linear ramp up in the squeeze, 1 in the hold, a linear ramp down in the
+        release (0 after it)."""
         approach, squeeze, hold, release = self.durations_s
         t = np.asarray(time_s, float)
-        rise = np.clip((t - approach) / squeeze, 0.0, 1.0) if squeeze > 0 else t >= approach
+        phase = self.phase(t)
+        up = np.clip((t - approach) / squeeze, 0.0, 1.0) if squeeze > 0 else np.ones_like(t)
         end_hold = approach + squeeze + hold
-        fall = np.clip((t - end_hold) / release, 0.0, 1.0) if release > 0 else t >= end_hold
-        return np.asarray(rise, float) * (1.0 - np.asarray(fall, float))
+        down = np.clip(1.0 - (t - end_hold) / release, 0.0, 1.0) if release > 0 else 0.0 * t
+        return np.select([phase == 0, phase == 1, phase == 2], [0.0 * t, up, 1.0 + 0.0 * t], down)
 
 
 @dataclass(frozen=True)
