@@ -237,7 +237,9 @@ def grasp_command(
     contacts = grasp_contacts(robot, grasp)
     if not contacts:
         fail(
-            f"the {grasp.object.shape} at --pose {pose} touches no patch of {robot.name!r}; "
+            f"the {grasp.object.shape} at "
+            f"{grasp_file if grasp_file is not None else '--pose ' + pose}"
+            f" touches no patch of {robot.name!r}; "
             "move it into the hand (tactsense sensor show lists where the patches are)"
         )
     forces = grasp_forces(robot, grasp, contacts)
