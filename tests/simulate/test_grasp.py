@@ -436,3 +436,18 @@ def test_the_command_writes_a_robot_recording(tmp_path):
     assert again.exit_code == 2 and "exists" in again.output
     inside = CliRunner().invoke(app, [*args[:-3], "--out", str(tmp_path), "--force"])
     assert inside.exit_code == 2 and "holds the input" in inside.output
+
+
+def test_the_docs_grasp_file_reads():
+    """The grasp file shown in docs/robot.md is one `--grasp` reads."""
+    import re
+    import tomllib
+    from pathlib import Path
+
+    from tactsense.simulate.grasp import grasp_from_dict
+
+    doc = (Path(__file__).resolve().parents[2] / "docs" / "robot.md").read_text()
+    section = doc[doc.index("<!-- r7-grasp -->") : doc.index("<!-- /r7-grasp -->")]
+    (block,) = re.findall(r"```toml\n(.*?)```", section, flags=re.S)
+    grasp = grasp_from_dict(tomllib.loads(block))
+    assert grasp.object.shape == "cylinder" and grasp.timing.total_s == pytest.approx(1.3)

@@ -267,11 +267,13 @@ def grasp_command(
                 str(len(stream)),
             )
         )
+    from rich.markup import escape
     from rich.table import Table
 
-    table = Table("patch", "link", "finger", "force [N]", "depth [mm]", "rate [Hz]", "frames")
+    headers = ("patch", "link", "finger", "force [N]", "depth [mm]", "rate [Hz]", "frames")
+    table = Table(*(escape(h) for h in headers))
     for row in rows:
-        table.add_row(*row)
+        table.add_row(*(escape(cell) for cell in row))
     print_table(table)
     console.print(
         f"wrote {out}: {len(recording.streams)} streams, {len(contacts)} patches touched, "

@@ -3,7 +3,10 @@ on its surface.
 
 A kind with a taxel grid in millimetres (``Kind.surface_grid``: a pad) takes the
 contact through :func:`~tactsense.simulate.frames_from_contacts` at its centre's (x, y)
-in the sensor frame (a pad's surface coordinates are its sensor frame's x and y). A kind
+in the sensor frame (a pad's surface coordinates are its sensor frame's x and y), on its
+reference path (``fast=False``: the kind's own layer model, each distinct load computed
+once: a grasp's hold is one load, its ramps a few hundred, far fewer than the fast
+path's table of responses costs to build; ``scripts/grasp_numbers.py`` measures both). A kind
 without one that places indenters on its surface (``Kind.surface_scenarios``: a point
 set) takes it in the tangent plane of the pressed taxel nearest the centre (the
 indenter's ``at_taxel``), since a curved set's "(x, y) seen from +z" is ambiguous where
@@ -67,7 +70,9 @@ def patch_frames(
             radius_mm=radius_mm,
             shape=shape,
         )
-        frames = frames_from_contacts(spec, batch, flaws=active, rng=rng, gains=gains)
+        # the reference path: a grasp's frames hold few distinct loads (the hold is one,
+        # computed once), far fewer than the fast path's table of responses costs
+        frames = frames_from_contacts(spec, batch, flaws=active, rng=rng, gains=gains, fast=False)
         return frames.reshape(n, rows, cols), gains
     return _frames_at_taxel(spec, contact, force_n, radius_mm, shape, active, gains, rng), gains
 
