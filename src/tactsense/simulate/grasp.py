@@ -58,85 +58,9 @@ from tactsense.simulate._grasp_geometry import (
     patch_contact,
     surface_sample,
 )
+from tactsense.simulate._grasp_timing import MAX_PHASE_S, PHASES, Timing
+from tactsense.simulate._grasp_truth import TRUTH_KEYS, stream_truth
 from tactsense.simulate.contact_frames import named_left_out_flaws, resolve_flaws
-
-PHASES = ("approach", "squeeze", "hold", "release")
-"""The phases of a grasp's time course, in order."""
-
-TRUTH_KEYS = (
-    "contact_position_mm",
-    "contact_position_base_m",
-    "contact_normal",
-    "contact_normal_base",
-    "contact_normal_force_n",
-    "contact_radius_mm",
-    "frame_step",
-    "step_n_contacts",
-)
-"""The truth every stream of a simulated grasp carries, whether touched or not (one
-contact per patch: ``k = 1``): ``contact_position_mm`` (T, 1, 3) [mm] in the patch's
-sensor frame and ``contact_position_base_m`` (T, 1, 3) [m] in the base frame (NaN in a
-frame without contact); ``contact_normal`` / ``contact_normal_base`` (T, 1, 3) the skin's
-outward unit normal there (the force presses along its negative; NaN without contact);
-``contact_normal_force_n`` (T, 1) [N]; ``contact_radius_mm`` (T, 1) [mm] the indenter's
-radius (NaN without contact); ``frame_step`` (T,) the phase of each frame (index into
-:data:`PHASES`) and ``step_n_contacts`` (4,) the contacts the patch has in each phase."""
-
-MAX_PHASE_S = 600.0
-"""Longest phase [s] (the frames of every patch are held in memory until written)."""
-
-
-@dataclass(frozen=True)
-class Timing:
-    """Durations of the grasp's phases [s], each 0 to :data:`MAX_PHASE_S`, more than 0
-    in all."""
-
-    approach_s: float = 0.2
-    squeeze_s: float = 0.3
-    hold_s: float = 0.5
-    release_s: float = 0.3
-
-    def __post_init__(self) -> None:
-        durations = self.durations_s
-        for name, value in zip(PHASES, durations, strict=True):
-            if not (math.isfinite(value) and 0.0 <= value <= MAX_PHASE_S):
-                raise GraspError(f"{name} duration {value!r}: expected 0 to {MAX_PHASE_S:g} [s]")
-        if sum(durations) <= 0:
-            raise GraspError("the grasp's phases last 0 s in all; give a duration > 0 [s]")
-
-    @property
-    def durations_s(self) -> tuple[float, float, float, float]:
-        """(approach, squeeze, hold, release) [s]."""
-        return (
-            float(self.approach_s),
-            float(self.squeeze_s),
-            float(self.hold_s),
-            float(self.release_s),
-        )
-
-    @property
-    def total_s(self) -> float:
-        """The whole course [s]."""
-        return float(sum(self.durations_s))
-
-    def phase(self, time_s: np.ndarray) -> np.ndarray:
-        """The phase (index into :data:`PHASES`) at each time [s]: a time on a boundary
-        (to a nanosecond: the decimal durations' rounding) starts the next phase; the end
-        belongs to the release."""
-        bounds = np.cumsum(self.durations_s) - 1e-9
-        return np.minimum(np.searchsorted(bounds, np.asarray(time_s), side="right"), 3)
-
-    def scale(self, time_s: np.ndarray) -> np.ndarray:
-        """The fraction of the full force at each time [s] (0 to 1): 0 in the approach,
-        a linear ramp up in the squeeze, 1 in the hold, a linear ramp down in the
-        release (0 after it)."""
-        approach, squeeze, hold, release = self.durations_s
-        t = np.asarray(time_s, float)
-        phase = self.phase(t)
-        up = np.clip((t - approach) / squeeze, 0.0, 1.0) if squeeze > 0 else np.ones_like(t)
-        end_hold = approach + squeeze + hold
-        down = np.clip(1.0 - (t - end_hold) / release, 0.0, 1.0) if release > 0 else 0.0 * t
-        return np.select([phase == 0, phase == 1, phase == 2], [0.0 * t, up, 1.0 + 0.0 * t], down)
 
 
 @dataclass(frozen=True)
@@ -364,7 +288,7 @@ def simulate_grasp(
             sensor=spec,
             scenario=scenario,
             flaws=resolve_flaws(grasp.flaws),
-            truth=_truth(patch, contact, force, radius, timing.phase(time_s), sensor_in_base),
+            truth=stream_truth(patch, contact, force, radius, timing.phase(time_s), sensor_in_base),
             gains=gains,
         )
         if progress is not None:
@@ -374,38 +298,6 @@ def simulate_grasp(
         streams=streams,
         description=scenario["description"],
     )
-
-
-def _truth(patch, contact, force, radius, phase, sensor_in_base) -> dict[str, Any]:
-    n = len(force)
-    touching = force > 0
-    position = np.full((n, 1, 3), np.nan)
-    base = np.full((n, 1, 3), np.nan)
-    normal = np.full((n, 1, 3), np.nan)
-    normal_base = np.full((n, 1, 3), np.nan)
-    radii = np.full((n, 1), np.nan)
-    if contact is not None:
-        rotation = sensor_in_base[:3, :3]
-        position[touching, 0] = contact.position_mm
-        base[touching, 0] = 1e-3 * (rotation @ contact.position_mm) + sensor_in_base[:3, 3]
-        normal[touching, 0] = contact.normal
-        normal_base[touching, 0] = rotation @ contact.normal
-        radii[touching, 0] = radius
-    n_contacts = np.zeros(len(PHASES), dtype=np.int64)
-    if contact is not None:
-        n_contacts[1:] = 1
-    return {
-        "contact_position_mm": position,
-        "contact_position_base_m": base,
-        "contact_normal": normal,
-        "contact_normal_base": normal_base,
-        "contact_normal_force_n": force[:, None].copy(),
-        "contact_radius_mm": radii,
-        "frame_step": np.asarray(phase, dtype=np.int64),
-        "step_n_contacts": n_contacts,
-        "patch": patch.name,
-        "link": patch.link,
-    }
 
 
 def _numbers(values) -> str:
@@ -530,6 +422,7 @@ def grasp_from_toml(path: str | Path) -> Grasp:
 
 
 __all__ = [
+    "MAX_PHASE_S",
     "OBJECTS",
     "PHASES",
     "SIZES",
