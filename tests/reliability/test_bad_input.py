@@ -598,6 +598,8 @@ GRASP_BAD_OPTIONS = [
     (f"{_GRASP_SPHERE} --force-n palm=1,palm=2 --out OUT", "'palm' is given twice"),
     (f"{_GRASP_SPHERE} --stiffness-n-per-mm 0 --out OUT", "--stiffness-n-per-mm"),
     (f"{_GRASP_SPHERE} --stiffness-n-per-mm nan --out OUT", "--stiffness-n-per-mm"),
+    (f"{_GRASP_SPHERE} --load-n 1,2 --out OUT", "--load-n"),
+    (f"{_GRASP_SPHERE} --load-n 0,0,2e4 --out OUT", "--load-n"),
     (f"{_GRASP_SPHERE} --duration-s 1,1,1 --out OUT", "--duration-s"),
     (f"{_GRASP_SPHERE} --duration-s 0,0,0,0 --out OUT", "--duration-s"),
     (f"{_GRASP_SPHERE} --duration-s 0,1,1,700 --out OUT", "--duration-s"),

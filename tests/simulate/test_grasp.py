@@ -230,6 +230,38 @@ def test_forces_by_name_and_the_stiffness_rule():
     assert depth == pytest.approx(1.5, abs=0.002)
 
 
+def test_a_load_on_the_object_is_shared_as_tangential_forces():
+    """Each touched patch carries the load in proportion to its normal force; on skins
+    whose normals are all +z (zero joint state here) the tangential parts are the load's
+    x and y, and they add up to them; the normal part is dropped."""
+    load = (0.3, -0.2, -1.0)
+    grasp = Grasp(_box_on_finger_and_palm(), force_n=1.5, load_n=load, timing=TIMING)
+    recording = simulate_grasp(SKIN, grasp)
+    total = np.zeros(3)
+    normal_total = sum(_hold_force(recording, n) for n in ("palm_pad", "finger_pad", "tip"))
+    for name in ("palm_pad", "finger_pad", "tip", "far_pad"):
+        truth = recording.streams[name].truth
+        hold = np.flatnonzero(truth["frame_step"] == PHASES.index("hold"))
+        base = truth["contact_tangential_force_base_n"][hold[0], 0]
+        share = _hold_force(recording, name) / normal_total
+        normal = truth["contact_normal_base"][hold[0], 0]
+        if name == "far_pad":
+            np.testing.assert_array_equal(truth["contact_tangential_force_base_n"], 0.0)
+            continue
+        expected = share * (np.asarray(load) - (np.asarray(load) @ normal) * normal)
+        np.testing.assert_allclose(base, expected, atol=1e-12)
+        # the same force in the sensor frame, turned by the patch's pose
+        pose = SKIN.patch_pose(name)
+        sensor = truth["contact_tangential_force_n"][hold[0], 0]
+        np.testing.assert_allclose(pose[:3, :3] @ sensor, base, atol=1e-12)
+        # it follows the time course: none in the approach
+        assert np.all(truth["contact_tangential_force_n"][truth["frame_step"] == 0] == 0)
+        total += base
+    # the tip's normal at its contact is not exactly +z: compare the sum loosely there
+    np.testing.assert_allclose(total[:2], load[:2], atol=0.02 * np.hypot(*load[:2]))
+    assert abs(total[2]) < 0.02
+
+
 def test_the_force_follows_approach_squeeze_hold_release():
     grasp = Grasp(_sphere_on_palm(), force_n=2.0, timing=TIMING, flaws="none")
     truth = simulate_grasp(SKIN, grasp).streams["palm_pad"].truth
@@ -400,6 +432,8 @@ def test_a_grasp_file_gives_the_grasp_of_the_options(tmp_path):
         (lambda: Grasp(_sphere_on_palm(), joints={"finger_yaw": 2.0}), "outside its limits"),
         (lambda: Grasp(_sphere_on_palm(), flaws="viscoelastic"), "need a frame sequence"),
         (lambda: Grasp(_sphere_on_palm(), force_n=-1.0), "more than 0"),
+        (lambda: Grasp(_sphere_on_palm(), load_n=(1.0, 2.0)), "load_n"),
+        (lambda: Grasp(_sphere_on_palm(), load_n=(1.0, 2.0, math.nan)), "load_n"),
         (lambda: Grasp(_sphere_on_palm(), timing=Timing(0, 0, 0, 0)), "0 s in all"),
         (lambda: Grasp(_sphere_on_palm(), timing=Timing(-1, 1, 1, 1)), "approach duration"),
         (lambda: Grasp(GraspObject("cone", (1.0,))), "expected one of sphere"),

@@ -66,7 +66,9 @@ def _force(text: str) -> float | dict[str, float]:
     return forces if "=" in text else forces[""]
 
 
-def _grasp_from_options(shape, size_mm, pose, joints, force_n, stiffness, durations, flaws, seed):
+def _grasp_from_options(
+    shape, size_mm, pose, joints, force_n, stiffness, load_n, durations, flaws, seed
+):
     from tactsense.robot import Pose
     from tactsense.simulate.grasp import Grasp, GraspObject, Timing
 
@@ -83,6 +85,9 @@ def _grasp_from_options(shape, size_mm, pose, joints, force_n, stiffness, durati
         fail(f"--size-mm {size_mm!r}: each size must be more than 0 and at most 10,000 [mm]")
     if not 0 < stiffness <= 1e6:  # NaN fails too
         fail(f"--stiffness-n-per-mm {stiffness:g}: expected more than 0 and at most 1e6 [N/mm]")
+    load = None if load_n is None else _numbers("--load-n", load_n, (3,), "N")
+    if load is not None and not all(abs(v) <= 1e4 for v in load):
+        fail(f"--load-n {load_n!r}: each component at most 10,000 in size [N]")
     phases = _numbers("--duration-s", durations, (4,), "s")
     if not all(0 <= v <= 600 for v in phases) or sum(phases) <= 0:
         fail(f"--duration-s {durations!r}: each phase 0 to 600 [s], more than 0 in all")
@@ -91,6 +96,7 @@ def _grasp_from_options(shape, size_mm, pose, joints, force_n, stiffness, durati
         joints=_pairs("--joints", joints, "rad or m") if joints else {},
         force_n=None if force_n is None else _force(force_n),
         stiffness_n_per_mm=stiffness,
+        load_n=None if load is None else tuple(load),
         timing=Timing(*phases),
         flaws=flaws,
         seed=seed,
@@ -174,6 +180,17 @@ def grasp_command(
             "and at most 1e6, times the object's deepest penetration into it [mm].",
         ),
     ] = 1.0,
+    load_n: Annotated[
+        str | None,
+        typer.Option(
+            "--load-n",
+            metavar="FX,FY,FZ",
+            help="A force on the object the contacts carry, in the base frame [N], each "
+            "at most 10,000 in size (its weight: 0,0,-m*g): each touched patch takes a "
+            "share by its normal force, the part tangent to the skin is its tangential "
+            "force (in the truth; pads and point sets do not sense it). Default: none.",
+        ),
+    ] = None,
     durations: Annotated[
         str,
         typer.Option(
@@ -219,6 +236,7 @@ def grasp_command(
             ("--force-n", force_n),
             ("--duration-s", None if durations == DEFAULT_DURATIONS else durations),
             ("--stiffness-n-per-mm", None if stiffness == 1.0 else stiffness),
+            ("--load-n", load_n),
             ("--flaws", None if flaws == "all" else flaws),
             ("--seed", None if seed == 0 else seed),
         )
@@ -231,7 +249,7 @@ def grasp_command(
         grasp = grasp_from_toml(grasp_file)
     else:
         grasp = _grasp_from_options(
-            shape, size_mm, pose, joints, force_n, stiffness, durations, flaws, seed
+            shape, size_mm, pose, joints, force_n, stiffness, load_n, durations, flaws, seed
         )
     _check_out(out, force, [Path(skin), grasp_file])
     contacts = grasp_contacts(robot, grasp)

@@ -18,6 +18,7 @@ per-frame flaws. Other kinds say they do not take a grasp.
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 
@@ -27,6 +28,7 @@ from tactsense.physics.transduction import sample_offsets
 from tactsense.simulate._grasp_geometry import PatchContact, tangents
 from tactsense.simulate.contact_frames import (
     ContactBatch,
+    ShearIgnoredWarning,
     check_gains,
     frames_from_contacts,
     resolve_flaws,
@@ -44,6 +46,7 @@ def patch_frames(
     contact: PatchContact | None,
     force_n: np.ndarray,
     *,
+    tangential_n: np.ndarray | None = None,
     radius_mm: float,
     shape: str,
     flaws,
@@ -51,7 +54,9 @@ def patch_frames(
 ) -> tuple[np.ndarray, np.ndarray]:
     """(frames (N, rows, cols) [counts], per-taxel gains (rows, cols) [-]) of a sensor
     pressed at ``contact`` with normal force ``force_n`` [N] (N,) in each frame (0: not
-    touched; ``contact`` None: never touched)."""
+    touched; ``contact`` None: never touched) and tangential force ``tangential_n``
+    (N, 3) [N] in the sensor frame (a pad takes its x and y parts, and its kind says
+    whether it senses them; a point set's contacts take none)."""
     kind = kind_of(spec)
     if not takes_grasp(spec):
         raise kind.unsupported(spec, "a simulated grasp (contacts placed on its surface)")
@@ -64,15 +69,23 @@ def patch_frames(
         force_n = np.zeros(n)
     if contact is None or kind.surface_grid(spec) is not None:
         centre = (0.0, 0.0) if contact is None else contact.position_mm[:2]
+        shear = None
+        if tangential_n is not None and contact is not None:
+            shear = np.asarray(tangential_n, float)[:, None, :2]
         batch = ContactBatch(
             position_mm=np.broadcast_to(np.asarray(centre, float), (n, 1, 2)),
             normal_force_n=force_n[:, None],
+            tangential_force_n=shear,
             radius_mm=radius_mm,
             shape=shape,
         )
         # the reference path: a grasp's frames hold few distinct loads (the hold is one,
         # computed once), far fewer than the fast path's table of responses costs
-        frames = frames_from_contacts(spec, batch, flaws=active, rng=rng, gains=gains, fast=False)
+        with warnings.catch_warnings():  # the truth keeps the shear; the docs say who senses it
+            warnings.simplefilter("ignore", ShearIgnoredWarning)
+            frames = frames_from_contacts(
+                spec, batch, flaws=active, rng=rng, gains=gains, fast=False
+            )
         return frames.reshape(n, rows, cols), gains
     return _frames_at_taxel(spec, contact, force_n, radius_mm, shape, active, gains, rng), gains
 

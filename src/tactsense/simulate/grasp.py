@@ -77,6 +77,12 @@ class Grasp:
         by finger or patch name; None: the penetration-stiffness rule.
     stiffness_n_per_mm : float
         The penetration-stiffness rule's spring [N/mm] > 0.
+    load_n : (3,) tuple or None
+        A force on the object the contacts carry, in the base frame [N] (its weight:
+        ``(0, 0, -m g)``): each touched patch takes a share in proportion to its normal
+        force, and the part of it tangent to the skin at its contact is the tangential
+        force the object applies there (following the time course as the normal forces
+        do). None: no tangential forces.
     timing : Timing
     flaws : str
         The per-frame flaws (as ``frames_from_contacts`` takes them: "all", "none" or a
@@ -89,6 +95,7 @@ class Grasp:
     joints: Mapping[str, float] = field(default_factory=dict)
     force_n: float | Mapping[str, float] | None = None
     stiffness_n_per_mm: float = 1.0
+    load_n: tuple[float, float, float] | None = None
     timing: Timing = field(default_factory=Timing)
     flaws: str = "all"
     seed: int = 0
@@ -108,6 +115,17 @@ class Grasp:
             force = _positive("force_n", force, "N", 1e4)
         object.__setattr__(self, "force_n", force)
         _positive("stiffness_n_per_mm", self.stiffness_n_per_mm, "N/mm", 1e6)
+        if self.load_n is not None:
+            try:
+                load = tuple(float(v) for v in self.load_n)
+            except (TypeError, ValueError):
+                load = ()
+            if len(load) != 3 or not all(math.isfinite(v) and abs(v) <= 1e4 for v in load):
+                raise GraspError(
+                    f"load_n = {self.load_n!r}: expected three finite numbers, each at most "
+                    "10,000 in size [N]"
+                )
+            object.__setattr__(self, "load_n", load)
         resolve_flaws(self.flaws)
         left_out = named_left_out_flaws(self.flaws)
         if left_out:
@@ -268,19 +286,23 @@ def simulate_grasp(
         rate = spec.electronics.scan_rate_hz
         time_s = np.arange(frame_count(timing.total_s, rate)) / rate
         contact = contacts.get(patch.name)
-        force = forces.get(patch.name, 0.0) * timing.scale(time_s)
+        scale = timing.scale(time_s)
+        force = forces.get(patch.name, 0.0) * scale
+        sensor_in_base = poses[patch.link] @ patch.origin.matrix()
+        shear = _tangential(grasp, contact, forces, patch.name, sensor_in_base)
+        tangential = scale[:, None] * shear
         radius = 1.0 if contact is None else contact.radius_mm(grasp.object)
         shape = "sphere" if grasp.object.curvature_radius_mm is not None else FLAT_BOX_SHAPE
         frames, gains = patch_frames(
             spec,
             contact,
             force,
+            tangential_n=tangential,
             radius_mm=radius,
             shape=shape,
             flaws=grasp.flaws,
             rng=np.random.default_rng(seed),
         )
-        sensor_in_base = poses[patch.link] @ patch.origin.matrix()
         streams[patch.name] = Recording(
             frames=frames,
             time_s=time_s,
@@ -288,7 +310,9 @@ def simulate_grasp(
             sensor=spec,
             scenario=scenario,
             flaws=resolve_flaws(grasp.flaws),
-            truth=stream_truth(patch, contact, force, radius, timing.phase(time_s), sensor_in_base),
+            truth=stream_truth(
+                patch, contact, force, tangential, radius, timing.phase(time_s), sensor_in_base
+            ),
             gains=gains,
         )
         if progress is not None:
@@ -298,6 +322,17 @@ def simulate_grasp(
         streams=streams,
         description=scenario["description"],
     )
+
+
+def _tangential(grasp, contact, forces, name, sensor_in_base) -> np.ndarray:
+    """The full tangential force [N] the object applies to patch ``name`` at its contact,
+    in its sensor frame, (3,): its share of the grasp's load (by normal force), less the
+    part along the skin's normal."""
+    if grasp.load_n is None or contact is None:
+        return np.zeros(3)
+    share = forces[name] / sum(forces.values()) * np.asarray(grasp.load_n)
+    local = sensor_in_base[:3, :3].T @ share
+    return local - (local @ contact.normal) * contact.normal
 
 
 def _numbers(values) -> str:
@@ -320,6 +355,7 @@ def grasp_scenario(skin: RobotSkin, grasp: Grasp, forces: Mapping[str, float]) -
         "joints": {k: float(v) for k, v in grasp.joints.items()},
         "force_rule": "penetration stiffness" if grasp.force_n is None else "commanded",
         "stiffness_n_per_mm": grasp.stiffness_n_per_mm,
+        "load_n": None if grasp.load_n is None else list(grasp.load_n),
         "patch_force_n": {k: float(v) for k, v in forces.items()},
         "steps": [
             {"name": name, "duration_s": d}
@@ -347,7 +383,7 @@ def write_grasp(
 _KEYS = {
     "object": {"shape", "size_mm", "xyz_mm", "rpy_deg"},
     "timing": {"approach_s", "squeeze_s", "hold_s", "release_s"},
-    "": {"object", "joints", "force_n", "stiffness_n_per_mm", "timing", "flaws", "seed"},
+    "": {"object", "joints", "force_n", "stiffness_n_per_mm", "load_n", "timing", "flaws", "seed"},
 }
 
 
@@ -355,6 +391,7 @@ def grasp_from_dict(data: Mapping[str, Any], *, source: str = "grasp") -> Grasp:
     """A :class:`Grasp` from the grasp file's content (docs/robot.md, "Simulated grasps"):
     ``[object]`` shape, size_mm, xyz_mm [mm], rpy_deg [deg]; ``[joints]`` name = rad;
     ``force_n`` a number or a table of finger/patch = N; ``stiffness_n_per_mm``;
+    ``load_n`` [N] (three numbers, base frame);
     ``[timing]`` approach_s, squeeze_s, hold_s, release_s; ``flaws``; ``seed``."""
     for section, allowed in _KEYS.items():
         table = data if not section else data.get(section, {})
@@ -389,6 +426,7 @@ def grasp_from_dict(data: Mapping[str, Any], *, source: str = "grasp") -> Grasp:
             joints={str(k): _finite(f"joint {k!r}", v) for k, v in joints.items()},
             force_n=dict(force) if isinstance(force, Mapping) else force,
             stiffness_n_per_mm=data.get("stiffness_n_per_mm", 1.0),
+            load_n=data.get("load_n"),
             timing=Timing(**{k: float(v) for k, v in data.get("timing", {}).items()}),
             flaws=str(data.get("flaws", "all")),
             seed=data.get("seed", 0),
