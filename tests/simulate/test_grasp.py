@@ -485,3 +485,44 @@ def test_the_docs_grasp_file_reads():
     (block,) = re.findall(r"```toml\n(.*?)```", section, flags=re.S)
     grasp = grasp_from_dict(tomllib.loads(block))
     assert grasp.object.shape == "cylinder" and grasp.timing.total_s == pytest.approx(1.3)
+
+
+def test_joints_left_out_rest_at_zero_clipped_into_their_limits():
+    from tactsense.simulate.grasp import joint_state
+
+    skin = dataclasses.replace(
+        SKIN,
+        joints=(
+            dataclasses.replace(SKIN.joints[0], lower=0.2, upper=1.0),
+            dataclasses.replace(SKIN.joints[1], lower=-1.0, upper=-0.1),
+        ),
+    )
+    assert joint_state(skin, {}) == {"finger_yaw": 0.2, "finger_pitch": -0.1}
+    assert joint_state(skin, {"finger_yaw": 0.5}) == {"finger_yaw": 0.5, "finger_pitch": -0.1}
+    grasp = Grasp(_sphere_on_palm(), force_n=1.0, timing=TIMING, flaws="none")
+    assert simulate_grasp(skin, grasp).streams["tip"].scenario["joints"] == {
+        "finger_yaw": 0.2,
+        "finger_pitch": -0.1,
+    }
+
+
+@pytest.mark.parametrize("name", ["hand4", "icub_hand"])
+def test_every_preset_takes_a_grasp_on_its_largest_patch(name):
+    """Whatever a preset's geometry: a sphere pressed 1 mm into its largest patch (at its
+    taxels' centroid, along their mean normal, at rest) touches it, and every patch keeps
+    its own rate."""
+    from tactsense.robot import load_skin
+    from tactsense.simulate.grasp import joint_state
+
+    skin = load_skin(name)
+    largest = max(skin.patches, key=lambda p: p.n_taxels)
+    positions, normals = skin.taxels_in_base(joint_state(skin, {}))[largest.name]
+    normal = normals.mean(axis=0) / np.linalg.norm(normals.mean(axis=0))
+    centre = positions.mean(axis=0) + 1e-3 * (10.0 - 1.0) * normal
+    grasp = Grasp(GraspObject("sphere", (20.0,), Pose(tuple(centre))), force_n=1.0, timing=TIMING)
+    assert largest.name in grasp_contacts(skin, grasp)
+    recording = simulate_grasp(skin, grasp)
+    for patch in skin.patches:
+        stream = recording.streams[patch.name]
+        assert len(stream) == frame_count(0.8, patch.sensor.electronics.scan_rate_hz)
+    assert np.max(recording.streams[largest.name].truth["contact_normal_force_n"]) > 0

@@ -157,7 +157,7 @@ def grasp_command(
             "--joints",
             metavar="NAME=POS,...",
             help="Joint positions [rad, or m for a prismatic joint], each within the "
-            "joint's limits; joints left out are at 0.",
+            "joint's limits; joints left out rest at 0 clipped into their limits.",
         ),
     ] = None,
     force_n: Annotated[

@@ -71,7 +71,8 @@ class Grasp:
     ----------
     object : GraspObject
     joints : mapping of str -> float
-        Position of each movable joint [rad or m] (those left out at 0).
+        Position of each movable joint [rad or m]; those left out at rest (0 clipped
+        into their limits, :func:`joint_state`).
     force_n : float, mapping of str -> float, or None
         The commanded force [N] > 0: one number for every finger the object touches, or
         by finger or patch name; None: the penetration-stiffness rule.
@@ -160,11 +161,20 @@ def fingers(skin: RobotSkin) -> dict[str, str]:
     return out
 
 
+def joint_state(skin: RobotSkin, joints: Mapping[str, float]) -> dict[str, float]:
+    """Every movable joint's position [rad or m]: ``joints``' where given, else its rest
+    position (0 clipped into its limits: a joint whose range leaves out 0 rests at the
+    nearer limit). Names are checked by :meth:`RobotSkin.link_poses`."""
+    state = {j.name: min(max(0.0, j.lower), j.upper) for j in skin.joints if j.type != "fixed"}
+    state.update({str(k): float(v) for k, v in joints.items()})
+    return state
+
+
 def grasp_contacts(skin: RobotSkin, grasp: Grasp) -> dict[str, PatchContact]:
     """The contact of the object on each patch it touches, in the patch's sensor frame,
     at the grasp's joint state (patches it does not touch are left out)."""
     try:
-        poses = skin.link_poses(grasp.joints)
+        poses = skin.link_poses(joint_state(skin, grasp.joints))
     except RobotSkinError as error:
         raise GraspError(str(error)) from None
     out = {}
@@ -271,7 +281,7 @@ def simulate_grasp(
             "joint state; move it into the hand"
         )
     forces = grasp_forces(skin, grasp, contacts)
-    poses = skin.link_poses(grasp.joints)
+    poses = skin.link_poses(joint_state(skin, grasp.joints))
     timing = grasp.timing
     seeds = np.random.SeedSequence(grasp.seed).spawn(len(skin.patches))
     scenario = grasp_scenario(skin, grasp, forces)
@@ -352,7 +362,7 @@ def grasp_scenario(skin: RobotSkin, grasp: Grasp, forces: Mapping[str, float]) -
             "xyz_m": list(g.pose.xyz_m),
             "rpy_rad": list(g.pose.rpy_rad),
         },
-        "joints": {k: float(v) for k, v in grasp.joints.items()},
+        "joints": joint_state(skin, grasp.joints),
         "force_rule": "penetration stiffness" if grasp.force_n is None else "commanded",
         "stiffness_n_per_mm": grasp.stiffness_n_per_mm,
         "load_n": None if grasp.load_n is None else list(grasp.load_n),
@@ -476,6 +486,7 @@ __all__ = [
     "grasp_from_dict",
     "grasp_from_toml",
     "grasp_scenario",
+    "joint_state",
     "simulate_grasp",
     "write_grasp",
 ]
