@@ -402,17 +402,60 @@ def test_truth_in_the_base_frame_follows_the_joint_state():
 
 # ---- the recording and the file ----------------------------------------------------
 def test_a_grasp_is_written_as_a_robot_recording_with_the_same_truth_keys(tmp_path):
-    grasp = Grasp(_box_on_finger_and_palm(), force_n=1.0, timing=TIMING, seed=2)
-    written = write_grasp(tmp_path / "run", SKIN, grasp)
+    grasp = Grasp(_box_on_finger_and_palm(), force_n=1.0, load_n=(0, 0.1, -1), timing=TIMING)
+    write_grasp(tmp_path / "run", SKIN, grasp)
+    in_memory = simulate_grasp(SKIN, grasp)
     back = read_robot_recording(tmp_path / "run")
-    assert set(back.streams) == set(RATES)
+    assert set(back.streams) == set(RATES) and back.closed_cleanly
     for name, stream in back.streams.items():
         assert set(TRUTH_KEYS) <= set(stream.truth)
         assert stream.truth["patch"] == name
-        np.testing.assert_array_equal(stream.frames, written.streams[name].frames)
-        assert stream.scenario["kind"] == "grasp"
+        same = in_memory.streams[name]
+        # one block per patch here (200 frames at most): the same noise draws
+        np.testing.assert_array_equal(stream.frames, same.frames)
+        np.testing.assert_array_equal(stream.time_s, same.time_s)
+        np.testing.assert_array_equal(stream.gains, same.gains)
+        for key in TRUTH_KEYS:
+            np.testing.assert_array_equal(stream.truth[key], same.truth[key])
+        assert stream.scenario == same.scenario and stream.scenario["kind"] == "grasp"
     with pytest.raises(FileExistsError):
         write_grasp(tmp_path / "run", SKIN, grasp)
+    assert not list(tmp_path.glob("*.partial"))
+
+
+def test_the_folder_is_written_block_by_block(tmp_path, monkeypatch):
+    """Blocks of 7 frames give the frames and truth of one block (without noise: the
+    noise is drawn block by block), so memory holds one block whatever the length."""
+    import importlib
+
+    module = importlib.import_module("tactsense.simulate.grasp")
+
+    grasp = Grasp(_sphere_on_palm(), force_n=1.0, timing=TIMING, flaws="gain_spread,dead")
+    whole = simulate_grasp(SKIN, grasp)
+    monkeypatch.setattr(module, "BLOCK_FRAMES", 7)
+    seen = []
+    write_grasp(tmp_path / "run", SKIN, grasp, progress=lambda done, total: seen.append(done))
+    back = read_robot_recording(tmp_path / "run")
+    for name, stream in back.streams.items():
+        np.testing.assert_array_equal(stream.frames, whole.streams[name].frames)
+        for key in TRUTH_KEYS:
+            np.testing.assert_array_equal(stream.truth[key], whole.streams[name].truth[key])
+    total = sum(len(s) for s in whole.streams.values())
+    assert seen[-1] == total and len(seen) == sum(
+        math.ceil(len(s) / 7) for s in back.streams.values()
+    )
+
+
+def test_an_interrupted_write_leaves_nothing(tmp_path):
+    grasp = Grasp(_sphere_on_palm(), force_n=1.0, timing=TIMING)
+
+    def stop(done, total):
+        if done > total // 2:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        write_grasp(tmp_path / "run", SKIN, grasp, progress=stop)
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_a_grasp_file_gives_the_grasp_of_the_options(tmp_path):

@@ -220,9 +220,8 @@ def grasp_command(
     from tactsense.robot import load_skin
     from tactsense.simulate.grasp import (
         fingers,
-        grasp_contacts,
-        grasp_forces,
         grasp_from_toml,
+        plan_grasp,
         write_grasp,
     )
 
@@ -252,18 +251,11 @@ def grasp_command(
             shape, size_mm, pose, joints, force_n, stiffness, load_n, durations, flaws, seed
         )
     _check_out(out, force, [Path(skin), grasp_file])
-    contacts = grasp_contacts(robot, grasp)
-    if not contacts:
-        fail(
-            f"the {grasp.object.shape} at "
-            f"{grasp_file if grasp_file is not None else '--pose ' + pose}"
-            f" touches no patch of {robot.name!r}; "
-            "move it into the hand (tactsense sensor show lists where the patches are)"
-        )
-    forces = grasp_forces(robot, grasp, contacts)
-    with progress_bar("grasp", unit="patches", quiet=quiet) as bar:
-        task = bar.add_task("grasp", total=len(robot.patches))
-        recording = write_grasp(
+    plan = plan_grasp(robot, grasp)  # every check before any frame is made
+    contacts, forces = plan.contacts, plan.forces
+    with progress_bar("grasp", unit="frames", quiet=quiet) as bar:
+        task = bar.add_task("grasp", total=None)
+        plan = write_grasp(
             out,
             robot,
             grasp,
@@ -273,7 +265,6 @@ def grasp_command(
     finger_of = fingers(robot)
     rows = []
     for name, contact in contacts.items():
-        stream = recording.streams[name]
         rows.append(
             (
                 name,
@@ -281,8 +272,8 @@ def grasp_command(
                 finger_of[name],
                 f"{forces[name]:.3g}",
                 f"{contact.depth_mm:.3g}",
-                f"{stream.sensor.electronics.scan_rate_hz:g}",
-                str(len(stream)),
+                f"{robot.patch(name).sensor.electronics.scan_rate_hz:g}",
+                str(plan.n_frames(name)),
             )
         )
     from rich.markup import escape
@@ -294,7 +285,7 @@ def grasp_command(
         table.add_row(*(escape(cell) for cell in row))
     print_table(table)
     console.print(
-        f"wrote {out}: {len(recording.streams)} streams, {len(contacts)} patches touched, "
+        f"wrote {out}: {len(robot.patches)} streams, {len(contacts)} patches touched, "
         f"{grasp.timing.total_s:g} s"
     )
 

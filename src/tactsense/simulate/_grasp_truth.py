@@ -33,6 +33,10 @@ radius (NaN without contact); ``frame_step`` (T,) the phase of each frame (index
 :data:`PHASES`) and ``step_n_contacts`` (4,) the contacts the patch has in each phase."""
 
 
+TIME_KEYS = frozenset(TRUTH_KEYS) - {"step_n_contacts"}
+"""The truth keys that run along time (one row per frame)."""
+
+
 def stream_truth(
     patch, contact, force, tangential, radius, phase, sensor_in_base
 ) -> dict[str, Any]:

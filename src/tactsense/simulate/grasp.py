@@ -43,7 +43,7 @@ from typing import Any
 import numpy as np
 
 from tactsense.io.recording import Recording
-from tactsense.io.robot_recording import RobotRecording, write_robot_recording
+from tactsense.io.robot_recording import RobotRecording
 from tactsense.kinds import kind_of
 from tactsense.physics.transduction import sample_offsets
 from tactsense.robot import Pose, RobotSkin, RobotSkinError
@@ -59,8 +59,8 @@ from tactsense.simulate._grasp_geometry import (
     surface_sample,
 )
 from tactsense.simulate._grasp_timing import MAX_PHASE_S, PHASES, Timing
-from tactsense.simulate._grasp_truth import TRUTH_KEYS, stream_truth
-from tactsense.simulate.contact_frames import named_left_out_flaws, resolve_flaws
+from tactsense.simulate._grasp_truth import TIME_KEYS, TRUTH_KEYS, stream_truth
+from tactsense.simulate.contact_frames import check_gains, named_left_out_flaws, resolve_flaws
 
 
 @dataclass(frozen=True)
@@ -240,13 +240,117 @@ def grasp_forces(
     return out
 
 
+BLOCK_FRAMES = 1024
+"""Frames of one patch made (and written) at a time [-]."""
+
+
+@dataclass(frozen=True)
+class GraspPlan:
+    """A grasp checked against a skin, ready to make frames: the touched patches'
+    contacts and full forces [N], the links' poses, the scenario and each patch's seed."""
+
+    skin: RobotSkin
+    grasp: Grasp
+    contacts: Mapping[str, PatchContact]
+    forces: Mapping[str, float]
+    poses: Mapping[str, np.ndarray]
+    scenario: dict
+    seeds: tuple
+
+    def n_frames(self, name: str) -> int:
+        """Frames of patch ``name`` over the whole course [-]."""
+        rate = self.skin.patch(name).sensor.electronics.scan_rate_hz
+        return frame_count(self.grasp.timing.total_s, rate)
+
+    def blocks(self, name: str, block_frames: int | None = None):
+        """Yield ``(first, last, frames (last - first, rows, cols) [counts], truth)`` for
+        patch ``name``, ``block_frames`` at a time (default :data:`BLOCK_FRAMES`: memory
+        does not grow with the course's length); ``truth`` holds those frames' part of
+        :data:`TRUTH_KEYS` (and the keys that do not run along time, whole). The gains
+        are :meth:`gains`'."""
+        patch = self.skin.patch(name)
+        spec, grasp, timing = patch.sensor, self.grasp, self.grasp.timing
+        rate = spec.electronics.scan_rate_hz
+        contact = self.contacts.get(name)
+        sensor_in_base = self.poses[patch.link] @ patch.origin.matrix()
+        shear = _tangential(grasp, contact, self.forces, name, sensor_in_base)
+        radius = 1.0 if contact is None else contact.radius_mm(grasp.object)
+        shape = "sphere" if grasp.object.curvature_radius_mm is not None else FLAT_BOX_SHAPE
+        rng = np.random.default_rng(self.seeds[self.skin.patches.index(patch)])
+        n = self.n_frames(name)
+        block_frames = block_frames or BLOCK_FRAMES
+        for first in range(0, max(n, 1), block_frames):
+            last = min(n, first + block_frames)
+            time_s = np.arange(first, last) / rate
+            scale = timing.scale(time_s)
+            force = self.forces.get(name, 0.0) * scale
+            tangential = scale[:, None] * shear
+            frames, _ = patch_frames(
+                spec, contact, force, tangential_n=tangential, radius_mm=radius, shape=shape,
+                flaws=grasp.flaws, rng=rng,
+            )  # fmt: skip
+            truth = stream_truth(
+                patch, contact, force, tangential, radius, timing.phase(time_s), sensor_in_base
+            )
+            yield first, last, frames, truth
+
+    def gains(self, name: str) -> np.ndarray:
+        """Per-taxel gains [-] of patch ``name``'s frames (its sensor's own)."""
+        spec = self.skin.patch(name).sensor
+        return check_gains(spec, None, resolve_flaws(self.grasp.flaws))
+
+
+def plan_grasp(skin: RobotSkin, grasp: Grasp) -> GraspPlan:
+    """Check ``grasp`` on ``skin`` and find its contacts and forces (:class:`GraspPlan`);
+    every error a simulation can meet is raised here, before any frame is made.
+
+    Raises
+    ------
+    GraspError
+        The object touches no patch, a force names what it does not touch, a joint
+        state is invalid, or a patch's kind does not take a grasp.
+    """
+    if not isinstance(skin, RobotSkin):
+        raise GraspError(f"skin must be a RobotSkin; got {type(skin).__name__}")
+    if not isinstance(grasp, Grasp):
+        raise GraspError(f"grasp must be a Grasp; got {type(grasp).__name__}")
+    for patch in skin.patches:
+        if not takes_grasp(patch.sensor):
+            raise kind_of(patch.sensor).unsupported(
+                patch.sensor, f"a simulated grasp (patch {patch.name!r})"
+            )
+    contacts = grasp_contacts(skin, grasp)
+    if not contacts:
+        raise GraspError(
+            f"the {grasp.object.shape} touches no patch of {skin.name!r} at this pose and "
+            "joint state; move it into the hand"
+        )
+    forces = grasp_forces(skin, grasp, contacts)
+    scenario = grasp_scenario(skin, grasp, forces)
+    scenario["description"] = (
+        f"simulated grasp on {skin.name}: {grasp.object.shape} "
+        f"{_numbers(grasp.object.size_mm)} mm, {scenario['force_rule']} forces, "
+        f"{len(contacts)} of {len(skin.patches)} patches touched"
+    )
+    return GraspPlan(
+        skin=skin,
+        grasp=grasp,
+        contacts=contacts,
+        forces=forces,
+        poses=skin.link_poses(joint_state(skin, grasp.joints)),
+        scenario=scenario,
+        seeds=tuple(np.random.SeedSequence(grasp.seed).spawn(len(skin.patches))),
+    )
+
+
 def simulate_grasp(
     skin: RobotSkin,
     grasp: Grasp,
     *,
     progress: Callable[[int, int], None] | None = None,
 ) -> RobotRecording:
-    """Frames of every patch of ``skin`` under ``grasp``, at each patch's own scan rate.
+    """Frames of every patch of ``skin`` under ``grasp``, at each patch's own scan rate,
+    in memory (:func:`write_grasp` writes them to a folder in bounded memory).
 
     Parameters
     ----------
@@ -264,74 +368,33 @@ def simulate_grasp(
     Raises
     ------
     GraspError
-        The object touches no patch, a force names what it does not touch, a joint
-        state is invalid, or a patch's kind does not take a grasp.
+        As :func:`plan_grasp`.
     """
-    if not isinstance(skin, RobotSkin):
-        raise GraspError(f"skin must be a RobotSkin; got {type(skin).__name__}")
-    for patch in skin.patches:
-        if not takes_grasp(patch.sensor):
-            raise kind_of(patch.sensor).unsupported(
-                patch.sensor, f"a simulated grasp (patch {patch.name!r})"
-            )
-    contacts = grasp_contacts(skin, grasp)
-    if not contacts:
-        raise GraspError(
-            f"the {grasp.object.shape} touches no patch of {skin.name!r} at this pose and "
-            "joint state; move it into the hand"
-        )
-    forces = grasp_forces(skin, grasp, contacts)
-    poses = skin.link_poses(joint_state(skin, grasp.joints))
-    timing = grasp.timing
-    seeds = np.random.SeedSequence(grasp.seed).spawn(len(skin.patches))
-    scenario = grasp_scenario(skin, grasp, forces)
-    scenario["description"] = (
-        f"simulated grasp on {skin.name}: {grasp.object.shape} "
-        f"{_numbers(grasp.object.size_mm)} mm, {scenario['force_rule']} forces, "
-        f"{len(contacts)} of {len(skin.patches)} patches touched"
-    )
+    plan = plan_grasp(skin, grasp)
     streams = {}
-    for done, (patch, seed) in enumerate(zip(skin.patches, seeds, strict=True)):
+    for done, patch in enumerate(skin.patches):
         spec = patch.sensor
-        rate = spec.electronics.scan_rate_hz
-        time_s = np.arange(frame_count(timing.total_s, rate)) / rate
-        contact = contacts.get(patch.name)
-        scale = timing.scale(time_s)
-        force = forces.get(patch.name, 0.0) * scale
-        sensor_in_base = poses[patch.link] @ patch.origin.matrix()
-        shear = _tangential(grasp, contact, forces, patch.name, sensor_in_base)
-        tangential = scale[:, None] * shear
-        radius = 1.0 if contact is None else contact.radius_mm(grasp.object)
-        shape = "sphere" if grasp.object.curvature_radius_mm is not None else FLAT_BOX_SHAPE
-        frames, gains = patch_frames(
-            spec,
-            contact,
-            force,
-            tangential_n=tangential,
-            radius_mm=radius,
-            shape=shape,
-            flaws=grasp.flaws,
-            rng=np.random.default_rng(seed),
-        )
+        blocks = list(plan.blocks(patch.name))
+        n = plan.n_frames(patch.name)
+        truth = {
+            key: np.concatenate([b[3][key] for b in blocks])[:n]
+            if key in TIME_KEYS
+            else blocks[0][3][key]
+            for key in blocks[0][3]
+        }
         streams[patch.name] = Recording(
-            frames=frames,
-            time_s=time_s,
+            frames=np.concatenate([b[2] for b in blocks])[:n],
+            time_s=np.arange(n) / spec.electronics.scan_rate_hz,
             sample_offset_s=sample_offsets(spec),
             sensor=spec,
-            scenario=scenario,
+            scenario=plan.scenario,
             flaws=resolve_flaws(grasp.flaws),
-            truth=stream_truth(
-                patch, contact, force, tangential, radius, timing.phase(time_s), sensor_in_base
-            ),
-            gains=gains,
+            truth=truth,
+            gains=plan.gains(patch.name),
         )
         if progress is not None:
             progress(done + 1, len(skin.patches))
-    return RobotRecording(
-        skin=skin,
-        streams=streams,
-        description=scenario["description"],
-    )
+    return RobotRecording(skin=skin, streams=streams, description=plan.scenario["description"])
 
 
 def _tangential(grasp, contact, forces, name, sensor_in_base) -> np.ndarray:
@@ -381,12 +444,26 @@ def write_grasp(
     *,
     overwrite: bool = False,
     progress: Callable[[int, int], None] | None = None,
-) -> RobotRecording:
-    """Simulate ``grasp`` on ``skin`` and write it as a robot recording folder at
-    ``path`` (written under a temporary name, moved into place when whole)."""
-    recording = simulate_grasp(skin, grasp, progress=progress)
-    write_robot_recording(path, recording, overwrite=overwrite)
-    return recording
+) -> GraspPlan:
+    """Simulate ``grasp`` on ``skin`` into a robot recording folder at ``path``, block by
+    block (memory holds one block of one patch, :data:`BLOCK_FRAMES` frames), under a
+    temporary name moved into place when whole.
+
+    Parameters
+    ----------
+    progress : callable, optional
+        Called with (frames written, frames) over every patch's frames.
+
+    Returns
+    -------
+    GraspPlan
+        The grasp's contacts and forces.
+    """
+    from tactsense.simulate._grasp_write import write_grasp_folder
+
+    plan = plan_grasp(skin, grasp)
+    write_grasp_folder(path, plan, overwrite=overwrite, progress=progress)
+    return plan
 
 
 # ---- the grasp file (TOML) -----------------------------------------------------------
@@ -478,6 +555,7 @@ __all__ = [
     "Grasp",
     "GraspError",
     "GraspObject",
+    "GraspPlan",
     "PatchContact",
     "Timing",
     "fingers",
@@ -487,6 +565,7 @@ __all__ = [
     "grasp_from_toml",
     "grasp_scenario",
     "joint_state",
+    "plan_grasp",
     "simulate_grasp",
     "write_grasp",
 ]
