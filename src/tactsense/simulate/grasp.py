@@ -33,12 +33,9 @@ Each frame takes the force at the start of its scan (``time_s = i / rate``).
 
 from __future__ import annotations
 
-import math
-import tomllib
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
@@ -46,7 +43,8 @@ from tactsense.io.recording import Recording
 from tactsense.io.robot_recording import RobotRecording
 from tactsense.kinds import kind_of
 from tactsense.physics.transduction import sample_offsets
-from tactsense.robot import Pose, RobotSkin, RobotSkinError
+from tactsense.robot import RobotSkin, RobotSkinError
+from tactsense.simulate._grasp_file import grasp_from_dict, grasp_from_toml
 from tactsense.simulate._grasp_frames import frame_count, patch_frames, takes_grasp
 from tactsense.simulate._grasp_geometry import (
     FLAT_BOX_SHAPE,
@@ -58,94 +56,10 @@ from tactsense.simulate._grasp_geometry import (
     patch_contact,
     surface_sample,
 )
+from tactsense.simulate._grasp_spec import Grasp
 from tactsense.simulate._grasp_timing import MAX_PHASE_S, PHASES, Timing
 from tactsense.simulate._grasp_truth import TIME_KEYS, TRUTH_KEYS, stream_truth
-from tactsense.simulate.contact_frames import check_gains, named_left_out_flaws, resolve_flaws
-
-
-@dataclass(frozen=True)
-class Grasp:
-    """A grasp to simulate.
-
-    Attributes
-    ----------
-    object : GraspObject
-    joints : mapping of str -> float
-        Position of each movable joint [rad or m]; those left out at rest (0 clipped
-        into their limits, :func:`joint_state`).
-    force_n : float, mapping of str -> float, or None
-        The commanded force [N] > 0: one number for every finger the object touches, or
-        by finger or patch name; None: the penetration-stiffness rule.
-    stiffness_n_per_mm : float
-        The penetration-stiffness rule's spring [N/mm] > 0.
-    load_n : (3,) tuple or None
-        A force on the object the contacts carry, in the base frame [N] (its weight:
-        ``(0, 0, -m g)``): each touched patch takes a share in proportion to its normal
-        force, and the part of it tangent to the skin at its contact is the tangential
-        force the object applies there (following the time course as the normal forces
-        do). None: no tangential forces.
-    timing : Timing
-    flaws : str
-        The per-frame flaws (as ``frames_from_contacts`` takes them: "all", "none" or a
-        comma list); a flaw with memory or jitter named is refused.
-    seed : int
-        Seed of the read noise [-] (each patch draws from its own stream of it).
-    """
-
-    object: GraspObject
-    joints: Mapping[str, float] = field(default_factory=dict)
-    force_n: float | Mapping[str, float] | None = None
-    stiffness_n_per_mm: float = 1.0
-    load_n: tuple[float, float, float] | None = None
-    timing: Timing = field(default_factory=Timing)
-    flaws: str = "all"
-    seed: int = 0
-
-    def __post_init__(self) -> None:
-        if not isinstance(self.object, GraspObject):
-            raise GraspError(f"object must be a GraspObject; got {type(self.object).__name__}")
-        if not isinstance(self.timing, Timing):
-            raise GraspError(f"timing must be a Timing; got {type(self.timing).__name__}")
-        object.__setattr__(self, "joints", dict(self.joints))
-        force = self.force_n
-        if isinstance(force, Mapping):
-            force = {str(k): _positive(f"force for {k!r}", v, "N", 1e4) for k, v in force.items()}
-            if not force:
-                raise GraspError("force_n names no finger or patch; give at least one")
-        elif force is not None:
-            force = _positive("force_n", force, "N", 1e4)
-        object.__setattr__(self, "force_n", force)
-        _positive("stiffness_n_per_mm", self.stiffness_n_per_mm, "N/mm", 1e6)
-        if self.load_n is not None:
-            try:
-                load = tuple(float(v) for v in self.load_n)
-            except (TypeError, ValueError):
-                load = ()
-            if len(load) != 3 or not all(math.isfinite(v) and abs(v) <= 1e4 for v in load):
-                raise GraspError(
-                    f"load_n = {self.load_n!r}: expected three finite numbers, each at most "
-                    "10,000 in size [N]"
-                )
-            object.__setattr__(self, "load_n", load)
-        resolve_flaws(self.flaws)
-        left_out = named_left_out_flaws(self.flaws)
-        if left_out:
-            raise GraspError(
-                f"flaws {', '.join(left_out)} need a frame sequence (memory or jitter); a "
-                "simulated grasp applies the per-frame flaws only"
-            )
-        if not (isinstance(self.seed, int) and self.seed >= 0):
-            raise GraspError(f"seed {self.seed!r}: expected a whole number >= 0")
-
-
-def _positive(name: str, value: Any, unit: str, most: float) -> float:
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise GraspError(f"{name} = {value!r}: expected a number [{unit}]") from None
-    if not (math.isfinite(number) and 0.0 < number <= most):
-        raise GraspError(f"{name} = {value!r}: expected more than 0 and at most {most:g} [{unit}]")
-    return number
+from tactsense.simulate.contact_frames import check_gains, resolve_flaws
 
 
 def fingers(skin: RobotSkin) -> dict[str, str]:
@@ -464,86 +378,6 @@ def write_grasp(
     plan = plan_grasp(skin, grasp)
     write_grasp_folder(path, plan, overwrite=overwrite, progress=progress)
     return plan
-
-
-# ---- the grasp file (TOML) -----------------------------------------------------------
-_KEYS = {
-    "object": {"shape", "size_mm", "xyz_mm", "rpy_deg"},
-    "timing": {"approach_s", "squeeze_s", "hold_s", "release_s"},
-    "": {"object", "joints", "force_n", "stiffness_n_per_mm", "load_n", "timing", "flaws", "seed"},
-}
-
-
-def grasp_from_dict(data: Mapping[str, Any], *, source: str = "grasp") -> Grasp:
-    """A :class:`Grasp` from the grasp file's content (docs/robot.md, "Simulated grasps"):
-    ``[object]`` shape, size_mm, xyz_mm [mm], rpy_deg [deg]; ``[joints]`` name = rad;
-    ``force_n`` a number or a table of finger/patch = N; ``stiffness_n_per_mm``;
-    ``load_n`` [N] (three numbers, base frame);
-    ``[timing]`` approach_s, squeeze_s, hold_s, release_s; ``flaws``; ``seed``."""
-    for section, allowed in _KEYS.items():
-        table = data if not section else data.get(section, {})
-        if not isinstance(table, Mapping):
-            raise GraspError(f"{source}: [{section}] must be a table")
-        unknown = sorted(set(table) - allowed)
-        if unknown:
-            where = f"[{section}]" if section else "the top level"
-            raise GraspError(
-                f"{source}: unknown key(s) {', '.join(unknown)} in {where}; expected "
-                + ", ".join(sorted(allowed))
-            )
-    if "object" not in data:
-        raise GraspError(f"{source}: no [object] table (shape, size_mm, xyz_mm, rpy_deg)")
-    item = data["object"]
-    try:
-        pose = Pose(
-            tuple(1e-3 * float(v) for v in item.get("xyz_mm", (0, 0, 0))),
-            tuple(math.radians(float(v)) for v in item.get("rpy_deg", (0, 0, 0))),
-        )
-        size = item.get("size_mm", ())
-        grasped = GraspObject(
-            str(item.get("shape", "")), tuple(size) if isinstance(size, list | tuple) else (size,),
-            pose,
-        )  # fmt: skip
-        joints = data.get("joints", {})
-        if not isinstance(joints, Mapping):
-            raise GraspError("[joints] must be a table of joint = position [rad or m]")
-        force = data.get("force_n")
-        return Grasp(
-            object=grasped,
-            joints={str(k): _finite(f"joint {k!r}", v) for k, v in joints.items()},
-            force_n=dict(force) if isinstance(force, Mapping) else force,
-            stiffness_n_per_mm=data.get("stiffness_n_per_mm", 1.0),
-            load_n=data.get("load_n"),
-            timing=Timing(**{k: float(v) for k, v in data.get("timing", {}).items()}),
-            flaws=str(data.get("flaws", "all")),
-            seed=data.get("seed", 0),
-        )
-    except (GraspError, RobotSkinError) as error:
-        raise GraspError(f"{source}: {error}") from None
-    except (TypeError, ValueError) as error:
-        raise GraspError(f"{source}: {error}") from None
-
-
-def _finite(name: str, value: Any) -> float:
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        number = math.nan
-    if not math.isfinite(number):
-        raise GraspError(f"{name} = {value!r}: expected a finite number [rad or m]")
-    return number
-
-
-def grasp_from_toml(path: str | Path) -> Grasp:
-    """A :class:`Grasp` from a grasp file (:func:`grasp_from_dict`)."""
-    path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise GraspError(f"grasp file {path} does not exist") from None
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as error:
-        raise GraspError(f"grasp file {path}: unreadable ({error})") from None
-    return grasp_from_dict(data, source=str(path))
 
 
 __all__ = [
