@@ -586,3 +586,24 @@ def test_every_preset_takes_a_grasp_on_its_largest_patch(name):
         stream = recording.streams[patch.name]
         assert len(stream) == frame_count(0.8, patch.sensor.electronics.scan_rate_hz)
     assert np.max(recording.streams[largest.name].truth["contact_normal_force_n"]) > 0
+
+
+def test_the_docs_figures_are_the_codes():
+    """The numbers docs/robot.md's grasp section states are the constants the code uses."""
+    from pathlib import Path
+
+    from tactsense.cli._grasp import DEFAULT_DURATIONS
+    from tactsense.simulate._grasp_geometry import SAMPLES
+    from tactsense.simulate.grasp import BLOCK_FRAMES, MAX_PHASE_S
+
+    doc = (Path(__file__).resolve().parents[2] / "docs" / "robot.md").read_text()
+    section = " ".join(
+        doc[doc.index("<!-- r7-grasp -->") : doc.index("<!-- /r7-grasp -->")].split()
+    )
+    assert f"a {SAMPLES} x {SAMPLES} square of points" in section
+    assert f"{BLOCK_FRAMES:,} frames at a time" in section
+    assert f"a phase is at most {MAX_PHASE_S:g} s" in section
+    assert f"default `{DEFAULT_DURATIONS}`" in section
+    assert Timing() == Timing(*(float(v) for v in DEFAULT_DURATIONS.split(",")))
+    stiffness = Grasp(GraspObject("sphere", (1.0,))).stiffness_n_per_mm
+    assert f"`--stiffness-n-per-mm` [N/mm] (default {stiffness:g})" in section
