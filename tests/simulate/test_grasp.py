@@ -607,3 +607,24 @@ def test_the_docs_figures_are_the_codes():
     assert Timing() == Timing(*(float(v) for v in DEFAULT_DURATIONS.split(",")))
     stiffness = Grasp(GraspObject("sphere", (1.0,))).stiffness_n_per_mm
     assert f"`--stiffness-n-per-mm` [N/mm] (default {stiffness:g})" in section
+
+
+def test_the_command_takes_a_grasp_file_and_the_stiffness_rule(tmp_path):
+    from tactsense.robot import skin_to_toml_string
+
+    (tmp_path / "skin.toml").write_text(skin_to_toml_string(SKIN))
+    (tmp_path / "grasp.toml").write_text(
+        "stiffness_n_per_mm = 0.5\nflaws = 'none'\n"
+        "[object]\nshape = 'sphere'\nsize_mm = 40\nxyz_mm = [7.3, 9.1, 18.5]\n"
+        "[timing]\napproach_s = 0.05\nsqueeze_s = 0.05\nhold_s = 0.1\nrelease_s = 0.0\n"
+    )
+    out = tmp_path / "run"
+    args = ["grasp", str(tmp_path / "skin.toml"), "--grasp", str(tmp_path / "grasp.toml"),
+            "--out", str(out), "--quiet"]  # fmt: skip
+    result = CliRunner().invoke(app, args, terminal_width=200)
+    assert result.exit_code == 0, result.output
+    stream = read_robot_recording(out).streams["palm_pad"]
+    assert stream.scenario["force_rule"] == "penetration stiffness"
+    # 0.5 N/mm times the sphere's 1.5-mm penetration (to the sample's 0.002 mm)
+    assert stream.truth["contact_normal_force_n"].max() == pytest.approx(0.75, abs=0.001)
+    assert len(stream) == round(0.2 * RATES["palm_pad"])
