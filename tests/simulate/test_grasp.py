@@ -628,3 +628,41 @@ def test_the_command_takes_a_grasp_file_and_the_stiffness_rule(tmp_path):
     # 0.5 N/mm times the sphere's 1.5-mm penetration (to the sample's 0.002 mm)
     assert stream.truth["contact_normal_force_n"].max() == pytest.approx(0.75, abs=0.001)
     assert len(stream) == round(0.2 * RATES["palm_pad"])
+
+
+def test_ctrl_c_in_the_command_leaves_nothing(tmp_path):
+    """SIGINT while the streams are being written: exit status 1, "interrupted", and
+    neither the recording nor its temporary folder is left (waits on the temporary
+    folder's first stream, not on a timer)."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    from tactsense.robot import skin_to_toml_string
+
+    (tmp_path / "skin.toml").write_text(skin_to_toml_string(SKIN))
+    out = tmp_path / "run"
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    process = subprocess.Popen(
+        [sys.executable, "-m", "tactsense", "grasp", str(tmp_path / "skin.toml"), "--object",
+         "sphere", "--size-mm", "40", "--pose", "7.3,9.1,18.5", "--force-n", "1",
+         "--duration-s", "0,1,120,1", "--out", str(out)],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
+    )  # fmt: skip
+    try:
+        deadline = time.monotonic() + 120
+        streams = out.with_name("run.partial") / "streams"
+        while not (streams.is_dir() and any(streams.iterdir())):
+            assert process.poll() is None, process.communicate()
+            assert time.monotonic() < deadline, "the command wrote no stream in 120 s"
+            time.sleep(0.05)
+        process.send_signal(signal.SIGINT)
+        _, err = process.communicate(timeout=120)
+    finally:
+        if process.poll() is None:
+            process.kill()
+    assert process.returncode == 1 and "interrupted" in err, err
+    assert "Traceback" not in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["skin.toml"]
