@@ -22,13 +22,18 @@ Forces, one of two rules:
 The indenter's radius comes from the object's curvature: a sphere's radius, a cylinder's
 radius across its axis (the contact is taken as a point contact of that radius; the line
 along the axis is not modelled), a box's flat face as uniform pressure on a disc of the
-contact's area. Tangential forces are not simulated (a grasp here holds, it does not
-slip).
+contact's area. Tangential forces come from a load on the object (``load_n``, its
+weight say), shared among the touched patches by normal force, the part tangent to the
+skin at each contact (no slip is modelled).
 
 Time course (:class:`Timing`): approach (nothing touches), squeeze (every force ramps
 linearly from 0 to its full value), hold (full force), release (linearly back to 0). The
 contacts stay where they are at the given pose: only their forces follow the course.
 Each frame takes the force at the start of its scan (``time_s = i / rate``).
+
+:func:`plan_grasp` checks everything and finds the contacts and forces
+(:class:`GraspPlan`) before any frame is made; :func:`write_grasp` writes the folder
+block by block (bounded memory), :func:`simulate_grasp` gives it in memory.
 """
 
 from __future__ import annotations
