@@ -628,3 +628,62 @@ def test_skin_bad_input(workspace, line, names):
 
 
 # ---- /r7-skin ----
+# ---- tactsense grasp (r7-grasp) ----
+_GRASP_SPHERE = "grasp hand4 --object sphere --size-mm 20 --pose 0,0,500"
+GRASP_BAD_OPTIONS = [
+    ("grasp hand4 --out OUT", "give the object (--object and --size-mm)"),
+    ("grasp bogus_skin --object sphere --size-mm 20 --out OUT", "bogus_skin"),
+    ("grasp hand4 --object cone --size-mm 20 --out OUT", "--object"),
+    ("grasp hand4 --object sphere --size-mm 0 --out OUT", "--size-mm"),
+    ("grasp hand4 --object sphere --size-mm nan --out OUT", "--size-mm"),
+    ("grasp hand4 --object sphere --size-mm 20000 --out OUT", "--size-mm"),
+    ("grasp hand4 --object cylinder --size-mm 20 --out OUT", "--size-mm"),
+    ("grasp hand4 --object box --size-mm 20,20 --out OUT", "--size-mm"),
+    ("grasp hand4 --object sphere --size-mm 20 --pose 1,2 --out OUT", "--pose"),
+    ("grasp hand4 --object sphere --size-mm 20 --pose 0,0,inf --out OUT", "--pose"),
+    (f"{_GRASP_SPHERE} --force-n 0 --out OUT", "--force-n"),
+    (f"{_GRASP_SPHERE} --force-n 2e4 --out OUT", "--force-n"),
+    (f"{_GRASP_SPHERE} --force-n palm=nan --out OUT", "--force-n"),
+    (f"{_GRASP_SPHERE} --force-n palm=1,palm=2 --out OUT", "'palm' is given twice"),
+    (f"{_GRASP_SPHERE} --stiffness-n-per-mm 0 --out OUT", "--stiffness-n-per-mm"),
+    (f"{_GRASP_SPHERE} --stiffness-n-per-mm nan --out OUT", "--stiffness-n-per-mm"),
+    (f"{_GRASP_SPHERE} --load-n 1,2 --out OUT", "--load-n"),
+    (f"{_GRASP_SPHERE} --load-n 0,0,2e4 --out OUT", "--load-n"),
+    (f"{_GRASP_SPHERE} --duration-s 1,1,1 --out OUT", "--duration-s"),
+    (f"{_GRASP_SPHERE} --duration-s 0,0,0,0 --out OUT", "--duration-s"),
+    (f"{_GRASP_SPHERE} --duration-s 0,1,1,700 --out OUT", "--duration-s"),
+    (f"{_GRASP_SPHERE} --duration-s 0,-1,1,1 --out OUT", "--duration-s"),
+    (f"{_GRASP_SPHERE} --joints bogus --out OUT", "--joints"),
+    (f"{_GRASP_SPHERE} --joints no_such_joint=0.1 --out OUT", "not a movable joint"),
+    (f"{_GRASP_SPHERE} --flaws bogus --out OUT", "unknown flaw(s) bogus"),
+    (f"{_GRASP_SPHERE} --flaws viscoelastic --out OUT", "need a frame sequence"),
+    (f"{_GRASP_SPHERE} --seed -1 --out OUT", "--seed"),
+    (f"{_GRASP_SPHERE} --out OUT", "touches no patch"),
+    (f"{_GRASP_SPHERE} --out no_such_folder/run", "does not exist"),
+    (f"{_GRASP_SPHERE} --out REC", "exists"),
+    (f"{_GRASP_SPHERE} --out REC --force", "is not a robot recording"),
+    ("grasp hand4 --grasp DIR/no_such.toml --out OUT", "does not exist"),
+    ("grasp hand4 --grasp DIR/a_file --out OUT", "grasp file"),
+    ("grasp hand4 --grasp DIR/a_file --object sphere --out OUT", "drop --object"),
+]
+
+
+@pytest.mark.parametrize(
+    "line, names", GRASP_BAD_OPTIONS, ids=[line for line, _ in GRASP_BAD_OPTIONS]
+)
+def test_grasp_bad_options(workspace, line, names):
+    out = workspace / "never_written"
+    args = (
+        line.replace("REC", str(workspace / "rec.h5"))
+        .replace("OUT", str(out))
+        .replace("DIR", str(workspace))
+        .split()
+    )
+    result = runner.invoke(app, args)
+    _check(result, names)
+    assert not out.exists()
+    assert (workspace / "rec.h5").is_file()
+    assert not [p for p in workspace.iterdir() if ".partial" in p.name]
+
+
+# ---- /r7-grasp ----

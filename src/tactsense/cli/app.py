@@ -64,6 +64,12 @@ from tactsense.cli import _dataset  # noqa: E402
 app.add_typer(_dataset.app)
 # ---- /r6-data ----
 
+# ---- tactsense grasp (r7-grasp) ----
+from tactsense.cli import _grasp  # noqa: E402
+
+app.add_typer(_grasp.app)
+# ---- /r7-grasp ----
+
 
 def _show_usage_error(self, file=None) -> None:
     """A usage error (unknown option, value out of range, missing argument) as one line
