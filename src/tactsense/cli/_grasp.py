@@ -108,7 +108,7 @@ def grasp_command(
     skin: Annotated[
         str,
         typer.Argument(
-            help="The robot's skin: a preset ('hand4', 'icub_hand') or a skin file "
+            help="The robot's skin: a preset ('hand4', 'icub_hand') , a skin TOML or a URDF with tactile sensors "
             "(tactsense sensor show SKIN lists its patches, links and joints)."
         ),
     ],
@@ -217,7 +217,7 @@ def grasp_command(
     """Simulate an object (sphere, cylinder or box) grasped by a robot's skin: every patch's
     frames at its own scan rate with its flaws, the contacts' truth in every stream, into a
     robot recording folder (docs/robot.md, "Simulated grasps")."""
-    from tactsense.robot import load_skin
+    from tactsense.interop.robot_urdf import load_robot_skin
     from tactsense.simulate.grasp import (
         fingers,
         grasp_from_toml,
@@ -243,7 +243,7 @@ def grasp_command(
     ]
     if grasp_file is not None and object_options:
         fail(f"--grasp {grasp_file} describes the grasp; drop {', '.join(object_options)}")
-    robot = load_skin(skin)
+    robot = load_robot_skin(skin)
     if grasp_file is not None:
         grasp = grasp_from_toml(grasp_file)
     else:
