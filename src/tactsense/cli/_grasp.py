@@ -108,7 +108,8 @@ def grasp_command(
     skin: Annotated[
         str,
         typer.Argument(
-            help="The robot's skin: a preset ('hand4', 'icub_hand') , a skin TOML or a URDF with tactile sensors "
+            help="The robot's skin: a preset ('hand4', 'icub_hand'), a skin TOML or a URDF "
+            "with tactile sensors "
             "(tactsense sensor show SKIN lists its patches, links and joints)."
         ),
     ],
