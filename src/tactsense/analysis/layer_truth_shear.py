@@ -222,6 +222,8 @@ def bonded_layer_shear_fields(
     h, z, nu = float(thickness), float(depth), float(poisson_ratio)
     if not (h > 0) or not (0 <= z <= h) or not (-1 < nu <= 0.5):
         raise TactsenseInputError("need thickness > 0, 0 <= depth <= thickness, -1 < nu <= 0.5")
+    if profile not in PROFILES:
+        raise TactsenseInputError(f"profile must be one of {', '.join(PROFILES)}; got {profile!r}")
     mu = youngs_modulus / (2 * (1 + nu))
     x, y = np.broadcast_arrays(np.asarray(x, float), np.asarray(y, float))
     shape = x.shape
