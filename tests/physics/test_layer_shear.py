@@ -30,17 +30,8 @@ DX = A / 12  # load sample spacing [m]
 PROBES = [(0, 0), (0, 8), (0, -8), (10, 0), (12, 16), (-6, 24)]  # (row, col) from the centre
 
 
-def sampled_traction(n, profile, m=16):
-    """tau(r) on an n x n grid centred on sample (n//2, n//2), each sample the mean of
-    the profile over its cell (m x m sub-points)."""
-    x = (np.arange(n) - n // 2) * DX
-    gx, gy = np.meshgrid(x, x)
-    sub = (np.arange(m) + 0.5) / m - 0.5
-    total = np.zeros_like(gx)
-    for sx in sub:
-        for sy in sub:
-            total += truth.traction_profile(np.hypot(gx + sx * DX, gy + sy * DX), A, F, profile)
-    return total / m**2
+def sampled_traction(n, profile):
+    return truth.sampled_disc_traction(n, DX, A, F, profile)
 
 
 def probe_positions():

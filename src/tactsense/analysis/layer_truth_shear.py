@@ -85,6 +85,24 @@ def traction_profile(r, radius, force, profile="hertz"):
     raise TactsenseInputError(f"profile must be one of {', '.join(PROFILES)}; got {profile!r}")
 
 
+def sampled_disc_traction(n, spacing, radius, force, profile="hertz", sub=16):
+    """tau(r) [Pa] on an ``n x n`` grid of ``spacing`` [m] centred on sample (n//2, n//2).
+
+    Each sample is the mean of :func:`traction_profile` over its cell (``sub x sub``
+    points), so the sampled load carries the disc's force to within the cell average
+    (what a :class:`tactsense.physics.layer.LayerResponse` takes as ``traction_x``).
+    """
+    x = (np.arange(n) - n // 2) * spacing
+    gx, gy = np.meshgrid(x, x)
+    offsets = (np.arange(sub) + 0.5) / sub - 0.5
+    total = np.zeros_like(gx)
+    for sx in offsets:
+        for sy in offsets:
+            r = np.hypot(gx + sx * spacing, gy + sy * spacing)
+            total += traction_profile(r, radius, force, profile)
+    return total / sub**2
+
+
 def _load_transform(k, radius, force, profile):
     """T0(k) = H_0[tau] [Pa m^2] of the disc's traction."""
     x = k * radius
