@@ -5,7 +5,8 @@ on one core). It compares ``physics.layer.LayerResponse(..., tangential=True)`` 
 tangential disc traction with the two references of
 ``tactsense.analysis.layer_truth_shear`` (Cerruti's point force integrated over the
 disc, for the half space; Hankel transforms of the order-1 fields, for the bonded
-layer), prints the block docs/model.md quotes (``--write`` replaces it there, between
+layer) and with the finite-element solution of ``tests/physics/test_layer_shear_fem.py``,
+prints the block docs/model.md quotes (``--write`` replaces it there, between
 ``<!-- r7-shear -->`` and ``<!-- /r7-shear -->``) and draws
 ``docs/images/layer_shear_profiles.png``. ``tests/physics/test_layer_shear.py`` checks
 the same comparisons against stated tolerances.
@@ -20,8 +21,10 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "scripts"))
 from docblock import replace_block, save_figure  # noqa: E402
+from tests.physics import test_layer_shear_fem as fe  # noqa: E402
 
 from tactsense.analysis import layer_truth_shear as truth  # noqa: E402
 from tactsense.physics import layer  # noqa: E402
@@ -113,6 +116,47 @@ def surface_against_hankel():
         disp = max(disp, *(err[q] for q in FIELDS[:3]))
         strain = max(strain, *(err[q] for q in FIELDS[3:] if q != "eps_yz"))
     return disp, strain
+
+
+def finite_elements():
+    """Worst FEM-vs-Hankel errors (displacements, strains) per (nu, mesh), and layer.py
+    against the coarse FEM."""
+    rows = []
+    for nu in (0.3, 0.45):
+        for nr, nz in ((48, 15), (96, 31)):
+            worst = fe.worst_errors(fe.fem_shear(nu, nr, nz), nu)
+            rows.append(
+                (
+                    nu,
+                    f"{nr} x {nz}",
+                    max(worst[q] for q in ("U", "V", "W")),
+                    max(worst[q] for q in ("eps_zz", "eps_rz")),
+                )
+            )
+    dx, n = fe.A / 20, 128
+    load = truth.sampled_disc_traction(n, dx, fe.A, fe.F, "hertz")
+    cols = np.rint(fe.RADII / dx).astype(int)
+    c = n // 2
+    model = [0.0, 0.0]
+    for nu in (0.3, 0.45):
+        for z, fields in fe.fem_shear(nu).items():
+            out = layer.LayerResponse(
+                load.shape,
+                dx,
+                z,
+                thickness=fe.H,
+                youngs_modulus=fe.E,
+                poisson_ratio=nu,
+                quantities=("u_x", "u_z", "eps_zz", "eps_xz"),
+                tangential=True,
+            )(np.zeros_like(load), load, None)
+            for i, pairs in enumerate(
+                ((("u_x", "U"), ("u_z", "W")), (("eps_zz", "eps_zz"), ("eps_xz", "eps_rz")))
+            ):
+                for name, fe_name in pairs:
+                    err = np.max(np.abs(out[name][c, c + cols] - fields[fe_name]))
+                    model[i] = max(model[i], err / np.max(np.abs(fields[fe_name])))
+    return rows, model
 
 
 def thick_layer_limit():
@@ -223,6 +267,7 @@ def block():
     rows = layer_against_hankel()
     thick = thick_layer_limit()
     surface_disp, surface_strain = surface_against_hankel()
+    fe_rows, fe_model = finite_elements()
     offset = half_space_offset()
     centre_ratio = draw(FIGURE)
     lines = [
@@ -238,7 +283,8 @@ def block():
         "order-1 fields u_r = U cos theta, u_theta = V sin theta, u_z = W cos theta,",
         "transformed with orders 0, 2 and 1; Navier's equations solved per wavenumber by a",
         "numerical 4x4 system; Muki 1960), where `layer.py` solves Cartesian Fourier modes",
-        "split into plane strain and anti-plane shear with Papkovich-Neuber potentials. The",
+        "split into plane strain and anti-plane shear with Papkovich-Neuber potentials; and",
+        "a finite-element solution (below). Surface loads and sign conventions as above. The",
         f"load: q_x = tau(r) on a disc of a = {1e3 * A:g} mm carrying F = {F} N, either",
         "Hertzian (`q0 sqrt(1 - r^2/a^2)`, the full-slip traction under a Hertz contact) or",
         f"uniform, sampled for `layer.py` at a / {round(A / DX)} with each sample the mean over",
@@ -274,6 +320,19 @@ def block():
         f"  strains there see the sampled load's edge unsmoothed: up to"
         f" {100 * surface_strain:.1f} % (eps_yz, zero",
         "  on the free surface, left out).",
+        "* A third solution by another method: **finite elements** (scikit-fem, quadratic",
+        "  quadrilaterals on the (r, z) half-plane for the order-1 harmonic, clamped at 15 h;",
+        "  `tests/physics/test_layer_shear_fem.py`) at z = h/4, h/2, 3h/4 and four radii out",
+        "  to 1.9 a, largest error in % of each quantity's peak against the Hankel solution:",
+        "",
+        "| nu | elements (r x z) | displacements U, V, W | strains eps_zz, eps_rz |",
+        "|---|---|---|---|",
+        *(f"| {nu} | {mesh} | {100 * d:.3f} | {100 * e:.2f} |" for nu, mesh, d, e in fe_rows),
+        "",
+        "  The FEM converges onto the Hankel solution as its mesh is refined; `layer.py`",
+        f"  (sampled at a / 20) against the coarse FEM directly: {100 * fe_model[0]:.2f} %"
+        f" (displacements), {100 * fe_model[1]:.2f} %",
+        "  (strains), mostly the FEM's own error.",
         "* The thick-layer limit: the fields at z = a (nu = 0.5, Hertzian) against Cerruti,",
         "  for the layer reference (exact) and for `layer.py`, largest error in %:",
         "",
@@ -302,8 +361,9 @@ def block():
         + ").",
         "  Under pressure the surface w has the same limit (above). A bonded layer of finite",
         "  thickness has no such offset: its response dies out within a few h.",
-        "* Nothing in `layer.py` had to change: the tangential path agrees with both",
-        "  references within the sampling of the load.",
+        "* Nothing in `layer.py` had to change: the tangential path agrees with all three",
+        "  within the sampling of the load (and, on the grid, obeys Betti's reciprocity between",
+        "  pressure and traction to round-off: `test_betti_reciprocity_on_the_surface`).",
         "",
         "![Fields along x under a tangential disc traction](images/layer_shear_profiles.png)",
         "",
