@@ -132,8 +132,8 @@ def _depth_functions(k, z, h, nu, t0_over_mu):
     # P(h) = 0, Wt(h) = 0
     m = np.zeros((n, 4, 4))
     kh = k * h if finite else np.zeros(n)
-    # P'/k at 0 = (-p0 + c) + (p1 + c' - c' kh) e_h;  Wt/1 at 0 = (-p0 - kappa c) + (p1 -
-    # kappa c' - c' kh) e_h
+    # at z = 0: P'/k = (-p0 + c) + (p1 + c' - c' kh) e_h and
+    # Wt = (-p0 - kappa c) + (p1 - kappa c' - c' kh) e_h; the row is P'/k + Wt
     m[:, 0] = np.stack(
         [
             -2 * np.ones(n),
@@ -143,8 +143,9 @@ def _depth_functions(k, z, h, nu, t0_over_mu):
         ],
         axis=1,
     )
-    # lam Delta / (mu k) + 2 Wt' / k at 0; Wt'/k = (p0 + (kappa - 1) c) + (p1 + (1 -
-    # kappa) c' - c' kh) e_h
+    # at z = 0: lam Delta / (mu k) = 4 nu (c - c' e_h) and
+    # Wt'/k = (p0 + (kappa - 1) c) + (p1 + (1 - kappa) c' - c' kh) e_h; the row is
+    # lam Delta / (mu k) + 2 Wt'/k
     m[:, 1] = np.stack(
         [
             2 * np.ones(n),
