@@ -318,8 +318,8 @@ def block():
         f"  On the surface (z = 0, Hertzian) the displacements agree within"
         f" {100 * surface_disp:.2f} %; the",
         f"  strains there see the sampled load's edge unsmoothed: up to"
-        f" {100 * surface_strain:.1f} % (eps_yz, zero",
-        "  on the free surface, left out).",
+        f" {100 * surface_strain:.1f} % (not counting",
+        "  eps_yz, which vanishes on the free surface).",
         "* A third solution by another method: **finite elements** (scikit-fem, quadratic",
         "  quadrilaterals on the (r, z) half-plane for the order-1 harmonic, clamped at 15 h;",
         "  `tests/physics/test_layer_shear_fem.py`) at z = h/4, h/2, 3h/4 and four radii out",
