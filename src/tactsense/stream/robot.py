@@ -63,8 +63,9 @@ class RobotFrame:
     sequence : int
         The device's frame counter (wraps at 65536).
     scan : int
-        The device's scan number (device time / scan period; else frames since the
-        first) [-].
+        Frames the device sent before this one since the first received (its scan
+        counter, lost frames included; a patch read every ``k``-th scan is in the frames
+        whose ``scan % k == 0``) [-].
     arrival : float
         Arrival on :func:`time.perf_counter` [s], for latencies.
     """
@@ -353,10 +354,9 @@ class RobotSources:
         if frame.device_time_us >= 0:
             status.clock.add(frame.device_time_s, frame.arrival)
             aligned = status.clock.to_host(frame.device_time_s) + self.wall_offset_s
-            scan = round(frame.device_time_us * 1e-6 * layout.rate_hz)
         else:
             aligned = host
-            scan = frame.index
+        scan = frame.index
         if status.first_host_s is None:
             status.first_host_s = host
         status.last_host_s = host

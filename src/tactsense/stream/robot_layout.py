@@ -3,8 +3,9 @@ taxels in it (``docs/robot.md``, "Capture from several devices").
 
 A device (a board of :attr:`tactsense.robot.RobotSkin.devices`) scans at the rate of its
 fastest patch; a patch whose rate is that divided by an integer ``k`` is read at every
-``k``-th scan (scan number ``n`` with ``n % k == 0``, ``n`` counted by the device clock)
-and holds its last reading in between. Each frame on the wire is an ordinary tactsense
+``k``-th scan (scan number ``n`` with ``n % k == 0``, ``n`` counting the device's frames
+from the first one the host received, lost ones included) and holds its last reading in
+between. Each frame on the wire is an ordinary tactsense
 frame (protocol version 1, unchanged): its taxels are every patch's, flattened row-major
 in the skin's order, then zeros up to the frame's shape: ``cols = min(N, 255)`` and
 ``rows = ceil(N / cols)`` for ``N`` taxels in all (the protocol's frame is at most
