@@ -67,8 +67,14 @@ ClockOffsetOption = Annotated[
 ]
 
 
-def one_source(sources: list[str]) -> str:
+DEFAULT_DROPOUT_S = 2.0
+"""--dropout-s's default [s]."""
+
+
+def one_source(sources: list[str], dropout_s: float) -> str:
     """The single source of a command without --skin."""
+    if dropout_s != DEFAULT_DROPOUT_S:
+        fail("--dropout-s applies with --skin (several devices)")
     if len(sources) != 1:
         fail(
             f"{len(sources)} sources given; give one SOURCE, or several with --skin SKIN "
@@ -133,6 +139,8 @@ def emulate_skin(ctx: typer.Context, options: dict[str, Any]) -> None:
     from tactsense.stream import FaultRates
     from tactsense.stream.robot_emulator import device_emulators, rest_streams
 
+    if options["skin"] is None:
+        fail("--drift-ppm and --clock-offset-s apply with --skin (a device per board)")
     given = [
         "--" + name.replace("_", "-")
         for name in SCENARIO_PARAMETERS

@@ -186,7 +186,7 @@ def emulate(
     from tactsense.stream import Emulator, FaultRates
     from tactsense.stream.sources import parse_format
 
-    if skin is not None:  # r7-capture
+    if (skin, drift_ppm, clock_offset_s) != (None, None, None):  # r7-capture
         return robot.emulate_skin(ctx, locals())
     if not 0 < speed <= 1e6:
         fail(
@@ -311,7 +311,7 @@ def record(
 
     if skin is not None:  # r7-capture
         return robot.record_skin(locals())
-    source = robot.one_source(source)  # r7-capture
+    source = robot.one_source(source, dropout_s)  # r7-capture
     _check_duration(duration)
     if record_format is None:
         mcap = out.suffix.lower() == ".mcap"
@@ -482,7 +482,7 @@ def live(
 
     if skin is not None:  # r7-capture
         return robot.live_skin(locals())
-    source = robot.one_source(source)  # r7-capture
+    source = robot.one_source(source, dropout_s)  # r7-capture
     _check_duration(duration)
     foxglove_address = check_foxglove(foxglove)  # r6-fox
     if out is not None:

@@ -419,7 +419,8 @@ class RobotSources:
 
     def devices_manifest(self) -> dict[str, dict]:
         """Each device as a robot recording's manifest holds it: patches, source, clock
-        fit (Unix time), status, dropped_at_s, error, losses."""
+        fit (Unix time), status, dropped_at_s, error, losses, and ``unused`` (frames that
+        arrived after the stop: neither kept nor lost)."""
         out = {}
         for device, status in self.status.items():
             out[device] = {
@@ -432,6 +433,7 @@ class RobotSources:
                 "error": status.error,
                 "rate_hz": status.layout.rate_hz,
                 "losses": status.losses.as_dict(),
+                "unused": int(getattr(self._readers.get(device), "unused", 0)),
             }
         return out
 

@@ -139,9 +139,9 @@ class DeviceLayout:
         """Device frames (T, rows, cols) from each patch's frames at its own rate
         ((T_p, rows, cols) each): scan ``n`` holds frame ``n // k`` of a patch read every
         ``k``-th scan (its frames repeat when they run out). ``scans``: how many
-        (default: as many as the patch with the fewest scans' worth of frames fills)."""
+        (default: enough for every frame of every patch: the longest stream's)."""
         if scans is None:
-            scans = min(len(streams[p]) * k for p, k in zip(self.patches, self.every, strict=True))
+            scans = max(len(streams[p]) * k for p, k in zip(self.patches, self.every, strict=True))
         out = np.zeros((scans, self.frame_shape[0] * self.frame_shape[1]), dtype=np.uint16)
         start = 0
         n = np.arange(scans)
