@@ -132,9 +132,15 @@ def _check_dropout(dropout_s: float) -> None:
 
 
 # ---- emulate --skin ---------------------------------------------------------------------
+EMULATE_SKIN_OPTIONS = (
+    "skin", "drift_ppm", "clock_offset_s", "recording", "port", "loop", "seed", "garbage",
+    "bitflip", "drop", "truncate", "stall", "stall_s", "fault_seed",
+)  # fmt: skip
+"""emulate's options that apply with --skin."""
+
+
 def emulate_skin(ctx: typer.Context, options: dict[str, Any]) -> None:
     """Serve a device per board of the skin on its own TCP port of 127.0.0.1."""
-    from tactsense.cli.live import SCENARIO_PARAMETERS
     from tactsense.io.robot_recording import is_robot_recording, read_robot_recording
     from tactsense.stream import FaultRates
     from tactsense.stream.robot_emulator import device_emulators, rest_streams
@@ -142,18 +148,16 @@ def emulate_skin(ctx: typer.Context, options: dict[str, Any]) -> None:
     if options["skin"] is None:
         fail("--drift-ppm and --clock-offset-s apply with --skin (a device per board)")
     given = [
-        "--" + name.replace("_", "-")
-        for name in SCENARIO_PARAMETERS
-        if name not in ("seed", "flaws")
+        "--" + name.replace("_", "-").replace("wire-format", "format")
+        for name in ctx.params
+        if name not in EMULATE_SKIN_OPTIONS
         and getattr(ctx.get_parameter_source(name), "name", "") == "COMMANDLINE"
     ]
     if given:
         fail(
             f"--skin excludes {', '.join(given)}: each patch sends untouched frames, or a "
-            "robot recording's (--recording RUN)"
+            "robot recording's (--recording RUN), in the tactsense protocol at its own rate"
         )
-    _refuse(options, {"wire_format": None, "speed": 1.0}, "to --skin (its devices speak the "
-            "tactsense protocol at their patches' rates)")  # fmt: skip
     skin = _skin(options["skin"])
     drift, offset = options["drift_ppm"], options["clock_offset_s"]
     if drift is not None and not abs(drift) <= 1000:

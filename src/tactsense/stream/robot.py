@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 import queue
+import re
 import threading
 import time
 from collections.abc import Iterator, Mapping, Sequence
@@ -38,6 +39,9 @@ from tactsense.stream.sources import open_source
 STATES = ("opening", "streaming", "ended", "dropped", "stopped")
 """A device's states: not yet streaming; streaming; its line ended (END); it dropped out
 (its line failed or closed, or it was silent for ``dropout_s``); stopped by the caller."""
+
+_DEVICE_NAME = re.compile(r"[A-Za-z0-9][\w.-]*")
+"""What a device's name looks like before ``=`` (a source's options hold a comma)."""
 
 QUEUE_FRAMES = 4096
 """Device frames the queue holds before the device threads wait for the caller."""
@@ -147,6 +151,11 @@ def parse_device_sources(skin: RobotSkin, sources: Sequence[str]) -> dict[str, s
             if name in named:
                 raise RobotSourceError(f"device {name!r} is given two sources")
             named[name] = rest
+        elif equals and _DEVICE_NAME.fullmatch(name):
+            raise RobotSourceError(
+                f"{item}: {name!r} is no device of {skin.name!r}; its devices: "
+                + ", ".join(devices)
+            )
         else:
             plain.append(item)
     if named and plain:
