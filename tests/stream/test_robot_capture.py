@@ -192,8 +192,8 @@ def test_silent_device_drops_out_after_the_timeout(skin):
             stalled = False
             for frame in sources.frames(duration_s=1.5):
                 if not stalled and frame.device == "board_c":
-                    # the device stalls for 60 s: its line stays open, silent
-                    emulators["board_c"].faults = FaultRates(stall=1.0, stall_s=60.0)
+                    # the device stalls for 5 s: its line stays open, silent
+                    emulators["board_c"].faults = FaultRates(stall=1.0, stall_s=5.0)
                     stalled = True
             status = sources.status["board_c"]
             assert status.state == "dropped" and "silent" in status.error

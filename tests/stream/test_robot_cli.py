@@ -122,3 +122,36 @@ def test_a_board_that_cannot_be_opened_stops_nothing_half_made(skin_file, tmp_pa
     assert result.exit_code == 2
     assert "cannot open socket://127.0.0.1:1" in " ".join(result.output.split())
     assert not out.exists()
+
+
+def test_emulate_skin_replays_a_robot_recording(skin_file, tmp_path):
+    from tactsense.stream.robot_recorder import record_robot
+
+    skin = small_skin()
+    running = start_device_emulators(device_emulators(skin, _streams(skin), seed=5))
+    try:
+        run = record_robot(RobotSources(skin, {d: r.url for d, r in running.items()}),
+                           tmp_path / "run", duration_s=0.5)  # fmt: skip
+    finally:
+        for device in running.values():
+            device.stop()
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    command = [sys.executable, "-m", "tactsense", "emulate", "--skin", str(skin_file),
+               "--recording", str(run), "--loop"]  # fmt: skip
+    process = subprocess.Popen(
+        command, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
+    try:
+        urls = [process.stdout.readline().strip() for _ in range(3)]
+        with RobotSources(skin, urls) as sources:
+            frames = list(sources.frames(duration_s=0.5))
+    finally:
+        process.send_signal(signal.SIGINT)
+        process.communicate(timeout=20)
+    assert frames
+    names = [p.name for p in skin.patches]
+    for frame in frames:
+        for name, counts in frame.patches.items():
+            # the recorded frames of that patch (1000 (p + 1) + t), none of another
+            value = int(counts.flat[0]) - 1000 * (names.index(name) + 1)
+            assert 0 <= value < 40 and (counts == counts.flat[0]).all(), (name, value)

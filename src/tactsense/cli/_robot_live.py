@@ -176,7 +176,11 @@ def emulate_skin(ctx: typer.Context, options: dict[str, Any]) -> None:
         if recording is not None:
             if not is_robot_recording(recording):
                 fail(f"--recording {recording}: with --skin, a robot recording (a folder)")
-            streams = {n: s.frames for n, s in read_robot_recording(recording).streams.items()}
+            played = {n: s.frames for n, s in read_robot_recording(recording).streams.items()}
+            if not set(played) & {p.name for p in skin.patches}:
+                fail(f"--recording {recording} holds no stream of a patch of {skin.name!r}")
+            # a patch that recorded nothing sends untouched frames
+            streams = {**rest_streams(skin, rng=options["seed"]), **played}
         else:
             streams = rest_streams(skin, rng=options["seed"])
         emulators = device_emulators(
