@@ -60,7 +60,7 @@ def test_live_reports_every_device_and_the_one_that_dropped(skin_file):
     assert sum(line["device"] == "board_a" for line in lines) >= 2
 
 
-def test_emulate_skin_serves_a_port_per_board_until_ctrl_c(skin_file):
+def test_emulate_skin_serves_a_pty_per_board_until_ctrl_c(skin_file):
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
     command = [sys.executable, "-m", "tactsense", "emulate", "--skin", str(skin_file),
                "--drift-ppm", "40", "--clock-offset-s", "12"]  # fmt: skip
@@ -70,6 +70,7 @@ def test_emulate_skin_serves_a_port_per_board_until_ctrl_c(skin_file):
     try:
         urls = [process.stdout.readline().strip() for _ in range(3)]
         assert [u.split("=")[0] for u in urls] == ["board_a", "board_b", "board_c"], urls
+        assert all(u.split("=")[1].startswith("/dev/") for u in urls), urls  # a pty each
         with RobotSources(small_skin(), urls) as sources:
             frames = list(sources.frames(duration_s=1.0))
         for status in sources.status.values():
@@ -137,7 +138,7 @@ def test_emulate_skin_replays_a_robot_recording(skin_file, tmp_path):
             device.stop()
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
     command = [sys.executable, "-m", "tactsense", "emulate", "--skin", str(skin_file),
-               "--recording", str(run), "--loop"]  # fmt: skip
+               "--recording", str(run), "--loop", "--port", "0"]  # fmt: skip
     process = subprocess.Popen(
         command, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
     )

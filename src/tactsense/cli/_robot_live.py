@@ -140,7 +140,8 @@ EMULATE_SKIN_OPTIONS = (
 
 
 def emulate_skin(ctx: typer.Context, options: dict[str, Any]) -> None:
-    """Serve a device per board of the skin on its own TCP port of 127.0.0.1."""
+    """Serve a device per board of the skin, each on its own pseudo-terminal, or with
+    --port on its own TCP port of 127.0.0.1 (--port P: P, P+1, ...; 0: free ones)."""
     from tactsense.io.robot_recording import is_robot_recording, read_robot_recording
     from tactsense.stream import FaultRates
     from tactsense.stream.robot_emulator import device_emulators, rest_streams
@@ -164,7 +165,7 @@ def emulate_skin(ctx: typer.Context, options: dict[str, Any]) -> None:
         fail(f"--drift-ppm must lie in -1000 to 1000 [ppm]; got {drift:g}")
     if offset is not None and not 0 <= offset <= 1e7:
         fail(f"--clock-offset-s must lie in 0 to 1e7 [s]; got {offset:g}")
-    port = options["port"] or 0
+    port = options["port"]
     devices = list(skin.devices)
     if port and port + len(devices) - 1 > 65535:
         fail(f"--port {port}: the {len(devices)} devices need ports {port} to "
@@ -192,13 +193,16 @@ def emulate_skin(ctx: typer.Context, options: dict[str, Any]) -> None:
     threads = []
     try:
         for i, (device, emulator) in enumerate(emulators.items()):
-            thread, chosen = emulator.start_tcp(port + i if port else 0)
+            if port is None:  # a pseudo-terminal each, as a board on USB
+                thread, where = emulator.start_pty()
+            else:
+                thread, chosen = emulator.start_tcp(port + i if port else 0)
+                where = f"socket://127.0.0.1:{chosen}"
             threads.append(thread)
-            typer.echo(f"{device}=socket://127.0.0.1:{chosen}")
+            typer.echo(f"{device}={where}")
             console.print(
-                f"emulating {device} ({', '.join(emulator.layout.patches)}) on 127.0.0.1:"
-                f"{chosen}: {emulator.layout.rate_hz:g} frames/s, clock "
-                f"{emulator.drift_ppm:+.1f} ppm"
+                f"emulating {device} ({', '.join(emulator.layout.patches)}) on {where}: "
+                f"{emulator.layout.rate_hz:g} frames/s, clock {emulator.drift_ppm:+.1f} ppm"
             )
         sys.stdout.flush()
         console.print("Ctrl-C stops")

@@ -176,7 +176,7 @@ def emulate(
 ) -> None:
     """Play a sensor as a device: frames of the twin (a finger, a pad or a point set) in the
     wire protocol on a pty or TCP; with --skin, a device per board of a robot skin, each on
-    its own TCP port (docs/robot.md).
+    its own pty or TCP port (--port P: P, P+1, ...), printed as DEVICE=URL (docs/robot.md).
 
     Prints where to connect on standard output (a pty path, or socket://127.0.0.1:PORT)
     and serves until Ctrl-C. The device streams after a host sends START
