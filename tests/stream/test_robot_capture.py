@@ -242,7 +242,10 @@ def test_boards_that_cannot_scan_their_patches_together_are_refused():
         DeviceLayout.of(big, "one")
 
 
-def test_sigint_mid_record_leaves_every_file_readable(skin, tmp_path):
+@pytest.mark.parametrize("sent", [signal.SIGINT, signal.SIGKILL], ids=["sigint", "sigkill"])
+def test_a_record_stopped_midway_leaves_every_file_readable(skin, tmp_path, sent):
+    """Ctrl-C closes everything cleanly; a kill leaves every stream readable up to its
+    last flush and a manifest that says capture never finished."""
     skin_file = tmp_path / "small.toml"
     skin_file.write_text(skin_to_toml_string(skin))
     _, running = _emulate(skin)
@@ -263,15 +266,21 @@ def test_sigint_mid_record_leaves_every_file_readable(skin, tmp_path):
                 pass
             time.sleep(0.2)
         assert process.poll() is None, process.stderr.read()
-        process.send_signal(signal.SIGINT)
+        process.send_signal(sent)
         _, err = process.communicate(timeout=30)
     finally:
         _stop(running)
+    manifest = json.loads((out / "robot.json").read_text())
+    recording = read_robot_recording(out)
+    if sent == signal.SIGKILL:
+        assert process.returncode == -signal.SIGKILL
+        assert not manifest["closed_cleanly"] and not recording.closed_cleanly
+        for stream in recording.streams.values():
+            assert len(stream.frames) > 50 and len(stream.frames) == len(stream.host_time_s)
+        return
     assert process.returncode == 0, err
     assert "stopped by" in err
-    manifest = json.loads((out / "robot.json").read_text())
     assert manifest["closed_cleanly"]
-    recording = read_robot_recording(out)
     for name, stream in recording.streams.items():
         losses = manifest["devices"][skin.patch(name).device]["losses"]
         if name != "a2":

@@ -53,6 +53,8 @@ def test_live_reports_every_device_and_the_one_that_dropped(skin_file):
         assert last[device]["state"] == "stopped"
         assert last[device]["lost"] == 0
         assert abs(last[device]["drift_ppm"]) < 1000
+        # skew: the drift over the time streamed
+        assert abs(last[device]["skew_ms"]) < 1000e-6 * 3 * 1e3
     # the rates are each board's: board_a 200 Hz, board_b 250 Hz (within 5 %)
     assert last["board_a"]["rate_hz"] == pytest.approx(200.0, rel=0.05)
     assert last["board_b"]["rate_hz"] == pytest.approx(250.0, rel=0.05)

@@ -339,6 +339,7 @@ def status_record(status, wall_offset_s: float) -> dict[str, Any]:
         "rate_hz": round(status.rate_hz, 3),
         **status.losses.as_dict(),
         "drift_ppm": clock.get("drift_ppm"),
+        "skew_ms": None if not clock else status.skew_s * 1e3,
         "delay_median_ms": None if not clock else clock["residual_s"] * 1e3,
         "delay_p99_ms": None if not clock else clock["residual_p99_s"] * 1e3,
         "dropped_at_s": status.dropped_at_s,
