@@ -287,3 +287,26 @@ def test_a_record_stopped_midway_leaves_every_file_readable(skin, tmp_path, sent
             assert len(stream.frames) == losses["frames"], name
         assert len(stream.frames) > 50
     assert not list(tmp_path.glob("*.partial"))
+
+
+def test_a_board_in_another_wire_format_has_host_times_and_no_clock_fit(skin):
+    """FORMAT:URL sources work too; without device time the aligned time is the arrival."""
+    from tactsense.stream.robot_emulator import DeviceEmulator
+    from tactsense.stream.robot_layout import device_layouts
+    from tactsense.stream.sources import parse_format
+
+    layout = device_layouts(skin)["board_b"]
+    frames = layout.pack_streams({"b1": _streams(skin)["b1"]})
+    emulator = DeviceEmulator(layout, frames, wire_format=parse_format("text"), repeat=True)
+    _, port = emulator.start_tcp()
+    try:
+        with RobotSources(skin, {"board_b": f"text:socket://127.0.0.1:{port}"}) as sources:
+            received = list(sources.frames(duration_s=1.0))
+    finally:
+        emulator.stop()
+    assert len(received) > 50
+    for frame in received:
+        assert frame.device_time_us == -1 and frame.aligned_time_s == frame.host_time_s
+        value = int(frame.patches["b1"].flat[0]) - 3000
+        assert 0 <= value < FRAMES and (frame.patches["b1"] == frame.patches["b1"].flat[0]).all()
+    assert sources.devices_manifest()["board_b"]["clock"] == {}
