@@ -37,8 +37,8 @@ SkinOption = Annotated[
     str | None,
     typer.Option(
         "--skin",
-        help="A robot skin (a preset: hand4, icub_hand; or a skin TOML file): read several "
-        "devices at once, one per board of the skin (docs/robot.md).",
+        help="A robot skin (a preset: hand4, icub_hand; or a skin TOML file): one device "
+        "per board of the skin, several at once (docs/robot.md).",
     ),
 ]
 DropoutOption = Annotated[
