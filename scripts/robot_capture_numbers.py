@@ -97,14 +97,16 @@ def real_run(seconds: float, seed: int = 1) -> list[str]:
         error = np.concatenate(errors)
         clock, losses = entry["clock"], entry["losses"]
         rows.append(
-            f"| {device} | {entry['rate_hz']:g} | {losses['frames']} | {losses['lost']} | "
+            f"| {device} ({len(entry['patches'])} patches, "
+            f"{sum(skin.patch(p).n_taxels for p in entry['patches'])} taxels) | "
+            f"{entry['rate_hz']:g} | {losses['frames']} | {losses['lost']} | "
             f"{clock['drift_ppm']:+.1f} | {clock['residual_s'] * 1e3:.2f} | "
             f"{clock['residual_p99_s'] * 1e3:.2f} | {np.max(np.abs(error)) * 1e3:.3f} |"
         )
     shutil.rmtree(folder)
     rows.append(
-        f"\nCPU of the process (the recorder and the five emulators): {cpu / seconds * 100:.0f} "
-        "% of one core."
+        f"\nCPU of the process (the recorder and the {len(emulators)} emulators): "
+        f"{cpu / seconds * 100:.0f} % of one core."
     )
     return rows
 
@@ -113,6 +115,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--seconds", type=float, default=30.0)
     args = parser.parse_args()
+    hand4_taxels = load_skin("hand4").n_taxels
     hour = simulated_hour()
     run = real_run(args.seconds)
     text = "\n".join(
@@ -128,7 +131,8 @@ def main() -> None:
             "|---|---|---|---|---|---|---|---|",
             *hour,
             "",
-            f"A real run: `hand4`'s five boards emulated on 127.0.0.1 for {args.seconds:g} s, "
+            f"A real run: `hand4`'s boards ({hand4_taxels} taxels) emulated on 127.0.0.1 for "
+            f"{args.seconds:g} s, "
             "every clock 50 ppm fast, recorded with `record_robot` on this 2-core machine "
             "(error against each emulator's own send schedule, in ms; delays = arrival "
             "minus aligned time):",

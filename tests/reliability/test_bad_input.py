@@ -585,7 +585,7 @@ BAD_CAPTURE = [
     ("record loop:// --dropout-s 5 --out OUT", "--dropout-s applies with --skin"),
     ("live loop:// --dropout-s 5", "--dropout-s applies with --skin"),
     ("record --skin nope loop:// --out OUT", "--skin: robot skin 'nope'"),
-    ("record --skin hand4 a b c d e f --out OUT", "6 sources for the 5 devices"),
+    ("record --skin hand4 a b c d e f g h i --out OUT", "9 sources for the"),
     ("record --skin hand4 board_thumb=x y --out OUT", "DEVICE=SOURCE or none"),
     ("record --skin hand4 board_nope=x --out OUT", "'board_nope' is no device of 'hand4'"),
     ("record --skin hand4 loop:// --dropout-s 0 --out OUT", "--dropout-s"),
