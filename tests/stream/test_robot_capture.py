@@ -165,13 +165,19 @@ def test_record_three_devices_frames_losses_and_clocks(skin, tmp_path):
 
 def test_a_device_that_drops_out_does_not_stop_the_others(skin, tmp_path):
     _, running = _emulate(skin)
-    killer = threading.Timer(1.0, running["board_b"].stop)
+
+    def kill_board_b() -> None:  # once it has streamed for a second
+        while running["board_b"].emulator.started_at is None:
+            time.sleep(0.01)
+        time.sleep(1.0)
+        running["board_b"].stop()
+
+    killer = threading.Thread(target=kill_board_b, daemon=True)
     try:
         sources = RobotSources(skin, {d: r.url for d, r in running.items()}, dropout_s=0.5)
         killer.start()
-        out = record_robot(sources, tmp_path / "run", duration_s=2.5)
+        out = record_robot(sources, tmp_path / "run", duration_s=3.0)
     finally:
-        killer.cancel()
         _stop(running)
     manifest = read_manifest(out)
     b = manifest["devices"]["board_b"]

@@ -7,6 +7,7 @@ import signal
 import subprocess
 import sys
 import threading
+import time
 
 import pytest
 from typer.testing import CliRunner
@@ -32,7 +33,14 @@ def skin_file(tmp_path):
 def test_live_reports_every_device_and_the_one_that_dropped(skin_file):
     skin = small_skin()
     running = start_device_emulators(device_emulators(skin, _streams(skin), seed=2))
-    killer = threading.Timer(0.8, running["board_c"].stop)
+
+    def kill_board_c() -> None:  # once it has streamed for half a second
+        while running["board_c"].emulator.started_at is None:
+            time.sleep(0.01)
+        time.sleep(0.5)
+        running["board_c"].stop()
+
+    killer = threading.Thread(target=kill_board_c, daemon=True)
     urls = [f"{d}={r.url}" for d, r in running.items()]
     try:
         killer.start()
@@ -41,7 +49,6 @@ def test_live_reports_every_device_and_the_one_that_dropped(skin_file):
             ["live", "--skin", str(skin_file), *urls, "--duration", "2.5", "--dropout-s", "0.5"],
         )
     finally:
-        killer.cancel()
         for device in running.values():
             device.stop()
     assert result.exit_code == 0, result.output
