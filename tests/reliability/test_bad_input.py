@@ -687,3 +687,50 @@ def test_grasp_bad_options(workspace, line, names):
 
 
 # ---- /r7-grasp ----
+# ---- several devices of a robot skin (r7-capture) ----
+BAD_CAPTURE = [
+    ("record loop:// loop:// --out OUT", "give one SOURCE, or several with --skin"),
+    ("record loop:// --dropout-s 5 --out OUT", "--dropout-s applies with --skin"),
+    ("live loop:// --dropout-s 5", "--dropout-s applies with --skin"),
+    ("record --skin nope loop:// --out OUT", "--skin: robot skin 'nope'"),
+    ("record --skin hand4 a b c d e f g h i --out OUT", "9 sources for the"),
+    ("record --skin hand4 board_thumb=x y --out OUT", "DEVICE=SOURCE or none"),
+    ("record --skin hand4 board_nope=x --out OUT", "'board_nope' is no device of 'hand4'"),
+    ("record --skin hand4 loop:// --dropout-s 0 --out OUT", "--dropout-s"),
+    ("record --skin hand4 loop:// --dropout-s nan --out OUT", "--dropout-s"),
+    ("record --skin hand4 loop:// --duration 0 --out OUT", "--duration"),
+    ("record --skin hand4 loop:// --frames 5 --out OUT", "--frames does not apply"),
+    ("record --skin hand4 loop:// --format mcap --out OUT", "--record-format does not apply"),
+    ("record --skin hand4 loop:// --out OUT.h5", "the recording is a folder"),
+    ("live --skin hand4 loop:// --lsl", "--lsl does not apply"),
+    ("live --skin hand4 loop:// --dropout-s -1", "--dropout-s"),
+    ("emulate --drift-ppm 5", "apply with --skin"),
+    ("emulate --skin hand4 --drift-ppm 5000", "--drift-ppm"),
+    ("emulate --skin hand4 --drift-ppm nan", "--drift-ppm"),
+    ("emulate --skin hand4 --clock-offset-s -1", "--clock-offset-s"),
+    ("emulate --skin hand4 --row 2", "--skin excludes --row"),
+    ("emulate --skin hand4 --format text", "--skin excludes --format"),
+    ("emulate --skin hand4 --port 65533", "beyond 65535"),
+    ("emulate --skin hand4 --recording REC", "with --skin, a robot recording"),
+    ("emulate --skin nope", "--skin: robot skin 'nope'"),
+]
+
+
+@pytest.mark.parametrize("line, names", BAD_CAPTURE, ids=[line for line, _ in BAD_CAPTURE])
+def test_capture_bad_input(workspace, line, names):
+    out = workspace / "never_written"
+    args = line.replace("REC", str(workspace / "rec.h5")).replace("OUT", str(out)).split()
+    result = runner.invoke(app, args)
+    _check(result, names)
+    assert not out.exists() and not (workspace / "never_written.h5").exists()
+
+
+def test_capture_refuses_to_replace_a_folder_that_is_no_robot_recording(workspace):
+    result = runner.invoke(
+        app, ["record", "--skin", "hand4", "loop://", "--out", str(workspace / "a_dir"), "--force"]
+    )
+    _check(result, "is not a robot recording")
+    assert (workspace / "a_dir").is_dir()
+
+
+# ---- /r7-capture ----

@@ -16,6 +16,7 @@ from rich.progress import Progress, TextColumn
 
 from tactsense._signals import stopped_by
 from tactsense._validation import TactsenseInputError
+from tactsense.cli import _robot_live as robot  # r7-capture
 from tactsense.cli._common import (
     BaselineFramesOption,
     CalibrationOption,
@@ -45,7 +46,6 @@ from tactsense.cli._live_outputs import (
 from tactsense.cli._live_sources import (
     DurationLimit,
     FramesLimit,
-    SourceArgument,
     StreamSensorOption,
     TimeoutOption,
     _check_duration,
@@ -168,9 +168,15 @@ def emulate(
             "streams as soon as a host connects.",
         ),
     ] = None,
+    # ---- robot skin (r7-capture) ----
+    skin: robot.SkinOption = None,
+    drift_ppm: robot.DriftOption = None,
+    clock_offset_s: robot.ClockOffsetOption = None,
+    # ---- /r7-capture ----
 ) -> None:
     """Play a sensor as a device: frames of the twin (a finger, a pad or a point set) in the
-    wire protocol on a pty or TCP.
+    wire protocol on a pty or TCP; with --skin, a device per board of a robot skin, each on
+    its own pty or TCP port (--port P: P, P+1, ...), printed as DEVICE=URL (docs/robot.md).
 
     Prints where to connect on standard output (a pty path, or socket://127.0.0.1:PORT)
     and serves until Ctrl-C. The device streams after a host sends START
@@ -180,6 +186,8 @@ def emulate(
     from tactsense.stream import Emulator, FaultRates
     from tactsense.stream.sources import parse_format
 
+    if (skin, drift_ppm, clock_offset_s) != (None, None, None):  # r7-capture
+        return robot.emulate_skin(ctx, locals())
     if not 0 < speed <= 1e6:
         fail(
             f"--speed must be more than 0 and at most 1e6 (a multiple of the scan rate); "
@@ -256,7 +264,7 @@ def emulate(
 
 @app.command()
 def record(
-    source: SourceArgument,
+    source: robot.SourcesArgument,  # r7-capture: several with --skin
     out: Annotated[
         Path,
         typer.Option(
@@ -288,8 +296,11 @@ def record(
     ] = None,
     quiet: Annotated[bool, typer.Option("--quiet", help="No live status line.")] = False,
     force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
+    skin: robot.SkinOption = None,  # ---- r7-capture ----
+    dropout_s: robot.DropoutOption = 2.0,  # ---- /r7-capture ----
 ) -> None:
-    """Record a device's frames as they arrive, until --frames, --duration or Ctrl-C.
+    """Record a device's frames as they arrive, until --frames, --duration or Ctrl-C;
+    with --skin, several devices into a robot recording (a folder; docs/robot.md).
 
     HDF5 is flushed at least once a second: if the recorder is killed, every frame up
     to the last flush is readable. Losses (bad check, gaps, timeouts...) are counted
@@ -298,6 +309,9 @@ def record(
     from tactsense.stream import StreamError
     from tactsense.stream import record as run_record
 
+    if skin is not None:  # r7-capture
+        return robot.record_skin(locals())
+    source = robot.one_source(source, dropout_s)  # r7-capture
     _check_duration(duration)
     if record_format is None:
         mcap = out.suffix.lower() == ".mcap"
@@ -364,7 +378,7 @@ def record(
 
 @app.command()
 def live(
-    source: SourceArgument,
+    source: robot.SourcesArgument,  # r7-capture: several with --skin
     calibration: CalibrationOption = None,
     output_format: Annotated[
         LiveFormat, typer.Option("--format", help="One JSON object per line, or CSV.")
@@ -447,6 +461,8 @@ def live(
         ),
     ] = None,
     # ---- /ROS 2 topics (r6-ros2) ----
+    skin: robot.SkinOption = None,  # ---- r7-capture ----
+    dropout_s: robot.DropoutOption = 2.0,  # ---- /r7-capture ----
 ) -> None:
     """Estimate the contact of every frame as it arrives: position, force, skew, flags and
     latency (from the frame's last byte to its estimate), until --frames, --duration,
@@ -464,6 +480,9 @@ def live(
 
     from tactsense.stream import StreamError
 
+    if skin is not None:  # r7-capture
+        return robot.live_skin(locals())
+    source = robot.one_source(source, dropout_s)  # r7-capture
     _check_duration(duration)
     foxglove_address = check_foxglove(foxglove)  # r6-fox
     if out is not None:

@@ -198,3 +198,177 @@ def read_robot_recording(path: str | Path) -> RobotRecording:
         description=str(content.get("description", "")),
         closed_cleanly=bool(content.get("closed_cleanly", False)),
     )
+
+
+# ---- streaming writer (r7-capture) ----
+class RobotRecordingWriter:
+    """Write a robot recording as the frames arrive: a crash-safe stream per patch.
+
+    The folder is made at once (not under a temporary name: a capture killed at any
+    moment leaves every stream readable up to its last flush, as
+    :class:`~tactsense.io.recording.RecordingWriter` does for one array), with the skin
+    and a manifest that says ``closed_cleanly: false``; :meth:`close` writes the final
+    manifest (clock fits, statuses, ``closed_cleanly: true``). A writer closed before any
+    frame came removes what it made (:meth:`discard`).
+
+    Parameters
+    ----------
+    path : path
+        The new recording's folder. An existing one is refused unless ``overwrite``, and
+        even then only a robot recording is replaced.
+    skin : RobotSkin
+    devices : dict of str -> dict
+        The manifest's devices (``patches``, ``source``, ...) at the start; a stream is
+        made for every patch of these devices.
+    description : str
+    losses : dict of str -> callable() -> dict, optional
+        Per patch, its loss counters (``LOSS_KINDS`` of :mod:`tactsense.stream.reader`)
+        when the file is flushed.
+    loss_kinds : sequence of str
+        The counters' names, in the order stored.
+    flush_interval_s : float
+        Each stream is flushed at least this often [s].
+    """
+
+    def __init__(
+        self,
+        path: str | Path,
+        skin: RobotSkin,
+        devices: dict[str, dict[str, Any]],
+        *,
+        description: str = "",
+        losses: dict[str, Any] | None = None,
+        loss_kinds=(),
+        overwrite: bool = False,
+        flush_interval_s: float = 1.0,
+    ):
+        from tactsense.io.recording import RecordingWriter
+        from tactsense.physics.transduction import sample_offsets
+
+        path = Path(path)
+        if not path.parent.is_dir():
+            raise RecordingError(f"folder {path.parent} does not exist")
+        if path.exists():
+            if not overwrite:
+                raise FileExistsError(f"{path} exists; pass overwrite=True (--force) to replace it")
+            if not is_robot_recording(path):
+                raise RecordingError(
+                    f"{path} exists and is not a robot recording; it is not replaced, whatever "
+                    "--force says"
+                )
+            shutil.rmtree(path)
+        self.path = path
+        self.skin = skin
+        self.devices = {name: dict(entry) for name, entry in devices.items()}
+        self.description = description
+        self._writers: dict[str, Any] = {}
+        losses = losses or {}
+        (path / STREAMS).mkdir(parents=True)
+        try:
+            (path / SKIN).write_text(skin_to_toml_string(skin), encoding="utf-8")
+            for entry in self.devices.values():
+                for name in entry.get("patches", []):
+                    sensor = skin.patch(name).sensor
+                    self._writers[name] = RecordingWriter(
+                        stream_path(path, name),
+                        sensor,
+                        sample_offsets(sensor),
+                        source=str(entry.get("source", "")),
+                        loss_kinds=tuple(loss_kinds),
+                        losses=losses.get(name),
+                        flush_interval_s=flush_interval_s,
+                    )
+            self.write_manifest(closed_cleanly=False)
+        except BaseException:
+            self._close_writers()
+            shutil.rmtree(path, ignore_errors=True)
+            raise
+        self.closed = False
+
+    @property
+    def patches(self) -> tuple[str, ...]:
+        """The patches with a stream, in the devices' order."""
+        return tuple(self._writers)
+
+    def frames(self, patch: str) -> int:
+        """Frames written to a patch's stream so far."""
+        return len(self._writers[patch])
+
+    def append(
+        self,
+        patch: str,
+        counts,
+        device_time_s: float,
+        sequence: int,
+        host_time_s: float,
+        *,
+        device_time_us: int = -1,
+    ) -> None:
+        """Add one frame [counts] to a patch's stream (times [s]; ``device_time_us`` as
+        the device sent it [us])."""
+        self._writers[patch].append(
+            counts, device_time_s, sequence, host_time_s, device_time_us=device_time_us
+        )
+
+    def write_manifest(self, *, closed_cleanly: bool) -> None:
+        """Write the manifest as it stands (atomically)."""
+        write_manifest(
+            self.path,
+            {
+                "format": ROBOT_FORMAT,
+                "format_version": ROBOT_FORMAT_VERSION,
+                "skin": self.skin.name,
+                "description": self.description,
+                "streams": sorted(self._writers),
+                "devices": self.devices,
+                "closed_cleanly": closed_cleanly,
+            },
+        )
+
+    def _close_writers(self) -> None:
+        for writer in self._writers.values():
+            writer.close()
+
+    def close(self, devices: dict[str, dict[str, Any]] | None = None) -> None:
+        """Close every stream and write the final manifest (``devices``: the devices'
+        entries at the end: clock fits, statuses). Idempotent."""
+        if self.closed:
+            return
+        if devices is not None:
+            self.devices = {name: dict(entry) for name, entry in devices.items()}
+        self._close_writers()
+        self.write_manifest(closed_cleanly=True)
+        self.closed = True
+
+    def discard(self) -> None:
+        """Close and remove the recording (a capture that ended before any frame)."""
+        self._close_writers()
+        self.closed = True
+        shutil.rmtree(self.path, ignore_errors=True)
+
+    def __len__(self) -> int:
+        return sum(len(writer) for writer in self._writers.values())
+
+
+def aligned_times(path: str | Path, patch: str):
+    """A patch's frame times on the host clock, Unix time [s]: the device times mapped by
+    its device's clock fit in the manifest (``offset_s + device / (1 + drift_ppm 1e-6)``);
+    the host arrival times where the device sent no clock or has no fit.
+    """
+    import h5py
+    import numpy as np
+
+    content = read_manifest(path)
+    clock: dict = {}
+    for entry in content.get("devices", {}).values():
+        if patch in entry.get("patches", []):
+            clock = entry.get("clock") or {}
+    with h5py.File(stream_path(path, patch), "r") as h5:
+        device_us = np.asarray(h5["device_time_us"])
+        host = np.asarray(h5["host_time"])
+    if not clock or not len(device_us) or np.any(device_us < 0):
+        return host
+    return clock["offset_s"] + device_us * 1e-6 / (1.0 + clock["drift_ppm"] * 1e-6)
+
+
+# ---- /streaming writer (r7-capture) ----

@@ -49,3 +49,9 @@ __all__ = [
     "open_source",
     "record",
 ]
+
+# ---- several devices of a robot skin (r7-capture) ----
+from tactsense.stream.robot import RobotFrame, RobotSources
+
+__all__ += ["RobotFrame", "RobotSources"]
+# ---- /r7-capture ----
