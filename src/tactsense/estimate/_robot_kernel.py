@@ -276,8 +276,8 @@ def hand_block(
                     point[f, j, 0] = rc[f, j, 0] * param[P_ROW_PITCH]
                     point[f, j, 1] = rc[f, j, 1] * param[P_COL_PITCH]
                     point[f, j, 2] = 0.0
-                    a = min(max(int(round(rc[f, j, 0])), 0), rows - 1)
-                    b = min(max(int(round(rc[f, j, 1])), 0), cols - 1)
+                    a = min(max(np.int64(rc[f, j, 0] + 0.5), 0), rows - 1)
+                    b = min(max(np.int64(rc[f, j, 1] + 0.5), 0), cols - 1)
                     normal_at[f, j] = a * cols + b
         else:
             g0 = p_graph_offset[p]

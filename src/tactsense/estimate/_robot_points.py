@@ -20,6 +20,12 @@ def _find(final, a):
     return a
 
 
+@jit(inline="always")
+def _before(v0, a0, b0, v, a, b):
+    """Whether (v0, a0, b0) sorts before (v, a, b) in decreasing tuple order."""
+    return v0 < v or (v0 == v and (a0 < a or (a0 == a and b0 < b)))
+
+
 @jit(nogil=True)
 def points_labels(s, threshold, saddle, floor, nb_offset, neighbours, label):
     """Labels of one frame (the maximum each taxel climbs to, -1 below the threshold),
@@ -61,12 +67,7 @@ def points_labels(s, threshold, saddle, floor, nb_offset, neighbours, label):
             if j > i and parent[j] >= 0 and root[j] != root[i]:
                 v, a, b = min(s[i], s[j]), root[i], root[j]
                 t = m
-                while t > 0 and (
-                    e_v[t - 1] < v
-                    or (
-                        e_v[t - 1] == v and (e_a[t - 1] < a or (e_a[t - 1] == a and e_b[t - 1] < b))
-                    )
-                ):
+                while t > 0 and _before(e_v[t - 1], e_a[t - 1], e_b[t - 1], v, a, b):
                     e_v[t] = e_v[t - 1]
                     e_a[t] = e_a[t - 1]
                     e_b[t] = e_b[t - 1]
