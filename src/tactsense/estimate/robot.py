@@ -13,9 +13,10 @@ merger does, and the grasp's total in the base frame about the base origin.
 
 :func:`locate_robot_recording` runs it over a robot recording (each patch at its own
 rate: a hand frame at each frame of the fastest stream, each patch contributing its
-latest frame; its contacts written once per frame of its own, its wrench held until its
-next frame). :func:`locate_robot_reference` is the straightforward per-patch loop the
-fast path is checked against. Joint states: :mod:`._robot_joints`.
+latest frame; its contacts written once per frame of its own, at that frame's time, its
+wrench held until its next frame). :func:`locate_robot_reference` is the
+straightforward per-patch loop the fast path is checked against. Joint states:
+:mod:`._robot_joints`.
 """
 
 from __future__ import annotations
@@ -307,7 +308,7 @@ class HandLocator:
     def pack(self, frames: Mapping[str, np.ndarray]) -> np.ndarray:
         """Hand frames (n, T) [counts] from each patch's frames (n, rows, cols)."""
         first = np.asarray(frames[self.patch_names[0]])
-        n = 1 if first.ndim == 2 else len(first)
+        n = first.size // int(self._rows[0] * self._cols[0])
         out = np.empty((n, self.n_taxels))
         for p, name in enumerate(self.patch_names):
             size = int(self._rows[p] * self._cols[p])
@@ -328,7 +329,10 @@ class HandLocator:
         joints = np.asarray(joints, float).reshape(n, len(self.joint_names))
         return joints
 
-    def locate(self, counts, joints=None, *, fresh=None, time_s=None, first_frame: int = 0):
+    def locate(
+        self, counts, joints=None, *, fresh=None, time_s=None, patch_time_s=None,
+        first_frame: int = 0,
+    ):  # fmt: skip
         """Contacts and wrenches of hand frames.
 
         Parameters
@@ -341,6 +345,9 @@ class HandLocator:
             Which patches hold a new frame (default all).
         time_s : array (n,), optional
             Time of each hand frame [s] (default the frame index).
+        patch_time_s : array (n, P), optional
+            Time of each patch's frame in each hand frame [s] (a contact row's
+            ``time_s``; default the hand frame's).
         """
         counts = np.asarray(counts)
         if counts.ndim == 1:
@@ -374,14 +381,19 @@ class HandLocator:
                 wrench_total, contacts_link,
             )  # fmt: skip
         time_s = np.arange(first_frame, first_frame + n, dtype=float) if time_s is None else time_s
+        time_s = np.asarray(time_s, float)
+        frame, patch = out_i[:m, K.I_FRAME], out_i[:m, K.I_PATCH]
+        row_time = time_s[frame] if patch_time_s is None else np.asarray(patch_time_s)[frame, patch]
         return self._tables(out_i[:m], out_f[:m], wrench_link, wrench_total, contacts_link,
-                            np.asarray(time_s, float), first_frame)  # fmt: skip
+                            time_s, row_time, first_frame)  # fmt: skip
 
-    def _tables(self, out_i, out_f, wrench_link, wrench_total, contacts_link, time_s, first):
+    def _tables(
+        self, out_i, out_f, wrench_link, wrench_total, contacts_link, time_s, row_time, first
+    ):
         frame = out_i[:, K.I_FRAME]
         force = out_f[:, K.F_FORCE]
         contacts = {
-            "time_s": time_s[frame],
+            "time_s": row_time,
             "frame": frame + first,
             "patch": np.asarray(self.patch_names, dtype=object)[out_i[:, K.I_PATCH]],
             "link": np.asarray(self.links, dtype=object)[out_i[:, K.I_LINK]],
@@ -506,8 +518,14 @@ def locate_robot_recording(
             q = joints.at(times[lo:hi], locator.joint_names)
         else:
             q = locator.joint_array(fixed, hi - lo)
-        parts.append(locator.locate(counts, q, fresh=fresh[lo:hi], time_s=times[lo:hi],
-                                    first_frame=lo))  # fmt: skip
+        own_time = np.zeros((hi - lo, len(names)))
+        for p, name in enumerate(names):
+            if name in streams and len(streams[name].frames):
+                own_time[:, p] = np.asarray(streams[name].time_s)[np.maximum(index[lo:hi, p], 0)]
+        parts.append(
+            locator.locate(counts, q, fresh=fresh[lo:hi], time_s=times[lo:hi],
+                           patch_time_s=own_time, first_frame=lo)
+        )  # fmt: skip
         if progress is not None:
             progress(hi, n)
     if not parts:
