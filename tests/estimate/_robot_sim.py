@@ -39,3 +39,27 @@ def hand_frames(skin, n, seed=0, **options):
     """Per patch (frames, baseline, positions, forces) of ``n`` hand frames."""
     rng = np.random.default_rng(seed)
     return {p.name: patch_frames(p, n, rng, **options) for p in skin.patches}
+
+
+def write_pressed_recording(path, skin, *, frames: int = 30, period_s: float = 0.01, seed=0):
+    """A robot recording (folder) of ``skin``: every patch untouched for its first 5
+    frames, then its first patch pressed at the middle of its taxels by 1 N."""
+    from tactsense.io._layout import Recording
+    from tactsense.io.robot_recording import RobotRecording, write_robot_recording
+
+    rng = np.random.default_rng(seed)
+    streams = {}
+    for index, patch in enumerate(skin.patches):
+        force = np.zeros((frames, 1))
+        position = np.zeros((frames, 1, 2))
+        if index == 0:
+            force[5:] = 1.0
+            position[:] = np.asarray(patch.sensor.taxel_positions_mm())[:, :2].mean(axis=0)
+        counts = frames_from_contacts(patch.sensor, ContactBatch(position, force), rng=rng)
+        streams[patch.name] = Recording(
+            frames=counts.reshape(frames, *patch.sensor.shape),
+            time_s=np.arange(frames) * period_s,
+            sample_offset_s=np.zeros(patch.sensor.shape),
+            sensor=patch.sensor,
+        )
+    return write_robot_recording(path, RobotRecording(skin=skin, streams=streams))
