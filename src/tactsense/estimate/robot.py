@@ -299,11 +299,31 @@ class HandLocator:
         self._link_has_patch = np.isin(np.arange(n_links), self._link)
         self.reset()
         self.locate(np.tile(self._baseline, (1, 1)))  # compile (or load) now
+        self.reset()
 
     def reset(self) -> None:
-        """Forget the held wrenches (a jump in time)."""
+        """Forget the held wrenches and the last frames (a jump in time)."""
         self._held = np.zeros((len(self.patch_names), 6))
         self._held_count = np.zeros(len(self.patch_names), np.int64)
+        self._last = self._baseline.copy()
+        self._patch_index = {name: p for p, name in enumerate(self.patch_names)}
+
+    def update(self, patches: Mapping[str, np.ndarray], joints=None, *, time_s=None):
+        """Live: the contacts of the patches in ``patches`` (name -> (rows, cols) counts,
+        e.g. one device's frame), every other patch's wrench held; one compiled call.
+        Returns a :class:`RobotContacts` of one hand frame (the wrenches of every link)."""
+        fresh = np.zeros((1, len(self.patch_names)), np.bool_)
+        for name, frame in patches.items():
+            p = self._patch_index.get(name)
+            if p is None:
+                raise TactsenseInputError(f"{self.skin.name!r} has no patch {name!r}")
+            size = int(self._rows[p] * self._cols[p])
+            self._last[self._offset[p] : self._offset[p] + size] = np.ravel(frame)
+            fresh[0, p] = True
+        return self.locate(
+            self._last[np.newaxis], joints, fresh=fresh,
+            time_s=None if time_s is None else np.array([time_s], float),
+        )  # fmt: skip
 
     def pack(self, frames: Mapping[str, np.ndarray]) -> np.ndarray:
         """Hand frames (n, T) [counts] from each patch's frames (n, rows, cols)."""
