@@ -170,16 +170,116 @@ def measure(name, skin, n_frames, repeats=3):
     return best
 
 
+def live_skin(rate_hz: float = 250.0) -> RobotSkin:
+    """:func:`pads4000` read by four boards of five patches each (a finger's four pads and
+    one palm pad), every patch at ``rate_hz``."""
+    skin = pads4000()
+    patches = []
+    for patch in skin.patches:
+        board = patch.device if not patch.name.startswith("palm_") else None
+        if board is None:
+            board = f"board_{('thumb', 'index', 'middle', 'ring')[int(patch.name[-1])]}"
+        sensor = patch.sensor.replace(electronics__scan_rate_hz=rate_hz)
+        patches.append(dataclasses.replace(patch, sensor=sensor, device=board))
+    return dataclasses.replace(skin, patches=tuple(patches))
+
+
+def _serve_devices(streams, seed, connection) -> None:
+    """In a child process: the four boards' emulators on 127.0.0.1, their URLs sent back;
+    they stop when the parent says so."""
+    from tactsense.stream.robot_emulator import device_emulators, start_device_emulators
+
+    running = start_device_emulators(device_emulators(live_skin(), streams, seed=seed))
+    connection.send({device: r.url for device, r in running.items()})
+    connection.recv()
+    for device in running.values():
+        device.stop()
+
+
+def live(duration_s: float, straightforward_s: float) -> dict | None:
+    """Four emulated boards at 250 Hz (five patches each, 4,000 taxels in all) over TCP on
+    127.0.0.1 (r7-capture's emulators, in a child process as devices are, and its
+    RobotSources in this one): latency from a device frame's
+    last byte (its arrival) to its contacts and the hand's wrenches, HandLocator.update
+    per device frame; then the straightforward loop (LiveContacts per patch) the same way
+    for a shorter time."""
+    try:
+        from tactsense.stream.robot import RobotSources
+    except ImportError:
+        print("\nlive: needs tactsense.stream.robot (the r7-capture branch); skipped")
+        return None
+    skin = live_skin()
+    sim = hand_frames(skin, N_UNIQUE, seed=2)
+    streams = {k: v[0] for k, v in sim.items()}
+    baselines = {k: v[1] for k, v in sim.items()}
+    joints = {skin.movable_joints[1]: 0.4}
+    locator = HandLocator(skin, baselines)
+    print(f"\nlive: {len(skin.devices)} emulated devices x {len(skin.patches) // len(skin.devices)}"
+          f" patches at 250 Hz, {skin.n_taxels} taxels, TCP on 127.0.0.1, emulators in a "
+          "child process")  # fmt: skip
+    out = {}
+    for what, seconds in (("HandLocator.update", duration_s),
+                          ("LiveContacts per patch", straightforward_s)):  # fmt: skip
+        if seconds <= 0:
+            continue
+        import multiprocessing
+
+        context = multiprocessing.get_context("spawn")
+        here, there = context.Pipe()
+        child = context.Process(target=_serve_devices, args=(streams, 3, there), daemon=True)
+        child.start()
+        urls = here.recv()
+        per_patch = None
+        if what != "HandLocator.update":
+            per_patch = {p.name: LiveContacts(p.sensor, baseline=baselines[p.name],
+                                              drift_s=None) for p in skin.patches}  # fmt: skip
+        latency, n_frames = [], 0
+        try:
+            sources = RobotSources(skin, urls)
+            with sources:
+                for frame in sources.frames(duration_s=seconds):
+                    if per_patch is None:
+                        locator.update(frame.patches, joints)
+                    else:
+                        for name, counts in frame.patches.items():
+                            per_patch[name](StreamFrame(0, 0, 0.0, 0.0, frame.arrival, counts))
+                    latency.append(time.perf_counter() - frame.arrival)
+                    n_frames += 1
+                lost = sum(s.losses.lost for s in sources.status.values())
+        finally:
+            here.send("stop")
+            child.join(timeout=10)
+        value = np.array(latency[len(latency) // 10 :]) * 1e3  # the first tenth: warm-up
+        out[what] = (n_frames / seconds, np.median(value), np.percentile(value, 99),
+                     value.max(), lost)  # fmt: skip
+        p50, p99 = np.median(value), np.percentile(value, 99)
+        print(f"  {what}: {n_frames / seconds:,.0f} device frames/s handled; last byte to "
+              f"contacts median {p50:.2f} ms, p99 {p99:.2f} ms, max {value.max():.1f} ms "
+              f"(after the first tenth); {lost} frames lost")  # fmt: skip
+    return out
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("frames", nargs="?", type=int, default=20_000)
-    parser.add_argument("--skin", choices=("hand4", "pads4000", "both"), default="both")
+    parser.add_argument("--skin", choices=("hand4", "pads4000", "both", "none"), default="both")
+    parser.add_argument(
+        "--live-s", type=float, default=20.0, help="seconds of the live measurement (0: none)"
+    )
+    parser.add_argument(
+        "--live-reference-s",
+        type=float,
+        default=3.0,
+        help="seconds of the straightforward loop's live measurement",
+    )
     args = parser.parse_args()
     print(f"numpy {np.__version__}; {args.frames:,} hand frames; one core (no parallel loops)")
     if args.skin in ("hand4", "both"):
         measure("hand4", skin_preset("hand4"), args.frames)
     if args.skin in ("pads4000", "both"):
         measure("pads4000", pads4000(), args.frames)
+    if args.live_s > 0:
+        live(args.live_s, args.live_reference_s)
 
 
 if __name__ == "__main__":

@@ -185,7 +185,7 @@ def pad_patch(
             i += 1
 
 
-@jit(nogil=True)
+@jit()  # holds the GIL: a live loop's reader threads would keep it for a switch interval
 def hand_block(
     counts, fresh, q, parent, jtype, origin, axis, column,
     p_mode, p_offset, p_rows, p_cols, p_link, p_kernel, p_param, p_pose, p_graph_offset,
@@ -229,6 +229,12 @@ def hand_block(
         for f in range(n):
             if fresh[f, p]:
                 n_new += 1
+        if n_new == 0:  # nothing new: its last wrench held through the block
+            for f in range(n):
+                for c in range(6):
+                    patch_wrench[f, p, c] = held[p, c]
+                patch_contacts[f, p] = held_count[p]
+            continue
         which = np.empty(n_new, np.int64)
         signal = np.empty((n_new, rows, cols))
         rail = np.zeros((n_new, rows, cols), np.bool_)

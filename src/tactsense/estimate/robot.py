@@ -175,6 +175,10 @@ class HandLocator:
         self.patch_names = tuple(p.name for p in skin.patches)
         self.links = tuple(skin._order())
         self.joint_names = skin.movable_joints
+        self._joint_column = {name: j for j, name in enumerate(self.joint_names)}
+        movable = {j.name: j for j in skin.joints}
+        self._lower = np.array([movable[name].lower - 1e-9 for name in self.joint_names])
+        self._upper = np.array([movable[name].upper + 1e-9 for name in self.joint_names])
         link_index = {name: i for i, name in enumerate(self.links)}
         by_child = {j.child: j for j in skin.joints}
         n_links = len(self.links)
@@ -343,9 +347,17 @@ class HandLocator:
         if joints is None:
             return np.zeros((n, len(self.joint_names)))
         if isinstance(joints, Mapping):
-            self.skin.link_poses(joints)  # names, values and limits checked there
-            row = np.array([float(joints.get(name, 0.0)) for name in self.joint_names])
-            return np.tile(row, (n, 1))
+            known = self._joint_column
+            try:
+                row = np.zeros(len(self.joint_names))
+                for name, value in joints.items():
+                    row[known[name]] = value
+                ok = bool(np.all((row >= self._lower) & (row <= self._upper)))
+            except (KeyError, TypeError, ValueError):
+                ok = False
+            if not ok:
+                self.skin.link_poses(joints)  # raises what is wrong (names, values, limits)
+            return np.broadcast_to(row, (n, len(row)))
         joints = np.asarray(joints, float).reshape(n, len(self.joint_names))
         return joints
 
