@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from tactsense._validation import TactsenseInputError
 from tactsense.estimate.robot import (
     CONTACT_COLUMNS,
     WRENCH_COLUMNS,
@@ -268,3 +269,27 @@ def test_bad_joint_names_and_values_give_clear_errors():
         locator.locate(frame, {"j3": 0.5})
     with pytest.raises(RobotSkinError, match="outside its limits"):
         locator.locate(frame, {"j1": float("nan")})
+
+
+def test_update_takes_one_device_frame_and_holds_the_others():
+    """Live: a frame of the pad alone gives the pad's contacts (as a whole hand frame
+    would); a frame of the dome next leaves the pad's wrench on link2 as it was."""
+    skin = small_skin()
+    rng = np.random.default_rng(8)
+    baselines = rest_baselines(skin, rng)
+    locator = HandLocator(skin, baselines)
+    pad = skin.patch("pad")
+    counts = frames_from_contacts(pad.sensor, ContactBatch([[[12.0, 14.0]]], [[1.0]]), rng=rng)
+    first = locator.update({"pad": counts.reshape(pad.sensor.shape)}, {"j1": 0.2})
+    whole = HandLocator(skin, baselines).locate(
+        locator.pack({"pad": counts, "dome": baselines["dome"]}), {"j1": 0.2}
+    )
+    np.testing.assert_array_equal(first.contacts["x_base_mm"], whole.contacts["x_base_mm"])
+    np.testing.assert_array_equal(first.wrenches["force_z_n"], whole.wrenches["force_z_n"])
+    second = locator.update({"dome": baselines["dome"]}, {"j1": 0.2})
+    assert len(second.contacts["frame"]) == 0
+    link2 = list(second.wrenches["link"]).index("link2")
+    assert second.wrenches["contacts"][link2] == 1
+    assert second.wrenches["force_z_n"][link2] == first.wrenches["force_z_n"][link2] != 0.0
+    with pytest.raises(TactsenseInputError, match="no patch 'thumb'"):
+        locator.update({"thumb": counts})
