@@ -167,7 +167,14 @@ def measure(name, skin, n_frames, repeats=3):
     print(f"  against find_contacts per patch on {N_UNIQUE} hand frames: "
           f"{'the same' if same else 'DIFFERENT'} {len(theirs)} contacts; largest "
           f"difference {dx:.1e} mm in the base frame, {df:.1e} N")  # fmt: skip
-    return best
+    return {
+        "skin": name, "patches": len(skin.patches), "taxels": n_taxels,
+        "sensors": ", ".join(sorted({p.sensor.name for p in skin.patches})),
+        "block_rate": best, "contacts_per_frame": rows / n_frames, "one_rate": 1 / one.mean(),
+        "one_median_ms": np.median(one) * 1e3, "one_p99_ms": np.percentile(one, 99) * 1e3,
+        "reference_rate": reference_rate, "reference_frames": n_ref, "same": same,
+        "contacts": len(theirs), "dx_mm": dx, "df_n": df, "frames": n_frames,
+    }  # fmt: skip
 
 
 def live_skin(rate_hz: float = 250.0) -> RobotSkin:
@@ -250,9 +257,9 @@ def live(duration_s: float, straightforward_s: float) -> dict | None:
             here.send("stop")
             child.join(timeout=10)
         value = np.array(latency[len(latency) // 10 :]) * 1e3  # the first tenth: warm-up
-        out[what] = (n_frames / seconds, np.median(value), np.percentile(value, 99),
-                     value.max(), lost)  # fmt: skip
         p50, p99 = np.median(value), np.percentile(value, 99)
+        out[what] = {"rate": n_frames / seconds, "median_ms": p50, "p99_ms": p99,
+                     "max_ms": value.max(), "lost": lost, "seconds": seconds}  # fmt: skip
         print(f"  {what}: {n_frames / seconds:,.0f} device frames/s handled; last byte to "
               f"contacts median {p50:.2f} ms, p99 {p99:.2f} ms, max {value.max():.1f} ms "
               f"(after the first tenth); {lost} frames lost")  # fmt: skip
