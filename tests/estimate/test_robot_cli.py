@@ -50,3 +50,19 @@ def test_locate_csv_and_no_overwrite(run, tmp_path):
     assert pyarrow.csv.read_csv(wrenches).num_rows == 30 * 3  # link2, link3, total
     again = runner.invoke(app, args)
     assert again.exit_code == 2 and "exists" in again.output
+
+
+def test_a_folder_read_block_by_block_equals_the_recording_in_memory(run):
+    """Blocks of 7 hand frames read from the folder give the tables of the whole
+    recording in memory, column for column (the held wrench carried across blocks)."""
+    from tactsense.estimate.robot import locate_robot_recording
+    from tactsense.io.robot_recording import read_robot_recording
+
+    joints = {"j1": 0.3}
+    streamed = locate_robot_recording(run, joints=joints, block_frames=7)
+    whole = locate_robot_recording(read_robot_recording(run), joints=joints)
+    for table in ("contacts", "wrenches"):
+        a, b = getattr(streamed, table), getattr(whole, table)
+        assert a.keys() == b.keys()
+        for key in a:
+            np.testing.assert_array_equal(a[key], b[key], err_msg=key)

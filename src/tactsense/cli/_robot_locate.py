@@ -65,15 +65,28 @@ def _joint_source(skin, joints, joints_csv, joints_bag, joints_topic):
     return states
 
 
-def _write(table, path: Path) -> None:
-    if path.suffix.lower() == ".csv":
-        import pyarrow.csv
+class _TableWriter:
+    """A table written block by block: Parquet or CSV by the extension."""
 
-        pyarrow.csv.write_csv(table, path)
-    else:
-        import pyarrow.parquet
+    def __init__(self, path: Path):
+        self.path = path
+        self._writer = None
 
-        pyarrow.parquet.write_table(table, path)
+    def write(self, table) -> None:
+        if self._writer is None:
+            if self.path.suffix.lower() == ".csv":
+                import pyarrow.csv
+
+                self._writer = pyarrow.csv.CSVWriter(self.path, table.schema)
+            else:
+                import pyarrow.parquet
+
+                self._writer = pyarrow.parquet.ParquetWriter(self.path, table.schema)
+        self._writer.write_table(table)
+
+    def close(self) -> None:
+        if self._writer is not None:
+            self._writer.close()
 
 
 def run_robot_locate(
@@ -93,8 +106,8 @@ def run_robot_locate(
     single_array_options: dict,
 ) -> None:
     """Locate a robot recording's contacts and write the contacts and wrench tables."""
-    from tactsense.estimate.robot import locate_robot_recording
-    from tactsense.io.robot_recording import read_robot_recording
+    from tactsense.estimate.robot import iter_robot_blocks
+    from tactsense.io.robot_recording import read_robot_skin
 
     try:
         unused = [name for name, value in single_array_options.items() if value]
@@ -119,27 +132,39 @@ def run_robot_locate(
             check_output(path, force, what=what, inputs=[recording])
         if Path(wrenches).resolve() == Path(out).resolve():
             raise TactsenseInputError("--wrenches names the same file as --out")
-        data = read_robot_recording(recording)
-        source = _joint_source(data.skin, joints, joints_csv, joints_bag, joints_topic)
-        with progress_bar("locating the hand", unit="hand frames", quiet=quiet) as bar:
+        skin = read_robot_skin(recording)
+        source = _joint_source(skin, joints, joints_csv, joints_bag, joints_topic)
+        warnings: list[str] = []
+        rows, frames, patches, links = 0, 0, set(), set()
+        with (
+            progress_bar("locating the hand", unit="hand frames", quiet=quiet) as bar,
+            atomic_output(out) as temporary_contacts,
+            atomic_output(wrenches) as temporary_wrenches,
+        ):
             task = bar.add_task("frames", total=None)
-            result = locate_robot_recording(
-                data, joints=source, baseline_frames=baseline_frames, threshold=threshold,
-                max_contacts=max_contacts,
-                progress=lambda done, total: bar.update(task, completed=done, total=total),
-            )  # fmt: skip
-        with atomic_output(out) as temporary_contacts, atomic_output(wrenches) as temporary:
-            _write(result.contacts_table(), temporary_contacts)
-            _write(result.wrenches_table(), temporary)
+            writers = (_TableWriter(temporary_contacts), _TableWriter(temporary_wrenches))
+            try:
+                for part in iter_robot_blocks(
+                    recording, joints=source, baseline_frames=baseline_frames,
+                    threshold=threshold, max_contacts=max_contacts, warnings=warnings,
+                    progress=lambda done, total: bar.update(task, completed=done, total=total),
+                ):  # fmt: skip
+                    writers[0].write(part.contacts_table())
+                    writers[1].write(part.wrenches_table())
+                    rows += len(part.contacts["frame"])
+                    frames += part.n_frames
+                    patches.update(part.contacts["patch"])
+                    links.update(part.contacts["link"])
+            finally:
+                for writer in writers:
+                    writer.close()
     except (TactsenseInputError, FileExistsError) as error:
         fail(str(error))
-    contacts = result.contacts
-    links = sorted(set(contacts["link"]))
     console.print(
-        f"wrote {out}: {len(contacts['frame'])} contact rows over {result.n_frames} hand "
-        f"frames, {len(set(contacts['patch']))} of {len(data.skin.patches)} patches touched, "
-        f"on links {', '.join(links) or '(none)'}; wrenches in {wrenches}",
+        f"wrote {out}: {rows} contact rows over {frames} hand frames, {len(patches)} of "
+        f"{len(skin.patches)} patches touched, on links {', '.join(sorted(links)) or '(none)'}"
+        f"; wrenches in {wrenches}",
         soft_wrap=True, markup=False, highlight=False, emoji=False,
     )  # fmt: skip
-    for line in result.warnings:
+    for line in warnings:
         console.print(f"warning: {line}", soft_wrap=True, markup=False, highlight=False)

@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -31,110 +30,15 @@ from tactsense._signals import deferred_interrupts
 from tactsense._validation import TactsenseInputError
 from tactsense.estimate import _robot_kernel as K
 from tactsense.estimate._robot_joints import JointStates
+from tactsense.estimate._robot_params import (
+    _pad_parameters,
+    _points_parameters,
+    locate_robot_reference,
+)
+from tactsense.estimate._robot_tables import CONTACT_COLUMNS, WRENCH_COLUMNS, RobotContacts
 from tactsense.estimate.results import Flag
 from tactsense.kinds import kind_of
 from tactsense.robot import RobotSkin
-
-CONTACT_COLUMNS = (
-    "time_s", "frame", "patch", "link", "contact", "x_mm", "y_mm", "z_mm",
-    "x_link_mm", "y_link_mm", "z_link_mm", "nx_link", "ny_link", "nz_link",
-    "x_base_mm", "y_base_mm", "z_base_mm", "nx_base", "ny_base", "nz_base",
-    "force_n", "fx_link_n", "fy_link_n", "fz_link_n", "fx_base_n", "fy_base_n", "fz_base_n",
-    "row", "col", "peak", "taxels", "flags",
-)  # fmt: skip
-"""Columns of the long table of contacts: the time and hand frame, the patch, its link,
-the contact's rank in its patch's frame (0: the largest summed signal); its point in the
-sensor's frame (``x_mm``...; a pad's ``row``/``col`` [taxel]), in the link's frame and in
-the base frame [mm] with the unit outward normal there; its normal force [N] and force
-vector (``-force_n * normal``) in both frames [N]; interpolated peak signal [-], taxels
-and flags (:class:`~tactsense.estimate.results.Flag`)."""
-
-WRENCH_COLUMNS = (
-    "time_s", "frame", "link", "what", "contacts", "force_x_n", "force_y_n", "force_z_n",
-    "torque_x_n_mm", "torque_y_n_mm", "torque_z_n_mm",
-)  # fmt: skip
-"""Columns of the wrench table: per hand frame one row per link holding patches
-(``what = "link"``: in the link's frame, torque about the link's origin) and one for the
-grasp (``what = "total"``, ``link`` the base link: in the base frame about its origin);
-``contacts`` the contacts held; force [N], torque [N mm]."""
-
-
-@dataclass
-class RobotContacts:
-    """The long table of contacts and the wrench table of some hand frames (columns as
-    :data:`CONTACT_COLUMNS` and :data:`WRENCH_COLUMNS`, NumPy arrays)."""
-
-    contacts: dict[str, np.ndarray]
-    wrenches: dict[str, np.ndarray]
-    n_frames: int = 0
-    warnings: list[str] = field(default_factory=list)
-
-    def contacts_table(self):
-        """The contacts as a :class:`pyarrow.Table`."""
-        return _arrow(self.contacts)
-
-    def wrenches_table(self):
-        """The wrenches as a :class:`pyarrow.Table`."""
-        return _arrow(self.wrenches)
-
-    @classmethod
-    def concatenate(cls, parts) -> RobotContacts:
-        parts = list(parts)
-        join = lambda what: {  # noqa: E731
-            key: np.concatenate([getattr(p, what)[key] for p in parts])
-            for key in getattr(parts[0], what)
-        }
-        return cls(join("contacts"), join("wrenches"), sum(p.n_frames for p in parts))
-
-
-def _arrow(columns):
-    import pyarrow as pa
-
-    return pa.table({key: pa.array(value) for key, value in columns.items()})
-
-
-def _pad_parameters(sensor, threshold: float) -> tuple[np.ndarray, tuple]:
-    from tactsense.estimate.contacts.pad import (
-        FIT_STEPS,
-        _kernel_max,
-        _kernel_total,
-        pad_force_kernel,
-        point_reach,
-        point_taxels,
-    )
-    from tactsense.estimate.contacts.segment import RING_RATIO, SADDLE_RATIO, WEAK_SHARE, dip_floor
-    from tactsense.estimate.reading import signal_noise_variance
-
-    noise_var = signal_noise_variance(sensor)
-    resistive = sensor.transduction.kind != "capacitive"
-    param = np.zeros(K.N_PARAM)
-    param[K.P_THRESHOLD] = threshold
-    param[K.P_SADDLE] = SADDLE_RATIO
-    param[K.P_FLOOR] = dip_floor(sensor, threshold)
-    param[K.P_RING] = RING_RATIO
-    param[K.P_WEAK] = WEAK_SHARE * threshold
-    param[K.P_FAR] = point_reach(sensor)
-    param[K.P_COVER] = point_taxels(sensor)
-    param[K.P_NOISE_VAR] = noise_var
-    param[K.P_MERGE_FLOOR] = 3.0 * math.sqrt(noise_var) if resistive else -math.inf
-    param[K.P_KERNEL_TOTAL] = _kernel_total(sensor)
-    param[K.P_ROW_PITCH] = sensor.grid.row_pitch_mm
-    param[K.P_COL_PITCH] = sensor.grid.col_pitch_mm
-    amp, amp_step, _ = pad_force_kernel(sensor)
-    sig, sig_step, _ = pad_force_kernel(sensor, FIT_STEPS, signed=True)
-    return param, (amp, amp_step, sig, sig_step, _kernel_max(sensor))
-
-
-def _points_parameters(sensor, threshold: float):
-    from tactsense.estimate.contacts.points import _points_geometry, points_force_kernel
-    from tactsense.estimate.contacts.segment import SADDLE_RATIO, dip_floor
-
-    param = np.zeros(K.N_PARAM)
-    param[K.P_THRESHOLD] = threshold
-    param[K.P_SADDLE] = SADDLE_RATIO
-    param[K.P_FLOOR] = dip_floor(sensor, threshold)
-    positions, _, neighbours = _points_geometry(sensor)
-    return param, positions, neighbours, np.asarray(points_force_kernel(sensor), float)
 
 
 class HandLocator:
@@ -491,7 +395,58 @@ def hand_frame_grid(streams_time_s: Mapping[str, np.ndarray], patch_names) -> tu
     return times, index, fresh
 
 
-def locate_robot_recording(
+class _Streams:
+    """Each patch's frame times [s] and frames, from a robot recording in memory
+    (:class:`~tactsense.io.robot_recording.RobotRecording`) or its folder (read block by
+    block: only the times are read whole)."""
+
+    def __init__(self, source):
+        from tactsense.io.robot_recording import RobotRecording
+
+        self._readers: dict = {}
+        self.times: dict[str, np.ndarray] = {}
+        if isinstance(source, RobotRecording):
+            self.skin = source.skin
+            self._memory = {k: v for k, v in source.streams.items() if len(v.frames)}
+            self.times = {k: np.asarray(v.time_s, float) for k, v in self._memory.items()}
+            return
+        from tactsense.io import robot_recording as layout
+        from tactsense.io.recording import RecordingReader
+
+        self._memory = {}
+        self.skin = layout.read_robot_skin(source)
+        content = layout.read_manifest(source)
+        clocks = [d.get("clock") for d in content.get("devices", {}).values()]
+        aligned = getattr(layout, "aligned_times", None)  # a capture's host-aligned times
+        use_aligned = aligned is not None and clocks and all(clocks)
+        try:
+            for name in content.get("streams", []):
+                self.skin.patch(name)
+                path = layout.stream_path(source, name)
+                if not path.exists():
+                    continue
+                reader = RecordingReader(path)
+                self._readers[name] = reader
+                if reader.n_frames == 0:
+                    continue
+                times = aligned(source, name) if use_aligned else reader.time_s(0, reader.n_frames)
+                self.times[name] = np.asarray(times, float)
+        except BaseException:
+            self.close()
+            raise
+
+    def frames(self, name: str, start: int, stop: int) -> np.ndarray:
+        if name in self._memory:
+            return np.asarray(self._memory[name].frames[start:stop])
+        return np.asarray(self._readers[name].frames(start, stop))
+
+    def close(self) -> None:
+        for reader in self._readers.values():
+            reader.close()
+        self._readers = {}
+
+
+def iter_robot_blocks(
     recording,
     *,
     joints: JointStates | Mapping[str, float] | None = None,
@@ -500,103 +455,94 @@ def locate_robot_recording(
     max_contacts: int = 8,
     block_frames: int = 4096,
     progress: Callable[[int, int], None] | None = None,
-) -> RobotContacts:
-    """Contacts and wrenches of a whole robot recording
-    (:class:`~tactsense.io.robot_recording.RobotRecording`).
-
-    Each patch's baseline is the median of its stream's first ``baseline_frames`` frames
-    (untouched). ``joints``: a fixed pose (joint name -> position [rad or m]), a
-    :class:`JointStates` interpolated to the hand frames' times, or None (all at 0).
-    """
+    warnings: list[str] | None = None,
+):
+    """:func:`locate_robot_recording` block by block: yields a :class:`RobotContacts` per
+    ``block_frames`` hand frames (memory bounded by the block, whatever the length; a
+    folder's frames are read a block at a time)."""
     if not (isinstance(baseline_frames, int) and baseline_frames >= 1):
         raise TactsenseInputError(
             f"baseline_frames must be a positive integer; got {baseline_frames!r}"
         )
-    skin = recording.skin
-    names = [p.name for p in skin.patches]
-    streams = recording.streams
-    baselines = {}
-    for patch in skin.patches:
-        stream = streams.get(patch.name)
-        if stream is None or len(stream.frames) == 0:
-            baselines[patch.name] = np.full(patch.sensor.shape, np.nan)
-            continue
-        baselines[patch.name] = np.nanmedian(
-            np.asarray(stream.frames[:baseline_frames], float), axis=0
-        )
-    locator = HandLocator(skin, baselines, threshold=threshold, max_contacts=max_contacts)
-    times, index, fresh = hand_frame_grid(
-        {name: s.time_s for name, s in streams.items() if len(s.frames)}, names
-    )
-    fixed = None if isinstance(joints, JointStates) else joints
-    if fixed is not None:
-        skin.link_poses(fixed)
-    parts = []
-    n = len(times)
-    for lo in range(0, n, block_frames):
-        hi = min(lo + block_frames, n)
-        counts = np.empty((hi - lo, locator.n_taxels))
-        for p, name in enumerate(names):
-            off = locator._offset[p]
-            size = skin.patches[p].n_taxels
-            if name not in streams or not len(streams[name].frames):
-                counts[:, off : off + size] = locator._baseline[off : off + size]
+    if not (isinstance(block_frames, int) and block_frames >= 1):
+        raise TactsenseInputError(f"block_frames must be a positive integer; got {block_frames!r}")
+    streams = _Streams(recording)
+    try:
+        skin = streams.skin
+        names = [p.name for p in skin.patches]
+        baselines = {}
+        for patch in skin.patches:
+            if patch.name not in streams.times:
+                baselines[patch.name] = np.full(patch.sensor.shape, np.nan)
+                if warnings is not None:
+                    warnings.append(f"patch {patch.name!r} has no frames: no contacts from it")
                 continue
-            rows = np.maximum(index[lo:hi, p], 0)
-            counts[:, off : off + size] = np.asarray(streams[name].frames[rows], float).reshape(
-                hi - lo, size
-            )
-        if isinstance(joints, JointStates):
-            q = joints.at(times[lo:hi], locator.joint_names)
-        else:
-            q = locator.joint_array(fixed, hi - lo)
-        own_time = np.zeros((hi - lo, len(names)))
-        for p, name in enumerate(names):
-            if name in streams and len(streams[name].frames):
-                own_time[:, p] = np.asarray(streams[name].time_s)[np.maximum(index[lo:hi, p], 0)]
-        parts.append(
-            locator.locate(counts, q, fresh=fresh[lo:hi], time_s=times[lo:hi],
-                           patch_time_s=own_time, first_frame=lo)
-        )  # fmt: skip
-        if progress is not None:
-            progress(hi, n)
+            first = streams.frames(patch.name, 0, baseline_frames).astype(float)
+            baselines[patch.name] = np.nanmedian(first, axis=0)
+        locator = HandLocator(skin, baselines, threshold=threshold, max_contacts=max_contacts)
+        if isinstance(joints, Mapping):
+            locator.joint_array(joints, 1)
+        present = [name for name in names if name in streams.times]
+        if not present:
+            raise TactsenseInputError("the recording holds no frames of the skin's patches")
+        lead = max(present, key=lambda name: len(streams.times[name]))
+        times = streams.times[lead]
+        n = len(times)
+        previous = np.full(len(names), -1, np.int64)
+        for lo in range(0, n, block_frames):
+            hi = min(lo + block_frames, n)
+            block_times = times[lo:hi]
+            counts = np.empty((hi - lo, locator.n_taxels))
+            own_time = np.zeros((hi - lo, len(names)))
+            fresh = np.zeros((hi - lo, len(names)), np.bool_)
+            for p, name in enumerate(names):
+                off = locator._offset[p]
+                size = skin.patches[p].n_taxels
+                if name not in streams.times:
+                    counts[:, off : off + size] = locator._baseline[off : off + size]
+                    continue
+                own = streams.times[name]
+                index = np.searchsorted(own, block_times, side="right") - 1
+                before = np.concatenate([[previous[p]], index[:-1]])
+                fresh[:, p] = (index >= 0) & (index != before)
+                previous[p] = index[-1]
+                rows = np.maximum(index, 0)
+                low, high = int(rows.min()), int(rows.max()) + 1
+                frames = streams.frames(name, low, high).reshape(high - low, size)
+                counts[:, off : off + size] = frames[rows - low]
+                own_time[:, p] = own[rows]
+            if isinstance(joints, JointStates):
+                q = joints.at(block_times, locator.joint_names)
+            else:
+                q = locator.joint_array(joints, hi - lo)
+            yield locator.locate(counts, q, fresh=fresh, time_s=block_times,
+                                 patch_time_s=own_time, first_frame=lo)  # fmt: skip
+            if progress is not None:
+                progress(hi, n)
+        if isinstance(joints, JointStates) and warnings is not None:
+            warnings.extend(joints.coverage_warnings(times))
+    finally:
+        streams.close()
+
+
+def locate_robot_recording(recording, **options) -> RobotContacts:
+    """Contacts and wrenches of a whole robot recording, in memory
+    (:class:`~tactsense.io.robot_recording.RobotRecording`) or its folder.
+
+    Each patch's baseline is the median of its stream's first ``baseline_frames`` frames
+    (untouched). ``joints``: a fixed pose (joint name -> position [rad or m]), a
+    :class:`JointStates` interpolated to the hand frames' times, or None (all at 0).
+    Times: the streams' ``time_s`` [s] (a captured folder whose devices all have a clock
+    fit: their frames' times on the host clock, Unix time). Options as
+    :func:`iter_robot_blocks`.
+    """
+    warnings: list[str] = []
+    parts = list(iter_robot_blocks(recording, warnings=warnings, **options))
     if not parts:
-        parts.append(locator.locate(np.empty((0, locator.n_taxels))))
+        raise TactsenseInputError("the recording holds no frames of the skin's patches")
     result = RobotContacts.concatenate(parts)
-    if isinstance(joints, JointStates):
-        result.warnings.extend(joints.coverage_warnings(times))
+    result.warnings.extend(warnings)
     return result
-
-
-def locate_robot_reference(skin: RobotSkin, frames, baselines, *, joints=None, threshold=None):
-    """The straightforward path: :func:`~tactsense.estimate.contacts.find_contacts` on
-    each patch's frames (n, rows, cols), each contact placed with
-    :meth:`~tactsense.robot.RobotSkin.link_poses` (a fixed pose) and the patch's origin;
-    the same contact columns as :meth:`HandLocator.locate` (without the wrenches)."""
-    from tactsense.estimate.contacts import default_threshold, find_contacts
-
-    poses = skin.link_poses(joints)
-    rows = {key: [] for key in ("frame", "patch", "link", "contact", "sensor", "link_xyz",
-                                "base_xyz", "force_n")}  # fmt: skip
-    for patch in skin.patches:
-        value = threshold if threshold is not None else default_threshold(patch.sensor)
-        table = find_contacts(
-            frames[patch.name], patch.sensor, baseline=baselines[patch.name], threshold=value
-        )
-        point = np.column_stack([table.x_mm, table.y_mm, table.z_mm])
-        origin = patch.origin.matrix()
-        in_link = point @ origin[:3, :3].T + 1e3 * origin[:3, 3]
-        pose = poses[patch.link]
-        in_base = in_link @ pose[:3, :3].T + 1e3 * pose[:3, 3]
-        rows["frame"].append(table.frame)
-        rows["patch"].append(np.full(len(table.frame), patch.name, dtype=object))
-        rows["link"].append(np.full(len(table.frame), patch.link, dtype=object))
-        rows["contact"].append(table.contact)
-        rows["sensor"].append(point)
-        rows["link_xyz"].append(in_link)
-        rows["base_xyz"].append(in_base)
-        rows["force_n"].append(table.force_n)
-    return {key: np.concatenate(value) for key, value in rows.items()}
 
 
 __all__ = [
@@ -606,6 +552,7 @@ __all__ = [
     "JointStates",
     "RobotContacts",
     "hand_frame_grid",
+    "iter_robot_blocks",
     "locate_robot_recording",
     "locate_robot_reference",
 ]
