@@ -245,8 +245,9 @@ def live(duration_s: float, straightforward_s: float) -> dict | None:
             sources = RobotSources(skin, urls)
             with sources:
                 for frame in sources.frames(duration_s=seconds):
-                    if per_patch is None:
-                        locator.update(frame.patches, joints)
+                    if per_patch is None:  # the grasp's wrench read; named tables on demand
+                        grasp = locator.update(frame.patches, joints).total[-1]
+                        assert grasp.shape == (6,)
                     else:
                         for name, counts in frame.patches.items():
                             per_patch[name](StreamFrame(0, 0, 0.0, 0.0, frame.arrival, counts))

@@ -3,8 +3,6 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 import numpy as np
 
 CONTACT_COLUMNS = (
@@ -31,15 +29,46 @@ grasp (``what = "total"``, ``link`` the base link: in the base frame about its o
 ``contacts`` the contacts held; force [N], torque [N mm]."""
 
 
-@dataclass
 class RobotContacts:
     """The long table of contacts and the wrench table of some hand frames (columns as
-    :data:`CONTACT_COLUMNS` and :data:`WRENCH_COLUMNS`, NumPy arrays)."""
+    :data:`CONTACT_COLUMNS` and :data:`WRENCH_COLUMNS`, NumPy arrays), built when first
+    asked for (a live loop that reads only :attr:`total` does not pay for them).
 
-    contacts: dict[str, np.ndarray]
-    wrenches: dict[str, np.ndarray]
-    n_frames: int = 0
-    warnings: list[str] = field(default_factory=list)
+    Attributes
+    ----------
+    n_frames : int
+        Hand frames covered.
+    total : ndarray (n_frames, 6) or None
+        The grasp's total wrench per hand frame, in the base frame about its origin:
+        force [N], torque [N mm].
+    n_contacts : int
+        Contact rows.
+    """
+
+    def __init__(self, contacts=None, wrenches=None, n_frames: int = 0, warnings=None, *,
+                 build=None, total=None, n_contacts: int | None = None):  # fmt: skip
+        self._contacts = contacts
+        self._wrenches = wrenches
+        self._build = build
+        self.n_frames = int(n_frames)
+        self.warnings: list[str] = list(warnings or [])
+        self.total = total
+        self.n_contacts = len(contacts["frame"]) if n_contacts is None else int(n_contacts)
+
+    def _materialize(self) -> None:
+        if self._build is not None:
+            self._contacts, self._wrenches = self._build()
+            self._build = None
+
+    @property
+    def contacts(self) -> dict[str, np.ndarray]:
+        self._materialize()
+        return self._contacts
+
+    @property
+    def wrenches(self) -> dict[str, np.ndarray]:
+        self._materialize()
+        return self._wrenches
 
     def contacts_table(self):
         """The contacts as a :class:`pyarrow.Table`."""
@@ -56,7 +85,10 @@ class RobotContacts:
             key: np.concatenate([getattr(p, what)[key] for p in parts])
             for key in getattr(parts[0], what)
         }
-        return cls(join("contacts"), join("wrenches"), sum(p.n_frames for p in parts))
+        totals = [p.total for p in parts]
+        total = np.concatenate(totals) if all(t is not None for t in totals) else None
+        return cls(join("contacts"), join("wrenches"), sum(p.n_frames for p in parts),
+                   total=total)  # fmt: skip
 
 
 def _arrow(columns):

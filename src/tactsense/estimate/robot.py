@@ -320,8 +320,11 @@ class HandLocator:
         time_s = np.asarray(time_s, float)
         frame, patch = out_i[:m, K.I_FRAME], out_i[:m, K.I_PATCH]
         row_time = time_s[frame] if patch_time_s is None else np.asarray(patch_time_s)[frame, patch]
-        return self._tables(out_i[:m], out_f[:m], wrench_link, wrench_total, contacts_link,
-                            time_s, row_time, first_frame)  # fmt: skip
+        return RobotContacts(
+            n_frames=n, total=wrench_total, n_contacts=m,
+            build=lambda: self._tables(out_i[:m], out_f[:m], wrench_link, wrench_total,
+                                       contacts_link, time_s, row_time, first_frame),
+        )  # fmt: skip
 
     def _tables(
         self, out_i, out_f, wrench_link, wrench_total, contacts_link, time_s, row_time, first
@@ -373,7 +376,7 @@ class HandLocator:
         for c, name in enumerate(("force_x_n", "force_y_n", "force_z_n", "torque_x_n_mm",
                                   "torque_y_n_mm", "torque_z_n_mm")):  # fmt: skip
             wrenches[name] = w[:, :, c].ravel()
-        return RobotContacts(contacts, wrenches, n)
+        return contacts, wrenches
 
 
 def hand_frame_grid(streams_time_s: Mapping[str, np.ndarray], patch_names) -> tuple:
