@@ -143,3 +143,41 @@ def test_recording_follows_the_joint_csv(tmp_path):
         expected = (pose[:3, :3] @ sensor + pose[:3, 3]) * 1e3
         got = np.array([c[f"{a}_base_mm"][k] for a in "xyz"])
         np.testing.assert_allclose(got, expected, atol=1e-9)
+
+
+JOINT_STATE_MSGDEF = """std_msgs/Header header
+string[] name
+float64[] position
+float64[] velocity
+float64[] effort
+================================================================================
+MSG: std_msgs/Header
+builtin_interfaces/Time stamp
+string frame_id
+================================================================================
+MSG: builtin_interfaces/Time
+int32 sec
+uint32 nanosec
+"""  # sensor_msgs/msg/JointState as ROS 2 defines it, with its dependencies
+
+
+def test_joint_topic_of_a_plain_mcap_file(tmp_path):
+    """A bare MCAP file (no rosbag2 metadata) written with mcap_ros2's writer; the stamp
+    of zero takes the log time."""
+    from mcap_ros2.writer import Writer
+
+    path = tmp_path / "joints.mcap"
+    with open(path, "wb") as stream:
+        writer = Writer(stream)
+        schema = writer.register_msgdef("sensor_msgs/msg/JointState", JOINT_STATE_MSGDEF)
+        for sec, log_ns, position in ((3, 0, 0.25), (0, 4_500_000_000, 0.75)):
+            header = {"stamp": {"sec": sec, "nanosec": 0}, "frame_id": ""}
+            message = {"header": header, "name": ["j1"], "position": [position],
+                       "velocity": [], "effort": []}  # fmt: skip
+            writer.write_message("/joint_states", schema, message, log_time=log_ns)
+        writer.finish()
+    states = read_joint_bag(path)
+    np.testing.assert_allclose(states.series["j1"][0], [3.0, 4.5])
+    np.testing.assert_allclose(states.at([3.75], ["j1"]), [[0.5]])
+    with pytest.raises(JointStateError, match="no JointState topic '/x'"):
+        read_joint_bag(path, "/x")

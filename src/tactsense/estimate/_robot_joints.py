@@ -1,7 +1,7 @@
 """Joint states for the hand's estimator: a fixed pose (``name=rad,...``), a CSV
 (``time_s`` and one column per joint) or a ``sensor_msgs/JointState`` topic of a
-rosbag2 bag (sqlite3 or MCAP storage, read with rosbags), each joint interpolated
-linearly to the hand frames' times (held at its first or last value outside its
+rosbag2 bag (sqlite3 or MCAP storage, read with rosbags) or of a plain MCAP file, each
+joint interpolated linearly to the hand frames' times (held at its first or last value outside its
 samples, with a warning).
 
 Times are on the recording's clock (its streams' ``time_s`` [s]); a bag's messages are
@@ -159,9 +159,82 @@ def read_joint_csv(path: str | Path) -> JointStates:
     )
 
 
+JOINT_STATE = "sensor_msgs/msg/JointState"
+
+
+def _add_sample(samples, when: float, names, positions) -> None:
+    for name, position in zip(names, positions, strict=False):
+        times, values = samples.setdefault(str(name), ([], []))
+        if times and when <= times[-1]:
+            continue  # a repeated or late stamp: the first sample at a time wins
+        times.append(when)
+        values.append(float(position))
+
+
+def _choose(path, found, topic):
+    if topic is None and len(found) != 1:
+        raise JointStateError(
+            f"{path}: {len(found)} JointState topics ({', '.join(found) or 'none'}); "
+            "name one with --joints-topic"
+        )
+    chosen = topic or found[0]
+    if chosen not in found:
+        raise JointStateError(
+            f"{path}: no JointState topic {chosen!r}; its JointState topics: "
+            f"{', '.join(found) or 'none'}"
+        )
+    return chosen
+
+
+def _read_joint_mcap(path: Path, topic: str | None) -> JointStates:
+    """A plain MCAP file's JointState topic (mcap's reader, the ros2 decoder)."""
+    try:
+        from mcap.exceptions import McapError
+        from mcap.reader import make_reader
+        from mcap_ros2.decoder import DecoderFactory
+    except ImportError:
+        raise JointStateError(
+            'MCAP files need the mcap extra: pip install "tactsense[mcap]"'
+        ) from None
+    samples: dict[str, tuple[list, list]] = {}
+    try:
+        with open(path, "rb") as stream:
+            reader = make_reader(stream, decoder_factories=[DecoderFactory()])
+            summary = reader.get_summary()
+            if summary is None:
+                raise JointStateError(f"{path}: the MCAP file has no summary; 'mcap recover' it")
+            found = sorted(
+                ch.topic for ch in summary.channels.values()
+                if ch.schema_id in summary.schemas
+                and summary.schemas[ch.schema_id].name == JOINT_STATE
+            )  # fmt: skip
+            chosen = _choose(path, found, topic)
+            for _, _, message, ros in reader.iter_decoded_messages(topics=[chosen]):
+                stamp = ros.header.stamp.sec + ros.header.stamp.nanosec * 1e-9
+                _add_sample(samples, stamp if stamp > 0 else message.log_time * 1e-9,
+                            ros.name, ros.position)  # fmt: skip
+    except (McapError, ValueError, KeyError, EOFError, OSError) as error:
+        raise JointStateError(f"{path} is not a readable MCAP file ({error})") from None
+    return JointStates(
+        {name: (np.array(t), np.array(v)) for name, (t, v) in samples.items()},
+        source=f"{path} ({chosen})",
+    )
+
+
 def read_joint_bag(path: str | Path, topic: str | None = None) -> JointStates:
     """The ``sensor_msgs/msg/JointState`` messages of a rosbag2 bag (a folder with its
-    metadata.yaml, or one of its files), on ``topic`` or the only such topic."""
+    metadata.yaml, or one of its files; rosbags) or of a plain MCAP file (mcap's reader),
+    on ``topic`` or the only such topic."""
+    path = Path(path)
+    bag = path.parent if path.is_file() else path
+    if path.is_file() and not (bag / "metadata.yaml").is_file():
+        with open(path, "rb") as stream:
+            if stream.read(8) == b"\x89MCAP0\r\n":
+                return _read_joint_mcap(path, topic)
+    if not (bag / "metadata.yaml").is_file():
+        raise JointStateError(
+            f"{path}: not a rosbag2 bag (no metadata.yaml in {bag}) nor an MCAP file"
+        )
     try:
         from rosbags.highlevel import AnyReader, AnyReaderError
         from rosbags.typesys import Stores, get_typestore
@@ -169,39 +242,19 @@ def read_joint_bag(path: str | Path, topic: str | None = None) -> JointStates:
         raise JointStateError(
             'joint topics need rosbags: pip install "tactsense[import]"'
         ) from None
-    path = Path(path)
-    bag = path.parent if path.is_file() else path
-    if not (bag / "metadata.yaml").is_file():
-        raise JointStateError(f"{path}: not a rosbag2 bag (no metadata.yaml in {bag})")
     samples: dict[str, tuple[list, list]] = {}
     try:
         with AnyReader([bag], default_typestore=get_typestore(Stores.ROS2_HUMBLE)) as reader:
             found = sorted(
-                name for name, info in reader.topics.items()
-                if info.msgtype == "sensor_msgs/msg/JointState"
-            )  # fmt: skip
-            if topic is None and len(found) != 1:
-                raise JointStateError(
-                    f"{path}: {len(found)} JointState topics ({', '.join(found) or 'none'}); "
-                    "name one with --joints-topic"
-                )
-            chosen = topic or found[0]
-            if chosen not in found:
-                raise JointStateError(
-                    f"{path}: no JointState topic {chosen!r}; its JointState topics: "
-                    f"{', '.join(found) or 'none'}"
-                )
+                name for name, info in reader.topics.items() if info.msgtype == JOINT_STATE
+            )
+            chosen = _choose(path, found, topic)
             connections = [c for c in reader.connections if c.topic == chosen]
             for connection, log_ns, raw in reader.messages(connections=connections):
                 message = reader.deserialize(raw, connection.msgtype)
                 stamp = message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
-                when = stamp if stamp > 0 else log_ns * 1e-9
-                for name, position in zip(message.name, message.position, strict=False):
-                    times, values = samples.setdefault(str(name), ([], []))
-                    if times and when <= times[-1]:
-                        continue  # a repeated or late stamp: the first sample at a time wins
-                    times.append(when)
-                    values.append(float(position))
+                _add_sample(samples, stamp if stamp > 0 else log_ns * 1e-9, message.name,
+                            message.position)  # fmt: skip
     except AnyReaderError as error:
         raise JointStateError(f"{path} is not a readable rosbag2 bag ({error})") from None
     return JointStates(
