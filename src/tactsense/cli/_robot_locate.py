@@ -25,8 +25,8 @@ JOINTS_CSV_HELP = (
 )
 JOINTS_BAG_HELP = (
     "Robot recordings: joint states from a sensor_msgs/JointState topic of a rosbag2 bag "
-    "(folder or one of its files; header stamps [s] on the recording's clock), "
-    "interpolated as --joints-csv."
+    "(folder or one of its files) or a plain MCAP file (header stamps [s] on the "
+    "recording's clock), interpolated as --joints-csv."
 )
 JOINTS_TOPIC_HELP = "With --joints-bag: the JointState topic [default: the bag's only one]."
 WRENCHES_HELP = (
