@@ -206,7 +206,9 @@ class RobotRecordingFeed:
             for name in manifest.get("streams", []):
                 self.skin.patch(name)
                 if stream_path(self.path, name).exists():
-                    self.streams[name] = _PatchStream(stream_path(self.path, name), clock_of.get(name))
+                    self.streams[name] = _PatchStream(
+                        stream_path(self.path, name), clock_of.get(name)
+                    )
             baselines = {}
             for name, stream in self.streams.items():
                 first = stream.file.frames(0, baseline_frames)

@@ -177,9 +177,7 @@ def contacts_in_base(
                 "position_link_mm": _mm(p_link[:3]),
                 "normal": np.round(normal, 6).tolist(),
                 "force_n": None if force is None else round(force, 6),
-                "force_vector_n": None
-                if force is None
-                else np.round(-force * normal, 6).tolist(),
+                "force_vector_n": None if force is None else np.round(-force * normal, 6).tolist(),
             }
         )
     return out

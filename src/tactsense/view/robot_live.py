@@ -1,0 +1,152 @@
+"""The hand's view live: frames from several devices at once
+(:class:`~tactsense.stream.robot.RobotSources`), shown at the display rate.
+
+Each device's frames arrive split into patches; the feed keeps the newest frame of every
+patch and, at each display tick, runs each patch that has a new one through its
+estimator (as the recording's playback does, :mod:`tactsense.view.robot_feed`). The
+devices' states (streaming, ended, dropped), rates, losses and clock fits go with every
+message.
+"""
+
+from __future__ import annotations
+
+import json
+import threading
+import time
+from collections.abc import Mapping
+
+import numpy as np
+
+from tactsense.stream.reader import StreamFrame
+from tactsense.view.robot_feed import DISPLAY_HZ, HandState
+from tactsense.view.robot_scene import scene_layout
+
+
+class RobotLiveFeed:
+    """A hand's devices as they stream (the feed interface the server uses)."""
+
+    kind = "robot live"
+
+    def __init__(
+        self,
+        sources,
+        *,
+        joint_positions: Mapping[str, float] | None = None,
+        baseline_frames: int = 5,
+        threshold: float | None = None,
+        display_hz: float = DISPLAY_HZ,
+    ):
+        self.sources = sources
+        self.skin = sources.skin
+        self.name = ", ".join(f"{d}={u}" for d, u in sources.sources.items())
+        self.period_s = 1.0 / float(display_hz)
+        self.state = HandState(
+            self.skin,
+            joint_positions,
+            baseline_frames=baseline_frames,
+            threshold=threshold,
+            frame_period_s=self.period_s,
+        )
+        self.frames_in = 0
+        self.device_frames = 0
+        self.status = "starting"
+        self.error: str | None = None
+        self._publish = lambda text: None
+        self._lock = threading.Lock()
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._latest: dict | None = None
+        self._pending: dict[str, tuple[np.ndarray, float, float, int]] = {}
+
+    def devices(self) -> list[dict]:
+        """Each device's state, rate [Hz], losses and clock (one line of text)."""
+        return [
+            {"device": device, "state": status.state, "rate_hz": round(status.rate_hz, 2),
+             "line": status.line()}
+            for device, status in self.sources.status.items()
+        ]  # fmt: skip
+
+    def layout(self) -> dict:
+        message = scene_layout(self.skin, self.state.joints)
+        message["signal_floor"] = self.state.signal_floor
+        message["source"] = {"kind": self.kind, "name": self.name}
+        with self._lock:
+            message["latest"] = self._latest
+        message["status"] = {"type": "status", "status": self.status, "error": self.error}
+        return message
+
+    def health(self) -> dict:
+        return {
+            "frames_in": self.frames_in,
+            "device_frames": self.device_frames,
+            "status": self.status,
+            "error": self.error,
+            "devices": self.devices(),
+        }
+
+    def command(self, message: dict) -> None:
+        """``{"command": "rezero"}``: every patch takes its baseline anew."""
+        if message.get("command") == "rezero":
+            with self._lock:
+                for locator in self.state.locators.values():
+                    rezero = getattr(locator, "rezero", None)
+                    if rezero is not None:
+                        rezero()
+
+    def _set_status(self, status: str, error: str | None = None) -> None:
+        self.status, self.error = status, error
+        self._publish(json.dumps({"type": "status", "status": status, "error": error}))
+
+    def start(self, publish) -> None:
+        self._publish = publish
+        self._thread = threading.Thread(target=self._guarded, name="tactsense-hand", daemon=True)
+        self._thread.start()
+
+    def stop(self, wait_s: float = 2.0) -> None:
+        self._stop.set()
+        self.sources.stop()
+        if self._thread is not None:
+            self._thread.join(wait_s)
+        self.sources.close()
+
+    def _guarded(self) -> None:
+        try:
+            self._run()
+        except Exception as error:  # shown on the page and by /api/health, not lost
+            self._set_status("error", f"{type(error).__name__}: {error}")
+
+    def _tick(self) -> None:
+        with self._lock:
+            pending, self._pending = self._pending, {}
+            for patch, (counts, aligned_s, device_s, sequence) in pending.items():
+                frame = StreamFrame(sequence, sequence, device_s, aligned_s, time.perf_counter(),
+                                    counts)  # fmt: skip
+                self.state.update(patch, frame)
+            self.frames_in += 1
+            message = self.state.message(self.frames_in, time.time())
+            message["devices"] = self.devices()
+            self._latest = message
+        self._publish(json.dumps(message, allow_nan=False))
+
+    def _run(self) -> None:
+        self.sources.open()
+        self._set_status("streaming")
+        next_tick = time.perf_counter()
+        while not self._stop.is_set():
+            frame = self.sources.get(timeout_s=max(0.0, min(next_tick - time.perf_counter(), 0.05)))
+            if frame is not None:
+                self.device_frames += 1
+                device_s = (
+                    frame.device_time_us * 1e-6 if frame.device_time_us >= 0 else frame.host_time_s
+                )
+                for patch, counts in frame.patches.items():
+                    self._pending[patch] = (np.asarray(counts), frame.aligned_time_s, device_s,
+                                            frame.sequence)  # fmt: skip
+            now = time.perf_counter()
+            if now >= next_tick:
+                self._tick()
+                next_tick = max(next_tick + self.period_s, now)
+            if frame is None and not self.sources.running:
+                self._tick()
+                self._set_status("ended", self.sources.status_line())
+                return
