@@ -1,0 +1,290 @@
+"""A whole hand in a real browser (headless Chromium driven by Playwright): the skin in 3-D.
+
+The robot recordings are made here with the batch forward model
+(:func:`tactsense.simulate.frames_from_contacts`): every patch untouched, one patch
+pressed from a third of the way in. What is asserted is read from the page's state
+(``window.tactsenseHand``: the layout it drew, the camera, where each taxel was drawn and
+with which colour), not from pixels, and waits on that state, never on timers:
+
+* every taxel of every patch is where the skin says at the joint state
+  (:meth:`RobotSkin.taxels_in_base`), and drawn where an independent evaluation of the
+  camera's perspective projection puts it (before and after orbiting and zooming);
+* the pressed patch's taxels are the hottest;
+* the contacts table lists the pressed patch's link, and the contact's base-frame
+  position is the pressed place moved by the skin's kinematics.
+"""
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from tactsense.io._layout import Recording
+from tactsense.io.robot_recording import RobotRecording, write_robot_recording
+from tactsense.robot import Joint, Patch, Pose, RobotSkin, load_skin
+from tactsense.sensor import Grid, preset
+from tactsense.simulate import ContactBatch, frames_from_contacts
+from tactsense.view.robot_feed import RobotRecordingFeed
+from tactsense.view.robot_server import RobotViewServer
+
+from .test_browser import browser, page  # noqa: F401  (the fixtures)
+
+JOINTS = {"knuckle": 0.5}
+
+
+def _pad(name, rows, cols, pitch_mm, rate_hz):
+    spec = preset("pad16").replace(
+        grid=Grid(rows=rows, cols=cols, row_pitch_mm=pitch_mm, col_pitch_mm=pitch_mm,
+                  electrode_x_mm=0.8 * pitch_mm, electrode_y_mm=0.8 * pitch_mm),
+        electronics__scan_rate_hz=rate_hz,
+    )  # fmt: skip
+    return dataclasses.replace(spec, name=name)
+
+
+def small_hand() -> RobotSkin:
+    """A palm and one finger on a revolute joint: a pad on each, a point-set tip; three
+    rates (100, 250 and 50 Hz: the dome's)."""
+    return RobotSkin(
+        name="testhand",
+        base_link="palm",
+        links=("palm", "finger"),
+        joints=(
+            Joint(
+                "knuckle",
+                "revolute",
+                "palm",
+                "finger",
+                Pose((0.06, 0.0, 0.0)),
+                (0.0, 1.0, 0.0),
+                -0.2,
+                1.6,
+            ),
+        ),
+        patches=(
+            Patch(
+                "palm_pad",
+                _pad("palmpad", 6, 6, 4.0, 100.0),
+                "palm",
+                Pose((0.0, -0.01, -0.005), (math.pi, 0.0, 0.0)),
+            ),
+            Patch(
+                "finger_pad",
+                _pad("fingerpad", 4, 8, 3.0, 250.0),
+                "finger",
+                Pose((0.005, -0.0105, -0.006), (math.pi, 0.0, 0.0)),
+            ),
+            Patch(
+                "tip",
+                dataclasses.replace(preset("dome12"), name="tip"),
+                "finger",
+                Pose((0.035, 0.0, 0.0), (0.0, math.pi / 2, 0.0)),
+            ),
+        ),
+    )
+
+
+def pressed_centre_mm(skin, patch):
+    """The middle of a patch's taxels (x, y) in its own frame [mm]: where it is pressed."""
+    return skin.patch(patch).sensor.taxel_positions_mm()[:, :2].mean(axis=0)
+
+
+def hand_recording(path, skin=None, pressed="finger_pad", *, seconds=1.0, force_n=1.0):
+    """A robot recording of ``skin`` (default :func:`small_hand`): every patch at rest with
+    its read noise, ``pressed`` (None: none) under a 3 mm sphere at its middle with
+    ``force_n`` from a third of the way in."""
+    skin = small_hand() if skin is None else skin
+    streams = {}
+    for k, patch in enumerate(skin.patches):
+        spec = patch.sensor
+        n = round(seconds * spec.electronics.scan_rate_hz)
+        force = np.zeros((n, 1))
+        if patch.name == pressed:
+            force[n // 3 :] = force_n
+        centre = np.broadcast_to(pressed_centre_mm(skin, patch.name), (n, 1, 2)).copy()
+        frames = frames_from_contacts(
+            spec, ContactBatch(position_mm=centre, normal_force_n=force, radius_mm=3.0), rng=k
+        )
+        streams[patch.name] = Recording(
+            frames=np.asarray(frames).reshape(n, *spec.shape),
+            time_s=np.arange(n) / spec.electronics.scan_rate_hz,
+            sample_offset_s=np.zeros(spec.shape),
+            sensor=spec,
+        )
+    return write_robot_recording(path, RobotRecording(skin, streams, description="test"))
+
+
+def _serve(path, joints=JOINTS, speed=4.0):
+    server = RobotViewServer(RobotRecordingFeed(path, joint_positions=joints, speed=speed))
+    server.start()
+    return server
+
+
+def _wait_ended(view):
+    """Wait until the recording has played to its end and that last frame is drawn."""
+    view.wait_for_function(
+        "() => { const s = window.tactsenseHand; return s.layout && s.status === 'ended'"
+        " && s.latest && s.drawnSerial === s.latest.serial && !s.dirty; }",
+        timeout=20000,
+    )
+
+
+def _projected(camera, points_mm):
+    """The perspective projection, evaluated independently of the page: a camera at
+    ``distance`` from ``target`` along azimuth ``yaw`` and elevation ``pitch`` (z up),
+    written as the rotation from base to camera axes (x right, y down, z forward) built
+    from Rz(yaw) and Ry(pitch), then pixels = focal * (x, y) / z + centre."""
+    yaw, pitch = camera["yaw"], camera["pitch"]
+    cz, sz, cp, sp = math.cos(yaw), math.sin(yaw), math.cos(pitch), math.sin(pitch)
+    rz = np.array([[cz, -sz, 0.0], [sz, cz, 0.0], [0.0, 0.0, 1.0]])
+    ry = np.array([[cp, 0.0, -sp], [0.0, 1.0, 0.0], [sp, 0.0, cp]])
+    # in the rotated frame the camera sits on +x looking down -x, with y to its right and
+    # z up
+    to_camera = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, -1.0], [-1.0, 0.0, 0.0]])
+    eye_local = np.array([camera["distance"], 0.0, 0.0])
+    local = (np.asarray(points_mm) - camera["target"]) @ (rz @ ry)
+    xyz = (local - eye_local) @ to_camera.T
+    return np.column_stack(
+        [camera["cx"] + camera["focal"] * xyz[:, 0] / xyz[:, 2],
+         camera["cy"] + camera["focal"] * xyz[:, 1] / xyz[:, 2], xyz[:, 2]]
+    )  # fmt: skip
+
+
+def _check_taxels_drawn_in_place(view, skin, joints):
+    state = view.evaluate(
+        "() => { const s = window.tactsenseHand; return {layout: s.layout, camera: s.camera,"
+        " screen: s.screen, width: s.layout && document.getElementById('scene').width,"
+        " height: document.getElementById('scene').height}; }"
+    )
+    expected = skin.taxels_in_base(joints)
+    drawn = {p["name"]: p for p in state["layout"]["patches"]}
+    assert list(drawn) == [p.name for p in skin.patches]
+    for name, (positions_m, normals) in expected.items():
+        # the layout's positions are rounded to 1e-4 mm on the wire
+        np.testing.assert_allclose(drawn[name]["positions_mm"], positions_m * 1e3, atol=2e-4)
+        np.testing.assert_allclose(drawn[name]["normals"], normals, atol=2e-6)
+        screen = np.asarray(state["screen"][name])
+        assert screen.shape == (len(positions_m), 3)
+        # the same formula evaluated twice in float64: agreement to well under a pixel
+        np.testing.assert_allclose(
+            screen, _projected(state["camera"], np.asarray(drawn[name]["positions_mm"])),
+            atol=1e-6,
+        )  # fmt: skip
+        assert (screen[:, 2] > 0).all(), f"{name}: taxels behind the camera"
+        assert (screen[:, 0] >= 0).all() and (screen[:, 0] <= state["width"]).all(), name
+        assert (screen[:, 1] >= 0).all() and (screen[:, 1] <= state["height"]).all(), name
+    return state
+
+
+def test_every_taxel_is_drawn_at_its_place_on_its_link(page, tmp_path):  # noqa: F811
+    skin = small_hand()
+    path = hand_recording(tmp_path / "run", skin)
+    server = _serve(path)
+    try:
+        page.goto(server.url)
+        _wait_ended(page)
+        before = _check_taxels_drawn_in_place(page, skin, JOINTS)
+        # orbit (drag) and zoom (wheel): the camera moves and the taxels with it
+        box = page.locator("#scene").bounding_box()
+        x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+        page.mouse.move(x, y)
+        page.mouse.down()
+        page.mouse.move(x + 80, y + 30, steps=4)
+        page.mouse.up()
+        page.mouse.wheel(0, 300)
+        page.wait_for_function(
+            f"() => {{ const s = window.tactsenseHand; return !s.dirty"
+            f" && s.camera.distance > {before['camera']['distance']}; }}"
+        )
+        after = _check_taxels_drawn_in_place(page, skin, JOINTS)
+        assert after["camera"]["yaw"] == pytest.approx(before["camera"]["yaw"] - 0.8)
+        assert after["camera"]["pitch"] == pytest.approx(before["camera"]["pitch"] + 0.3)
+        moved = np.asarray(after["screen"]["palm_pad"]) - np.asarray(before["screen"]["palm_pad"])
+        assert np.abs(moved[:, :2]).max() > 5.0  # pixels: the view really turned
+        page.click("#reset-view")
+        page.wait_for_function(
+            f"() => window.tactsenseHand.camera.yaw === {before['camera']['yaw']}"
+            " && !window.tactsenseHand.dirty"
+        )
+    finally:
+        server.stop()
+
+
+def test_the_preset_hand_at_a_joint_state(page, tmp_path):  # noqa: F811
+    skin = load_skin("hand4")
+    joints = {name: 0.3 for name in skin.movable_joints}
+    path = hand_recording(tmp_path / "run", skin, pressed=None, seconds=0.1)
+    server = _serve(path, joints=joints)
+    try:
+        page.goto(server.url)
+        _wait_ended(page)
+        state = _check_taxels_drawn_in_place(page, skin, joints)
+        assert sum(len(v) for v in state["screen"].values()) == skin.n_taxels
+        assert page.locator("#patch-rows tr").count() == len(skin.patches)
+        assert page.locator("#link-rows tr").count() == 0  # nothing pressed: no contacts
+        assert page.locator("#no-contacts").is_visible()
+    finally:
+        server.stop()
+
+
+def test_pressed_patch_is_hottest_and_its_link_is_in_the_table(page, tmp_path):  # noqa: F811
+    skin = small_hand()
+    path = hand_recording(tmp_path / "run", skin, pressed="finger_pad")
+    server = _serve(path)
+    try:
+        page.goto(server.url)
+        _wait_ended(page)
+        state = page.evaluate(
+            "() => { const s = window.tactsenseHand; return {colours: s.colourIndex,"
+            " latest: s.latest, arrows: s.arrows, scale: s.scale}; }"
+        )
+        colours = {name: np.asarray(v) for name, v in state["colours"].items()}
+        hottest = max(colours, key=lambda name: colours[name].max())
+        assert hottest == "finger_pad"
+        assert colours["finger_pad"].max() == 255  # the scale tops at the hottest taxel
+        for name in ("palm_pad", "tip"):  # untouched: read noise only, far below
+            assert colours[name].max() < 64, name
+        # the hottest taxel is the one under the press
+        centre = pressed_centre_mm(skin, "finger_pad")
+        taxels = skin.patch("finger_pad").sensor.taxel_positions_mm()[:, :2]
+        nearest = np.argsort(((taxels - centre) ** 2).sum(axis=1))[:4]  # centre of a 4x8 grid
+        assert int(np.argmax(colours["finger_pad"])) in nearest
+        # the tables: one link, one contact, on the pressed patch
+        links = page.locator("#link-rows tr")
+        assert links.count() == 1
+        assert links.nth(0).locator("td").nth(0).text_content() == "finger"
+        assert links.nth(0).locator("td").nth(3).text_content() == "finger_pad"
+        rows = page.locator("#contact-rows tr")
+        assert rows.count() == 1
+        cells = [rows.nth(0).locator("td").nth(k).text_content() for k in range(7)]
+        assert cells[:2] == ["finger", "finger_pad"]
+        assert page.locator("#no-contacts").is_hidden()
+        assert [(a["patch"], a["link"]) for a in state["arrows"]] == [("finger_pad", "finger")]
+        # where: the pressed place moved by the kinematics, computed here from the link
+        # pose and the patch origin; 2 mm: the pad estimator's bias on a 3 mm pitch grid
+        # (0.8 mm measured) plus the displayed rounding
+        contact = state["latest"]["contacts"][0]
+        pose = skin.patch_pose("finger_pad", JOINTS)
+        pressed = pose[:3, :3] @ np.array([*centre, 0.0]) * 1e-3 + pose[:3, 3]
+        np.testing.assert_allclose(contact["position_mm"], pressed * 1e3, atol=2.0)
+        np.testing.assert_allclose([float(c) for c in cells[3:6]], pressed * 1e3, atol=2.0)
+        # the force pushes into the skin: against the pad's outward normal (its +z)
+        outward = pose[:3, 2]
+        assert np.dot(contact["force_vector_n"], outward) < 0
+        assert float(cells[6]) > 0
+    finally:
+        server.stop()
+
+
+def test_the_page_and_health_of_the_hands_server(tmp_path):
+    import json
+    import urllib.request
+
+    server = _serve(hand_recording(tmp_path / "run", pressed=None, seconds=0.2))
+    try:
+        page = urllib.request.urlopen(server.url, timeout=5).read().decode()
+        assert "hand.js" in page and "tactsense hand" in page
+        health = json.loads(urllib.request.urlopen(server.url + "api/health", timeout=5).read())
+        assert set(health["feed"]["patch_frames"]) == {"palm_pad", "finger_pad", "tip"}
+    finally:
+        server.stop()
