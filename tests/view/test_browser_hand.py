@@ -288,3 +288,50 @@ def test_the_page_and_health_of_the_hands_server(tmp_path):
         assert set(health["feed"]["patch_frames"]) == {"palm_pad", "finger_pad", "tip"}
     finally:
         server.stop()
+
+
+def _recorded_streams(path):
+    from tactsense.io.robot_recording import read_robot_recording
+
+    return {name: rec.frames for name, rec in read_robot_recording(path).streams.items()}
+
+
+def test_live_from_several_devices(page, tmp_path):  # noqa: F811
+    from tactsense.stream.robot import RobotSources
+    from tactsense.stream.robot_emulator import device_emulators, start_device_emulators
+    from tactsense.view.robot_live import RobotLiveFeed
+
+    skin = small_hand()  # a device per patch: three boards at 100, 250 and 50 Hz
+    streams = _recorded_streams(hand_recording(tmp_path / "run", skin, seconds=1.5))
+    running = start_device_emulators(device_emulators(skin, streams, repeat=False, seed=3))
+    server = None
+    try:
+        sources = RobotSources(skin, {device: d.url for device, d in running.items()})
+        server = RobotViewServer(RobotLiveFeed(sources, joint_positions=JOINTS))
+        server.start()
+        page.goto(server.url)
+        # every device streams its frames, then sends END: the page's last state holds
+        page.wait_for_function(
+            "() => { const s = window.tactsenseHand; return s.status === 'ended' && s.latest"
+            " && s.drawnSerial === s.latest.serial && !s.dirty; }",
+            timeout=20000,
+        )
+        _check_taxels_drawn_in_place(page, skin, JOINTS)
+        state = page.evaluate(
+            "() => ({colours: window.tactsenseHand.colourIndex,"
+            " devices: window.tactsenseHand.latest.devices})"
+        )
+        assert {d["device"]: d["state"] for d in state["devices"]} == {
+            "palm_pad": "ended", "finger_pad": "ended", "tip": "ended"
+        }  # fmt: skip
+        colours = {name: np.asarray(v) for name, v in state["colours"].items()}
+        assert max(colours, key=lambda name: colours[name].max()) == "finger_pad"
+        links = page.locator("#link-rows tr")
+        assert links.count() == 1
+        assert links.nth(0).locator("td").nth(0).text_content() == "finger"
+        assert page.locator("#devices").text_content().count("ended") == 3
+    finally:
+        if server is not None:
+            server.stop()
+        for device in running.values():
+            device.stop()

@@ -191,6 +191,17 @@
       cells(contactRows, [[c.link, 1], [c.patch, 1], [c.id ?? "–"], [fmt(c.position_mm[0], 1)],
         [fmt(c.position_mm[1], 1)], [fmt(c.position_mm[2], 1)], [fmt(c.force_n, 3)]]);
     }
+    if (message.devices) {
+      const list = document.getElementById("devices");
+      list.replaceChildren();
+      for (const d of message.devices) {
+        const li = document.createElement("li");
+        li.textContent = d.line;
+        li.className = d.state;
+        list.appendChild(li);
+      }
+      document.getElementById("device-panel").hidden = false;
+    }
     const frames = message.frame_counts || {};
     document.querySelectorAll("#patch-rows tr").forEach((tr) => {
       tr.lastChild.textContent = frames[tr.dataset.patch] ?? "–";
@@ -212,6 +223,7 @@
       cells(rows, [[p.name, 1], [p.link, 1], [p.kind, 1], [p.n_taxels], ["–"]]);
       rows.lastChild.dataset.patch = p.name;
     }
+    document.getElementById("rezero").hidden = !(layout.source && layout.source.kind === "robot live");
     if (!state.camera) {
       state.camera = homeCamera(layout);
       state.home = { ...state.camera };
@@ -268,9 +280,11 @@
   document.getElementById("show-bones").onchange = (e) => { state.showBones = e.target.checked; redraw(); };
   const resetView = () => { if (state.home) { state.camera = { ...state.home }; redraw(); } };
   document.getElementById("reset-view").onclick = resetView;
+  document.getElementById("rezero").onclick = () => send("rezero");
   document.addEventListener("keydown", (e) => {
     if (e.target.tagName === "INPUT" || e.target.tagName === "SELECT") return;
     if (e.key === "r") resetView();
+    if (e.key === "z" && !document.getElementById("rezero").hidden) send("rezero");
     if (e.key === " ") { e.preventDefault(); document.getElementById("play").click(); }
   });
   let drag = null;
