@@ -54,7 +54,10 @@ def parse_joint_state(text: str | None, skin: RobotSkin) -> dict[str, float]:
                 f"--joints {name}={value.strip()!r}: not a number (radians, or metres for a "
                 "prismatic joint)"
             ) from None
-    skin.link_poses(positions)  # unknown names, NaN and limits: the skin's own errors
+    try:
+        skin.link_poses(positions)  # unknown names, NaN and limits: the skin's own checks
+    except RobotSkinError as error:
+        raise RobotSkinError(f"--joints: {error}") from None
     return positions
 
 
