@@ -335,3 +335,36 @@ def test_live_from_several_devices(page, tmp_path):  # noqa: F811
             server.stop()
         for device in running.values():
             device.stop()
+
+
+def test_the_view_command_on_a_robot_recording(page, tmp_path):  # noqa: F811
+    import subprocess
+    import sys
+
+    path = hand_recording(tmp_path / "run", pressed="finger_pad")
+    view = subprocess.Popen(
+        [sys.executable, "-m", "tactsense", "view", str(path), "--joints", "knuckle=0.5",
+         "--speed", "4"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )  # fmt: skip
+    try:
+        address = view.stdout.readline().strip()
+        assert address.startswith("http://127.0.0.1:"), view.stderr.read()
+        page.goto(address)
+        _wait_ended(page)
+        _check_taxels_drawn_in_place(page, small_hand(), JOINTS)
+        assert page.text_content("#skin") == "testhand"
+        assert page.text_content("#joints") == "knuckle=0.5"
+        assert page.locator("#link-rows tr").nth(0).locator("td").nth(0).text_content() == "finger"
+    finally:
+        view.send_signal(2)
+        try:
+            view.wait(10)
+        except subprocess.TimeoutExpired:
+            view.kill()
+    err = view.stderr.read()
+    assert view.returncode == 0, err
+    assert "hand frames shown" in err  # Ctrl-C: a summary line, no traceback
+    assert "Traceback" not in err
