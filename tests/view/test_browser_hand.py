@@ -368,3 +368,41 @@ def test_the_view_command_on_a_robot_recording(page, tmp_path):  # noqa: F811
     assert view.returncode == 0, err
     assert "hand frames shown" in err  # Ctrl-C: a summary line, no traceback
     assert "Traceback" not in err
+
+
+def test_seek_pause_and_play_act_on_the_whole_hand(page, tmp_path):  # noqa: F811
+    skin = small_hand()
+    path = hand_recording(tmp_path / "run", skin, pressed="finger_pad")  # pressed from 1/3 s
+    server = _serve(path)
+    try:
+        page.goto(server.url)
+        _wait_ended(page)
+        assert page.locator("#link-rows tr").count() == 1
+        # back to 0.1 s, before the press: no contacts, every patch at rest
+        page.evaluate(
+            "() => { const s = document.getElementById('seek'); s.value = 0.1;"
+            " s.dispatchEvent(new Event('input')); }"
+        )
+        page.wait_for_function(
+            "() => { const s = window.tactsenseHand; return s.latest && s.latest.playback"
+            " && Math.abs(s.latest.playback.time_s - 0.1) < 1e-9"
+            " && s.drawnSerial === s.latest.serial && !s.dirty; }"
+        )
+        assert page.locator("#link-rows tr").count() == 0
+        assert page.text_content("#play") == "play"  # it ended: seeking does not play
+        times = page.evaluate("() => window.tactsenseHand.latest.frame_times_s")
+        # each patch shows its newest frame due by 0.1 s, at its own rate (the device times
+        # of a simulation start at 0): within one scan period
+        for name, rate in (("palm_pad", 100.0), ("finger_pad", 250.0)):
+            assert 0.1 - 1.0 / rate - 1e-9 <= times[name] <= 0.1 + 1e-9, name
+        page.click("#play")
+        # played on to the end (the time at 0.1 s till then: no stale 'ended' passes)
+        page.wait_for_function(
+            "() => { const s = window.tactsenseHand, p = s.latest && s.latest.playback;"
+            " return p && p.time_s === p.duration_s && s.status === 'ended'"
+            " && s.drawnSerial === s.latest.serial && !s.dirty; }",
+            timeout=20000,
+        )
+        assert page.locator("#link-rows tr").count() == 1
+    finally:
+        server.stop()
