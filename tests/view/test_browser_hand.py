@@ -406,3 +406,49 @@ def test_seek_pause_and_play_act_on_the_whole_hand(page, tmp_path):  # noqa: F81
         assert page.locator("#link-rows tr").count() == 1
     finally:
         server.stop()
+
+
+def test_a_device_that_drops_out_is_shown_and_the_others_go_on(page, tmp_path):  # noqa: F811
+    from tactsense.stream.robot import RobotSources
+    from tactsense.stream.robot_emulator import device_emulators, start_device_emulators
+    from tactsense.view.robot_live import RobotLiveFeed
+
+    skin = small_hand()
+    streams = _recorded_streams(hand_recording(tmp_path / "run", skin, pressed=None))
+    running = start_device_emulators(device_emulators(skin, streams, repeat=True, seed=4))
+    server = None
+    try:
+        sources = RobotSources(skin, {device: d.url for device, d in running.items()})
+        feed = RobotLiveFeed(sources, joint_positions=JOINTS)
+        server = RobotViewServer(feed)
+        server.start()
+        page.goto(server.url)
+        states_js = (
+            "() => { const s = window.tactsenseHand; if (!s.latest || !s.latest.devices)"
+            " return null; return Object.fromEntries(s.latest.devices.map("
+            "d => [d.device, d.state])); }"
+        )
+        page.wait_for_function(
+            f"() => {{ const d = ({states_js})(); return d && Object.values(d).every("
+            "v => v === 'streaming'); }",
+            timeout=20000,
+        )
+        running["tip"].stop()  # the tip's board goes away: its line closes
+        page.wait_for_function(
+            f"() => {{ const d = ({states_js})(); return d && d.tip === 'dropped'; }}",
+            timeout=20000,
+        )
+        shown = feed.state.frames_seen["palm_pad"]
+        page.wait_for_function(  # the others go on: more frames shown after the drop
+            f"() => window.tactsenseHand.latest.frame_counts.palm_pad > {shown + 5}",
+            timeout=20000,
+        )
+        states = page.evaluate(states_js)
+        assert states == {"palm_pad": "streaming", "finger_pad": "streaming", "tip": "dropped"}
+        assert page.locator("#devices li.dropped").count() == 1
+        assert page.text_content("#status") == "streaming"
+    finally:
+        if server is not None:
+            server.stop()
+        for device in running.values():
+            device.stop()
