@@ -452,3 +452,49 @@ def test_a_device_that_drops_out_is_shown_and_the_others_go_on(page, tmp_path): 
             server.stop()
         for device in running.values():
             device.stop()
+
+
+def test_the_view_command_live_from_several_devices(page, tmp_path):  # noqa: F811
+    import subprocess
+    import sys
+
+    from tactsense.robot import skin_to_toml_string
+    from tactsense.stream.robot_emulator import device_emulators, start_device_emulators
+
+    skin = small_hand()
+    skin_file = tmp_path / "hand.toml"
+    skin_file.write_text(skin_to_toml_string(skin))
+    streams = _recorded_streams(hand_recording(tmp_path / "run", skin))
+    running = start_device_emulators(device_emulators(skin, streams, repeat=False, seed=5))
+    # plain sources in the skin's device order (palm_pad, finger_pad, tip)
+    urls = [running[device].url for device in skin.devices]
+    view = subprocess.Popen(
+        [sys.executable, "-m", "tactsense", "view", "--skin", str(skin_file), *urls,
+         "--joints", "knuckle=0.5"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )  # fmt: skip
+    try:
+        address = view.stdout.readline().strip()
+        assert address.startswith("http://127.0.0.1:"), view.stderr.read()
+        page.goto(address)
+        page.wait_for_function(
+            "() => { const s = window.tactsenseHand; return s.status === 'ended' && s.latest"
+            " && s.drawnSerial === s.latest.serial && !s.dirty; }",
+            timeout=30000,
+        )
+        _check_taxels_drawn_in_place(page, skin, JOINTS)
+        assert page.locator("#link-rows tr").nth(0).locator("td").nth(0).text_content() == "finger"
+        assert page.locator("#rezero").is_visible()  # live: the baseline can be taken anew
+    finally:
+        view.send_signal(2)
+        try:
+            view.wait(10)
+        except subprocess.TimeoutExpired:
+            view.kill()
+        for device in running.values():
+            device.stop()
+    err = view.stderr.read()
+    assert view.returncode == 0, err
+    assert "hand frames shown" in err and "Traceback" not in err

@@ -3,9 +3,10 @@
 
 Each device's frames arrive split into patches; the feed keeps the newest frame of every
 patch and, at each display tick, runs each patch that has a new one through its
-estimator (as the recording's playback does, :mod:`tactsense.view.robot_feed`). The
-devices' states (streaming, ended, dropped), rates, losses and clock fits go with every
-message.
+estimator (every one of a patch's first frames while its baseline is being taken, so a
+backlog at the start does not put a touch into the baseline), as the recording's
+playback does (:mod:`tactsense.view.robot_feed`). The devices' states (streaming,
+ended, dropped), rates, losses and clock fits go with every message.
 """
 
 from __future__ import annotations
@@ -115,13 +116,17 @@ class RobotLiveFeed:
         except Exception as error:  # shown on the page and by /api/health, not lost
             self._set_status("error", f"{type(error).__name__}: {error}")
 
-    def _tick(self) -> None:
+    def _take(self, patch: str, item: tuple) -> None:
+        counts, aligned_s, device_s, sequence = item
+        frame = StreamFrame(sequence, sequence, device_s, aligned_s, time.perf_counter(), counts)
         with self._lock:
-            pending, self._pending = self._pending, {}
-            for patch, (counts, aligned_s, device_s, sequence) in pending.items():
-                frame = StreamFrame(sequence, sequence, device_s, aligned_s, time.perf_counter(),
-                                    counts)  # fmt: skip
-                self.state.update(patch, frame)
+            self.state.update(patch, frame)
+
+    def _tick(self) -> None:
+        pending, self._pending = self._pending, {}
+        for patch, item in pending.items():
+            self._take(patch, item)
+        with self._lock:
             self.frames_in += 1
             message = self.state.message(self.frames_in, time.time())
             message["devices"] = self.devices()
@@ -140,8 +145,11 @@ class RobotLiveFeed:
                     frame.device_time_us * 1e-6 if frame.device_time_us >= 0 else frame.host_time_s
                 )
                 for patch, counts in frame.patches.items():
-                    self._pending[patch] = (np.asarray(counts), frame.aligned_time_s, device_s,
-                                            frame.sequence)  # fmt: skip
+                    item = (np.asarray(counts), frame.aligned_time_s, device_s, frame.sequence)
+                    if getattr(self.state.locators[patch], "ready", True):
+                        self._pending[patch] = item
+                    else:  # the baseline: every one of a patch's first frames, not the newest
+                        self._take(patch, item)
             now = time.perf_counter()
             if now >= next_tick:
                 self._tick()
