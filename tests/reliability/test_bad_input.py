@@ -579,6 +579,55 @@ def test_fix38_mujoco_seconds_help_range_is_the_one_checked(workspace):
 # ---- /r6-fix38 ----
 
 
+# ---- locate on a robot recording (r7-handloc) ----
+HANDLOC_BAD = [
+    ("locate RUN --joints elbow=1 --out OUT", "'elbow': not a movable joint"),
+    ("locate RUN --joints j3=5 --out OUT", "joint 'j3' at 5.0: outside its limits"),
+    ("locate RUN --joints j1 --out OUT", "NAME=POSITION"),
+    ("locate RUN --joints j1=inf --out OUT", "finite position"),
+    ("locate RUN --joints-csv DIR/a_file --out OUT", "expected 'time_s'"),
+    ("locate RUN --joints-csv DIR/no_such.csv --out OUT", "cannot read it"),
+    ("locate RUN --joints-bag DIR/a_dir --out OUT", "not a rosbag2 bag"),
+    ("locate RUN --joints-topic /js --out OUT", "add --joints-bag"),
+    ("locate RUN --joints j1=0 --joints-csv DIR/a_file --out OUT", "give one of --joints"),
+    ("locate RUN --method fit --out OUT", "--method apply to a single array"),
+    ("locate RUN --workers 2 --out OUT", "--workers apply to a single array"),
+    ("locate RUN --out DIR/x.h5", "go to .parquet or .csv"),
+    ("locate RUN --out OUT --wrenches DIR/w.txt", "--wrenches"),
+    ("locate RUN --out OUT --wrenches OUT", "same file as --out"),
+    ("locate RUN --out RUN/x.parquet", "lies inside the robot recording"),
+    ("locate RUN --max-contacts 0 --out OUT", "--max-contacts"),
+    ("locate RUN --threshold -1 --out OUT", "--threshold"),
+    ("locate REC --joints j1=0 --out OUT", "apply to a robot recording's folder"),
+]
+
+
+@pytest.fixture(scope="module")
+def handloc_run(workspace):
+    from tests.estimate._robot_sim import write_pressed_recording
+    from tests.estimate.test_robot_locate import small_skin
+
+    return write_pressed_recording(workspace / "robot_run", small_skin(), frames=8)
+
+
+@pytest.mark.parametrize("line, names", HANDLOC_BAD, ids=[line for line, _ in HANDLOC_BAD])
+def test_handloc_bad_options(workspace, handloc_run, line, names):
+    out = workspace / "never_written.parquet"
+    args = (
+        line.replace("RUN", str(handloc_run)).replace("REC", str(workspace / "rec.h5"))
+        .replace("OUT", str(out)).replace("DIR", str(workspace)).split()
+    )  # fmt: skip
+    _check(runner.invoke(app, args), names)
+    assert not out.exists()
+    assert not (workspace / "never_written_wrenches.parquet").exists()
+    assert not [p for p in workspace.iterdir() if ".partial" in p.name]
+    assert not [p for p in handloc_run.iterdir() if p.name not in ("robot.json", "skin.toml",
+                                                                    "streams")]  # fmt: skip
+
+
+# ---- /r7-handloc ----
+
+
 # ---- view of a hand (r7-hand3d) ----
 HAND_VIEW_BAD = [
     # (command line, what the message must say); RUN: a robot recording of a small hand

@@ -12,6 +12,7 @@ from typing import Annotated
 import typer
 
 from tactsense._validation import TactsenseInputError
+from tactsense.cli import _robot_locate as _robot  # r7-handloc: robot recordings
 from tactsense.cli._batch import batch
 from tactsense.cli._calibrate import calibrate
 from tactsense.cli._common import (
@@ -168,12 +169,49 @@ def locate(
         bool, typer.Option("--quiet", "-q", help="No progress bar, only the summary line.")
     ] = False,
     force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
+    # ---- contacts in the robot's frame (r7-handloc) ----
+    joints: Annotated[str | None, typer.Option("--joints", help=_robot.JOINTS_HELP)] = None,
+    joints_csv: Annotated[
+        Path | None, typer.Option("--joints-csv", help=_robot.JOINTS_CSV_HELP)
+    ] = None,
+    joints_bag: Annotated[
+        Path | None, typer.Option("--joints-bag", help=_robot.JOINTS_BAG_HELP)
+    ] = None,
+    joints_topic: Annotated[
+        str | None, typer.Option("--joints-topic", help=_robot.JOINTS_TOPIC_HELP)
+    ] = None,
+    wrenches: Annotated[Path | None, typer.Option("--wrenches", help=_robot.WRENCHES_HELP)] = None,
+    # ---- /r7-handloc ----
 ) -> None:
     """Locate the contact in every frame: position, force, skew and quality flags.
 
     The recording is read and the estimates written piece by piece, so memory stays
-    bounded whatever its length; a progress bar shows on a terminal.
+    bounded whatever its length; a progress bar shows on a terminal. A robot recording's
+    folder (docs/robot.md): every patch's contacts in its link's and the base frame, and
+    the wrench per link.
     """
+    # ---- a robot recording's folder (r7-handloc) ----
+    from tactsense.io.robot_recording import is_robot_recording
+
+    robot_options = _robot.robot_only_options(joints, joints_csv, joints_bag, joints_topic,
+                                              wrenches)  # fmt: skip
+    if is_robot_recording(recording):
+        single = {"--calibration": calibration is not None, "--contacts": contacts,
+                  "--method": method != "interpolate", "--chunk-frames": chunk_frames is not None,
+                  "--workers": workers != 1, "--drift-s": drift_s != 2.0}  # fmt: skip
+        _robot.run_robot_locate(
+            recording, out, force=force, quiet=quiet, joints=joints, joints_csv=joints_csv,
+            joints_bag=joints_bag, joints_topic=joints_topic, wrenches=wrenches,
+            baseline_frames=baseline_frames, threshold=threshold, max_contacts=max_contacts,
+            single_array_options=single,
+        )  # fmt: skip
+        return
+    if robot_options:
+        fail(
+            f"{', '.join(robot_options)} apply to a robot recording's folder; "
+            f"{recording} is not one"
+        )
+    # ---- /r7-handloc ----
 
     from tactsense.batch import locate_file, output_format
     from tactsense.estimate.contacts import METHODS

@@ -1,0 +1,599 @@
+"""Contacts in the robot's frame: every patch of a skin at once, wrenches per link.
+
+:class:`HandLocator` takes hand frames (every taxel of the skin in one vector, patches in
+skin order) and, in one compiled call per block of frames (:mod:`._robot_kernel`),
+finds every patch's contacts exactly as the single-array estimator does
+(:func:`~tactsense.estimate.contacts.find_contacts`, method ``interpolate``, a fixed
+baseline), places each in its link's frame (the patch's ``origin``) and in the base frame
+(the links' poses for the joint state: URDF forward kinematics), gives it a force vector
+(the normal force along the taxel's normal, pressing inward: ``-force_n * normal``; the
+kinds estimate no tangential force today) and sums per link the wrench about the link's
+origin (force [N], torque [N mm], in the link's frame), as the ROS tactile toolbox's
+merger does, and the grasp's total in the base frame about the base origin.
+
+:func:`locate_robot_recording` runs it over a robot recording (each patch at its own
+rate: a hand frame at each frame of the fastest stream, each patch contributing its
+latest frame; its contacts written once per frame of its own, at that frame's time, its
+wrench held until its next frame). :func:`locate_robot_reference` is the
+straightforward per-patch loop the fast path is checked against. Joint states:
+:mod:`._robot_joints`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tactsense._signals import deferred_interrupts
+from tactsense._validation import TactsenseInputError
+from tactsense.estimate import _robot_kernel as K
+from tactsense.estimate._robot_joints import JointStates
+from tactsense.estimate.results import Flag
+from tactsense.kinds import kind_of
+from tactsense.robot import RobotSkin
+
+CONTACT_COLUMNS = (
+    "time_s", "frame", "patch", "link", "contact", "x_mm", "y_mm", "z_mm",
+    "x_link_mm", "y_link_mm", "z_link_mm", "nx_link", "ny_link", "nz_link",
+    "x_base_mm", "y_base_mm", "z_base_mm", "nx_base", "ny_base", "nz_base",
+    "force_n", "fx_link_n", "fy_link_n", "fz_link_n", "fx_base_n", "fy_base_n", "fz_base_n",
+    "row", "col", "peak", "taxels", "flags",
+)  # fmt: skip
+"""Columns of the long table of contacts: the time and hand frame, the patch, its link,
+the contact's rank in its patch's frame (0: the largest summed signal); its point in the
+sensor's frame (``x_mm``...; a pad's ``row``/``col`` [taxel]), in the link's frame and in
+the base frame [mm] with the unit outward normal there; its normal force [N] and force
+vector (``-force_n * normal``) in both frames [N]; interpolated peak signal [-], taxels
+and flags (:class:`~tactsense.estimate.results.Flag`)."""
+
+WRENCH_COLUMNS = (
+    "time_s", "frame", "link", "what", "contacts", "force_x_n", "force_y_n", "force_z_n",
+    "torque_x_n_mm", "torque_y_n_mm", "torque_z_n_mm",
+)  # fmt: skip
+"""Columns of the wrench table: per hand frame one row per link holding patches
+(``what = "link"``: in the link's frame, torque about the link's origin) and one for the
+grasp (``what = "total"``, ``link`` the base link: in the base frame about its origin);
+``contacts`` the contacts held; force [N], torque [N mm]."""
+
+
+@dataclass
+class RobotContacts:
+    """The long table of contacts and the wrench table of some hand frames (columns as
+    :data:`CONTACT_COLUMNS` and :data:`WRENCH_COLUMNS`, NumPy arrays)."""
+
+    contacts: dict[str, np.ndarray]
+    wrenches: dict[str, np.ndarray]
+    n_frames: int = 0
+    warnings: list[str] = field(default_factory=list)
+
+    def contacts_table(self):
+        """The contacts as a :class:`pyarrow.Table`."""
+        return _arrow(self.contacts)
+
+    def wrenches_table(self):
+        """The wrenches as a :class:`pyarrow.Table`."""
+        return _arrow(self.wrenches)
+
+    @classmethod
+    def concatenate(cls, parts) -> RobotContacts:
+        parts = list(parts)
+        join = lambda what: {  # noqa: E731
+            key: np.concatenate([getattr(p, what)[key] for p in parts])
+            for key in getattr(parts[0], what)
+        }
+        return cls(join("contacts"), join("wrenches"), sum(p.n_frames for p in parts))
+
+
+def _arrow(columns):
+    import pyarrow as pa
+
+    return pa.table({key: pa.array(value) for key, value in columns.items()})
+
+
+def _pad_parameters(sensor, threshold: float) -> tuple[np.ndarray, tuple]:
+    from tactsense.estimate.contacts.pad import (
+        FIT_STEPS,
+        _kernel_max,
+        _kernel_total,
+        pad_force_kernel,
+        point_reach,
+        point_taxels,
+    )
+    from tactsense.estimate.contacts.segment import RING_RATIO, SADDLE_RATIO, WEAK_SHARE, dip_floor
+    from tactsense.estimate.reading import signal_noise_variance
+
+    noise_var = signal_noise_variance(sensor)
+    resistive = sensor.transduction.kind != "capacitive"
+    param = np.zeros(K.N_PARAM)
+    param[K.P_THRESHOLD] = threshold
+    param[K.P_SADDLE] = SADDLE_RATIO
+    param[K.P_FLOOR] = dip_floor(sensor, threshold)
+    param[K.P_RING] = RING_RATIO
+    param[K.P_WEAK] = WEAK_SHARE * threshold
+    param[K.P_FAR] = point_reach(sensor)
+    param[K.P_COVER] = point_taxels(sensor)
+    param[K.P_NOISE_VAR] = noise_var
+    param[K.P_MERGE_FLOOR] = 3.0 * math.sqrt(noise_var) if resistive else -math.inf
+    param[K.P_KERNEL_TOTAL] = _kernel_total(sensor)
+    param[K.P_ROW_PITCH] = sensor.grid.row_pitch_mm
+    param[K.P_COL_PITCH] = sensor.grid.col_pitch_mm
+    amp, amp_step, _ = pad_force_kernel(sensor)
+    sig, sig_step, _ = pad_force_kernel(sensor, FIT_STEPS, signed=True)
+    return param, (amp, amp_step, sig, sig_step, _kernel_max(sensor))
+
+
+def _points_parameters(sensor, threshold: float):
+    from tactsense.estimate.contacts.points import _points_geometry, points_force_kernel
+    from tactsense.estimate.contacts.segment import SADDLE_RATIO, dip_floor
+
+    param = np.zeros(K.N_PARAM)
+    param[K.P_THRESHOLD] = threshold
+    param[K.P_SADDLE] = SADDLE_RATIO
+    param[K.P_FLOOR] = dip_floor(sensor, threshold)
+    positions, _, neighbours = _points_geometry(sensor)
+    return param, positions, neighbours, np.asarray(points_force_kernel(sensor), float)
+
+
+class HandLocator:
+    """Contacts and wrenches of a whole skin, one compiled call per block of hand frames.
+
+    Parameters
+    ----------
+    skin : RobotSkin
+        Its patches must be pads or point sets (the kinds whose contacts are many).
+    baselines : mapping of patch name -> array_like (rows, cols)
+        Each patch's untouched readings [counts] (a fixed baseline).
+    threshold : float or mapping of patch name -> float, optional
+        Smallest signal that counts as contact [-]; default each sensor's
+        (:func:`~tactsense.estimate.contacts.default_threshold`).
+    max_contacts : int
+        At most this many contacts per patch and frame (1-64), the largest kept.
+    """
+
+    def __init__(
+        self,
+        skin: RobotSkin,
+        baselines: Mapping[str, np.ndarray],
+        *,
+        threshold: float | Mapping[str, float] | None = None,
+        max_contacts: int = 8,
+    ):
+        from tactsense.estimate.contacts import default_threshold
+        from tactsense.estimate.contacts.pad import MERGED_GAIN, MERGED_HALVES, MERGED_SPREAD
+        from tactsense.estimate.contacts.segment import PAIR_RIDGE
+        from tactsense.estimate.finger.localize import MAX_ITERATIONS, TOLERANCE
+        from tactsense.estimate.reading import reading_mode, unusable_baseline
+
+        if not (isinstance(max_contacts, int) and 1 <= max_contacts <= 64):
+            raise TactsenseInputError(
+                f"max_contacts must be an integer in 1-64; got {max_contacts!r}"
+            )
+        self.skin = skin
+        self.patch_names = tuple(p.name for p in skin.patches)
+        self.links = tuple(skin._order())
+        self.joint_names = skin.movable_joints
+        link_index = {name: i for i, name in enumerate(self.links)}
+        by_child = {j.child: j for j in skin.joints}
+        n_links = len(self.links)
+        self._parent = np.full(n_links, -1, np.int64)
+        self._jtype = np.zeros(n_links, np.int64)
+        self._origin = np.tile(np.eye(4), (n_links, 1, 1))
+        self._axis = np.zeros((n_links, 3))
+        self._column = np.full(n_links, -1, np.int64)
+        for i, name in enumerate(self.links):
+            joint = by_child.get(name)
+            if joint is None:
+                continue
+            self._parent[i] = link_index[joint.parent]
+            self._origin[i] = joint.origin.matrix()
+            self._axis[i] = joint.axis
+            self._jtype[i] = {"fixed": 0, "prismatic": 2}.get(joint.type, 1)
+            if joint.type != "fixed":
+                self._column[i] = self.joint_names.index(joint.name)
+        n_patches = len(skin.patches)
+        sizes = [p.n_taxels for p in skin.patches]
+        self._offset = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
+        self.n_taxels = int(sum(sizes))
+        self._mode = np.zeros(n_patches, np.int64)
+        self._rows = np.array([p.sensor.shape[0] for p in skin.patches], np.int64)
+        self._cols = np.array([p.sensor.shape[1] for p in skin.patches], np.int64)
+        self._link = np.array([link_index[p.link] for p in skin.patches], np.int64)
+        self._kernel_of = np.zeros(n_patches, np.int64)
+        self._param = np.zeros((n_patches, K.N_PARAM))
+        self._pose = np.array([p.origin.matrix() for p in skin.patches]).reshape(-1, 4, 4)
+        self._baseline = np.zeros(self.n_taxels)
+        self._unusable = np.zeros(self.n_taxels, np.bool_)
+        self._normals = np.zeros((self.n_taxels, 3))
+        self._positions = np.zeros((self.n_taxels, 3))
+        graph_offset = np.zeros(n_patches, np.int64)
+        nb_offsets, nb_lists, kernels, pt_offset = [], [], [], np.zeros(n_patches, np.int64)
+        pad_kernels: dict = {}
+        kernel_list: list = []
+        graph_start, kernel_start = 0, 0
+        for p, patch in enumerate(skin.patches):
+            sensor = patch.sensor
+            kind = kind_of(sensor)
+            off, size = self._offset[p], sizes[p]
+            if isinstance(threshold, Mapping):
+                value = threshold.get(patch.name)
+            else:
+                value = threshold
+            value = default_threshold(sensor) if value is None else value
+            if not (isinstance(value, float | int) and math.isfinite(value) and value > 0):
+                raise TactsenseInputError(
+                    f"threshold for patch {patch.name!r} must be a positive number; got {value!r}"
+                )
+            if kind.image_grid and kind.multi_contact and kind.response_fit:
+                if kind.periodic(sensor):
+                    raise TactsenseInputError(f"patch {patch.name!r}: a periodic grid is not a pad")
+                param, tables = _pad_parameters(sensor, float(value))
+                key = id(tables[0])
+                if key not in pad_kernels:
+                    pad_kernels[key] = len(kernel_list)
+                    kernel_list.append(tables)
+                self._kernel_of[p] = pad_kernels[key]
+            elif not kind.image_grid and kind.multi_contact:
+                self._mode[p] = K.MODE_POINTS
+                param, positions, neighbours, kernel = _points_parameters(sensor, float(value))
+                self._positions[off : off + size] = positions
+                starts = np.cumsum([0] + [len(n) for n in neighbours]) + sum(map(len, nb_lists))
+                graph_offset[p] = graph_start
+                nb_offsets.append(starts)
+                nb_lists.extend(neighbours)
+                graph_start += size + 1
+                pt_offset[p] = kernel_start
+                kernels.append(kernel.ravel())
+                kernel_start += size * size
+            else:
+                raise TactsenseInputError(
+                    f"patch {patch.name!r} is a {kind.label}: the hand's estimator places the "
+                    "contacts of pads and point sets; locate this patch's stream on its own"
+                )
+            resistive, falling, per_count = reading_mode(sensor)
+            param[K.P_FULL_SCALE] = float(2**sensor.electronics.adc_bits - 1)
+            param[K.P_RESISTIVE] = float(resistive)
+            param[K.P_FALLING] = float(falling)
+            param[K.P_PER_COUNT] = per_count
+            self._param[p] = param
+            self._normals[off : off + size] = np.asarray(sensor.taxel_normals(), float)
+            if patch.name not in baselines:
+                raise TactsenseInputError(f"no baseline for patch {patch.name!r}")
+            base = np.asarray(baselines[patch.name], float)
+            if base.shape != tuple(sensor.shape):
+                raise TactsenseInputError(
+                    f"baseline of patch {patch.name!r} has shape {base.shape}; expected "
+                    f"{tuple(sensor.shape)}"
+                )
+            bad = unusable_baseline(base, sensor)
+            self._unusable[off : off + size] = bad.ravel()
+            self._baseline[off : off + size] = np.where(bad, 1.0, base).ravel()
+        self._graph_offset = graph_offset
+        self._nb_offset = (
+            np.concatenate(nb_offsets).astype(np.int64) if nb_offsets else np.zeros(1, np.int64)
+        )
+        self._neighbours = (
+            np.concatenate(nb_lists).astype(np.int64) if nb_lists else np.zeros(1, np.int64)
+        )
+        self._pt_kernel = np.concatenate(kernels) if kernels else np.zeros(1)
+        self._pt_offset = pt_offset
+        if not kernel_list:  # no pad: tables of the right type, never read
+            from tactsense.sensor import preset
+
+            kernel_list.append(_pad_parameters(preset("pad16"), 0.01)[1])
+        self._k_amp = np.ascontiguousarray(np.stack([t[0] for t in kernel_list]))
+        self._amp_step = float(kernel_list[0][1])
+        self._k_sig = np.ascontiguousarray(np.stack([t[2] for t in kernel_list]))
+        self._sig_step = float(kernel_list[0][3])
+        self._k_max = np.ascontiguousarray(np.stack([t[4] for t in kernel_list]))
+        self._halves = np.asarray(MERGED_HALVES, float)
+        self._settings = (max_contacts, TOLERANCE, MAX_ITERATIONS, PAIR_RIDGE, MERGED_GAIN,
+                          MERGED_SPREAD)  # fmt: skip
+        self._flag_bits = np.array(
+            [Flag.NAN_INPUT, Flag.SATURATED, Flag.DEAD_TACTEL, Flag.NOT_CONVERGED, Flag.EDGE],
+            np.int64,
+        )
+        self.max_contacts = max_contacts
+        self._link_has_patch = np.isin(np.arange(n_links), self._link)
+        self.reset()
+        self.locate(np.tile(self._baseline, (1, 1)))  # compile (or load) now
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget the held wrenches and the last frames (a jump in time)."""
+        self._held = np.zeros((len(self.patch_names), 6))
+        self._held_count = np.zeros(len(self.patch_names), np.int64)
+        self._last = self._baseline.copy()
+        self._patch_index = {name: p for p, name in enumerate(self.patch_names)}
+
+    def update(self, patches: Mapping[str, np.ndarray], joints=None, *, time_s=None):
+        """Live: the contacts of the patches in ``patches`` (name -> (rows, cols) counts,
+        e.g. one device's frame), every other patch's wrench held; one compiled call.
+        Returns a :class:`RobotContacts` of one hand frame (the wrenches of every link)."""
+        fresh = np.zeros((1, len(self.patch_names)), np.bool_)
+        for name, frame in patches.items():
+            p = self._patch_index.get(name)
+            if p is None:
+                raise TactsenseInputError(f"{self.skin.name!r} has no patch {name!r}")
+            size = int(self._rows[p] * self._cols[p])
+            self._last[self._offset[p] : self._offset[p] + size] = np.ravel(frame)
+            fresh[0, p] = True
+        return self.locate(
+            self._last[np.newaxis], joints, fresh=fresh,
+            time_s=None if time_s is None else np.array([time_s], float),
+        )  # fmt: skip
+
+    def pack(self, frames: Mapping[str, np.ndarray]) -> np.ndarray:
+        """Hand frames (n, T) [counts] from each patch's frames (n, rows, cols)."""
+        first = np.asarray(frames[self.patch_names[0]])
+        n = first.size // int(self._rows[0] * self._cols[0])
+        out = np.empty((n, self.n_taxels))
+        for p, name in enumerate(self.patch_names):
+            size = int(self._rows[p] * self._cols[p])
+            out[:, self._offset[p] : self._offset[p] + size] = np.asarray(frames[name]).reshape(
+                n, size
+            )
+        return out
+
+    def joint_array(self, joints, n: int) -> np.ndarray:
+        """Joint positions (n, J) [rad or m] from a mapping (a fixed pose), an array, or
+        None (every joint at 0); a mapping is checked against the skin."""
+        if joints is None:
+            return np.zeros((n, len(self.joint_names)))
+        if isinstance(joints, Mapping):
+            self.skin.link_poses(joints)  # names, values and limits checked there
+            row = np.array([float(joints.get(name, 0.0)) for name in self.joint_names])
+            return np.tile(row, (n, 1))
+        joints = np.asarray(joints, float).reshape(n, len(self.joint_names))
+        return joints
+
+    def locate(
+        self, counts, joints=None, *, fresh=None, time_s=None, patch_time_s=None,
+        first_frame: int = 0,
+    ):  # fmt: skip
+        """Contacts and wrenches of hand frames.
+
+        Parameters
+        ----------
+        counts : array_like, shape (n, T) or (T,)
+            Hand frames [counts] (:meth:`pack`).
+        joints : mapping, array (n, J) or None
+            The joint state (:meth:`joint_array`; columns in :attr:`joint_names`).
+        fresh : array of bool (n, P), optional
+            Which patches hold a new frame (default all).
+        time_s : array (n,), optional
+            Time of each hand frame [s] (default the frame index).
+        patch_time_s : array (n, P), optional
+            Time of each patch's frame in each hand frame [s] (a contact row's
+            ``time_s``; default the hand frame's).
+        """
+        counts = np.asarray(counts)
+        if counts.ndim == 1:
+            counts = counts[np.newaxis]
+        if counts.ndim != 2 or counts.shape[1] != self.n_taxels:
+            raise TactsenseInputError(
+                f"hand frames have shape {counts.shape}; expected (n, {self.n_taxels})"
+            )
+        if counts.dtype not in (np.float64,):
+            counts = counts.astype(np.float64)
+        n = len(counts)
+        q = np.ascontiguousarray(self.joint_array(joints, n))
+        n_patches = len(self.patch_names)
+        fresh = np.ones((n, n_patches), np.bool_) if fresh is None else np.asarray(fresh, bool)
+        capacity = max(16, int(fresh.sum()) * self.max_contacts)
+        out_i = np.empty((capacity, K.N_INT), np.int64)
+        out_f = np.empty((capacity, K.N_FLOAT))
+        n_links = len(self.links)
+        wrench_link = np.empty((n, n_links, 6))
+        wrench_total = np.empty((n, 6))
+        contacts_link = np.empty((n, n_links), np.int64)
+        with deferred_interrupts():
+            m = K.hand_block(
+                np.ascontiguousarray(counts), fresh, q, self._parent, self._jtype, self._origin,
+                self._axis, self._column, self._mode, self._offset, self._rows, self._cols,
+                self._link, self._kernel_of, self._param, self._pose, self._graph_offset,
+                self._baseline, self._unusable, self._normals, self._positions, self._neighbours,
+                self._nb_offset, self._pt_kernel, self._pt_offset, self._k_amp, self._amp_step,
+                self._k_sig, self._sig_step, self._k_max, self._halves, *self._settings,
+                self._flag_bits, self._held, self._held_count, out_i, out_f, wrench_link,
+                wrench_total, contacts_link,
+            )  # fmt: skip
+        time_s = np.arange(first_frame, first_frame + n, dtype=float) if time_s is None else time_s
+        time_s = np.asarray(time_s, float)
+        frame, patch = out_i[:m, K.I_FRAME], out_i[:m, K.I_PATCH]
+        row_time = time_s[frame] if patch_time_s is None else np.asarray(patch_time_s)[frame, patch]
+        return self._tables(out_i[:m], out_f[:m], wrench_link, wrench_total, contacts_link,
+                            time_s, row_time, first_frame)  # fmt: skip
+
+    def _tables(
+        self, out_i, out_f, wrench_link, wrench_total, contacts_link, time_s, row_time, first
+    ):
+        frame = out_i[:, K.I_FRAME]
+        force = out_f[:, K.F_FORCE]
+        contacts = {
+            "time_s": row_time,
+            "frame": frame + first,
+            "patch": np.asarray(self.patch_names, dtype=object)[out_i[:, K.I_PATCH]],
+            "link": np.asarray(self.links, dtype=object)[out_i[:, K.I_LINK]],
+            "contact": out_i[:, K.I_RANK],
+        }
+        for name, column in (
+            ("x_mm", K.F_XS), ("y_mm", K.F_YS), ("z_mm", K.F_ZS), ("x_link_mm", K.F_XL),
+            ("y_link_mm", K.F_YL), ("z_link_mm", K.F_ZL), ("nx_link", K.F_NXL),
+            ("ny_link", K.F_NYL), ("nz_link", K.F_NZL), ("x_base_mm", K.F_XB),
+            ("y_base_mm", K.F_YB), ("z_base_mm", K.F_ZB), ("nx_base", K.F_NXB),
+            ("ny_base", K.F_NYB), ("nz_base", K.F_NZB),
+        ):  # fmt: skip
+            contacts[name] = out_f[:, column].copy()
+        contacts["force_n"] = force.copy()
+        for frame_name, column in (("link", K.F_NXL), ("base", K.F_NXB)):
+            for a, axis in enumerate("xyz"):
+                contacts[f"f{axis}_{frame_name}_n"] = -force * out_f[:, column + a]
+        contacts["row"] = out_f[:, K.F_ROW].copy()
+        contacts["col"] = out_f[:, K.F_COL].copy()
+        contacts["peak"] = out_f[:, K.F_PEAK].copy()
+        contacts["taxels"] = out_i[:, K.I_TAXELS].copy()
+        contacts["flags"] = out_i[:, K.I_FLAGS].copy()
+        n = len(time_s)
+        links = np.flatnonzero(self._link_has_patch)
+        per = len(links) + 1
+        w = np.empty((n, per, 6))
+        w[:, :-1] = wrench_link[:, links]
+        w[:, -1] = wrench_total
+        held = np.empty((n, per), np.int64)
+        held[:, :-1] = contacts_link[:, links]
+        held[:, -1] = contacts_link.sum(axis=1)
+        names = np.asarray([self.links[i] for i in links] + [self.skin.base_link], dtype=object)
+        what = np.asarray(["link"] * len(links) + ["total"], dtype=object)
+        wrenches = {
+            "time_s": np.repeat(time_s, per),
+            "frame": np.repeat(np.arange(first, first + n), per),
+            "link": np.tile(names, n),
+            "what": np.tile(what, n),
+            "contacts": held.ravel(),
+        }
+        for c, name in enumerate(("force_x_n", "force_y_n", "force_z_n", "torque_x_n_mm",
+                                  "torque_y_n_mm", "torque_z_n_mm")):  # fmt: skip
+            wrenches[name] = w[:, :, c].ravel()
+        return RobotContacts(contacts, wrenches, n)
+
+
+def hand_frame_grid(streams_time_s: Mapping[str, np.ndarray], patch_names) -> tuple:
+    """Hand frames of streams at their own rates: at each frame of the fastest stream
+    (the most frames; ties: the first in skin order), each patch's latest frame at or
+    before it. Returns ``(time_s (n,), index (n, P) frame of each patch or -1, fresh (n, P))``."""
+    present = [name for name in patch_names if name in streams_time_s]
+    if not present:
+        raise TactsenseInputError("the recording holds no stream of the skin's patches")
+    lead = max(present, key=lambda name: len(streams_time_s[name]))
+    times = np.asarray(streams_time_s[lead], float)
+    index = np.full((len(times), len(patch_names)), -1, np.int64)
+    for p, name in enumerate(patch_names):
+        if name in streams_time_s:
+            own = np.asarray(streams_time_s[name], float)
+            index[:, p] = np.searchsorted(own, times, side="right") - 1
+    fresh = index >= 0
+    fresh[1:] &= index[1:] != index[:-1]
+    return times, index, fresh
+
+
+def locate_robot_recording(
+    recording,
+    *,
+    joints: JointStates | Mapping[str, float] | None = None,
+    baseline_frames: int = 5,
+    threshold: float | None = None,
+    max_contacts: int = 8,
+    block_frames: int = 4096,
+    progress: Callable[[int, int], None] | None = None,
+) -> RobotContacts:
+    """Contacts and wrenches of a whole robot recording
+    (:class:`~tactsense.io.robot_recording.RobotRecording`).
+
+    Each patch's baseline is the median of its stream's first ``baseline_frames`` frames
+    (untouched). ``joints``: a fixed pose (joint name -> position [rad or m]), a
+    :class:`JointStates` interpolated to the hand frames' times, or None (all at 0).
+    """
+    if not (isinstance(baseline_frames, int) and baseline_frames >= 1):
+        raise TactsenseInputError(
+            f"baseline_frames must be a positive integer; got {baseline_frames!r}"
+        )
+    skin = recording.skin
+    names = [p.name for p in skin.patches]
+    streams = recording.streams
+    baselines = {}
+    for patch in skin.patches:
+        stream = streams.get(patch.name)
+        if stream is None or len(stream.frames) == 0:
+            baselines[patch.name] = np.full(patch.sensor.shape, np.nan)
+            continue
+        baselines[patch.name] = np.nanmedian(
+            np.asarray(stream.frames[:baseline_frames], float), axis=0
+        )
+    locator = HandLocator(skin, baselines, threshold=threshold, max_contacts=max_contacts)
+    times, index, fresh = hand_frame_grid(
+        {name: s.time_s for name, s in streams.items() if len(s.frames)}, names
+    )
+    fixed = None if isinstance(joints, JointStates) else joints
+    if fixed is not None:
+        skin.link_poses(fixed)
+    parts = []
+    n = len(times)
+    for lo in range(0, n, block_frames):
+        hi = min(lo + block_frames, n)
+        counts = np.empty((hi - lo, locator.n_taxels))
+        for p, name in enumerate(names):
+            off = locator._offset[p]
+            size = skin.patches[p].n_taxels
+            if name not in streams or not len(streams[name].frames):
+                counts[:, off : off + size] = locator._baseline[off : off + size]
+                continue
+            rows = np.maximum(index[lo:hi, p], 0)
+            counts[:, off : off + size] = np.asarray(streams[name].frames[rows], float).reshape(
+                hi - lo, size
+            )
+        if isinstance(joints, JointStates):
+            q = joints.at(times[lo:hi], locator.joint_names)
+        else:
+            q = locator.joint_array(fixed, hi - lo)
+        own_time = np.zeros((hi - lo, len(names)))
+        for p, name in enumerate(names):
+            if name in streams and len(streams[name].frames):
+                own_time[:, p] = np.asarray(streams[name].time_s)[np.maximum(index[lo:hi, p], 0)]
+        parts.append(
+            locator.locate(counts, q, fresh=fresh[lo:hi], time_s=times[lo:hi],
+                           patch_time_s=own_time, first_frame=lo)
+        )  # fmt: skip
+        if progress is not None:
+            progress(hi, n)
+    if not parts:
+        parts.append(locator.locate(np.empty((0, locator.n_taxels))))
+    result = RobotContacts.concatenate(parts)
+    if isinstance(joints, JointStates):
+        result.warnings.extend(joints.coverage_warnings(times))
+    return result
+
+
+def locate_robot_reference(skin: RobotSkin, frames, baselines, *, joints=None, threshold=None):
+    """The straightforward path: :func:`~tactsense.estimate.contacts.find_contacts` on
+    each patch's frames (n, rows, cols), each contact placed with
+    :meth:`~tactsense.robot.RobotSkin.link_poses` (a fixed pose) and the patch's origin;
+    the same contact columns as :meth:`HandLocator.locate` (without the wrenches)."""
+    from tactsense.estimate.contacts import default_threshold, find_contacts
+
+    poses = skin.link_poses(joints)
+    rows = {key: [] for key in ("frame", "patch", "link", "contact", "sensor", "link_xyz",
+                                "base_xyz", "force_n")}  # fmt: skip
+    for patch in skin.patches:
+        value = threshold if threshold is not None else default_threshold(patch.sensor)
+        table = find_contacts(
+            frames[patch.name], patch.sensor, baseline=baselines[patch.name], threshold=value
+        )
+        point = np.column_stack([table.x_mm, table.y_mm, table.z_mm])
+        origin = patch.origin.matrix()
+        in_link = point @ origin[:3, :3].T + 1e3 * origin[:3, 3]
+        pose = poses[patch.link]
+        in_base = in_link @ pose[:3, :3].T + 1e3 * pose[:3, 3]
+        rows["frame"].append(table.frame)
+        rows["patch"].append(np.full(len(table.frame), patch.name, dtype=object))
+        rows["link"].append(np.full(len(table.frame), patch.link, dtype=object))
+        rows["contact"].append(table.contact)
+        rows["sensor"].append(point)
+        rows["link_xyz"].append(in_link)
+        rows["base_xyz"].append(in_base)
+        rows["force_n"].append(table.force_n)
+    return {key: np.concatenate(value) for key, value in rows.items()}
+
+
+__all__ = [
+    "CONTACT_COLUMNS",
+    "WRENCH_COLUMNS",
+    "HandLocator",
+    "JointStates",
+    "RobotContacts",
+    "hand_frame_grid",
+    "locate_robot_recording",
+    "locate_robot_reference",
+]
