@@ -253,7 +253,7 @@ def test_pressed_patch_is_hottest_and_its_link_is_in_the_table(page, tmp_path): 
         links = page.locator("#link-rows tr")
         assert links.count() == 1
         assert links.nth(0).locator("td").nth(0).text_content() == "finger"
-        assert links.nth(0).locator("td").nth(3).text_content() == "finger_pad"
+        assert links.nth(0).locator("td").nth(4).text_content() == "finger_pad"
         rows = page.locator("#contact-rows tr")
         assert rows.count() == 1
         cells = [rows.nth(0).locator("td").nth(k).text_content() for k in range(7)]
@@ -498,3 +498,63 @@ def test_the_view_command_live_from_several_devices(page, tmp_path):  # noqa: F8
     err = view.stderr.read()
     assert view.returncode == 0, err
     assert "hand frames shown" in err and "Traceback" not in err
+
+
+def _last_message(path, state_kind=None, joints=JOINTS):
+    """The feed's message at the recording's end, shown in one tick (no thread, no page)."""
+    feed = RobotRecordingFeed(path, joint_positions=joints)
+    try:
+        if state_kind is not None:  # the per-patch state, for comparison
+            from tactsense.view.robot_state import HandState
+
+            baselines = {
+                name: np.median(s.file.frames(0, 5).astype(float), axis=0)
+                for name, s in feed.streams.items()
+            }
+            feed.state = HandState(feed.skin, joints, baselines=baselines,
+                                   frame_period_s=feed.period_s)  # fmt: skip
+        feed._publish = lambda text: None
+        feed.time_s = feed.end_s
+        feed._tick()
+        return feed, feed._latest
+    finally:
+        feed.close_streams()
+
+
+def test_the_robot_estimator_and_each_patchs_own_agree(tmp_path):
+    from tactsense.view.robot_estimator import HandEstimatorState
+    from tactsense.view.robot_state import HandState
+
+    path = hand_recording(tmp_path / "run", pressed="finger_pad")
+    feed, hand = _last_message(path)
+    assert type(feed.state) is HandEstimatorState  # pads and a point set: it takes them
+    _, each = _last_message(path, state_kind=HandState)
+    assert [(c["patch"], c["link"]) for c in hand["contacts"]] == [("finger_pad", "finger")]
+    assert [(c["patch"], c["link"]) for c in each["contacts"]] == [("finger_pad", "finger")]
+    a, b = hand["contacts"][0], each["contacts"][0]
+    # the same interpolation on the same frame and baseline (the per-patch one's drift
+    # baseline has not moved: the press is the only signal); 1e-3 mm and 1e-4 N: the
+    # messages' rounding and the two code paths' arithmetic
+    np.testing.assert_allclose(a["position_mm"], b["position_mm"], atol=1e-3)
+    np.testing.assert_allclose(a["normal"], b["normal"], atol=1e-6)
+    assert a["force_n"] == pytest.approx(b["force_n"], abs=1e-4)
+    # the link's wrench: r x F about the link's origin, in the link's frame, by hand
+    row = hand["links"][0]
+    r = np.asarray(a["position_link_mm"])
+    force_link = np.array([0.0, 0.0, a["force_n"]])  # the pad's -z normal, pressing +z
+    np.testing.assert_allclose(row["force_link_n"], force_link, atol=1e-5)
+    np.testing.assert_allclose(row["torque_link_n_mm"], np.cross(r, force_link), atol=1e-3)
+
+
+def test_a_kind_the_robot_estimator_does_not_place_falls_back_to_each_patch(tmp_path):
+    from tactsense.sensor import preset as sensor_preset
+    from tactsense.view.robot_state import HandState
+
+    skin = small_hand()
+    finger = dataclasses.replace(skin.patches[0], sensor=sensor_preset("initial"))
+    skin = dataclasses.replace(skin, patches=(finger, *skin.patches[1:]))
+    path = hand_recording(tmp_path / "run", skin, pressed=None, seconds=0.3)
+    feed, message = _last_message(path)
+    assert type(feed.state) is HandState
+    assert "each patch" in feed.layout()["estimator"]
+    assert message["contacts"] == []

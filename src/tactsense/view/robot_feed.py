@@ -24,98 +24,13 @@ import numpy as np
 
 from tactsense.io.recording import RecordingReader
 from tactsense.io.robot_recording import read_manifest, read_robot_skin, stream_path
-from tactsense.robot import RobotSkin
 from tactsense.stream.reader import StreamFrame
-from tactsense.view.locators import view_locator
-from tactsense.view.robot_scene import contacts_by_link, contacts_in_base, scene_layout
+from tactsense.view.robot_estimator import hand_state
+from tactsense.view.robot_scene import scene_layout
+from tactsense.view.robot_state import HandState  # noqa: F401 - its home was here
 
 DISPLAY_HZ = 30.0
 """Hand frames shown per second at most [Hz]."""
-
-
-def _signal(locator) -> list | None:
-    deflection = getattr(locator, "last_deflection", None)
-    if deflection is None:
-        return None
-    values = np.nan_to_num(np.asarray(deflection, dtype=float).reshape(-1), nan=0.0)
-    return np.round(values, 5).tolist()
-
-
-class HandState:
-    """The latest frame, signal and contacts of every patch, and the message that shows them.
-
-    ``contacts_of`` turns one patch's estimate into contacts in the base frame
-    (:func:`~tactsense.view.robot_scene.contacts_in_base` by default: the one place
-    to swap in the robot estimator).
-    """
-
-    def __init__(
-        self,
-        skin: RobotSkin,
-        joint_positions: Mapping[str, float] | None = None,
-        *,
-        baseline_frames: int = 5,
-        threshold: float | None = None,
-        frame_period_s: float | None = None,
-        baselines: Mapping[str, np.ndarray] | None = None,
-        contacts_of=contacts_in_base,
-    ):
-        self.skin = skin
-        self.joints = dict(joint_positions or {})
-        self.poses = skin.link_poses(self.joints)
-        self.contacts_of = contacts_of
-        baselines = baselines or {}
-        self.locators = {
-            patch.name: view_locator(
-                patch.sensor,
-                baseline_frames=baseline_frames,
-                threshold=threshold,
-                frame_period_s=frame_period_s,
-                baseline=baselines.get(patch.name),
-            )
-            for patch in skin.patches
-        }
-        self.signals: dict[str, list | None] = {p.name: None for p in skin.patches}
-        self.contacts: dict[str, list[dict]] = {p.name: [] for p in skin.patches}
-        self.frame_times: dict[str, float | None] = {p.name: None for p in skin.patches}
-        self.frames_seen: dict[str, int] = {p.name: 0 for p in skin.patches}
-
-    def update(self, patch: str, frame: StreamFrame) -> None:
-        """Run ``patch``'s estimator on ``frame`` and keep its signal and contacts."""
-        estimate = self.locators[patch](frame)
-        self.signals[patch] = _signal(self.locators[patch])
-        self.contacts[patch] = self.contacts_of(self.skin, self.poses, patch, estimate)
-        self.frame_times[patch] = float(frame.device_time_s)
-        self.frames_seen[patch] += 1
-
-    @property
-    def signal_floor(self) -> float:
-        """The smallest signal the page's colour scale tops at [-]: twice the largest
-        contact threshold of the patches (noise alone stays dark)."""
-        thresholds = [getattr(loc, "threshold", None) for loc in self.locators.values()]
-        thresholds = [float(t) for t in thresholds if t is not None and math.isfinite(t)]
-        return 2.0 * max(thresholds) if thresholds else 0.01
-
-    def reset(self) -> None:
-        """Forget the tracks (a jump in time)."""
-        for locator in self.locators.values():
-            locator.reset()
-
-    def message(self, serial: int, time_s: float, extra: dict | None = None) -> dict:
-        contacts = [c for p in self.skin.patches for c in self.contacts[p.name]]
-        message = {
-            "type": "robot_frame",
-            "serial": serial,
-            "time_s": round(float(time_s), 6),
-            "signals": self.signals,
-            "frame_times_s": self.frame_times,
-            "contacts": contacts,
-            "links": contacts_by_link(self.skin, contacts),
-            "frame_counts": self.frames_seen,
-        }
-        if extra:
-            message.update(extra)
-        return message
 
 
 class _PatchStream:
@@ -215,7 +130,7 @@ class RobotRecordingFeed:
                 if len(first):
                     baselines[name] = np.median(np.asarray(first, dtype=float), axis=0)
             self.period_s = 1.0 / float(display_hz)
-            self.state = HandState(
+            self.state = hand_state(
                 self.skin,
                 joint_positions if joint_positions is not None else manifest.get("joints"),
                 baseline_frames=baseline_frames,
@@ -257,6 +172,7 @@ class RobotRecordingFeed:
     def layout(self) -> dict:
         message = scene_layout(self.skin, self.state.joints)
         message["signal_floor"] = self.state.signal_floor
+        message["estimator"] = self.state.estimator
         message["source"] = {"kind": self.kind, "name": self.name, "streams": sorted(self.streams)}
         with self._lock:
             message["playback"] = self._playback()
@@ -333,15 +249,16 @@ class RobotRecordingFeed:
                 self.state.reset()
                 self._jumped = False
             t = self.time_s
+            frames = {}
             for name, stream in self.streams.items():
                 index = stream.advance_to(t)
                 if index is None:
                     continue
                 counts, device_t = stream.frame(index)
-                frame = StreamFrame(
+                frames[name] = StreamFrame(
                     index % 65536, index, device_t, time.time(), time.perf_counter(), counts
                 )
-                self.state.update(name, frame)
+            self.state.update_all(frames)
             self.frames_in += 1
             message = self.state.message(self.frames_in, t - self.start_s)
             message["playback"] = self._playback()

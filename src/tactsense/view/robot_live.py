@@ -19,8 +19,9 @@ from collections.abc import Mapping
 import numpy as np
 
 from tactsense.stream.reader import StreamFrame
-from tactsense.view.robot_feed import DISPLAY_HZ, HandState
+from tactsense.view.robot_feed import DISPLAY_HZ
 from tactsense.view.robot_scene import scene_layout
+from tactsense.view.robot_state import HandState
 
 
 class RobotLiveFeed:
@@ -70,6 +71,7 @@ class RobotLiveFeed:
     def layout(self) -> dict:
         message = scene_layout(self.skin, self.state.joints)
         message["signal_floor"] = self.state.signal_floor
+        message["estimator"] = self.state.estimator
         message["source"] = {"kind": self.kind, "name": self.name}
         with self._lock:
             message["latest"] = self._latest

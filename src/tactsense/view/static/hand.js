@@ -183,7 +183,10 @@
   function tables(message) {
     const linkRows = document.getElementById("link-rows");
     linkRows.replaceChildren();
-    for (const l of message.links) cells(linkRows, [[l.link, 1], [l.n_contacts], [fmt(l.force_n, 3)], [l.patches.join(", "), 1]]);
+    for (const l of message.links) {
+      const torque = l.torque_link_n_mm ? Math.hypot(...l.torque_link_n_mm) : null;
+      cells(linkRows, [[l.link, 1], [l.n_contacts], [fmt(l.force_n, 3)], [fmt(torque, 1)], [l.patches.join(", "), 1]]);
+    }
     document.getElementById("no-contacts").hidden = message.links.length > 0;
     const contactRows = document.getElementById("contact-rows");
     contactRows.replaceChildren();
@@ -217,6 +220,7 @@
     const joints = Object.entries(layout.joints);
     document.getElementById("joints").textContent = joints.length ? joints.map(([k, v]) => `${k}=${v}`).join(", ") : "all at 0";
     document.getElementById("mm-per-n").textContent = layout.arrow_mm_per_n;
+    document.getElementById("estimator").textContent = layout.estimator || "–";
     const rows = document.getElementById("patch-rows");
     rows.replaceChildren();
     for (const p of layout.patches) {
