@@ -330,6 +330,8 @@ def test_live_from_several_devices(page, tmp_path):  # noqa: F811
         assert links.count() == 1
         assert links.nth(0).locator("td").nth(0).text_content() == "finger"
         assert page.locator("#devices").text_content().count("ended") == 3
+        # each patch's own estimator took the baselines, then the robot estimator took over
+        assert "robot estimator" in page.text_content("#estimator")
     finally:
         if server is not None:
             server.stop()

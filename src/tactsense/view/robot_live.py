@@ -18,7 +18,9 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from tactsense._validation import TactsenseInputError
 from tactsense.stream.reader import StreamFrame
+from tactsense.view.robot_estimator import HandEstimatorState
 from tactsense.view.robot_feed import DISPLAY_HZ
 from tactsense.view.robot_scene import scene_layout
 from tactsense.view.robot_state import HandState
@@ -42,13 +44,10 @@ class RobotLiveFeed:
         self.skin = sources.skin
         self.name = ", ".join(f"{d}={u}" for d, u in sources.sources.items())
         self.period_s = 1.0 / float(display_hz)
-        self.state = HandState(
-            self.skin,
-            joint_positions,
-            baseline_frames=baseline_frames,
-            threshold=threshold,
-            frame_period_s=self.period_s,
-        )
+        self._options = {"baseline_frames": baseline_frames, "threshold": threshold,
+                         "frame_period_s": self.period_s}  # fmt: skip
+        self.state: HandState = HandState(self.skin, joint_positions, **self._options)
+        self._may_switch = True  # to the robot estimator, once every patch has a baseline
         self.frames_in = 0
         self.device_frames = 0
         self.status = "starting"
@@ -88,13 +87,43 @@ class RobotLiveFeed:
         }
 
     def command(self, message: dict) -> None:
-        """``{"command": "rezero"}``: every patch takes its baseline anew."""
-        if message.get("command") == "rezero":
-            with self._lock:
-                for locator in self.state.locators.values():
-                    rezero = getattr(locator, "rezero", None)
-                    if rezero is not None:
-                        rezero()
+        """``{"command": "rezero"}``: every patch takes its baseline anew (the robot
+        estimator's fixed baselines too: each patch's own estimator takes them, then the
+        robot estimator takes over again)."""
+        if message.get("command") != "rezero":
+            return
+        with self._lock:
+            if isinstance(self.state, HandEstimatorState):
+                fresh = HandState(self.skin, self.state.joints, **self._options)
+                fresh.frames_seen = dict(self.state.frames_seen)
+                self.state, self._may_switch = fresh, True
+                return
+            for locator in self.state.locators.values():
+                rezero = getattr(locator, "rezero", None)
+                if rezero is not None:
+                    rezero()
+
+    def _switch(self) -> None:
+        """Hand the patches to the robot estimator once each has its baseline (where it
+        takes the skin): one compiled call a tick instead of one estimate a patch."""
+        locators = self.state.locators
+        if not all(getattr(locator, "ready", False) for locator in locators.values()):
+            return
+        self._may_switch = False
+        baselines = {name: getattr(locator, "baseline", None) for name, locator in locators.items()}
+        if any(baseline is None for baseline in baselines.values()):
+            return
+        try:
+            hand = HandEstimatorState(self.skin, self.state.joints, baselines=baselines,
+                                      threshold=self._options["threshold"])  # fmt: skip
+        except TactsenseInputError:  # a kind the robot estimator does not place
+            return
+        # what each patch shows stays until its next frame
+        hand.frames_seen = dict(self.state.frames_seen)
+        hand.signals = dict(self.state.signals)
+        hand.contacts = dict(self.state.contacts)
+        hand.frame_times = dict(self.state.frame_times)
+        self.state = hand
 
     def _set_status(self, status: str, error: str | None = None) -> None:
         self.status, self.error = status, error
@@ -126,9 +155,15 @@ class RobotLiveFeed:
 
     def _tick(self) -> None:
         pending, self._pending = self._pending, {}
-        for patch, item in pending.items():
-            self._take(patch, item)
+        now = time.perf_counter()
+        frames = {
+            patch: StreamFrame(sequence, sequence, device_s, aligned_s, now, counts)
+            for patch, (counts, aligned_s, device_s, sequence) in pending.items()
+        }
         with self._lock:
+            self.state.update_all(frames)
+            if self._may_switch and not isinstance(self.state, HandEstimatorState):
+                self._switch()
             self.frames_in += 1
             message = self.state.message(self.frames_in, time.time())
             message["devices"] = self.devices()
@@ -148,7 +183,8 @@ class RobotLiveFeed:
                 )
                 for patch, counts in frame.patches.items():
                     item = (np.asarray(counts), frame.aligned_time_s, device_s, frame.sequence)
-                    if getattr(self.state.locators[patch], "ready", True):
+                    locators = getattr(self.state, "locators", {})
+                    if getattr(locators.get(patch), "ready", True):
                         self._pending[patch] = item
                     else:  # the baseline: every one of a patch's first frames, not the newest
                         self._take(patch, item)

@@ -110,6 +110,7 @@ class HandState:
             "contacts": contacts,
             "links": self.links_table(contacts),
             "frame_counts": self.frames_seen,
+            "estimator": self.estimator,
         }
         if extra:
             message.update(extra)

@@ -240,6 +240,7 @@
 
   function setFrame(message) {
     state.latest = message;
+    if (message.estimator) document.getElementById("estimator").textContent = message.estimator;
     tables(message);
     if (message.playback) setPlayback(message.playback);
     redraw();
