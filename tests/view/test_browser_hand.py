@@ -153,21 +153,27 @@ def _projected(camera, points_mm):
 def _check_taxels_drawn_in_place(view, skin, joints):
     state = view.evaluate(
         "() => { const s = window.tactsenseHand; return {layout: s.layout, camera: s.camera,"
-        " screen: s.screen, width: s.layout && document.getElementById('scene').width,"
+        " screen: s.screen, positions: s.positions, normals: s.normals,"
+        " width: document.getElementById('scene').width,"
         " height: document.getElementById('scene').height}; }"
     )
     expected = skin.taxels_in_base(joints)
     drawn = {p["name"]: p for p in state["layout"]["patches"]}
     assert list(drawn) == [p.name for p in skin.patches]
+    for patch in skin.patches:
+        in_link, _ = patch.taxels_in_link()
+        np.testing.assert_allclose(drawn[patch.name]["positions_link_mm"], in_link * 1e3,
+                                   atol=2e-4)  # fmt: skip
     for name, (positions_m, normals) in expected.items():
-        # the layout's positions are rounded to 1e-4 mm on the wire
-        np.testing.assert_allclose(drawn[name]["positions_mm"], positions_m * 1e3, atol=2e-4)
-        np.testing.assert_allclose(drawn[name]["normals"], normals, atol=2e-6)
+        # where the page put them (its link poses applied to the link-frame positions, both
+        # rounded on the wire: 1e-4 mm and 1e-9)
+        np.testing.assert_allclose(state["positions"][name], positions_m * 1e3, atol=1e-3)
+        np.testing.assert_allclose(state["normals"][name], normals, atol=1e-6)
         screen = np.asarray(state["screen"][name])
         assert screen.shape == (len(positions_m), 3)
         # the same formula evaluated twice in float64: agreement to well under a pixel
         np.testing.assert_allclose(
-            screen, _projected(state["camera"], np.asarray(drawn[name]["positions_mm"])),
+            screen, _projected(state["camera"], np.asarray(state["positions"][name])),
             atol=1e-6,
         )  # fmt: skip
         assert (screen[:, 2] > 0).all(), f"{name}: taxels behind the camera"
@@ -560,3 +566,43 @@ def test_a_kind_the_robot_estimator_does_not_place_falls_back_to_each_patch(tmp_
     assert type(feed.state) is HandState
     assert "each patch" in feed.layout()["estimator"]
     assert message["contacts"] == []
+
+
+def test_the_hand_moves_as_the_recordings_joint_states_say(page, tmp_path):  # noqa: F811
+    from tactsense.estimate._robot_joints import read_joint_csv
+
+    skin = small_hand()
+    path = hand_recording(tmp_path / "run", skin, pressed="finger_pad")
+    table = tmp_path / "joints.csv"
+    table.write_text("time_s,knuckle\n0,0\n1,1.2\n")  # 0 -> 1.2 rad over the second
+    server = RobotViewServer(
+        RobotRecordingFeed(path, joint_states=read_joint_csv(table), speed=4.0)
+    )
+    server.start()
+    try:
+        page.goto(server.url)
+        _wait_ended(page)
+        for t in (0.25, 0.75):
+            page.evaluate(
+                "(t) => { const s = document.getElementById('seek'); s.value = t;"
+                " s.dispatchEvent(new Event('input')); }",
+                t,
+            )
+            page.wait_for_function(
+                "(t) => { const s = window.tactsenseHand; return s.latest"
+                " && Math.abs(s.latest.playback.time_s - t) < 1e-9"
+                " && s.drawnSerial === s.latest.serial && !s.dirty; }",
+                arg=t,
+            )
+            # the joint state interpolated at t (the streams' clock starts at 0)
+            joints = {"knuckle": 1.2 * t}
+            _check_taxels_drawn_in_place(page, skin, joints)
+            assert page.text_content("#joints") == f"knuckle={1.2 * t:g}"
+        # the contact moves with its link: at 0.75 s, where the kinematics put the press
+        contact = page.evaluate("() => window.tactsenseHand.latest.contacts[0]")
+        pose = skin.patch_pose("finger_pad", {"knuckle": 0.9})
+        centre = pressed_centre_mm(skin, "finger_pad")
+        pressed = pose[:3, :3] @ np.array([*centre, 0.0]) * 1e-3 + pose[:3, 3]
+        np.testing.assert_allclose(contact["position_mm"], pressed * 1e3, atol=2.0)
+    finally:
+        server.stop()

@@ -92,6 +92,10 @@ class _PatchStream:
 class RobotRecordingFeed:
     """A robot recording played back: play, pause, seek [s] and speed from the page.
 
+    The hand stands at ``joint_positions`` [rad or m] (default the manifest's ``joints``
+    where it holds them, else every joint at 0), or moves as ``joint_states`` (a
+    :class:`~tactsense.estimate.robot.JointStates`, on the recording's clock) says.
+
     The interface of :class:`~tactsense.view.feed.Feed` the server uses: ``start``,
     ``stop``, ``layout``, ``command``, ``health``, ``frames_in``.
     """
@@ -103,6 +107,7 @@ class RobotRecordingFeed:
         path: str | Path,
         *,
         joint_positions: Mapping[str, float] | None = None,
+        joint_states=None,
         speed: float = 1.0,
         baseline_frames: int = 5,
         threshold: float | None = None,
@@ -130,6 +135,11 @@ class RobotRecordingFeed:
                 if len(first):
                     baselines[name] = np.median(np.asarray(first, dtype=float), axis=0)
             self.period_s = 1.0 / float(display_hz)
+            firsts = [s.time_of(0) for s in self.streams.values() if s.n_frames]
+            self.joint_states = joint_states
+            if joint_states is not None:
+                joint_states.check(self.skin)
+                joint_positions = self._joints_at(min(firsts) if firsts else 0.0)
             self.state = hand_state(
                 self.skin,
                 joint_positions if joint_positions is not None else manifest.get("joints"),
@@ -159,6 +169,11 @@ class RobotRecordingFeed:
         self._thread: threading.Thread | None = None
         self._jumped = False
         self._latest: dict | None = None
+
+    def _joints_at(self, t: float) -> dict[str, float]:
+        """The joint state at ``t`` [s] on the recording's clock, interpolated."""
+        names = self.skin.movable_joints
+        return dict(zip(names, map(float, self.joint_states.at([t], names)[0]), strict=True))
 
     # ---- what pages receive ---------------------------------------------------------
     def _playback(self) -> dict:
@@ -249,6 +264,8 @@ class RobotRecordingFeed:
                 self.state.reset()
                 self._jumped = False
             t = self.time_s
+            if self.joint_states is not None:
+                self.state.set_joints(self._joints_at(t))
             frames = {}
             for name, stream in self.streams.items():
                 index = stream.advance_to(t)

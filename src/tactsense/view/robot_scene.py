@@ -65,6 +65,17 @@ def _mm(array: np.ndarray) -> list:
     return np.round(np.asarray(array, dtype=float) * 1e3, 4).tolist()
 
 
+def link_poses_message(poses: Mapping[str, np.ndarray]) -> dict[str, list]:
+    """Every link's pose in the base frame for the page: the 3 x 4 ``[R | t]`` row by
+    row, ``t`` in mm (12 numbers a link)."""
+    out = {}
+    for link, pose in poses.items():
+        rows = np.asarray(pose, dtype=float)[:3].copy()
+        rows[:, 3] *= 1e3
+        out[link] = np.round(rows, 9).reshape(-1).tolist()
+    return out
+
+
 def scene_layout(skin: RobotSkin, joint_positions: Mapping[str, float] | None = None) -> dict:
     """What the page draws of the skin at a joint state (JSON-ready).
 
@@ -73,10 +84,12 @@ def scene_layout(skin: RobotSkin, joint_positions: Mapping[str, float] | None = 
     dict
         ``skin``, ``base_link``, ``joints`` (the state [rad or m]), ``patches`` (per patch:
         ``name``, ``link``, ``device``, ``kind``, ``n_taxels``, ``positions_mm`` (N, 3)
-        and ``normals`` (N, 3) in the base frame, taxels in the order of a frame's
-        counts flattened row by row), ``links`` (name and origin [mm] in the base frame),
-        ``bones`` (parent and child link origins of each joint [mm]), ``colormap``
-        (name and its 256-entry RGB table), ``arrow_mm_per_n``.
+        and ``normals`` (N, 3) in the base frame, ``positions_link_mm`` and
+        ``normals_link`` in the link's frame, taxels in the order of a frame's counts
+        flattened row by row), ``links`` (name and origin [mm] in the base frame),
+        ``bones`` (parent and child links and origins of each joint [mm]), ``link_poses``
+        (:func:`link_poses_message`), ``colormap`` (name and its 256-entry RGB table),
+        ``arrow_mm_per_n``.
     """
     joints = dict(joint_positions or {})
     poses = skin.link_poses(joints)
@@ -84,6 +97,7 @@ def scene_layout(skin: RobotSkin, joint_positions: Mapping[str, float] | None = 
     patches = []
     for patch in skin.patches:
         positions, normals = taxels[patch.name]
+        in_link, normals_in_link = patch.taxels_in_link()
         patches.append(
             {
                 "name": patch.name,
@@ -93,12 +107,16 @@ def scene_layout(skin: RobotSkin, joint_positions: Mapping[str, float] | None = 
                 "n_taxels": int(patch.n_taxels),
                 "positions_mm": _mm(positions),
                 "normals": np.round(normals, 6).tolist(),
+                "positions_link_mm": _mm(in_link),
+                "normals_link": np.round(normals_in_link, 9).tolist(),
             }
         )
     links = [{"name": link, "origin_mm": _mm(poses[link][:3, 3])} for link in skin.links]
     bones = [
         {
             "joint": joint.name,
+            "parent": joint.parent,
+            "child": joint.child,
             "from_mm": _mm(poses[joint.parent][:3, 3]),
             "to_mm": _mm(poses[joint.child][:3, 3]),
         }
@@ -114,6 +132,7 @@ def scene_layout(skin: RobotSkin, joint_positions: Mapping[str, float] | None = 
         "patches": patches,
         "links": links,
         "bones": bones,
+        "link_poses": link_poses_message(poses),
         "colormap": {"name": COLORMAP, "lut": lut.tolist()},
         "arrow_mm_per_n": ARROW_MM_PER_N,
     }

@@ -13,7 +13,7 @@ import numpy as np
 from tactsense.robot import RobotSkin
 from tactsense.stream.reader import StreamFrame
 from tactsense.view.locators import view_locator
-from tactsense.view.robot_scene import contacts_by_link, contacts_in_base
+from tactsense.view.robot_scene import contacts_by_link, contacts_in_base, link_poses_message
 
 
 def _signal(locator) -> list | None:
@@ -66,6 +66,12 @@ class HandState:
         self.frame_times: dict[str, float | None] = {p.name: None for p in skin.patches}
         self.frames_seen: dict[str, int] = {p.name: 0 for p in skin.patches}
 
+    def set_joints(self, joint_positions: Mapping[str, float]) -> None:
+        """Move the hand to a new joint state [rad or m] (contacts found from now on are
+        placed with it)."""
+        self.poses = self.skin.link_poses(joint_positions)
+        self.joints = dict(joint_positions)
+
     estimator = "each patch's own (single-array, tracked)"
     """What the contacts come from, as the page says it."""
 
@@ -111,6 +117,8 @@ class HandState:
             "links": self.links_table(contacts),
             "frame_counts": self.frames_seen,
             "estimator": self.estimator,
+            "joints": {name: round(float(v), 9) for name, v in self.joints.items()},
+            "link_poses": link_poses_message(self.poses),
         }
         if extra:
             message.update(extra)

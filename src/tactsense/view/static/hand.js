@@ -14,6 +14,9 @@
     latest: null,
     camera: null, // {yaw, pitch, distance, target: [x, y, z] mm, focal px, cx, cy}
     home: null,
+    positions: {}, // patch -> [[x, y, z] mm, ...] every taxel in the base frame now
+    normals: {}, // patch -> [[x, y, z], ...] their outward normals in the base frame now
+    poses: null, // link -> [R | t] row by row (t in mm): the hand's joint state now
     screen: {}, // patch -> [[x px, y px, depth mm], ...] where each taxel was drawn
     colourIndex: {}, // patch -> colour-map index (0-255) each taxel was drawn with
     arrows: [], // [{patch, link, tail: [x, y], head: [x, y]}] as drawn
@@ -72,6 +75,19 @@
     };
   }
 
+  // ---- the joint state: taxels from their links' frames into the base frame -------------
+  const place = (m, p) => [0, 1, 2].map((r) => m[4 * r] * p[0] + m[4 * r + 1] * p[1] + m[4 * r + 2] * p[2] + m[4 * r + 3]);
+  const turn = (m, v) => [0, 1, 2].map((r) => m[4 * r] * v[0] + m[4 * r + 1] * v[1] + m[4 * r + 2] * v[2]);
+
+  function setPoses(poses) {
+    state.poses = poses;
+    for (const patch of state.layout.patches) {
+      const m = poses[patch.link];
+      state.positions[patch.name] = patch.positions_link_mm.map((p) => place(m, p));
+      state.normals[patch.name] = patch.normals_link.map((v) => turn(m, v));
+    }
+  }
+
   // ---- drawing --------------------------------------------------------------------------
   function pitchOf(positions) {
     // the median distance of a taxel to its nearest neighbour [mm] (sizes the dots)
@@ -107,7 +123,8 @@
       ctx.strokeStyle = "#b0bec5";
       ctx.lineWidth = 3;
       for (const bone of layout.bones) {
-        const a = project(bone.from_mm), b = project(bone.to_mm);
+        const from = state.poses[bone.parent], to = state.poses[bone.child];
+        const a = project([from[3], from[7], from[11]]), b = project([to[3], to[7], to[11]]);
         if (a[2] <= 0 || b[2] <= 0) continue;
         ctx.beginPath(); ctx.moveTo(a[0], a[1]); ctx.lineTo(b[0], b[1]); ctx.stroke();
       }
@@ -119,7 +136,7 @@
     for (const patch of layout.patches) {
       const values = signals[patch.name];
       const screen = [], colours = [];
-      patch.positions_mm.forEach((p, i) => {
+      state.positions[patch.name].forEach((p, i) => {
         const s = project(p);
         const v = values ? values[i] : 0;
         const index = Math.max(0, Math.min(255, Math.round((255 * v) / top)));
@@ -211,14 +228,19 @@
     });
   }
 
+  function showJoints(joints) {
+    const items = Object.entries(joints);
+    document.getElementById("joints").textContent = items.length ? items.map(([k, v]) => `${k}=${v}`).join(", ") : "all at 0";
+  }
+
   function setLayout(layout) {
     for (const patch of layout.patches) patch.pitch_mm = pitchOf(patch.positions_mm);
     state.layout = layout;
+    setPoses(layout.link_poses);
     document.getElementById("skin").textContent = layout.skin;
     document.getElementById("source").textContent = layout.source ? layout.source.name : "";
     document.getElementById("base-link").textContent = layout.base_link;
-    const joints = Object.entries(layout.joints);
-    document.getElementById("joints").textContent = joints.length ? joints.map(([k, v]) => `${k}=${v}`).join(", ") : "all at 0";
+    showJoints(layout.joints);
     document.getElementById("mm-per-n").textContent = layout.arrow_mm_per_n;
     document.getElementById("estimator").textContent = layout.estimator || "–";
     const rows = document.getElementById("patch-rows");
@@ -240,6 +262,8 @@
 
   function setFrame(message) {
     state.latest = message;
+    if (message.link_poses && state.layout) setPoses(message.link_poses);
+    if (message.joints) showJoints(message.joints);
     if (message.estimator) document.getElementById("estimator").textContent = message.estimator;
     tables(message);
     if (message.playback) setPlayback(message.playback);
