@@ -643,7 +643,14 @@ HAND_VIEW_BAD = [
     ("view RUN --foxglove 0", "--foxglove applies to one array"),
     ("view RUN --timeout 1", "--timeout applies to devices"),
     ("view RUN RUN", "give --skin SKIN"),
-    ("view REC --joints knuckle=0", "--joints applies to a robot skin's view"),
+    ("view REC --joints knuckle=0", "--joints and --joints-csv apply to a robot skin's view"),
+    ("view REC --joints-csv DIR/a_file", "--joints and --joints-csv apply to a robot skin's"),
+    ("view RUN --joints-csv DIR/no_such.csv", "--joints-csv: no file at"),
+    ("view RUN --joints-csv DIR/a_file", "expected 'time_s' then one column per joint"),
+    ("view RUN --joints-csv DIR/bogus_joints.csv", "joint 'bogus' is not a movable joint"),
+    ("view RUN --joints-csv DIR/far_joints.csv", "outside its limits"),
+    ("view RUN --joints knuckle=0 --joints-csv DIR/a_file", "give the joint state once"),
+    ("view --skin hand4 loop:// --joints-csv DIR/a_file", "--joints-csv applies to a recording"),
     ("view --skin hand4 socket://127.0.0.1:1 --speed 2", "--speed applies to recordings"),
     ("view --skin bogus socket://127.0.0.1:1", "'bogus' is neither a preset"),
     ("view --skin hand4 a b c d e f", "6 sources for the 5 devices of 'hand4'"),
@@ -659,7 +666,14 @@ def test_hand_view_bad_input(workspace, line, names):
     run = workspace / "hand_run"
     if not run.exists():
         hand_recording(run, pressed=None, seconds=0.1)
-    args = line.replace("RUN", str(run)).replace("REC", str(workspace / "rec.h5")).split()
+        (workspace / "bogus_joints.csv").write_text("time_s,bogus\n0,0\n1,0\n")
+        (workspace / "far_joints.csv").write_text("time_s,knuckle\n0,0\n1,3\n")
+    args = (
+        line.replace("RUN", str(run))
+        .replace("REC", str(workspace / "rec.h5"))
+        .replace("DIR", str(workspace))
+        .split()
+    )
     result = _invoke_with_deadline(args)
     _check(result, names)
 

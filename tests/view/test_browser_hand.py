@@ -606,3 +606,44 @@ def test_the_hand_moves_as_the_recordings_joint_states_say(page, tmp_path):  # n
         np.testing.assert_allclose(contact["position_mm"], pressed * 1e3, atol=2.0)
     finally:
         server.stop()
+
+
+def test_the_view_command_takes_the_recordings_own_joint_states(tmp_path):
+    import json
+    import subprocess
+    import sys
+    import time
+    import urllib.request
+
+    path = hand_recording(tmp_path / "run", pressed=None, seconds=0.5)
+    (path / "joint_states.csv").write_text("time_s,knuckle\n0,0.2\n1,1.2\n")
+    view = subprocess.Popen(
+        [sys.executable, "-m", "tactsense", "view", str(path), "--speed", "4"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        address = view.stdout.readline().strip()
+        assert address.startswith("http://127.0.0.1:"), view.stderr.read()
+        deadline = time.monotonic() + 30
+        while time.monotonic() < deadline:
+            feed = json.loads(urllib.request.urlopen(address + "api/health", timeout=5).read())
+            if feed["feed"]["status"] == "ended":
+                break
+            time.sleep(0.1)
+        feed = feed["feed"]
+        assert feed["status"] == "ended"
+        # at the end of the streams: the last frame of the slowest stream (the dome at
+        # 50 Hz: 0.48 s) or later; the joint interpolated there
+        end = feed["playback"]["time_s"]
+        assert feed["joints"]["knuckle"] == pytest.approx(0.2 + end, abs=1e-9)
+    finally:
+        view.send_signal(2)
+        try:
+            view.wait(10)
+        except subprocess.TimeoutExpired:
+            view.kill()
+    err = view.stderr.read()
+    assert "joint states from" in err and "joint_states.csv" in err, err
+    assert view.returncode == 0 and "Traceback" not in err, err

@@ -16,11 +16,23 @@ ROBOT_SKIN_HELP = (
     "devices, as DEVICE=SOURCE items or plain sources in the skin's device order; the "
     "page draws the hand in 3-D. A robot recording (a folder) names its own skin."
 )
+ROBOT_JOINTS_CSV_HELP = (
+    "A recording's joint states over time: a CSV with a time_s column [s, on the "
+    "recording's clock] and one column per joint [rad; m for a prismatic joint], "
+    "interpolated to each shown frame. Default: the recording's own joint_states.csv "
+    "where it holds one."
+)
 ROBOT_JOINTS_HELP = (
     "The hand's joint state, NAME=POSITION items separated by commas [rad; m for a "
     "prismatic joint], each within its joint's limits; joints left out are at 0. "
-    "Default: the recording's joint state if its manifest holds one, else every joint at 0."
+    "Default: the recording's joint states (--joints-csv), else its manifest's joint state "
+    "where it holds one, else every joint at 0."
 )
+
+
+JOINT_STATES_FILE = "joint_states.csv"
+"""A robot recording's joint states over time, where it holds them (the iCub import
+writes one: ``time_s`` then one column per joint [rad])."""
 
 
 def is_robot_view(sources: list[str], skin: str | None) -> bool:
@@ -36,6 +48,7 @@ def view_robot(
     *,
     skin: str | None,
     joints: str | None,
+    joints_csv: Path | None,
     port: int,
     host: str | None,
     open_browser: bool,
@@ -68,15 +81,32 @@ def view_robot(
         fail("--speed applies to recordings; devices send at their own rate")
     if recording and len(sources) != 1:
         fail("give one robot recording (a folder), or --skin SKIN and its devices' sources")
+    if not recording and joints_csv is not None:
+        fail("--joints-csv applies to a recording; live, give the joint state with --joints")
+    if joints is not None and joints_csv is not None:
+        fail("give the joint state once: --joints (fixed) or --joints-csv (over time)")
+    if joints_csv is not None and not joints_csv.is_file():
+        fail(f"--joints-csv: no file at {joints_csv}")
     try:
         if recording:
             from tactsense.view.robot_feed import RobotRecordingFeed
 
             hand = read_robot_skin(sources[0])
             state = None if joints is None else parse_joint_state(joints, hand)
+            own = Path(sources[0]) / JOINT_STATES_FILE
+            if joints is None and joints_csv is None and own.is_file():
+                joints_csv = own
+            table = None
+            if joints_csv is not None:
+                from tactsense.estimate._robot_joints import read_joint_csv
+
+                table = read_joint_csv(joints_csv)
+                table.check(hand)
+                console.print(f"joint states from {joints_csv}", soft_wrap=True)
             feed = RobotRecordingFeed(
                 Path(sources[0]),
                 joint_positions=state,
+                joint_states=table,
                 speed=speed,
                 baseline_frames=baseline_frames,
                 threshold=threshold,

@@ -32,6 +32,7 @@ from tactsense.cli._live_sources import (
     _open_reader,
 )
 from tactsense.cli._robot_view import (  # r7-hand3d
+    ROBOT_JOINTS_CSV_HELP,
     ROBOT_JOINTS_HELP,
     ROBOT_SKIN_HELP,
     is_robot_view,
@@ -91,6 +92,9 @@ def view(
     joints: Annotated[
         str | None, typer.Option("--joints", metavar="NAME=RAD,...", help=ROBOT_JOINTS_HELP)
     ] = None,
+    joints_csv: Annotated[
+        Path | None, typer.Option("--joints-csv", metavar="FILE", help=ROBOT_JOINTS_CSV_HELP)
+    ] = None,
     # ---- /robot view (r7-hand3d) ----
 ) -> None:
     """Show the sensor in a web browser: a live stream as it arrives, or a recording played
@@ -115,14 +119,17 @@ def view(
     # ---- robot view (r7-hand3d): a robot recording or a skin's devices, in 3-D ----
     if is_robot_view(source, skin):
         view_robot(
-            source, skin=skin, joints=joints, port=port, host=host, open_browser=open_browser,
+            source, skin=skin, joints=joints, joints_csv=joints_csv, port=port, host=host,
+            open_browser=open_browser,
             speed=speed, baseline_frames=baseline_frames, threshold=threshold, timeout=timeout,
             refused={"--calibration": calibration is not None, "--sensor": sensor is not None,
                      "--foxglove": foxglove is not None},
         )  # fmt: skip
         return
-    if joints is not None:
-        fail("--joints applies to a robot skin's view (a robot recording, or --skin)")
+    if joints is not None or joints_csv is not None:
+        fail(
+            "--joints and --joints-csv apply to a robot skin's view (a robot recording, or --skin)"
+        )
     if len(source) != 1:
         fail("several sources are a robot skin's devices: give --skin SKIN")
     source = source[0]

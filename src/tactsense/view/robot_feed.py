@@ -201,6 +201,8 @@ class RobotRecordingFeed:
             "status": self.status,
             "error": self.error,
             "patch_frames": dict(self.state.frames_seen),
+            "joints": dict(self.state.joints),
+            "playback": self._playback(),
         }
 
     def _set_status(self, status: str, error: str | None = None) -> None:
