@@ -97,7 +97,7 @@ def hand_recording(path, skin=None, pressed="finger_pad", *, seconds=1.0, force_
     streams = {}
     for k, patch in enumerate(skin.patches):
         spec = patch.sensor
-        n = round(seconds * spec.electronics.scan_rate_hz)
+        n = max(round(seconds * spec.electronics.scan_rate_hz), 6)  # a baseline's frames
         force = np.zeros((n, 1))
         if patch.name == pressed:
             force[n // 3 :] = force_n
@@ -218,7 +218,8 @@ def test_every_taxel_is_drawn_at_its_place_on_its_link(page, tmp_path):  # noqa:
 
 def test_the_preset_hand_at_a_joint_state(page, tmp_path):  # noqa: F811
     skin = load_skin("hand4")
-    joints = {name: 0.3 for name in skin.movable_joints}
+    limits = {j.name: (j.lower, j.upper) for j in skin.joints if j.type != "fixed"}
+    joints = {name: min(max(0.3, low), high) for name, (low, high) in limits.items()}
     path = hand_recording(tmp_path / "run", skin, pressed=None, seconds=0.1)
     server = _serve(path, joints=joints)
     try:
