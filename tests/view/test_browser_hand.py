@@ -89,7 +89,9 @@ def pressed_centre_mm(skin, patch):
     return skin.patch(patch).sensor.taxel_positions_mm()[:, :2].mean(axis=0)
 
 
-def hand_recording(path, skin=None, pressed="finger_pad", *, seconds=1.0, force_n=1.0):
+def hand_recording(
+    path, skin=None, pressed="finger_pad", *, seconds=1.0, force_n=1.0, scenario=None
+):
     """A robot recording of ``skin`` (default :func:`small_hand`): every patch at rest with
     its read noise, ``pressed`` (None: none) under a 3 mm sphere at its middle with
     ``force_n`` from a third of the way in."""
@@ -110,6 +112,7 @@ def hand_recording(path, skin=None, pressed="finger_pad", *, seconds=1.0, force_
             time_s=np.arange(n) / spec.electronics.scan_rate_hz,
             sample_offset_s=np.zeros(spec.shape),
             sensor=spec,
+            scenario=scenario or {},
         )
     return write_robot_recording(path, RobotRecording(skin, streams, description="test"))
 
@@ -648,3 +651,23 @@ def test_the_view_command_takes_the_recordings_own_joint_states(tmp_path):
     err = view.stderr.read()
     assert "joint states from" in err and "joint_states.csv" in err, err
     assert view.returncode == 0 and "Traceback" not in err, err
+
+
+def test_a_simulations_joint_state_is_the_default(tmp_path):
+    path = hand_recording(tmp_path / "run", pressed=None, seconds=0.2,
+                          scenario={"kind": "grasp", "joints": {"knuckle": 0.7}})  # fmt: skip
+    feed = RobotRecordingFeed(path)
+    try:
+        assert feed.state.joints == {"knuckle": 0.7}
+        layout = feed.layout()
+        expected = small_hand().taxels_in_base({"knuckle": 0.7})
+        for patch in layout["patches"]:
+            np.testing.assert_allclose(patch["positions_mm"], expected[patch["name"]][0] * 1e3,
+                                       atol=2e-4)  # fmt: skip
+    finally:
+        feed.close_streams()
+    feed = RobotRecordingFeed(path, joint_positions={"knuckle": 0.1})  # --joints wins
+    try:
+        assert feed.state.joints == {"knuckle": 0.1}
+    finally:
+        feed.close_streams()

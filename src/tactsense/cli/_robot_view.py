@@ -25,8 +25,8 @@ ROBOT_JOINTS_CSV_HELP = (
 ROBOT_JOINTS_HELP = (
     "The hand's joint state, NAME=POSITION items separated by commas [rad; m for a "
     "prismatic joint], each within its joint's limits; joints left out are at 0. "
-    "Default: the recording's joint states (--joints-csv), else its manifest's joint state "
-    "where it holds one, else every joint at 0."
+    "Default: the recording's joint states (--joints-csv), else its manifest's or its "
+    "simulation's joint state where it holds one, else every joint at 0."
 )
 
 

@@ -93,7 +93,8 @@ class RobotRecordingFeed:
     """A robot recording played back: play, pause, seek [s] and speed from the page.
 
     The hand stands at ``joint_positions`` [rad or m] (default the manifest's ``joints``
-    where it holds them, else every joint at 0), or moves as ``joint_states`` (a
+    where it holds them, else those of the streams' scenario (a simulated grasp's), else
+    every joint at 0), or moves as ``joint_states`` (a
     :class:`~tactsense.estimate.robot.JointStates`, on the recording's clock) says.
 
     The interface of :class:`~tactsense.view.feed.Feed` the server uses: ``start``,
@@ -140,9 +141,11 @@ class RobotRecordingFeed:
             if joint_states is not None:
                 joint_states.check(self.skin)
                 joint_positions = self._joints_at(min(firsts) if firsts else 0.0)
+            if joint_positions is None:
+                joint_positions = manifest.get("joints") or self._scenario_joints()
             self.state = hand_state(
                 self.skin,
-                joint_positions if joint_positions is not None else manifest.get("joints"),
+                joint_positions,
                 baseline_frames=baseline_frames,
                 threshold=threshold,
                 frame_period_s=self.period_s,
@@ -169,6 +172,19 @@ class RobotRecordingFeed:
         self._thread: threading.Thread | None = None
         self._jumped = False
         self._latest: dict | None = None
+
+    def _scenario_joints(self) -> dict | None:
+        """The joint state a simulation put in its streams' scenario (a simulated grasp's
+        ``joints``), if one did."""
+        for stream in self.streams.values():
+            try:
+                scenario = json.loads(str(stream.file.attrs.get("scenario_json", "{}")))
+            except ValueError:
+                continue
+            joints = scenario.get("joints") if isinstance(scenario, dict) else None
+            if isinstance(joints, dict) and joints:
+                return joints
+        return None
 
     def _joints_at(self, t: float) -> dict[str, float]:
         """The joint state at ``t`` [s] on the recording's clock, interpolated."""
