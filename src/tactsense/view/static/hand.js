@@ -9,6 +9,7 @@
   const ctx = canvas.getContext("2d");
   const FOV_RAD = (40 * Math.PI) / 180; // vertical field of view of the camera
   const MAX_ARROW_MM = 40;
+  const AXIS_MM = 20; // length of the base frame's axes as drawn
   const state = {
     layout: null,
     latest: null,
@@ -67,7 +68,7 @@
     return {
       yaw: (-60 * Math.PI) / 180,
       pitch: (35 * Math.PI) / 180,
-      distance: (1.15 * radius) / Math.sin(FOV_RAD / 2),
+      distance: (1.02 * radius) / Math.sin(FOV_RAD / 2), // the bounding sphere fits whatever the turn
       target,
       focal,
       cx: canvas.width / 2,
@@ -128,6 +129,17 @@
         if (a[2] <= 0 || b[2] <= 0) continue;
         ctx.beginPath(); ctx.moveTo(a[0], a[1]); ctx.lineTo(b[0], b[1]); ctx.stroke();
       }
+    }
+    // the base frame's axes at its origin (x red, y green, z blue; AXIS_MM long)
+    const origin = project([0, 0, 0]);
+    if (origin[2] > 0) {
+      ctx.lineWidth = 2;
+      [[AXIS_MM, 0, 0, "#e53935"], [0, AXIS_MM, 0, "#43a047"], [0, 0, AXIS_MM, "#1e88e5"]].forEach(([x, y, z, colour]) => {
+        const end = project([x, y, z]);
+        if (end[2] <= 0) return;
+        ctx.strokeStyle = colour;
+        ctx.beginPath(); ctx.moveTo(origin[0], origin[1]); ctx.lineTo(end[0], end[1]); ctx.stroke();
+      });
     }
     // every taxel, far ones first (the painter's order)
     const dots = [];
