@@ -781,3 +781,56 @@ def test_handloc_bad_options(workspace, handloc_run, line, names):
 
 
 # ---- /r7-handloc ----
+
+
+# ---- view of a hand (r7-hand3d) ----
+HAND_VIEW_BAD = [
+    # (command line, what the message must say); RUN: a robot recording of a small hand
+    # with one joint, 'knuckle' in [-0.2, 1.6] rad
+    ("view RUN --joints bogus=1", "--joints: joint position for 'bogus': not a movable"),
+    ("view RUN --joints knuckle=abc", "--joints knuckle='abc': not a number"),
+    ("view RUN --joints knuckle=nan", "outside its limits"),
+    ("view RUN --joints knuckle=9", "--joints: joint 'knuckle' at 9.0: outside its limits"),
+    ("view RUN --joints knuckle", "expected NAME=POSITION"),
+    ("view RUN --joints knuckle=0.1,knuckle=0.2", "names joint 'knuckle' twice"),
+    ("view RUN --sensor pad16", "--sensor applies to one array"),
+    ("view RUN --calibration REC", "--calibration applies to one array"),
+    ("view RUN --foxglove 0", "--foxglove applies to one array"),
+    ("view RUN --timeout 1", "--timeout applies to devices"),
+    ("view RUN RUN", "give --skin SKIN"),
+    ("view REC --joints knuckle=0", "--joints and --joints-csv apply to a robot skin's view"),
+    ("view REC --joints-csv DIR/a_file", "--joints and --joints-csv apply to a robot skin's"),
+    ("view RUN --joints-csv DIR/no_such.csv", "--joints-csv: no file at"),
+    ("view RUN --joints-csv DIR/a_file", "expected 'time_s' then one column per joint"),
+    ("view RUN --joints-csv DIR/bogus_joints.csv", "joint 'bogus' is not a movable joint"),
+    ("view RUN --joints-csv DIR/far_joints.csv", "outside its limits"),
+    ("view RUN --joints knuckle=0 --joints-csv DIR/a_file", "give the joint state once"),
+    ("view --skin hand4 loop:// --joints-csv DIR/a_file", "--joints-csv applies to a recording"),
+    ("view --skin hand4 socket://127.0.0.1:1 --speed 2", "--speed applies to recordings"),
+    ("view --skin bogus socket://127.0.0.1:1", "'bogus' is neither a preset"),
+    ("view --skin hand4 a b c d e f", "6 sources for the 5 devices of 'hand4'"),
+    ("view --skin hand4 --joints bogus=0 loop://", "--joints: joint position for 'bogus'"),
+    ("view --skin hand4 socket://127.0.0.1:1", "cannot open socket://127.0.0.1:1"),
+]
+
+
+@pytest.mark.parametrize("line, names", HAND_VIEW_BAD, ids=[line for line, _ in HAND_VIEW_BAD])
+def test_hand_view_bad_input(workspace, line, names):
+    from tests.view.test_browser_hand import hand_recording
+
+    run = workspace / "hand_run"
+    if not run.exists():
+        hand_recording(run, pressed=None, seconds=0.1)
+        (workspace / "bogus_joints.csv").write_text("time_s,bogus\n0,0\n1,0\n")
+        (workspace / "far_joints.csv").write_text("time_s,knuckle\n0,0\n1,3\n")
+    args = (
+        line.replace("RUN", str(run))
+        .replace("REC", str(workspace / "rec.h5"))
+        .replace("DIR", str(workspace))
+        .split()
+    )
+    result = _invoke_with_deadline(args)
+    _check(result, names)
+
+
+# ---- /view of a hand (r7-hand3d) ----

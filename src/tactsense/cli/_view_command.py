@@ -31,18 +31,27 @@ from tactsense.cli._live_sources import (
     TimeoutOption,
     _open_reader,
 )
+from tactsense.cli._robot_view import (  # r7-hand3d
+    ROBOT_JOINTS_CSV_HELP,
+    ROBOT_JOINTS_HELP,
+    ROBOT_SKIN_HELP,
+    is_robot_view,
+    view_robot,
+)
 from tactsense.estimate.contacts.array_calibration import load_calibration
 from tactsense.sensor import load_sensor
 
 
 def view(
     source: Annotated[
-        str,
+        list[str],  # r7-hand3d: several sources with --skin (a hand's devices)
         typer.Argument(
             help="A recording (.h5 from 'tactsense record' or 'simulate') to play back, or "
             "a device: a serial port, a pty path, socket://127.0.0.1:PORT or any pyserial "
             "URL; or lsl:NAME, a Lab Streaming Layer frames outlet; or FORMAT:URL for a "
-            "device speaking text lines, marker-framed bytes or JustFloat (docs/devices.md)."
+            "device speaking text lines, marker-framed bytes or JustFloat (docs/devices.md). "
+            "A robot recording (a folder), or with --skin the skin's devices "
+            "(docs/robot.md)."
         ),
     ],
     port: Annotated[
@@ -78,6 +87,15 @@ def view(
         str | None, typer.Option("--foxglove", metavar="[HOST:]PORT", help=FOXGLOVE_HELP)
     ] = None,
     # ---- /foxglove live (r6-fox) ----
+    # ---- robot view (r7-hand3d) ----
+    skin: Annotated[str | None, typer.Option("--skin", help=ROBOT_SKIN_HELP)] = None,
+    joints: Annotated[
+        str | None, typer.Option("--joints", metavar="NAME=RAD,...", help=ROBOT_JOINTS_HELP)
+    ] = None,
+    joints_csv: Annotated[
+        Path | None, typer.Option("--joints-csv", metavar="FILE", help=ROBOT_JOINTS_CSV_HELP)
+    ] = None,
+    # ---- /robot view (r7-hand3d) ----
 ) -> None:
     """Show the sensor in a web browser: a live stream as it arrives, or a recording played
     back (play, pause, step, seek, speed).
@@ -98,6 +116,24 @@ def view(
     from tactsense.view import LiveFeed, RecordingFeed, ViewServer, view_locator
     from tactsense.view.server import is_loopback
 
+    # ---- robot view (r7-hand3d): a robot recording or a skin's devices, in 3-D ----
+    if is_robot_view(source, skin):
+        view_robot(
+            source, skin=skin, joints=joints, joints_csv=joints_csv, port=port, host=host,
+            open_browser=open_browser,
+            speed=speed, baseline_frames=baseline_frames, threshold=threshold, timeout=timeout,
+            refused={"--calibration": calibration is not None, "--sensor": sensor is not None,
+                     "--foxglove": foxglove is not None},
+        )  # fmt: skip
+        return
+    if joints is not None or joints_csv is not None:
+        fail(
+            "--joints and --joints-csv apply to a robot skin's view (a robot recording, or --skin)"
+        )
+    if len(source) != 1:
+        fail("several sources are a robot skin's devices: give --skin SKIN")
+    source = source[0]
+    # ---- /robot view (r7-hand3d) ----
     foxglove_address = check_foxglove(foxglove)  # r6-fox
     listen = "127.0.0.1" if host is None else host.strip()
     if not listen:
