@@ -77,8 +77,10 @@ def main() -> int:
         repo_id=f"local/{args.dataset.name}", root=args.dataset,
         delta_timestamps={k: [-1 / meta.fps, 0.0] for k in keys},
     )[len(dataset) - 1]  # fmt: skip
+    last = dataset[len(dataset) - 1]
     for key in keys:
-        assert tuple(window[key].shape)[0] == 2, key
+        assert window[key].shape[0] == 2, key
+        assert np.array_equal(window[key][-1].numpy(), last[key].numpy()), key
     print("delta_timestamps windows of every patch: OK")
     print("LeRobotDataset loaded the robot dataset: OK")
     return 0
