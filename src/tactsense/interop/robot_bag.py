@@ -263,3 +263,21 @@ def read_robot_bag(source: str | Path, *, skin=None):
         "skipped": skipped,
     }
     return recording, summary
+
+
+def is_robot_mcap(source: str | Path) -> bool:
+    """Whether ``source`` is an MCAP file a robot export wrote (its ``tactsense.robot``
+    metadata record); False for anything unreadable (the importers say why)."""
+    source = Path(source)
+    if not (source.is_file() and source.suffix.lower() == ".mcap"):
+        return False
+    try:
+        from mcap.reader import make_reader
+
+        with open(source, "rb") as stream:
+            summary = make_reader(stream).get_summary()
+    except Exception:  # not an MCAP file or a damaged one: the plain importer says what
+        return False
+    return summary is not None and any(
+        index.name == ROBOT_METADATA for index in summary.metadata_indexes
+    )

@@ -163,14 +163,21 @@ def _write_csv(path: Path, header: list[str], columns: list[np.ndarray]) -> None
             writer.writerow([repr(float(v)) for v in row])
 
 
-def write_icub_hand(path: str | Path, recording, joints: dict) -> Path:
+def write_icub_hand(path: str | Path, recording, joints: dict, *, overwrite: bool = False) -> Path:
     """Write the robot recording with ``icub_encoders.csv`` and ``joint_states.csv`` in its
-    folder, all or nothing (a temporary folder moved into place)."""
-    from tactsense.io.robot_recording import write_robot_recording
+    folder, all or nothing (a temporary folder moved into place). An existing folder is
+    replaced only with ``overwrite`` and only if it is a robot recording."""
+    from tactsense.io.robot_recording import is_robot_recording, write_robot_recording
 
     path = Path(path)
     if path.exists():
-        raise FileExistsError(f"{path} exists; choose a new folder for the recording")
+        if not overwrite:
+            raise FileExistsError(f"{path} exists; pass --force to replace it")
+        if not is_robot_recording(path):
+            raise ImportError_(
+                f"{path} exists and is not a robot recording; it is not replaced, whatever "
+                "--force says"
+            )
     temporary = path.with_name(f".{path.name}.{os.getpid()}.partial")
     shutil.rmtree(temporary, ignore_errors=True)
     try:
@@ -189,6 +196,8 @@ def write_icub_hand(path: str | Path, recording, joints: dict) -> Path:
                 ["time_s", *positions],
                 [time_s, *positions.values()],
             )
+        if path.exists():
+            shutil.rmtree(path)
         os.replace(temporary, path)
     except BaseException:
         shutil.rmtree(temporary, ignore_errors=True)
