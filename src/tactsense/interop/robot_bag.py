@@ -54,7 +54,7 @@ class _Collector:
         self.stamps: dict[str, list] = {}
         self.messages = 0
 
-    def add(self, topic: str, sensors, stamp_s: float) -> None:
+    def add(self, topic: str, sensors, stamp_ns: int) -> None:
         self.messages += 1
         entries = [(str(_get(s, "name")), _get(s, "values")) for s in sensors]
         routed = [(name, values) for name, values in entries if name in self.by_name]
@@ -78,7 +78,7 @@ class _Collector:
                     f"carries {values.size} values"
                 )
             self.frames.setdefault(name, []).append(values)
-            self.stamps.setdefault(name, []).append(stamp_s)
+            self.stamps.setdefault(name, []).append(stamp_ns)
 
 
 def _get(obj, name):
@@ -147,7 +147,7 @@ def _read_mcap_file(source: Path, skin) -> tuple:
             for _, channel, _, ros in reader.iter_decoded_messages(
                 topics=states, log_time_order=True
             ):
-                stamp = ros.header.stamp.sec + ros.header.stamp.nanosec * 1e-9
+                stamp = ros.header.stamp.sec * 1_000_000_000 + ros.header.stamp.nanosec
                 collector.add(channel.topic, ros.sensors, stamp)
     except ImportError_:
         raise
@@ -177,7 +177,7 @@ def _read_bag(source: Path, skin) -> tuple:
                 raise ImportError_(f"{source}: no tactile_msgs/msg/TactileState topic in it")
             for connection, _, raw in reader.messages(connections=connections):
                 message = reader.deserialize(raw, connection.msgtype)
-                stamp = message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
+                stamp = message.header.stamp.sec * 1_000_000_000 + message.header.stamp.nanosec
                 collector.add(connection.topic, message.sensors, stamp)
     except AnyReaderError as error:
         raise ImportError_(f"{source} is not a readable rosbag2 bag ({error})") from None
@@ -217,15 +217,15 @@ def read_robot_bag(source: str | Path, *, skin=None):
         )
     if not collector.frames:
         raise ImportError_(f"{source}: no TactileState message in it")
-    firsts = [stamps[0] for stamps in collector.stamps.values()]
-    unix = min(firsts) >= UNIX_EPOCH_THRESHOLD_S
-    origin = min(firsts) if unix else 0.0
+    origin_ns = min(stamps[0] for stamps in collector.stamps.values())
+    unix = origin_ns * 1e-9 >= UNIX_EPOCH_THRESHOLD_S
     streams = {}
     for patch in collector.skin.patches:
         name = patch.name
         if name not in collector.frames:
             continue
-        stamps = np.asarray(collector.stamps[name], float)
+        stamps_ns = np.asarray(collector.stamps[name], np.int64)
+        stamps = stamps_ns * 1e-9
         frames = np.stack(collector.frames[name]).reshape(-1, *patch.sensor.shape)
         recording = build_recording(
             patch.sensor, list(frames), stamps, source=str(source),
@@ -233,7 +233,9 @@ def read_robot_bag(source: str | Path, *, skin=None):
             losses={k: int(v) for k, v in losses.get(name, {}).items()},
         )  # fmt: skip
         if unix:  # one origin for every stream
-            recording = dataclasses.replace(recording, host_time_s=stamps, time_s=stamps - origin)
+            recording = dataclasses.replace(
+                recording, host_time_s=stamps, time_s=(stamps_ns - origin_ns) * 1e-9
+            )
         exact = extras.get(name)
         if exact is not None and len(exact.get("time_s", ())) == len(frames):
             recording = dataclasses.replace(

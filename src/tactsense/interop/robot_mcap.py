@@ -195,16 +195,13 @@ def export_robot_mcap(
                     "source": path.name,
                 },
             )
-            from tactsense.stream.reader import LOSS_KINDS
-
             templates, channels = {}, {}
             for name in names:
                 patch = skin.patch(name)
                 losses = readers[name].losses
                 if losses:
                     raw.add_metadata(
-                        LOSSES_PREFIX + name,
-                        {k: str(int(losses.get(k, 0))) for k in LOSS_KINDS},
+                        LOSSES_PREFIX + name, {k: str(int(v)) for k, v in losses.items()}
                     )
 
                 def make_state(sec, nanosec, values, _name=name, _link=patch.link):
