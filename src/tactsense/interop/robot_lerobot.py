@@ -155,7 +155,8 @@ def export_robot_lerobot(
     start = max(t[0] for t in times.values())
     stop = max(t[-1] for t in times.values())
     n = int(np.floor((stop - start) * fps + 1e-9)) + 1
-    row_time = start + np.arange(n) / fps
+    since_start = np.arange(n) / fps
+    row_time = start + since_start
     split = int(episode_split or n)
     starts = list(range(0, n, split))
     episode = np.repeat(np.arange(len(starts)), [min(n, s + split) - s for s in starts])
@@ -169,7 +170,7 @@ def export_robot_lerobot(
         columns[patch_feature(name) + ".frame_index"] = pick.astype(np.int64)
         columns[patch_feature(name) + ".frame_time"] = times[name][pick] - start
         held[name] = int(np.count_nonzero(np.diff(pick) == 0))
-    columns["frame_time"] = row_time - start
+    columns["frame_time"] = since_start
     columns["timestamp"] = (frame_index / fps).astype(np.float32)
     columns["frame_index"] = frame_index.astype(np.int64)
     columns["episode_index"] = episode.astype(np.int64)
