@@ -265,3 +265,26 @@ def test_a_bag_that_names_no_patch_is_refused(tmp_path, topics, message):
 def test_topic_tokens_are_ros2_names():
     assert topic_token("palm-0.left") == "palm_0_left"
     assert topic_token("3rd_pad") == "_3rd_pad"
+
+
+@pytest.mark.parametrize("fmt", ["mcap", "lerobot"])
+def test_an_interrupted_export_leaves_nothing(simulated, tmp_path, monkeypatch, fmt):
+    """Ctrl-C in the middle of the work: exit status 1, no output, no temporary file."""
+    import tactsense.interop.robot_lerobot as robot_lerobot
+    import tactsense.interop.robot_mcap as robot_mcap
+
+    folder = simulated[0]
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    if fmt == "mcap":
+        monkeypatch.setattr(robot_mcap, "iter_patch_contacts", interrupted)
+        out = tmp_path / "hand.mcap"
+    else:
+        monkeypatch.setattr(robot_lerobot, "_write_json", interrupted)
+        out = tmp_path / "ds"
+    result = runner.invoke(app, ["export", str(folder), "--format", fmt, "--out", str(out)])
+    assert result.exit_code == 1, result.output
+    assert "interrupted" in result.output
+    assert list(tmp_path.iterdir()) == []
