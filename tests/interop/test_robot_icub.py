@@ -16,7 +16,7 @@ from typer.testing import CliRunner
 from tactsense.cli import app
 from tactsense.interop.robot_icub import ICUB_ENCODERS, encoder_joints
 from tactsense.io.robot_recording import read_robot_recording
-from tactsense.robot import Joint, Patch, RobotSkin, skin_preset
+from tactsense.robot import Joint, Patch, Pose, RobotSkin, skin_preset, skin_to_toml_string
 from tactsense.sensor import preset
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -45,11 +45,36 @@ def _by_hand(path: Path):
     return encoders, taxels
 
 
+def icub_like_skin() -> RobotSkin:
+    """The five fingertips on a hand with icub-models' joint names (four revolute joints
+    a finger, ``r_hand_<finger>_<k>_joint``), written here rather than taken from the
+    preset, limits wide enough for every encoder angle."""
+    tip = preset("icub_fingertip")
+    links, joints, patches = ["r_hand"], [], []
+    for finger in FINGERS:
+        parent = "r_hand"
+        for k in range(4):
+            link = f"r_hand_{finger}_{k}"
+            links.append(link)
+            joints.append(
+                Joint(name=f"{link}_joint", type="revolute", parent=parent, child=link,
+                      origin=Pose((0.02, 0.0, 0.0)), axis=(0, 0, 1), lower=-4.0, upper=4.0)
+            )  # fmt: skip
+            parent = link
+        patches.append(Patch(name=f"{finger}_tip", sensor=tip, link=parent, device="skin"))
+    return RobotSkin(
+        name="icub_like", base_link="r_hand", links=tuple(links), joints=tuple(joints),
+        patches=tuple(patches),
+    )  # fmt: skip
+
+
 @pytest.mark.parametrize("name", ["book_8.txt", "none_3.txt"])
 def test_a_trial_imports_as_one_hand(trials, tmp_path, name):
+    skin_file = tmp_path / "icub_like.toml"
+    skin_file.write_text(skin_to_toml_string(icub_like_skin()))
     out = tmp_path / "hand"
     result = runner.invoke(
-        app, ["import", str(trials / name), "--skin", "icub_hand", "--out", str(out)]
+        app, ["import", str(trials / name), "--skin", str(skin_file), "--out", str(out)]
     )
     assert result.exit_code == 0, result.output
     encoders, taxels = _by_hand(trials / name)
@@ -65,7 +90,7 @@ def test_a_trial_imports_as_one_hand(trials, tmp_path, name):
     kept = sum(len(s) for s in recording.streams.values())
     assert int(printed[1]) == int(printed[2]) == kept == taxels.shape[0] * 5
     assert f"{len(taxels)} slices of 5 fingertips" in result.output
-    # the encoders kept whole [deg]; the mapped ones as joint states [rad]
+    # the encoders kept whole [deg]; the joints they drive as joint states [rad]
     with open(out / "icub_encoders.csv") as stream:
         rows = list(csv.reader(stream))
     assert rows[0] == ["time_s", *(f"{e}_deg" for e in ICUB_ENCODERS)]
@@ -74,29 +99,42 @@ def test_a_trial_imports_as_one_hand(trials, tmp_path, name):
         rows = list(csv.reader(stream))
     values = np.array(rows[1:], float)
     column = {name: j for j, name in enumerate(rows[0])}
-    # iCub's joint 10 is the thumb's distal, 15 the ring and little fingers' (coupled)
-    np.testing.assert_allclose(values[:, column["thumb_distal_joint"]], np.deg2rad(encoders[:, 3]))
-    np.testing.assert_allclose(values[:, column["ring_distal_joint"]], np.deg2rad(encoders[:, 8]))
-    np.testing.assert_allclose(values[:, column["little_distal_joint"]], np.deg2rad(encoders[:, 8]))
+
+    def joint(name):
+        return values[:, column[f"r_hand_{name}_joint"]]
+
+    # iCub's joints 8-15 (columns 1-8 of the encoders): oppose, proximal, distal (halved
+    # over two joints), ..., pinky (a third to each of six joints)
+    np.testing.assert_allclose(joint("thumb_0"), np.deg2rad(encoders[:, 1]))
+    np.testing.assert_allclose(joint("thumb_1"), np.deg2rad(encoders[:, 2]))
+    np.testing.assert_allclose(joint("thumb_2") + joint("thumb_3"), np.deg2rad(encoders[:, 3]))
+    np.testing.assert_allclose(joint("index_1"), np.deg2rad(encoders[:, 4]))
+    np.testing.assert_allclose(joint("index_3"), np.deg2rad(encoders[:, 5]) / 2)
+    np.testing.assert_allclose(joint("middle_1"), np.deg2rad(encoders[:, 6]))
+    np.testing.assert_allclose(joint("middle_2"), np.deg2rad(encoders[:, 7]) / 2)
+    for k in (1, 2, 3):
+        np.testing.assert_allclose(joint(f"ring_{k}"), np.deg2rad(encoders[:, 8]) / 3)
+        np.testing.assert_allclose(joint(f"little_{k}"), np.deg2rad(encoders[:, 8]) / 3)
+    assert "r_hand_index_0_joint" not in column  # hand_finger: not mapped
+    assert len(column) == 1 + 16  # time, thumb 0-3, and joints 1-3 of the four fingers
 
 
 def test_encoder_mapping_by_joint_names():
-    """A joint named as iCub's (with a side prefix and a _joint suffix) is driven by its
-    encoder; a skin without such joints maps none."""
+    """A left hand's joints are found too; a skin without iCub's joints maps none."""
     tip = preset("icub_fingertip")
     joints = tuple(
-        Joint(name=f"r_{name}_joint", type="revolute", parent="hand", child=f"l{k}",
+        Joint(name=f"l_hand_{name}_joint", type="revolute", parent="hand", child=f"l{k}",
               axis=(0, 0, 1), lower=-3, upper=3)
-        for k, name in enumerate(("thumb_oppose", "index_proximal", "pinky"))
+        for k, name in enumerate(("thumb_0", "index_2", "little_3"))
     )  # fmt: skip
     skin = RobotSkin(
         name="t", base_link="hand", links=("hand", "l0", "l1", "l2"), joints=joints,
         patches=(Patch(name="p", sensor=tip, link="l0"),),
     )  # fmt: skip
     assert encoder_joints(skin) == {
-        "thumb_oppose": ["r_thumb_oppose_joint"],
-        "index_proximal": ["r_index_proximal_joint"],
-        "pinky": ["r_pinky_joint"],
+        "thumb_oppose": [("l_hand_thumb_0_joint", 1.0)],
+        "index_distal": [("l_hand_index_2_joint", 0.5)],
+        "pinky": [("l_hand_little_3_joint", pytest.approx(1 / 3))],
     }
     assert encoder_joints(skin_preset("hand4")) == {}
 

@@ -160,7 +160,10 @@ def import_robot(
         write_icub_hand(out, recording, joints, overwrite=force)
         lines = len(trial) * len(recording.streams)
         kept = sum(len(s) for s in recording.streams.values())
-        mapped = ", ".join(f"{e}->{'/'.join(j)}" for e, j in joints["mapping"].items())
+        mapped = ", ".join(
+            f"{e} -> " + "/".join(f"{j} x{share:.3g}" for j, share in driven)
+            for e, driven in joints["mapping"].items()
+        )
         console.print(
             f"wrote {out}: {len(trial)} slices of {len(recording.streams)} fingertips "
             f"({lines} taxel lines read, {kept} frames kept), the 9 joint encoders in "

@@ -8,14 +8,19 @@ slice ``k`` is at ``k x period_s`` (default 1 s: frame times are slice numbers).
 
 The 9 joint encoders of each slice (the hand's joints 7-15 of iCub's arm, in degrees,
 :data:`ICUB_ENCODERS`) are kept whole in ``icub_encoders.csv`` in the recording's folder
-(``time_s`` then one column per encoder [deg]). Those whose joint the skin has are also
-written, in radians, to ``joint_states.csv`` (``time_s`` then one column per joint of the
-skin [rad]), the joint-state table of the robot's frame (:data:`ENCODER_JOINTS` says which
-encoder drives which joints: a joint of the skin named as the encoder, with or without a
-side prefix ``r_``/``l_`` and a ``_joint`` suffix; the ``pinky`` encoder drives the ring's
-and the little finger's distal joints, coupled on iCub). iCub's coupled distal joints
-(one motor and encoder for two phalanges) are not split between the phalanges: the
-encoder's angle is given to each joint it drives.
+(``time_s`` then one column per encoder [deg]). The joints of the skin they drive get
+their angles, in radians, in ``joint_states.csv`` (``time_s`` then one column per joint
+[rad]), the joint-state table of the robot's frame. Which joints: :data:`ICUB_COUPLING`,
+iCub's coupling of its hand as the iCub simulator's control board undoes it
+(robotology/gazebo-yarp-plugins, ``plugins/controlboard/src/ControlBoardDriverCoupling.
+cpp``, commit 01796a2787784eb220b69dfd850cb21b1be54cde: ``ThumbCouplingHandler``,
+``IndexCouplingHandler``, ``MiddleCouplingHandler``, ``PinkyCouplingHandler``,
+``decoupleRefPos``): an opposition or proximal encoder drives its one joint, a distal
+encoder the finger's two distal joints by half its angle each, ``pinky`` the ring's and
+the little finger's three flexion joints by a third each. The joints are found by the
+names of icub-models (``r_hand_thumb_0_joint`` ... ``r_hand_little_3_joint``; a ``l_``
+hand too). ``hand_finger`` (the abduction of the fingers) is kept in the encoders' file
+only: its coupling in the simulator depends on a configuration this does not read.
 """
 
 from __future__ import annotations
@@ -45,14 +50,20 @@ ICUB_ENCODERS = (
 )
 """The 9 encoders of a slice: iCub's arm joints 7 to 15 (iCub's joint names)."""
 
-ENCODER_JOINTS = {
-    "thumb_distal": ("thumb_distal",),
-    "index_distal": ("index_distal",),
-    "middle_distal": ("middle_distal",),
-    "pinky": ("pinky", "ring_distal", "little_distal"),
+ICUB_COUPLING = {
+    "thumb_oppose": (("thumb_0", 1.0),),
+    "thumb_proximal": (("thumb_1", 1.0),),
+    "thumb_distal": (("thumb_2", 0.5), ("thumb_3", 0.5)),
+    "index_proximal": (("index_1", 1.0),),
+    "index_distal": (("index_2", 0.5), ("index_3", 0.5)),
+    "middle_proximal": (("middle_1", 1.0),),
+    "middle_distal": (("middle_2", 0.5), ("middle_3", 0.5)),
+    "pinky": tuple(
+        (f"{finger}_{k}", 1.0 / 3.0) for finger in ("ring", "little") for k in (1, 2, 3)
+    ),
 }
-"""Joint names (without side prefix and ``_joint`` suffix) other than the encoder's own
-that an encoder drives."""
+"""Per encoder, the joints it drives (icub-models' names without ``r_hand_``/``l_hand_``
+and ``_joint``) and the share of its angle each takes [-]."""
 
 ENCODERS_FILE = "icub_encoders.csv"
 JOINT_STATES_FILE = "joint_states.csv"
@@ -60,18 +71,20 @@ JOINT_STATES_FILE = "joint_states.csv"
 
 def _bare(joint: str) -> str:
     name = joint.removesuffix("_joint")
-    for side in ("r_", "l_"):
+    for side in ("r_hand_", "l_hand_"):
         name = name.removeprefix(side)
     return name
 
 
-def encoder_joints(skin: RobotSkin) -> dict[str, list[str]]:
-    """Which of the skin's movable joints each iCub encoder drives (empty lists left out)."""
-    out: dict[str, list[str]] = {}
-    movable = skin.movable_joints
-    for encoder in ICUB_ENCODERS:
-        names = {encoder, *ENCODER_JOINTS.get(encoder, ())}
-        joints = [j for j in movable if _bare(j) in names]
+def encoder_joints(skin: RobotSkin) -> dict[str, list[tuple[str, float]]]:
+    """Which of the skin's movable joints each iCub encoder drives, and by what share of
+    its angle (:data:`ICUB_COUPLING`); encoders that drive none are left out."""
+    by_bare: dict[str, list[str]] = {}
+    for joint in skin.movable_joints:
+        by_bare.setdefault(_bare(joint), []).append(joint)
+    out: dict[str, list[tuple[str, float]]] = {}
+    for encoder, driven in ICUB_COUPLING.items():
+        joints = [(j, share) for bare, share in driven for j in by_bare.get(bare, [])]
         if joints:
             out[encoder] = joints
     return out
@@ -127,8 +140,8 @@ def icub_hand_recording(trial: GraspTrial, skin="icub_hand", *, period_s: float 
     positions = {}
     for encoder, joints in mapping.items():
         angle = np.deg2rad(trial.encoders_deg[:, ICUB_ENCODERS.index(encoder)])
-        for joint in joints:
-            positions[joint] = angle
+        for joint, share in joints:
+            positions[joint] = share * angle
     recording = RobotRecording(
         skin=skin,
         streams=streams,
