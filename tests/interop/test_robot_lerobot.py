@@ -65,8 +65,8 @@ def test_a_feature_per_patch_holding_the_latest_frame(run, tmp_path):
             k = _latest(hosts[name], start + row_time[i])
             assert index[i] == k
             np.testing.assert_array_equal(frames[i], recording.streams[name].frames[k])
-    assert meta["patches"]["palm_0"]["losses"] == {"lost": 3, "gaps": 1}
-    assert "a feature per patch (3 patches" in result.output
+    assert meta["patches"]["palm_pad"]["losses"] == {"lost": 3, "gaps": 1}
+    assert "a feature per patch (4 patches" in result.output
 
 
 def test_fps_and_episodes(run, tmp_path):
@@ -82,7 +82,7 @@ def test_fps_and_episodes(run, tmp_path):
         index = table.column(f"observation.tactile.{name}.frame_index").to_numpy()
         assert counts["held"][name] == sum(index[1:] == index[:-1])
     # at 50 rows/s the 250 Hz pad is sampled: about every fifth frame
-    pad = table.column("observation.tactile.index_distal_pad.frame_index").to_numpy()
+    pad = table.column("observation.tactile.distal_pad.frame_index").to_numpy()
     assert np.median(np.diff(pad)) == 5
 
 

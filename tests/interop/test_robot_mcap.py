@@ -16,7 +16,7 @@ from tactsense.interop.robot_mcap import export_robot_mcap, topic_token
 from tactsense.io.robot_recording import read_robot_recording
 from tactsense.robot import rotation_matrix
 
-from .robot_helpers import PATCHES, PRESS, robot_recording, write
+from .robot_helpers import PATCHES, PRESS, robot_recording, small_hand, write
 
 pytest.importorskip("mcap_ros2")
 pytest.importorskip("rosbags")
@@ -117,8 +117,8 @@ def test_contacts_per_link_in_the_link_frame(simulated):
     _folder, out, recording, counts = simulated
     store = _typestore()
     skin = recording.skin
-    patch = skin.patch("index_distal_pad")
-    (xy, newtons) = PRESS["index_distal_pad"]
+    patch = skin.patch("distal_pad")
+    (xy, newtons) = PRESS["distal_pad"]
     rotation = rotation_matrix(patch.origin.rpy_rad)
     expected = rotation @ np.array([xy[0], xy[1], 0.0]) * 1e-3 + np.array(patch.origin.xyz_m)
     normal = rotation @ np.array([0.0, 0.0, 1.0])
@@ -126,13 +126,17 @@ def test_contacts_per_link_in_the_link_frame(simulated):
     for topic, schema, _, data in _messages(out):
         if schema == "tactile_msgs/msg/TactileContacts":
             by_link.setdefault(topic, []).append(store.deserialize_cdr(data, schema).contacts)
-    assert sorted(by_link) == ["/tactile_contacts/index_distal", "/tactile_contacts/palm"]
-    assert not any(by_link["/tactile_contacts/palm"])  # palm_0 is not touched
-    pressed = [c for cs in by_link["/tactile_contacts/index_distal"] for c in cs]
+    assert sorted(by_link) == [
+        "/tactile_contacts/finger_distal", "/tactile_contacts/finger_proximal",
+        "/tactile_contacts/palm",
+    ]  # fmt: skip
+    assert not any(by_link["/tactile_contacts/palm"])  # palm_pad is not touched
+    assert not any(by_link["/tactile_contacts/finger_proximal"])  # nor the finger
+    pressed = [c for cs in by_link["/tactile_contacts/finger_distal"] for c in cs]
     assert pressed and sum(counts["contacts"].values()) > 0
     for contact in pressed:
-        assert contact.header.frame_id == "index_distal"
-        assert contact.name.startswith("index_distal_pad/")
+        assert contact.header.frame_id == "finger_distal"
+        assert contact.name.startswith("distal_pad/")
         p = np.array([contact.position.x, contact.position.y, contact.position.z])
         n = np.array([contact.normal.x, contact.normal.y, contact.normal.z])
         f = np.array([contact.wrench.force.x, contact.wrench.force.y, contact.wrench.force.z])
@@ -174,7 +178,7 @@ def test_cli_export_and_import_back(captured, tmp_path):
     result = runner.invoke(app, ["export", str(folder), "--out", str(out), "-q"])
     assert result.exit_code == 0, result.output
     total = sum(len(s) for s in recording.streams.values())
-    assert f"{total} frames of 3 patches" in result.output
+    assert f"{total} frames of 4 patches" in result.output
     assert "host clock" in result.output
     back = tmp_path / "back"
     result = runner.invoke(app, ["import", str(out), "--out", str(back)])
@@ -212,46 +216,42 @@ def _bag(path, store, topics):
 
 
 def test_a_bag_of_several_sensors_goes_to_the_patches_it_names(tmp_path):
-    """Routing: a channel named as a patch (a device's message carrying two patches); a
+    """Routing: a channel named as a patch (a board's message carrying two patches); a
     lone channel of another name, by the topic's last part; streams keep one origin."""
     store = _typestore()
+    skin = small_hand()
+    sizes = {p.name: p.n_taxels for p in skin.patches}
     rng = np.random.default_rng(5)
     t0 = 1_763_900_000 * 10**9
-    index = [(t0 + k * 4_000_000, rng.integers(0, 4000, 32)) for k in range(6)]
-    thumb = [(t0 + 2_000_000 + k * 20_000_000, rng.integers(0, 4000, 12)) for k in range(3)]
-    palm = [(t0 + 5_000_000 + k * 10_000_000, rng.integers(0, 4000, 144)) for k in range(4)]
+    pad = [(t0 + k * 4_000_000, rng.integers(0, 4000, sizes["distal_pad"])) for k in range(6)]
+    tip = [(ns, rng.integers(0, 4000, sizes["tip"])) for ns, _ in pad]
+    palm = [(t0 + 2_000_000 + k * 20_000_000, rng.integers(0, 4000, sizes["palm_pad"]))
+            for k in range(3)]  # fmt: skip
     topics = {
-        "/board_index/tactile_states": [
-            (ns, [("index_distal_pad", v), ("index_tip", v[:12])]) for ns, v in index
+        "/board_a/tactile_states": [
+            (ns, [("distal_pad", v), ("tip", w)]) for (ns, v), (_, w) in zip(pad, tip, strict=True)
         ],
-        "/hand/thumb_tip": [(ns, [("fingertip", v)]) for ns, v in thumb],
-        "/palm/palm_0": [(ns, [("palm_0", v)]) for ns, v in palm],
+        "/hand/palm_pad": [(ns, [("some_sensor", v)]) for ns, v in palm],
     }
     _bag(tmp_path / "bag", store, topics)
-    back, summary = read_robot_bag(tmp_path / "bag", skin="hand4")
-    assert summary["frames"] == {
-        "thumb_tip": 3, "index_distal_pad": 6, "index_tip": 6, "palm_0": 4
-    }  # fmt: skip
-    assert summary["messages"] == 13
-    np.testing.assert_array_equal(
-        back.streams["index_distal_pad"].frames.reshape(6, -1), [v for _, v in index]
-    )
-    np.testing.assert_array_equal(
-        back.streams["index_tip"].frames.reshape(6, -1), [v[:12] for _, v in index]
-    )
-    np.testing.assert_array_equal(back.streams["thumb_tip"].frames.reshape(3, -1),
-                                  [v for _, v in thumb])  # fmt: skip
-    # one origin: the earliest first stamp of all streams (index's), to the ns
-    np.testing.assert_allclose(back.streams["thumb_tip"].time_s, [0.002, 0.022, 0.042], atol=1e-9)
-    np.testing.assert_allclose(back.streams["palm_0"].time_s[0], 0.005, atol=1e-9)
-    assert back.streams["palm_0"].host_time_s[0] == pytest.approx(1_763_900_000.005, abs=1e-6)
+    back, summary = read_robot_bag(tmp_path / "bag", skin=skin)
+    assert summary["frames"] == {"distal_pad": 6, "tip": 6, "palm_pad": 3}
+    assert summary["messages"] == 9
+    assert summary["missing"] == ["finger_skin"]
+    for name, sent in (("distal_pad", pad), ("tip", tip), ("palm_pad", palm)):
+        frames = back.streams[name].frames.reshape(len(sent), -1)
+        np.testing.assert_array_equal(frames, [v for _, v in sent])
+    # one origin: the earliest first stamp of all streams (the board's), to the ns
+    np.testing.assert_allclose(back.streams["palm_pad"].time_s, [0.002, 0.022, 0.042], atol=1e-9)
+    np.testing.assert_allclose(back.streams["tip"].time_s[1], 0.004, atol=1e-9)
+    assert back.streams["palm_pad"].host_time_s[0] == pytest.approx(1_763_900_000.002, abs=1e-6)
 
 
 @pytest.mark.parametrize(
     "topics, message",
     [
         ({"/hand/unknown": [(10**18, [("something", np.zeros(32))])]}, "name a patch"),
-        ({"/hand/index_tip": [(10**18, [("x", np.zeros(5))])]}, "has 12 taxels"),
+        ({"/hand/tip": [(10**18, [("x", np.zeros(5))])]}, "has 12 taxels"),
     ],
 )
 def test_a_bag_that_names_no_patch_is_refused(tmp_path, topics, message):
@@ -259,7 +259,7 @@ def test_a_bag_that_names_no_patch_is_refused(tmp_path, topics, message):
 
     _bag(tmp_path / "bag", _typestore(), topics)
     with pytest.raises(ImportError_, match=message):
-        read_robot_bag(tmp_path / "bag", skin="hand4")
+        read_robot_bag(tmp_path / "bag", skin=small_hand())
 
 
 def test_topic_tokens_are_ros2_names():
