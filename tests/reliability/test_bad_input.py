@@ -622,7 +622,7 @@ ROBOT_BAD_OPTIONS = [
     ("export RUN --format mcap --out RUN/x.mcap", "inside the input"),
     ("export REC --fps 10 --out OUT.mcap", "--fps applies to a robot recording"),
     ("import MCAP --skin bogus --out OUT", "--skin"),
-    ("import MCAP --skin hand4 --out OUT", "name a patch of 'hand4'"),
+    ("import MCAP --skin hand4 --out OUT", "topic /tactile_states/"),
     ("import MCAP --out OUT.h5", "a robot recording is a folder"),
     ("import MCAP --out RUN", "exists; pass --force"),
     ("import MCAP --out MCAP/x", "overlap"),
