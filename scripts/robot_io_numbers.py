@@ -112,6 +112,7 @@ def icub_numbers(folder: Path) -> list[str]:
                 (folder / name).write_bytes(tar.extractfile(member).read())
     trials = sorted(p for p in folder.glob("*.txt") if re.match(r".+_\d+\.txt$", p.name))
     slices = frames = equal = 0
+    encoders = []
     outside: dict[str, int] = {}
     mapping = None
     for path in trials:
@@ -131,18 +132,30 @@ def icub_numbers(folder: Path) -> list[str]:
             for k, f in enumerate(fingers)
         )
         slices += len(trial)
+        encoders.append(trial.encoders_deg)
         frames += sum(len(s) for s in recording.streams.values())
         mapping = joints["mapping"]
         for joint, bad in outside_limits(recording.skin, joints["positions_rad"]).items():
             outside[joint] = outside.get(joint, 0) + bad
-    mapped = ", ".join(f"{e} -> {'/'.join(j)}" for e, j in (mapping or {}).items())
+    mapped = "; ".join(
+        f"{e} -> " + ", ".join(f"{j} x{share:.3g}" for j, share in driven)
+        for e, driven in (mapping or {}).items()
+    )
     said = ", ".join(f"{j} {n}" for j, n in outside.items()) or "none"
+    from tactsense.interop.robot_icub import ICUB_ENCODERS
+
+    encoders = np.concatenate(encoders)
+    ranges = ", ".join(
+        f"{name} {low:.2f} to {high:.2f}"
+        for name, low, high in zip(ICUB_ENCODERS, encoders.min(0), encoders.max(0), strict=True)
+    )
     return [
         f"iCub grasp dataset: {len(trials)} trials imported as icub_hand, {slices} slices, "
         f"{frames} fingertip frames (5 per slice); trials whose every frame equals the "
         f"file's line: {equal} of {len(trials)}",
         f"encoders mapped to icub_hand's joints: {mapped or 'none'}",
         f"slices outside the skin's joint limits, per joint: {said}",
+        f"encoder readings over the dataset [deg]: {ranges}",
     ]
 
 
