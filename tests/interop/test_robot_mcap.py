@@ -6,6 +6,8 @@ is imported into a robot recording by its topics' and channels' names."""
 
 from __future__ import annotations
 
+import shutil
+
 import numpy as np
 import pytest
 from typer.testing import CliRunner
@@ -13,7 +15,7 @@ from typer.testing import CliRunner
 from tactsense.cli import app
 from tactsense.interop.robot_bag import read_robot_bag
 from tactsense.interop.robot_mcap import export_robot_mcap, topic_token
-from tactsense.io.robot_recording import read_robot_recording
+from tactsense.io.robot_recording import read_manifest, read_robot_recording, write_manifest
 from tactsense.robot import rotation_matrix
 
 from .robot_helpers import PATCHES, PRESS, robot_recording, small_hand, write
@@ -288,3 +290,40 @@ def test_an_interrupted_export_leaves_nothing(simulated, tmp_path, monkeypatch, 
     assert result.exit_code == 1, result.output
     assert "interrupted" in result.output
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_capture_is_stamped_with_its_aligned_clock(captured, tmp_path, monkeypatch):
+    """With the capture's clock fit (``aligned_times``; here a stand-in: the device clock
+    plus an offset), every header stamp is the frame's scan on the host clock and every
+    log time its arrival, to the nanosecond."""
+    import tactsense.io.robot_recording as robot_recording_module
+
+    folder, _, recording = captured
+    offset = 1_763_900_000.25
+
+    def aligned_times(path, patch):
+        return offset + recording.streams[patch].device_time_us * 1e-6
+
+    monkeypatch.setattr(robot_recording_module, "aligned_times", aligned_times, raising=False)
+    # without a clock fit in the manifest, the arrival times stay the stamps
+    assert export_robot_mcap(folder, tmp_path / "plain.mcap", contacts=False)["clock"] == "host"
+    fitted = tmp_path / "fitted"
+    shutil.copytree(folder, fitted)
+    manifest = read_manifest(fitted)
+    for entry in manifest["devices"].values():
+        entry["clock"] = {"offset_s": offset, "drift_ppm": 0.0, "residual_s": 0.0}
+    write_manifest(fitted, manifest)
+    out = tmp_path / "aligned.mcap"
+    counts = export_robot_mcap(fitted, out, contacts=False)
+    assert counts["clock"] == "aligned"
+    store = _typestore()
+    seen = {}
+    for _, schema, log_time, data in _messages(out):
+        msg = store.deserialize_cdr(data, schema)
+        stamp = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
+        seen.setdefault(msg.sensors[0].name, []).append((stamp, log_time))
+    for name, stream in recording.streams.items():
+        stamps, logs = np.array(seen[name]).T
+        expected = np.round(aligned_times(folder, name) * 1e9).astype(np.int64)
+        np.testing.assert_array_equal(stamps, expected)
+        np.testing.assert_array_equal(logs, np.round(stream.host_time_s * 1e9).astype(np.int64))

@@ -16,8 +16,11 @@ A patch name that is not a valid ROS 2 topic token (a ``-`` or ``.`` in it) is w
 with ``_`` in the topic; the channel keeps the name. Messages are in time order over
 all patches (merged piece by piece: memory is that of one piece per patch).
 
-Stamps: every stream's host arrival times when the recording holds them (a capture),
-else its frame times plus ``start_time_s`` (a simulation); log time = header stamp.
+Stamps: for a capture, the header stamp is each frame's scan on the host's clock (its
+device's clock mapped by the capture's clock fit, ``aligned_times``; the arrival where
+there is no fit) and the log time its arrival on the host (ROS's convention: the stamp
+says when the data was measured, the log time when it was received); for a
+simulation, the frame times plus ``start_time_s``, log time = stamp.
 
 What ROS messages cannot carry goes in tactsense's own records, which other tools
 ignore: metadata ``tactsense.robot`` (the skin's TOML, the manifest's devices and
@@ -83,6 +86,30 @@ def _stream_extras(reader) -> dict[str, np.ndarray]:
     return out
 
 
+def _aligned(path: Path, readers: dict, manifest: dict) -> dict[str, np.ndarray]:
+    """Per captured stream, its frames' scan times on the host's clock [Unix s]: the
+    device clock mapped by its device's clock fit (``tactsense.io.robot_recording.
+    aligned_times``, the capture's); none where the capture has no such function, the
+    manifest no fit for the stream's device, or the stream no device clock."""
+    try:
+        from tactsense.io.robot_recording import aligned_times
+    except ImportError:
+        return {}
+    fitted = {
+        patch
+        for entry in manifest.get("devices", {}).values()
+        if isinstance(entry, dict) and (entry.get("clock") or {}).get("offset_s") is not None
+        for patch in entry.get("patches", [])
+    }
+    out = {}
+    for name, reader in readers.items():
+        if name in fitted and "device_time_us" in reader._h5:
+            times = np.asarray(aligned_times(path, name), float)
+            if times.shape == (reader.n_frames,) and np.all(np.isfinite(times)):
+                out[name] = times
+    return out
+
+
 def _npz_bytes(arrays: dict[str, np.ndarray]) -> bytes:
     buffer = io.BytesIO()
     np.savez(buffer, **arrays)
@@ -122,7 +149,8 @@ def export_robot_mcap(
     -------
     dict
         ``frames`` and ``contacts`` per patch, ``messages`` (contact lists written),
-        ``clock`` (``host`` or ``recording``) and ``patches`` (streams written).
+        ``clock`` (``aligned``, ``host`` or ``recording``) and ``patches`` (streams
+        written).
     """
     from mcap_ros2._dynamic import serialize_dynamic
 
@@ -165,6 +193,8 @@ def export_robot_mcap(
                 "for recordings without them"
             )
         offset = 0.0 if start_time_s is None else float(start_time_s)
+        aligned = _aligned(path, readers, manifest) if host else {}
+        clock = "aligned" if aligned else "host" if host else "recording"
         total = sum(r.n_frames for r in readers.values())
         with open(out, "wb") as stream:
             writer = Writer(stream, chunk_size=1 << 20)
@@ -186,12 +216,14 @@ def export_robot_mcap(
                     "devices": json.dumps(manifest.get("devices", {}), sort_keys=True),
                     "description": str(manifest.get("description", "")),
                     "closed_cleanly": json.dumps(bool(manifest.get("closed_cleanly", True))),
-                    "clock": "host" if host else "recording",
-                    "clock_meaning": (
-                        "arrival of each frame on the recording host, Unix time"
-                        if host
-                        else f"the streams' frame times plus {offset:.6f} s (Unix time)"
-                    ),
+                    "clock": clock,
+                    "clock_meaning": {
+                        "aligned": "header stamps: each frame's scan on the host's clock "
+                        "(its device's clock mapped by the manifest's fit), Unix time; log "
+                        "times: its arrival on the host",
+                        "host": "arrival of each frame on the recording host, Unix time",
+                        "recording": f"the streams' frame times plus {offset:.6f} s (Unix time)",
+                    }[clock],
                     "source": path.name,
                 },
             )
@@ -263,17 +295,20 @@ def export_robot_mcap(
                         numbers[:, 9:12] = np.cross(piece.points_m, force)
                     else:
                         start, frames, time_s = piece
-                    stamps = (
-                        reader.host_time_s(start, start + len(time_s)) if host
-                        else np.asarray(time_s, float) + offset
-                    )  # fmt: skip
+                    stop = start + len(time_s)
+                    arrival = reader.host_time_s(start, stop) if host else None
+                    if name in aligned:
+                        stamps = aligned[name][start:stop]
+                    else:
+                        stamps = arrival if host else np.asarray(time_s, float) + offset
                     ns = np.round(np.asarray(stamps, float) * 1e9).astype(np.int64)
+                    logged = ns if arrival is None else np.round(arrival * 1e9).astype(np.int64)
                     for k in range(len(time_s)):
                         found = (
                             [(piece.names[i], numbers[i]) for i in range(bounds[k], bounds[k + 1])]
                             if contacts else None
                         )  # fmt: skip
-                        yield int(ns[k]), order, start + k, frames[k], found
+                        yield int(ns[k]), order, start + k, frames[k], found, int(logged[k])
 
             latest: dict[str, dict[str, list]] = {link: {} for link in links}
             written = {name: 0 for name in names}
@@ -283,11 +318,11 @@ def export_robot_mcap(
                 *(events(name, order) for order, name in enumerate(names)),
                 key=lambda event: (event[0], event[1]),
             )
-            for done, (t, order, index, frame, found) in enumerate(merged, start=1):
+            for done, (t, order, index, frame, found, logged) in enumerate(merged, start=1):
                 name = names[order]
                 sec, nanosec = t // 1_000_000_000, t % 1_000_000_000
                 raw.add_message(
-                    channel_id=channels[name], log_time=t, publish_time=t,
+                    channel_id=channels[name], log_time=logged, publish_time=logged,
                     sequence=index % (1 << 32),
                     data=templates[name].encode(sec, nanosec, np.ravel(frame)),
                 )  # fmt: skip
@@ -298,7 +333,7 @@ def export_robot_mcap(
                     found_contacts[name] += len(found)
                     items = [item for p in latest[link] for item in latest[link][p]]
                     raw.add_message(
-                        channel_id=list_channels[link], log_time=t, publish_time=t,
+                        channel_id=list_channels[link], log_time=logged, publish_time=logged,
                         sequence=lists % (1 << 32), data=contact_bytes[link].contacts(items),
                     )  # fmt: skip
                     lists += 1
@@ -318,6 +353,6 @@ def export_robot_mcap(
         "frames": written,
         "contacts": found_contacts,
         "messages": lists,
-        "clock": "host" if host else "recording",
+        "clock": clock,
         "patches": names,
     }
