@@ -32,8 +32,9 @@ CONTACT_MSG = (
     "geometry_msgs/Vector3 normal\ngeometry_msgs/Wrench wrench\n"
 )
 CONTACTS_MSG = "tactile_msgs/TactileContact[] contacts\n"
-"""The upstream .msg texts (ubi-agni/tactile_toolbox, tactile_msgs/msg/*.msg), typed here
-again rather than taken from tactsense.interop.ros."""
+"""The upstream .msg texts without their comments (ubi-agni/tactile_toolbox,
+tactile_msgs/msg/TactileState.msg at db670ce7, TactileContact.msg at bb47fdbf,
+TactileContacts.msg), typed here again rather than taken from tactsense.interop.ros."""
 
 
 @pytest.fixture(scope="module")
