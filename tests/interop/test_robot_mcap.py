@@ -16,7 +16,7 @@ from tactsense.cli import app
 from tactsense.interop.robot_bag import read_robot_bag
 from tactsense.interop.robot_mcap import export_robot_mcap, topic_token
 from tactsense.io.robot_recording import read_manifest, read_robot_recording, write_manifest
-from tactsense.robot import rotation_matrix
+from tactsense.robot import rotation_matrix, skin_to_toml_string
 
 from .robot_helpers import PATCHES, PRESS, robot_recording, small_hand, write
 
@@ -328,3 +328,41 @@ def test_a_capture_is_stamped_with_its_aligned_clock(captured, tmp_path, monkeyp
         expected = np.round(aligned_times(folder, name) * 1e9).astype(np.int64)
         np.testing.assert_array_equal(stamps, expected)
         np.testing.assert_array_equal(logs, np.round(stream.host_time_s * 1e9).astype(np.int64))
+
+
+def test_map_sends_foreign_names_to_patches(tmp_path):
+    """A lab's own names: --map CHANNEL=PATCH and --map TOPIC=PATCH, on the command line."""
+    store = _typestore()
+    skin = small_hand()
+    sizes = {p.name: p.n_taxels for p in skin.patches}
+    rng = np.random.default_rng(8)
+    t0 = 1_763_900_000 * 10**9
+    pad = [(t0 + k * 4_000_000, rng.integers(0, 4000, sizes["distal_pad"])) for k in range(4)]
+    palm = [(t0 + k * 10_000_000, rng.integers(0, 4000, sizes["palm_pad"])) for k in range(2)]
+    topics = {
+        "/rh/ff/tactile": [(ns, [("ff_distal", v)]) for ns, v in pad],
+        "/rh/palm/tactile": [(ns, [("sensor0", v)]) for ns, v in palm],
+    }
+    _bag(tmp_path / "bag", store, topics)
+    skin_file = tmp_path / "hand.toml"
+    skin_file.write_text(skin_to_toml_string(skin))
+    out = tmp_path / "run"
+    result = runner.invoke(
+        app,
+        ["import", str(tmp_path / "bag"), "--skin", str(skin_file), "--map",
+         "ff_distal=distal_pad", "--map", "/rh/palm/tactile=palm_pad", "--out", str(out)],
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    back = read_robot_recording(out)
+    np.testing.assert_array_equal(back.streams["distal_pad"].frames.reshape(4, -1),
+                                  [v for _, v in pad])  # fmt: skip
+    np.testing.assert_array_equal(back.streams["palm_pad"].frames.reshape(2, -1),
+                                  [v for _, v in palm])  # fmt: skip
+    assert "6 TactileState messages read, 6 frames kept" in result.output
+    # without the map, the names are no patches: refused, nothing written
+    result = runner.invoke(
+        app, ["import", str(tmp_path / "bag"), "--skin", str(skin_file), "--out",
+              str(tmp_path / "other")],
+    )  # fmt: skip
+    assert result.exit_code == 2 and "ff_distal" in result.output
+    assert not (tmp_path / "other").exists()

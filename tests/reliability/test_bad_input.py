@@ -631,6 +631,11 @@ ROBOT_BAD_OPTIONS = [
     ("import TRIAL --skin icub_hand --sensor pad4 --out OUT", "--sensor do not apply"),
     ("import TRIAL --skin icub_hand --period 0 --out OUT", "--period"),
     ("import MCAP --skin icub_hand --period 1 --out OUT", "--period applies to iCub"),
+    ("import MCAP --skin icub_hand --map x --out OUT", "--map 'x': expected NAME=PATCH"),
+    ("import MCAP --skin icub_hand --map a=palm --out OUT", "has no patch 'palm'"),
+    ("import MCAP --skin icub_hand --map a=thumb_tip --map a=index_tip --out OUT", "twice"),
+    ("import TRIAL --skin icub_hand --map a=thumb_tip --out OUT", "--map applies to bags"),
+    ("import REC --map a=b --out OUT.h5", "--map applies to a robot import"),
 ]
 
 

@@ -119,6 +119,7 @@ def import_robot(
     period: float | None,
     others: dict,
     force: bool,
+    mapping: list[str] | None = None,
 ) -> None:
     """``tactsense import FILE --skin SKIN --out RUN``: a bag of several sensors' topics,
     or an iCub grasp trial's five fingertips, into one robot recording (a folder)."""
@@ -145,7 +146,17 @@ def import_robot(
         format == "auto" and source.is_file() and source.suffix.lower() == ".txt"
         and _is_icub_grasp(source)
     )  # fmt: skip
+    pairs = {}
+    for item in mapping or []:
+        name, sep, patch = item.partition("=")
+        if not sep or not name.strip() or not patch.strip():
+            fail(f"--map {item!r}: expected NAME=PATCH (a channel name or a topic, and a patch)")
+        if name.strip() in pairs:
+            fail(f"--map: {name.strip()!r} is mapped twice")
+        pairs[name.strip()] = patch.strip()
     if icub:
+        if pairs:
+            fail("--map applies to bags; an iCub grasp trial's fingertips are its patches")
         from tactsense.interop.icub_grasp import read_trial
         from tactsense.interop.robot_icub import (
             icub_hand_recording,
@@ -192,7 +203,7 @@ def import_robot(
     from tactsense.interop.robot_bag import read_robot_bag
     from tactsense.io.robot_recording import write_robot_recording
 
-    recording, summary = read_robot_bag(source, skin=skin)
+    recording, summary = read_robot_bag(source, skin=skin, mapping=pairs)
     write_robot_recording(out, recording, overwrite=force)
     frames = sum(summary["frames"].values())
     console.print(

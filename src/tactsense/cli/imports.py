@@ -85,6 +85,14 @@ def import_(
             "robot MCAP that tactsense wrote needs none.",
         ),
     ] = None,
+    patch_map: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--map",
+            help="With --skin, a bag: NAME=PATCH sends the channel named NAME (or the one "
+            "channel of the topic NAME) to the skin's patch PATCH; repeat for several.",
+        ),
+    ] = None,
     # ---- /a robot recording (r7-handio) ----
 ) -> None:
     """Import frames and their times from another tool's file into a recording.
@@ -102,8 +110,12 @@ def import_(
         others = {"--sensor": sensor, "--topic": topic, "--stream": stream, "--finger": finger,
                   "--time-column": time_column != "time"}  # fmt: skip
         import_robot(source, out, skin=skin, format=format, period=period, others=others,
-                     force=force)  # fmt: skip
+                     force=force, mapping=patch_map)  # fmt: skip
         return
+    if patch_map:
+        from tactsense.cli._common import fail
+
+        fail("--map applies to a robot import (--skin)")
     # ---- /a robot recording (r7-handio) ----
     from tactsense.interop.importers import read_source
     from tactsense.io.recording import write_recording

@@ -5,6 +5,8 @@ its ``.db3``/``.mcap``): every ``tactile_msgs/msg/TactileState`` message is read
 (MCAP: ``mcap``'s reader with the ``mcap_ros2`` decoder; rosbag2: ``rosbags``, the type
 registered from the upstream ``.msg`` text) and its frames go to the skin's patches:
 
+0. ``--map NAME=PATCH`` first: a channel named NAME, or the one channel of a message on
+   the topic NAME, goes to PATCH;
 1. each ``ChannelFloat32`` of a message whose ``name`` is a patch of the skin goes to
    that patch (a device's one message may carry all its patches, as upstream's
    ``sensors[]`` allows);
@@ -46,9 +48,16 @@ STATE_TYPES = ("tactile_msgs/msg/TactileState", "tactile_msgs/TactileState")
 class _Collector:
     """Frames and stamps per patch, routed by the rules of the module's description."""
 
-    def __init__(self, skin: RobotSkin, source: Path):
+    def __init__(self, skin: RobotSkin, source: Path, mapping: dict[str, str] | None = None):
         self.skin, self.source = skin, source
         self.by_name = {p.name: p for p in skin.patches}
+        self.mapping = dict(mapping or {})
+        for name, patch in self.mapping.items():
+            if patch not in self.by_name:
+                raise ImportError_(
+                    f"--map {name}={patch}: {skin.name!r} has no patch {patch!r}; its "
+                    f"patches: {', '.join(self.by_name)}"
+                )
         self.by_token = {topic_token(p.name): p.name for p in skin.patches}
         self.frames: dict[str, list] = {}
         self.stamps: dict[str, list] = {}
@@ -57,6 +66,9 @@ class _Collector:
     def add(self, topic: str, sensors, stamp_ns: int) -> None:
         self.messages += 1
         entries = [(str(_get(s, "name")), _get(s, "values")) for s in sensors]
+        entries = [(self.mapping.get(name, name), values) for name, values in entries]
+        if len(entries) == 1 and topic in self.mapping:
+            entries = [(self.mapping[topic], entries[0][1])]
         routed = [(name, values) for name, values in entries if name in self.by_name]
         if not routed and len(entries) == 1:
             token = topic.rstrip("/").rsplit("/", 1)[-1]
@@ -104,7 +116,7 @@ def _skin_of(skin, stored: dict | None, source: Path) -> RobotSkin:
     )
 
 
-def _read_mcap_file(source: Path, skin) -> tuple:
+def _read_mcap_file(source: Path, skin, mapping) -> tuple:
     from mcap.exceptions import McapError
     from mcap.reader import make_reader
     from mcap_ros2.decoder import DecoderFactory
@@ -134,7 +146,7 @@ def _read_mcap_file(source: Path, skin) -> tuple:
                     with np.load(io.BytesIO(attachment.data)) as arrays:
                         extras[name] = {k: arrays[k] for k in arrays.files}
             spec_skin = _skin_of(skin, stored, source)
-            collector = _Collector(spec_skin, source)
+            collector = _Collector(spec_skin, source, mapping)
             states = [
                 ch.topic
                 for ch in summary.channels.values()
@@ -157,7 +169,7 @@ def _read_mcap_file(source: Path, skin) -> tuple:
     return collector, stored, losses, extras, skipped
 
 
-def _read_bag(source: Path, skin) -> tuple:
+def _read_bag(source: Path, skin, mapping) -> tuple:
     from rosbags.highlevel import AnyReader, AnyReaderError
     from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
@@ -166,7 +178,7 @@ def _read_bag(source: Path, skin) -> tuple:
     bag = source.parent if source.is_file() else source
     typestore = get_typestore(Stores.ROS2_HUMBLE)
     typestore.register(get_types_from_msg(TACTILE_STATE_MSGDEF.split(SEPARATOR)[0], TACTILE_STATE))
-    collector = _Collector(_skin_of(skin, None, source), source)
+    collector = _Collector(_skin_of(skin, None, source), source, mapping)
     try:
         with AnyReader([bag], default_typestore=typestore) as reader:
             connections = [c for c in reader.connections if c.msgtype in STATE_TYPES]
@@ -184,7 +196,7 @@ def _read_bag(source: Path, skin) -> tuple:
     return collector, None, {}, {}, skipped
 
 
-def read_robot_bag(source: str | Path, *, skin=None):
+def read_robot_bag(source: str | Path, *, skin=None, mapping: dict[str, str] | None = None):
     """A bag of several sensors' ``TactileState`` topics as a robot recording.
 
     Parameters
@@ -193,6 +205,8 @@ def read_robot_bag(source: str | Path, *, skin=None):
         An MCAP file, a rosbag2 bag folder (``metadata.yaml``) or a file in one.
     skin : preset name, TOML path or RobotSkin, optional
         The robot skin whose patches the topics fill (default: the one the file stores).
+    mapping : dict of str -> str, optional
+        Channel names or topics -> patches, applied before the rules (``--map``).
 
     Returns
     -------
@@ -207,9 +221,9 @@ def read_robot_bag(source: str | Path, *, skin=None):
         raise ImportError_(f"{source} does not exist")
     in_bag = (source if source.is_dir() else source.parent) / "metadata.yaml"
     if in_bag.is_file():
-        collector, stored, losses, extras, skipped = _read_bag(source, skin)
+        collector, stored, losses, extras, skipped = _read_bag(source, skin, mapping)
     elif source.is_file() and source.suffix.lower() == ".mcap":
-        collector, stored, losses, extras, skipped = _read_mcap_file(source, skin)
+        collector, stored, losses, extras, skipped = _read_mcap_file(source, skin, mapping)
     else:
         raise ImportError_(
             f"{source}: expected an MCAP file (.mcap) or a rosbag2 bag (a folder with "
