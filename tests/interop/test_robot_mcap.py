@@ -366,3 +366,34 @@ def test_map_sends_foreign_names_to_patches(tmp_path):
     )  # fmt: skip
     assert result.exit_code == 2 and "ff_distal" in result.output
     assert not (tmp_path / "other").exists()
+
+
+def test_a_device_that_dropped_out_at_once(tmp_path):
+    """A stream of two frames (too few for a baseline) and an empty one: the MCAP export
+    writes the short stream's frames without contacts, the LeRobot export leaves the
+    empty one out, and both say so."""
+    import dataclasses
+
+    recording = robot_recording(rng=4)
+    short = recording.streams["palm_pad"]
+    recording.streams["palm_pad"] = dataclasses.replace(
+        short, frames=short.frames[:2], time_s=short.time_s[:2]
+    )
+    tip = recording.streams["tip"]
+    recording.streams["tip"] = dataclasses.replace(
+        tip, frames=tip.frames[:0], time_s=tip.time_s[:0]
+    )
+    folder = write(tmp_path / "run", recording)
+    result = runner.invoke(app, ["export", str(folder), "--out", str(tmp_path / "x.mcap")])
+    assert result.exit_code == 0, result.output
+    assert "their frames without contacts: palm_pad\n" in result.output
+    assert "streams without a frame, left out: tip" in result.output
+    assert "frames of 3 patches" in result.output
+    back, summary = read_robot_bag(tmp_path / "x.mcap")
+    np.testing.assert_array_equal(back.streams["palm_pad"].frames, short.frames[:2])
+    assert "tip" not in summary["frames"]
+    result = runner.invoke(
+        app, ["export", str(folder), "--format", "lerobot", "--out", str(tmp_path / "ds")]
+    )
+    assert result.exit_code == 0, result.output
+    assert "streams without a frame, left out: tip" in result.output

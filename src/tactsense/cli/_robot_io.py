@@ -80,6 +80,8 @@ def export_robot(
             f"{counts['episodes']} episodes, a feature per patch ({len(counts['patches'])} "
             f"patches; {held} patch frames held from the row before) (lerobot)"
         )
+        if counts["empty"]:
+            console.print(f"streams without a frame, left out: {', '.join(counts['empty'])}")
         return
     if episode_split is not None or fps is not None:
         fail("--episode-split and --fps apply to --format lerobot only")
@@ -108,6 +110,13 @@ def export_robot(
         f"TactileState topic each), {contacts} contacts in {counts['messages']} "
         f"TactileContacts per link (mcap, {counts['clock']} clock)"
     )
+    if counts["empty"]:
+        console.print(f"streams without a frame, left out: {', '.join(counts['empty'])}")
+    if counts["without_contacts"]:
+        console.print(
+            "streams too short for a baseline, their frames without contacts: "
+            + ", ".join(counts["without_contacts"])
+        )
 
 
 def import_robot(

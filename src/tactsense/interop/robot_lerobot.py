@@ -116,8 +116,9 @@ def export_robot_lerobot(
     Returns
     -------
     dict
-        ``rows``, ``episodes``, ``fps``, ``patches`` and ``held`` (per patch, rows that
-        repeat the previous row's frame).
+        ``rows``, ``episodes``, ``fps``, ``patches``, ``held`` (per patch, rows that
+        repeat the previous row's frame) and ``empty`` (streams without a frame, left
+        out).
     """
     import pyarrow as pa
     import pyarrow.parquet as pq
@@ -143,9 +144,11 @@ def export_robot_lerobot(
     if not names:
         raise LeRobotError(f"{path}: the robot recording holds no stream")
     streams = {name: read_recording(stream_path(path, name)) for name in names}
-    empty = [name for name, s in streams.items() if len(s) == 0]
-    if empty:
-        raise LeRobotError(f"{path}: the streams {', '.join(empty)} hold no frame")
+    empty = [name for name, s in streams.items() if len(s) == 0]  # a device that never sent
+    names = [name for name in names if name not in empty]
+    streams = {name: streams[name] for name in names}
+    if not names:
+        raise LeRobotError(f"{path}: every stream of the robot recording is empty")
     host = all(s.host_time_s is not None for s in streams.values())
     times = {
         name: np.asarray(s.host_time_s if host else s.time_s, float) for name, s in streams.items()
@@ -259,4 +262,7 @@ def export_robot_lerobot(
     except BaseException:
         shutil.rmtree(temporary, ignore_errors=True)
         raise
-    return {"rows": n, "episodes": len(starts), "fps": fps, "patches": names, "held": held}
+    return {
+        "rows": n, "episodes": len(starts), "fps": fps, "patches": names, "held": held,
+        "empty": empty,
+    }  # fmt: skip

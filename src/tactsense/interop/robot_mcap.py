@@ -149,8 +149,10 @@ def export_robot_mcap(
     -------
     dict
         ``frames`` and ``contacts`` per patch, ``messages`` (contact lists written),
-        ``clock`` (``aligned``, ``host`` or ``recording``) and ``patches`` (streams
-        written).
+        ``clock`` (``aligned``, ``host`` or ``recording``), ``patches`` (streams
+        written), ``without_contacts`` (streams shorter than ``baseline_frames``:
+        their frames are written, no contacts) and ``empty`` (streams without a frame,
+        left out).
     """
     from mcap_ros2._dynamic import serialize_dynamic
 
@@ -179,7 +181,11 @@ def export_robot_mcap(
     try:
         for name in names:
             readers[name] = RecordingReader(stream_path(path, name))
-        hosts = {name: r.has_host_time for name, r in readers.items()}
+        empty = [name for name in names if readers[name].n_frames == 0]  # never sent
+        names = [name for name in names if name not in empty]
+        if not names:
+            raise RobotExportError(f"{path}: every stream of the robot recording is empty")
+        hosts = {name: readers[name].has_host_time for name in names}
         if len(set(hosts.values())) > 1:
             with_host = ", ".join(n for n, h in hosts.items() if h)
             raise RobotExportError(
@@ -193,7 +199,7 @@ def export_robot_mcap(
                 "for recordings without them"
             )
         offset = 0.0 if start_time_s is None else float(start_time_s)
-        aligned = _aligned(path, readers, manifest) if host else {}
+        aligned = _aligned(path, {n: readers[n] for n in names}, manifest) if host else {}
         clock = "aligned" if aligned else "host" if host else "recording"
         total = sum(r.n_frames for r in readers.values())
         with open(out, "wb") as stream:
@@ -275,17 +281,23 @@ def export_robot_mcap(
                         schema_id=lists_schema.id,
                     )  # fmt: skip
 
+            # a stream too short for a baseline (a device that dropped out at once): its
+            # frames without contacts
+            estimated = {
+                name for name in names if contacts and readers[name].n_frames >= baseline_frames
+            }
+
             def events(name: str, order: int):
                 reader = readers[name]
                 patch = skin.patch(name)
-                if contacts:
+                if name in estimated:
                     pieces = iter_patch_contacts(
                         reader, patch, baseline_frames=baseline_frames, threshold=threshold
                     )
                 else:
                     pieces = ((start, frames, time_s) for start, frames, time_s in reader.chunks())
                 for piece in pieces:
-                    if contacts:
+                    if name in estimated:
                         start, frames, time_s = piece.start, piece.frames, piece.time_s
                         bounds = np.searchsorted(piece.frame, np.arange(len(time_s) + 1))
                         force = -piece.force_n[:, None] * piece.normals
@@ -306,7 +318,7 @@ def export_robot_mcap(
                     for k in range(len(time_s)):
                         found = (
                             [(piece.names[i], numbers[i]) for i in range(bounds[k], bounds[k + 1])]
-                            if contacts else None
+                            if name in estimated else []
                         )  # fmt: skip
                         yield int(ns[k]), order, start + k, frames[k], found, int(logged[k])
 
@@ -355,4 +367,6 @@ def export_robot_mcap(
         "messages": lists,
         "clock": clock,
         "patches": names,
+        "without_contacts": [n for n in names if contacts and n not in estimated],
+        "empty": empty,
     }
