@@ -74,6 +74,26 @@ def import_(
         ),
     ] = None,
     force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
+    # ---- a robot recording (r7-handio) ----
+    skin: Annotated[
+        str | None,
+        typer.Option(
+            "--skin",
+            help="Import into a robot recording (OUT a new folder) for this robot skin (a "
+            "preset or a skin TOML): a bag's TactileState topics go to the patches they "
+            "name; an iCub grasp trial's five fingertips to icub_hand's (docs/robot.md). A "
+            "robot MCAP that tactsense wrote needs none.",
+        ),
+    ] = None,
+    patch_map: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--map",
+            help="With --skin, a bag: NAME=PATCH sends the channel named NAME (or the one "
+            "channel of the topic NAME) to the skin's patch PATCH; repeat for several.",
+        ),
+    ] = None,
+    # ---- /a robot recording (r7-handio) ----
 ) -> None:
     """Import frames and their times from another tool's file into a recording.
 
@@ -81,6 +101,22 @@ def import_(
     (LabRecorder), one frame per CSV row, a LeRobot dataset written by tactsense, or one
     fingertip of an iCub grasp trial.
     """
+    # ---- a robot recording (r7-handio) ----
+    from tactsense.interop.robot_bag import is_robot_mcap
+
+    if skin is not None or (topic is None and is_robot_mcap(source)):
+        from tactsense.cli._robot_io import import_robot
+
+        others = {"--sensor": sensor, "--topic": topic, "--stream": stream, "--finger": finger,
+                  "--time-column": time_column != "time"}  # fmt: skip
+        import_robot(source, out, skin=skin, format=format, period=period, others=others,
+                     force=force, mapping=patch_map)  # fmt: skip
+        return
+    if patch_map:
+        from tactsense.cli._common import fail
+
+        fail("--map applies to a robot import (--skin)")
+    # ---- /a robot recording (r7-handio) ----
     from tactsense.interop.importers import read_source
     from tactsense.io.recording import write_recording
 

@@ -96,12 +96,40 @@ def export(
     threshold: ContactThresholdOption = None,
     quiet: Annotated[bool, typer.Option("--quiet", "-q", help="No progress bar.")] = False,
     force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
+    # ---- a robot recording (r7-handio) ----
+    fps: Annotated[
+        int | None,
+        typer.Option(
+            "--fps",
+            min=1,
+            max=10_000,
+            help="lerobot, a robot recording: rows per second [Hz], 1-10000 (default: the "
+            "fastest patch's scan rate); each row holds every patch's latest frame.",
+        ),
+    ] = None,
+    # ---- /a robot recording (r7-handio) ----
 ) -> None:
     """Export a recording's frames and contacts to another tool's format (docs/interop.md).
 
     Frames and contacts are estimated a piece at a time, as 'locate' does; the file is
-    written to a temporary name and moved into place when complete.
+    written to a temporary name and moved into place when complete. A robot recording
+    (a folder, docs/robot.md) exports to mcap or lerobot.
     """
+    # ---- a robot recording (r7-handio) ----
+    from tactsense.io.robot_recording import is_robot_recording
+
+    if is_robot_recording(recording):
+        from tactsense.cli._robot_io import export_robot
+
+        export_robot(
+            recording, out, export_format, frame_id_given=frame_id != DEFAULT_FRAME_ID,
+            calibration=calibration, start_time=start_time, baseline_frames=baseline_frames,
+            threshold=threshold, episode_split=episode_split, fps=fps, quiet=quiet, force=force,
+        )  # fmt: skip
+        return
+    if fps is not None:
+        fail("--fps applies to a robot recording's --format lerobot only")
+    # ---- /a robot recording (r7-handio) ----
 
     if export_format is None:
         by_suffix = {suffix: kind for kind, suffix in SUFFIXES.items()}
