@@ -628,6 +628,8 @@ def test_skin_bad_input(workspace, line, names):
 
 
 # ---- /r7-skin ----
+
+
 # ---- tactsense grasp (r7-grasp) ----
 _GRASP_SPHERE = "grasp hand4 --object sphere --size-mm 20 --pose 0,0,500"
 GRASP_BAD_OPTIONS = [
@@ -665,63 +667,6 @@ GRASP_BAD_OPTIONS = [
     ("grasp hand4 --grasp DIR/no_such.toml --out OUT", "does not exist"),
     ("grasp hand4 --grasp DIR/a_file --out OUT", "grasp file"),
     ("grasp hand4 --grasp DIR/a_file --object sphere --out OUT", "drop --object"),
-# ---- robot export/import (r7-handio) ----
-@pytest.fixture(scope="module")
-def robot_workspace(workspace):
-    """A robot recording of icub_hand (constant frames), its MCAP and an iCub trial."""
-    import numpy as np
-
-    from tactsense.interop.robot_mcap import export_robot_mcap
-    from tactsense.io.recording import Recording
-    from tactsense.io.robot_recording import RobotRecording, write_robot_recording
-    from tactsense.physics.transduction import sample_offsets
-    from tactsense.robot import skin_preset
-
-    skin = skin_preset("icub_hand")
-    streams = {
-        p.name: Recording(
-            frames=np.full((8, *p.sensor.shape), 240, np.uint16),
-            time_s=np.arange(8) / 50,
-            sample_offset_s=sample_offsets(p.sensor),
-            sensor=p.sensor,
-        )
-        for p in skin.patches
-    }
-    run = workspace / "robot_run"
-    if not run.exists():
-        write_robot_recording(run, RobotRecording(skin=skin, streams=streams))
-        export_robot_mcap(run, workspace / "robot.mcap", contacts=False)
-        slice_ = ["1 " * 9, "0 " * 5] + ["240 " * 12] * 5
-        (workspace / "trial_1.txt").write_text("\n".join(["-10000", *slice_]) + "\n")
-    return workspace
-
-
-ROBOT_BAD_OPTIONS = [
-    ("export RUN --format csv --out OUT.csv", "a robot recording exports to mcap or lerobot"),
-    ("export RUN --out OUT.txt", "say --format mcap or lerobot"),
-    ("export RUN --frame-id x --out OUT.mcap", "--frame-id"),
-    ("export RUN --format lerobot --fps 0 --out OUT", "--fps"),
-    ("export RUN --format lerobot --fps 20000 --out OUT", "--fps"),
-    ("export RUN --format mcap --fps 10 --out OUT.mcap", "--fps apply to --format lerobot"),
-    ("export RUN --format lerobot --start-time 5 --out OUT", "--start-time"),
-    ("export RUN --format lerobot --out OUT.h5", "a LeRobot dataset is a folder"),
-    ("export RUN --format mcap --out RUN/x.mcap", "inside the input"),
-    ("export REC --fps 10 --out OUT.mcap", "--fps applies to a robot recording"),
-    ("import MCAP --skin bogus --out OUT", "--skin"),
-    ("import MCAP --skin hand4 --out OUT", "topic /tactile_states/"),
-    ("import MCAP --out OUT.h5", "a robot recording is a folder"),
-    ("import MCAP --out RUN", "exists; pass --force"),
-    ("import MCAP --out MCAP/x", "overlap"),
-    ("import REC --skin icub_hand --out OUT", "expected an MCAP file"),
-    ("import TRIAL --skin hand4 --out OUT", "no patch little_tip"),
-    ("import TRIAL --skin icub_hand --sensor pad4 --out OUT", "--sensor do not apply"),
-    ("import TRIAL --skin icub_hand --period 0 --out OUT", "--period"),
-    ("import MCAP --skin icub_hand --period 1 --out OUT", "--period applies to iCub"),
-    ("import MCAP --skin icub_hand --map x --out OUT", "--map 'x': expected NAME=PATCH"),
-    ("import MCAP --skin icub_hand --map a=palm --out OUT", "has no patch 'palm'"),
-    ("import MCAP --skin icub_hand --map a=thumb_tip --map a=index_tip --out OUT", "twice"),
-    ("import TRIAL --skin icub_hand --map a=thumb_tip --out OUT", "--map applies to bags"),
-    ("import REC --map a=b --out OUT.h5", "--map applies to a robot import"),
 ]
 
 
@@ -744,6 +689,8 @@ def test_grasp_bad_options(workspace, line, names):
 
 
 # ---- /r7-grasp ----
+
+
 # ---- several devices of a robot skin (r7-capture) ----
 BAD_CAPTURE = [
     ("record loop:// loop:// --out OUT", "give one SOURCE, or several with --skin"),
@@ -791,6 +738,8 @@ def test_capture_refuses_to_replace_a_folder_that_is_no_robot_recording(workspac
 
 
 # ---- /r7-capture ----
+
+
 # ---- locate on a robot recording (r7-handloc) ----
 HANDLOC_BAD = [
     ("locate RUN --joints elbow=1 --out OUT", "'elbow': not a movable joint"),
@@ -891,6 +840,69 @@ def test_hand_view_bad_input(workspace, line, names):
 
 
 # ---- /view of a hand (r7-hand3d) ----
+
+
+# ---- robot export/import (r7-handio) ----
+@pytest.fixture(scope="module")
+def robot_workspace(workspace):
+    """A robot recording of icub_hand (constant frames), its MCAP and an iCub trial."""
+    import numpy as np
+
+    from tactsense.interop.robot_mcap import export_robot_mcap
+    from tactsense.io.recording import Recording
+    from tactsense.io.robot_recording import RobotRecording, write_robot_recording
+    from tactsense.physics.transduction import sample_offsets
+    from tactsense.robot import skin_preset
+
+    skin = skin_preset("icub_hand")
+    streams = {
+        p.name: Recording(
+            frames=np.full((8, *p.sensor.shape), 240, np.uint16),
+            time_s=np.arange(8) / 50,
+            sample_offset_s=sample_offsets(p.sensor),
+            sensor=p.sensor,
+        )
+        for p in skin.patches
+    }
+    run = workspace / "robot_run"
+    if not run.exists():
+        write_robot_recording(run, RobotRecording(skin=skin, streams=streams))
+        export_robot_mcap(run, workspace / "robot.mcap", contacts=False)
+        slice_ = ["1 " * 9, "0 " * 5] + ["240 " * 12] * 5
+        (workspace / "trial_1.txt").write_text("\n".join(["-10000", *slice_]) + "\n")
+    return workspace
+
+
+ROBOT_BAD_OPTIONS = [
+    ("export RUN --format csv --out OUT.csv", "a robot recording exports to mcap or lerobot"),
+    ("export RUN --out OUT.txt", "say --format mcap or lerobot"),
+    ("export RUN --frame-id x --out OUT.mcap", "--frame-id"),
+    ("export RUN --format lerobot --fps 0 --out OUT", "--fps"),
+    ("export RUN --format lerobot --fps 20000 --out OUT", "--fps"),
+    ("export RUN --format mcap --fps 10 --out OUT.mcap", "--fps apply to --format lerobot"),
+    ("export RUN --format lerobot --start-time 5 --out OUT", "--start-time"),
+    ("export RUN --format lerobot --out OUT.h5", "a LeRobot dataset is a folder"),
+    ("export RUN --format mcap --out RUN/x.mcap", "inside the input"),
+    ("export REC --fps 10 --out OUT.mcap", "--fps applies to a robot recording"),
+    ("import MCAP --skin bogus --out OUT", "--skin"),
+    ("import MCAP --skin hand4 --out OUT", "topic /tactile_states/"),
+    ("import MCAP --out OUT.h5", "a robot recording is a folder"),
+    ("import MCAP --out RUN", "exists; pass --force"),
+    ("import MCAP --out MCAP/x", "overlap"),
+    ("import REC --skin icub_hand --out OUT", "expected an MCAP file"),
+    ("import TRIAL --skin hand4 --out OUT", "no patch little_tip"),
+    ("import TRIAL --skin icub_hand --sensor pad4 --out OUT", "--sensor do not apply"),
+    ("import TRIAL --skin icub_hand --period 0 --out OUT", "--period"),
+    ("import MCAP --skin icub_hand --period 1 --out OUT", "--period applies to iCub"),
+    ("import MCAP --skin icub_hand --map x --out OUT", "--map 'x': expected NAME=PATCH"),
+    ("import MCAP --skin icub_hand --map a=palm --out OUT", "has no patch 'palm'"),
+    ("import MCAP --skin icub_hand --map a=thumb_tip --map a=index_tip --out OUT", "twice"),
+    ("import TRIAL --skin icub_hand --map a=thumb_tip --out OUT", "--map applies to bags"),
+    ("import REC --map a=b --out OUT.h5", "--map applies to a robot import"),
+]
+
+
+@pytest.mark.parametrize(
     "line, names", ROBOT_BAD_OPTIONS, ids=[line for line, _ in ROBOT_BAD_OPTIONS]
 )
 def test_robot_io_bad_options(robot_workspace, line, names):
