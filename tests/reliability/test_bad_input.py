@@ -814,7 +814,7 @@ HAND_VIEW_BAD = [
     ("view --skin hand4 loop:// --joints-csv DIR/a_file", "--joints-csv applies to a recording"),
     ("view --skin hand4 socket://127.0.0.1:1 --speed 2", "--speed applies to recordings"),
     ("view --skin bogus socket://127.0.0.1:1", "'bogus' is neither a preset"),
-    ("view --skin hand4 a b c d e f", "6 sources for the 5 devices of 'hand4'"),
+    ("view --skin hand4 a b c d e f", "6 sources for the 4 devices of 'hand4'"),
     ("view --skin hand4 --joints bogus=0 loop://", "--joints: joint position for 'bogus'"),
     ("view --skin hand4 socket://127.0.0.1:1", "cannot open socket://127.0.0.1:1"),
 ]
@@ -864,12 +864,12 @@ def robot_workspace(workspace):
         )
         for p in skin.patches
     }
-    run = workspace / "robot_run"
-    if not run.exists():
+    run = workspace / "robot_io_run"
+    if not (workspace / "robot_io_trial_1.txt").exists():  # the last one written
         write_robot_recording(run, RobotRecording(skin=skin, streams=streams))
-        export_robot_mcap(run, workspace / "robot.mcap", contacts=False)
+        export_robot_mcap(run, workspace / "robot_io.mcap", contacts=False)
         slice_ = ["1 " * 9, "0 " * 5] + ["240 " * 12] * 5
-        (workspace / "trial_1.txt").write_text("\n".join(["-10000", *slice_]) + "\n")
+        (workspace / "robot_io_trial_1.txt").write_text("\n".join(["-10000", *slice_]) + "\n")
     return workspace
 
 
@@ -909,15 +909,15 @@ def test_robot_io_bad_options(robot_workspace, line, names):
     folder = robot_workspace
     out = folder / "never_written_robot"
     replaced = (
-        line.replace("REC", str(folder / "rec.h5")).replace("RUN", str(folder / "robot_run"))
-        .replace("MCAP", str(folder / "robot.mcap")).replace("TRIAL", str(folder / "trial_1.txt"))
+        line.replace("REC", str(folder / "rec.h5")).replace("RUN", str(folder / "robot_io_run"))
+        .replace("MCAP", str(folder / "robot_io.mcap")).replace("TRIAL", str(folder / "robot_io_trial_1.txt"))
         .replace("OUT", str(out))
     )  # fmt: skip
     result = runner.invoke(app, replaced.split())
     _check(result, names)
     assert not [p for p in folder.iterdir() if p.name.startswith("never_written_robot")]
     assert not [p for p in folder.iterdir() if ".partial" in p.name]
-    assert not (folder / "robot_run" / "x.mcap").exists()
+    assert not (folder / "robot_io_run" / "x.mcap").exists()
 
 
 # ---- /robot export/import (r7-handio) ----
