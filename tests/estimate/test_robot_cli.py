@@ -66,3 +66,46 @@ def test_a_folder_read_block_by_block_equals_the_recording_in_memory(run):
         assert a.keys() == b.keys()
         for key in a:
             np.testing.assert_array_equal(a[key], b[key], err_msg=key)
+
+
+def _base_positions(path):
+    table = pyarrow.parquet.read_table(path)
+    return np.column_stack(
+        [np.asarray(table.column(c)) for c in ("x_base_mm", "y_base_mm", "z_base_mm")]
+    )
+
+
+def test_locate_takes_the_recordings_own_joint_state(run, tmp_path):
+    """Without a joint option, locate uses the joint state the recording carries (a
+    simulation's, in its streams' scenario; or its joint_states.csv), not all zeros: the
+    base-frame positions equal those of the same state given with --joints."""
+    import shutil
+
+    import h5py
+
+    from tactsense.io.robot_recording import recorded_joint_state, stream_path
+
+    explicit = tmp_path / "explicit.parquet"
+    args = ["locate", str(run), "--joints", "j1=0.3,j2=-0.2", "--out", str(explicit)]
+    assert runner.invoke(app, args).exit_code == 0
+    zero = tmp_path / "zero.parquet"
+    assert runner.invoke(app, ["locate", str(run), "--out", str(zero)]).exit_code == 0
+    assert recorded_joint_state(run) == ("none", None)
+
+    simulated = tmp_path / "simulated"
+    shutil.copytree(run, simulated)
+    with h5py.File(stream_path(simulated, "pad"), "r+") as h5:
+        h5.attrs["scenario_json"] = '{"joints": {"j1": 0.3, "j2": -0.2}}'
+    assert recorded_joint_state(simulated) == ("fixed", {"j1": 0.3, "j2": -0.2})
+    own = tmp_path / "own.parquet"
+    assert runner.invoke(app, ["locate", str(simulated), "--out", str(own)]).exit_code == 0
+    np.testing.assert_allclose(_base_positions(own), _base_positions(explicit), atol=1e-9)
+    assert np.abs(_base_positions(own) - _base_positions(zero)).max() > 1.0  # [mm]: it moved
+
+    table = tmp_path / "table"
+    shutil.copytree(run, table)
+    (table / "joint_states.csv").write_text("time_s,j1,j2\n0,0.3,-0.2\n1,0.3,-0.2\n")
+    assert recorded_joint_state(table)[0] == "csv"
+    from_csv = tmp_path / "from_csv.parquet"
+    assert runner.invoke(app, ["locate", str(table), "--out", str(from_csv)]).exit_code == 0
+    np.testing.assert_allclose(_base_positions(from_csv), _base_positions(explicit), atol=1e-9)

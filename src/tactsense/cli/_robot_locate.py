@@ -16,7 +16,10 @@ OUTPUT_FORMATS = (".parquet", ".csv")
 
 JOINTS_HELP = (
     "Robot recordings: a fixed joint state, NAME=POSITION,... [rad for revolute joints, m "
-    "for prismatic ones], each within the joint's limits; joints not named are at 0."
+    "for prismatic ones], each within the joint's limits; joints not named are at 0. "
+    "Default (no joint option): the recording's own joint_states.csv, else the joint state "
+    "a simulated grasp wrote, else every joint at 0 (or at its nearer limit when 0 is outside "
+    "its limits)."
 )
 JOINTS_CSV_HELP = (
     "Robot recordings: joint states over time, a CSV with a time_s column [s, the "
@@ -43,7 +46,7 @@ def robot_only_options(joints, joints_csv, joints_bag, joints_topic, wrenches) -
     return [name for name, value in given.items() if value is not None]
 
 
-def _joint_source(skin, joints, joints_csv, joints_bag, joints_topic):
+def _joint_source(skin, joints, joints_csv, joints_bag, joints_topic, recording=None):
     from tactsense.estimate._robot_joints import parse_joints, read_joint_bag, read_joint_csv
 
     chosen = [v for v in (joints, joints_csv, joints_bag) if v is not None]
@@ -59,8 +62,16 @@ def _joint_source(skin, joints, joints_csv, joints_bag, joints_topic):
         states = read_joint_csv(joints_csv)
     elif joints_bag is not None:
         states = read_joint_bag(joints_bag, joints_topic)
-    else:
-        return None
+    else:  # none given: the recording's own (its joint_states.csv, a simulation's state)
+        from tactsense.io.robot_recording import recorded_joint_state
+
+        what, value = recorded_joint_state(recording) if recording is not None else ("none", None)
+        if what == "fixed":
+            skin.link_poses(value)
+            return value
+        if what != "csv":
+            return skin.rest_joint_positions()
+        states = read_joint_csv(value)
     states.check(skin)
     return states
 
@@ -133,7 +144,7 @@ def run_robot_locate(
         if Path(wrenches).resolve() == Path(out).resolve():
             raise TactsenseInputError("--wrenches names the same file as --out")
         skin = read_robot_skin(recording)
-        source = _joint_source(skin, joints, joints_csv, joints_bag, joints_topic)
+        source = _joint_source(skin, joints, joints_csv, joints_bag, joints_topic, recording)
         warnings: list[str] = []
         rows, frames, patches, links = 0, 0, set(), set()
         with (

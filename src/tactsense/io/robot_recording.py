@@ -372,3 +372,39 @@ def aligned_times(path: str | Path, patch: str):
 
 
 # ---- /streaming writer (r7-capture) ----
+
+
+JOINT_STATES_FILE = "joint_states.csv"
+"""A robot recording's joint states over time, where it holds them (the iCub import writes
+one: ``time_s`` then one column per joint [rad or m])."""
+
+
+def recorded_joint_state(path: str | Path) -> tuple[str, Any]:
+    """The joint state a robot recording carries itself, for commands given none.
+
+    Returns
+    -------
+    ("csv", Path)
+        The folder's ``joint_states.csv`` (joint states over time).
+    ("fixed", dict)
+        The joint state a simulation wrote in its streams' scenario (a simulated grasp's
+        ``joints`` [rad or m]).
+    ("none", None)
+        Neither: the commands' own default applies.
+    """
+    path = Path(path)
+    table = path / JOINT_STATES_FILE
+    if table.is_file():
+        return "csv", table
+    import h5py
+
+    for file in sorted((path / STREAMS).glob("*.h5")):
+        try:
+            with h5py.File(file, "r") as h5:
+                scenario = json.loads(str(h5.attrs.get("scenario_json", "{}")))
+        except (OSError, ValueError):
+            continue
+        joints = scenario.get("joints") if isinstance(scenario, dict) else None
+        if isinstance(joints, dict) and joints:
+            return "fixed", {str(k): float(v) for k, v in joints.items()}
+    return "none", None
