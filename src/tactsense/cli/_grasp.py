@@ -286,7 +286,8 @@ def grasp_command(
         table.add_row(*(escape(cell) for cell in row))
     print_table(table)
     console.print(
-        f"wrote {out}: {len(robot.patches)} streams, {len(contacts)} patches touched, "
+        f"wrote {out}: {len(robot.patches)} streams, {len(contacts)} "
+        f"{'patch' if len(contacts) == 1 else 'patches'} touched, "
         f"{grasp.timing.total_s:g} s"
     )
 
