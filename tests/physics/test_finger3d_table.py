@@ -14,6 +14,23 @@ from tactsense.physics.finger3d_table import deflection_batch_3d, strain_per_new
 runner = CliRunner()
 
 
+def _table_mesh(meta):
+    """The mesh and the formulation a table records (``scripts/finger3d_table.py``)."""
+    from tactsense.physics import finger3d
+
+    formulation = str(meta.get("formulation", "displacement"))
+    if int(meta["mesh_level"]) >= 0:
+        return finger3d.LEVELS[int(meta["mesh_level"])], formulation
+    spec = finger3d.MeshSpec(
+        int(meta["mesh_n_r"]),
+        int(meta["mesh_n_fine"]),
+        int(meta["mesh_n_coarse"]),
+        float(meta["mesh_fine_mm"]) * 1e-3,
+    )
+    return spec, formulation
+
+
+@pytest.mark.slow
 def test_regression_the_table_is_a_fresh_solve_at_its_nodes_and_between():
     """A fresh solve of the mesh level the table records, at table nodes and at points
     between them: the nodes equal to rounding, the points between within the bilinear
@@ -30,7 +47,8 @@ def test_regression_the_table_is_a_fresh_solve_at_its_nodes_and_between():
     _, _, strain, meta = table()
     force = 0.05 * 9.80665
     pressure, _ = finger3d.hertz_probe(force)
-    solution = finger3d.solve_load(pressure, force, spec=finger3d.LEVELS[int(meta["mesh_level"])])
+    spec, formulation = _table_mesh(meta)
+    solution = finger3d.solve_load(pressure, force, spec=spec, formulation=formulation)
     x = np.array([0.0, 2.0, 3.75, 7.5, 15.0, 0.6, 1.6, 4.4])
     a = np.array([0.0, 0.0, 10.0, 44.0, 90.0, 3.0, 5.0, 23.0])
     fem = solution.radial_strain(x * 1e-3, np.radians(a)) / force
@@ -248,6 +266,7 @@ def test_a_tilted_probe_adds_the_twins_tangential_share():
     np.testing.assert_allclose(three[0] - three[1], twin[0] - twin[1], rtol=1e-9, atol=1e-15)
 
 
+@pytest.mark.slow
 def test_regression_the_foam_table_is_a_fresh_solve_at_its_nodes():
     """finger3d-foam: a fresh solve of the skin on the foam dielectric the table records
     (its modulus, nu and thickness), read as the capacitor reads it (the layer's mean
@@ -269,8 +288,9 @@ def test_regression_the_foam_table_is_a_fresh_solve_at_its_nodes():
     )
     force = 0.05 * 9.80665
     pressure, _ = finger3d.hertz_probe(force)
+    spec, formulation = _table_mesh(meta)
     solution = finger3d.solve_load(
-        pressure, force, spec=finger3d.LEVELS[int(meta["mesh_level"])], dielectric=layer
+        pressure, force, spec=spec, dielectric=layer, formulation=formulation
     )
     x = np.array([0.0, 2.0, 3.75, 7.5, 15.0])
     a = np.array([0.0, 0.0, 10.0, 44.0, 90.0])
