@@ -126,7 +126,7 @@ def compute() -> dict:
         )
 
     solid_pt = next(c for c in study["cases"] if c["modulus_pa"] is None)
-    dielectric = {
+    dielectric: dict = {
         "point_strain_pct": solid_pt["probe_50g_deflection_pct"],
         "rubber_layer_0.5_pct": case(2.5e5, 0.49, 0.5)["probe_50g_deflection_pct"],
         "rubber_layer_0.7_pct": case(2.5e5, 0.49, 0.7)["probe_50g_deflection_pct"],
@@ -134,8 +134,18 @@ def compute() -> dict:
         "level": study["level"],
         "formulation": study.get("formulation", "displacement"),
     }
-    meta = {f: table("probe", f)[3] for f in ("finger3d", "finger3d-foam")}
-    levels = {f: int(m["mesh_level"]) for f, m in meta.items()}
+    tables = {f: table("probe", f) for f in ("finger3d", "finger3d-foam")}
+    meta = {f: t[3] for f, t in tables.items()}
+    force = GRAMS * 9.80665e-3
+    dielectric["table_peak_pct"] = {f: -100 * force * float(t[2][0, 0]) for f, t in tables.items()}
+    levels = {
+        f: (
+            f"level {int(m['mesh_level'])}"
+            if int(m["mesh_level"]) >= 0
+            else f"mesh {m['mesh_n_r']}/{m['mesh_n_fine']}/{m['mesh_n_coarse']}"
+        )
+        for f, m in meta.items()
+    }
     forms = {f: str(m.get("formulation", "displacement")) for f, m in meta.items()}
     return {
         "peaks": peaks,
@@ -194,23 +204,28 @@ def block(data) -> str:
         "0.5 (the depth takes up the difference), so the fitted nu is not a measurement of "
         "the rubber's or the foam's Poisson's ratio, and matching the paper's 0.4 says little.",
         "",
-        "What a forward model reads under the probe's centre, no rings (section 3c's study, "
-        f"mesh level {d['level']}, {d['formulation']} elements): the solid skin's point strain "
-        f"at the ring depth {d['point_strain_pct']:.1f} %; the mean strain of the bottom 0.5 "
-        f"mm of the same solid rubber {d['rubber_layer_0.5_pct']:.1f} %; of a 0.7-mm solid "
-        f"rubber dielectric {d['rubber_layer_0.7_pct']:.1f} %; of the 0.5-mm foam "
-        f"{d['foam_layer_pct']:.1f} %. `finger3d` reads the point strain, `finger3d-foam` "
-        "the layer's mean: the two tables are not the same quantity. The paper's "
+        "What each forward model reads under the 50-g probe's centre, before the rings: "
+        f"`finger3d` the point strain at the ring depth, {d['table_peak_pct']['finger3d']:.1f} "
+        f"%; `finger3d-foam` the foam layer's mean strain, "
+        f"{d['table_peak_pct']['finger3d-foam']:.1f} % (the shipped tables). They are not "
+        "the same quantity on two skins: in section 3c's study (mesh level "
+        f"{d['level']}, {d['formulation']} elements) the mean strain of the bottom 0.5 mm "
+        "of the solid rubber itself is "
+        f"{d['rubber_layer_0.5_pct'] / d['point_strain_pct']:.2f} of the point strain "
+        f"({d['rubber_layer_0.5_pct']:.1f} % against {d['point_strain_pct']:.1f} %), so a "
+        "solid finger read as the capacitor reads it would read that share of the "
+        "`finger3d` table. The paper's "
         '"one-fourth" (a solid 0.7-mm rubber dielectric "had only about one-fourth the '
         'sensitivity of the molded dielectric") compares solid rubber with the *molded* '
         "dielectric, whose hollow spaces have no measured modulus, not with the foam; the "
-        f"model's solid 0.7 mm against its foam is "
-        f"{d['rubber_layer_0.7_pct'] / d['foam_layer_pct']:.2f}, which bears on the foam, "
-        "not on the paper's comparison.",
+        f"model's solid 0.7 mm against its foam, "
+        f"{d['rubber_layer_0.7_pct'] / d['foam_layer_pct']:.2f} in the same study, bears on "
+        "the foam, not on the paper's comparison.",
         "",
-        f"Tables: `finger3d` mesh level {data['levels']['finger3d']} "
-        f"({data['formulations']['finger3d']}), `finger3d-foam` level "
-        f"{data['levels']['finger3d-foam']} ({data['formulations']['finger3d-foam']}).",
+        f"Tables: `finger3d` {data['levels']['finger3d']} "
+        f"({data['formulations']['finger3d']} elements), `finger3d-foam` "
+        f"{data['levels']['finger3d-foam']} ({data['formulations']['finger3d-foam']}); "
+        "meshes: elements through the skin / on the fine zone / graded.",
         "",
         END,
     ]

@@ -45,11 +45,29 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import sparse
 from scipy.sparse.linalg import splu
-from skfem import Basis, ElementTetP2, FacetBasis, LinearForm, MeshTet, MeshTet2, asm
+from skfem import (
+    Basis,
+    ElementTetP1,
+    ElementTetP2,
+    FacetBasis,
+    LinearForm,
+    MeshTet,
+    MeshTet2,
+    asm,
+)
 from skfem.models.elasticity import lame_parameters
 
 from tactsense._validation import check_choice
-from tactsense.physics.finger3d import CORE_M, OUTER_M, RING_DEPTH_M, YOUNGS_PA, _graded, _stiffness
+from tactsense.physics.finger3d import (
+    CORE_M,
+    OUTER_M,
+    RING_DEPTH_M,
+    YOUNGS_PA,
+    _graded,
+    _lame,
+    _stiffness,
+    mixed_system,
+)
 
 RUBBER_AT_APEX_M = 10e-3
 """Rubber thickness from the top of the hemisphere to the core (section 3.6) [m]."""
@@ -287,6 +305,8 @@ class TipSolution:
     free: np.ndarray
     lu: object
     poisson_ratio: float
+    n_pressure: int = 0
+    """Pressure unknowns after the displacement's (``formulation="mixed"``), else 0."""
 
     @property
     def n_dofs(self) -> int:
@@ -294,9 +314,11 @@ class TipSolution:
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
         """Displacement (3, N) [m] for a load vector (component-major, length 3 N)."""
-        u = np.zeros(self.n_dofs)
-        u[self.free] = self.lu.solve(np.asarray(rhs, float)[self.free])
-        return u.reshape(3, -1)
+        full = np.zeros(self.n_dofs + self.n_pressure)
+        full[: self.n_dofs] = rhs
+        u = np.zeros_like(full)
+        u[self.free] = self.lu.solve(full[self.free])
+        return u[: self.n_dofs].reshape(3, -1)
 
     @functools.cached_property
     def skin(self) -> FacetBasis:
@@ -420,26 +442,46 @@ class TipSolution:
         return (0.5 * reading / total).reshape(s_mm.shape)
 
 
-def assemble(spec: TipMeshSpec = TIP_LEVELS[1], *, poisson_ratio=0.49, base="clamped"):
+def assemble(
+    spec: TipMeshSpec = TIP_LEVELS[1],
+    *,
+    poisson_ratio=0.49,
+    base="clamped",
+    formulation="displacement",
+):
     """Mesh, assemble and factorise the half finger.
 
     ``base``: ``"clamped"`` (the finger's base) or ``"sliding"`` (``u_x = 0`` only: with
     ``length_m = 0`` and a spherical core, half a spherical shell, the closed-form check).
+    ``formulation``: ``"displacement"`` (quadratic tetrahedra; the shipped tip table) or
+    ``"mixed"`` (quadratic displacement with linear continuous pressure, Taylor-Hood
+    P2-P1: free of volumetric locking, :func:`~tactsense.physics.finger3d.mixed_system`).
     """
     check_choice(base, "base", ("clamped", "sliding"))
+    check_choice(formulation, "formulation", ("mixed", "displacement"))
     tip = build_tip_mesh(spec)
     basis = Basis(tip.mesh, ElementTetP2(), intorder=4)
-    lam, mu = lame_parameters(YOUNGS_PA, poisson_ratio)
-    stiffness = _stiffness(basis, lam, mu)
+    n_pressure = 0
+    if formulation == "mixed":
+        lam, mu = _lame(YOUNGS_PA, poisson_ratio)
+        stiffness, keep = mixed_system(
+            _stiffness(basis, 0.0, mu),
+            basis,
+            Basis(tip.mesh, ElementTetP1(), intorder=4),
+            lambda x: 0 * x[0] + 1 / lam,
+        )
+        n_pressure = len(keep)
+    else:
+        stiffness = _stiffness(basis, *lame_parameters(YOUNGS_PA, poisson_ratio))
     n = basis.N
     core = basis.get_dofs(facets=tip.core).all()
     end = basis.get_dofs(facets=tip.base).all()
     fixed = [core, core + n, core + 2 * n, basis.get_dofs(facets=tip.sym).all() + n, end]
     if base == "clamped":
         fixed += [end + n, end + 2 * n]
-    free = np.setdiff1d(np.arange(3 * n), np.unique(np.concatenate(fixed)))
+    free = np.setdiff1d(np.arange(3 * n + n_pressure), np.unique(np.concatenate(fixed)))
     lu = splu(stiffness[free][:, free].tocsc())
-    return TipSolution(tip, basis, free, lu, poisson_ratio)
+    return TipSolution(tip, basis, free, lu, poisson_ratio, n_pressure)
 
 
 def sphere_radial_strain(r, pressure_pa, poisson_ratio, youngs_modulus=YOUNGS_PA):
