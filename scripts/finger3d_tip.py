@@ -62,9 +62,9 @@ def row_functional(solution, row_m):
     return solution.normal_strain_functional([[row_m], [0.0], [rho]], [[0.0], [0.0], [1.0]])
 
 
-def solve_level(level, with_tables):
+def solve_level(level, with_tables, formulation="displacement"):
     start = time.perf_counter()
-    solution = tip.assemble(tip.TIP_LEVELS[level])
+    solution = tip.assemble(tip.TIP_LEVELS[level], formulation=formulation)
     s, angle = np.meshgrid(S_MM, ANGLE_DEG, indexing="ij")
     out = {"dofs": solution.n_dofs}
     for name, inner in (("tip", 0.5), ("tip_rim", 0.75)):
@@ -91,9 +91,16 @@ def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--level", type=int, default=1, help="mesh level of TIP_LEVELS")
     parser.add_argument("--study", action="store_true", help="also solve every other level")
+    parser.add_argument(
+        "--formulation",
+        choices=("mixed", "displacement"),
+        default="displacement",
+        help="finite elements: displacement only (the shipped table) or mixed u-p "
+        "(locking-free, docs/model.md section 3a; slower)",
+    )
     args = parser.parse_args(argv)
     levels = list(range(len(tip.TIP_LEVELS))) if args.study else [args.level]
-    study = [solve_level(k, k == args.level) for k in levels]
+    study = [solve_level(k, k == args.level, args.formulation) for k in levels]
     main_level = study[levels.index(args.level)]
     OUT.mkdir(parents=True, exist_ok=True)
     path = OUT / "finger3d_tip.npz"
@@ -115,6 +122,7 @@ def main(argv=None) -> None:
         study_row1_peak=np.array([x["row1_peak"] for x in study]),
         study_row1_at_junction=np.array([x["row1_at_junction"] for x in study]),
         mesh_level=args.level,
+        formulation=args.formulation,
         poisson_ratio=0.49,
         youngs_modulus_pa=tip.YOUNGS_PA,
         core_end_mm=tip.CORE_END_M * 1e3,

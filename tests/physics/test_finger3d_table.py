@@ -191,7 +191,10 @@ def test_regression_the_tip_table_is_a_fresh_solve():
     script = importlib.util.module_from_spec(loader)
     loader.loader.exec_module(script)
     t = tip_table()
-    solution = finger3d_tip.assemble(finger3d_tip.TIP_LEVELS[int(t["mesh_level"])])
+    solution = finger3d_tip.assemble(
+        finger3d_tip.TIP_LEVELS[int(t["mesh_level"])],
+        formulation=str(t.get("formulation", "displacement")),
+    )
     v = solution.solve(script.tip_functional(solution, 0.5))
     s = np.array([t["s_mm"][10], t["s_mm"][40], t["s_mm"][70], -9.1, -3.6, 0.4])
     a = np.array([0.0, t["angle_deg"][5], t["angle_deg"][45], 2.5, 37.0, 11.3])
