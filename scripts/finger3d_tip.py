@@ -104,8 +104,9 @@ def main(argv=None) -> None:
     main_level = study[levels.index(args.level)]
     OUT.mkdir(parents=True, exist_ok=True)
     path = OUT / "finger3d_tip.npz"
+    tmp = path.with_name(path.stem + ".tmp.npz")
     np.savez_compressed(
-        path,
+        tmp,
         s_mm=S_MM,
         s_tip_mm=S_TIP_MM,
         angle_deg=ANGLE_DEG,
@@ -134,6 +135,7 @@ def main(argv=None) -> None:
             "its tip (tactsense.physics.finger3d_tip); scripts/finger3d_tip.py"
         ),
     )
+    tmp.replace(path)
     print(f"wrote {path}")
 
 
