@@ -215,9 +215,10 @@ def block(n) -> str:
             "under-resolved through the skin as the cylinder's old level 1 was (section 3a; "
             "its row 1 peak rises with refinement in the mesh study below)."
             if n["formulation"] == "displacement"
-            else " (both mixed elements; the tip's mesh has four elements through the "
-            "rubber, the cylinder's six: section 3a's radial family puts most of a step of "
-            "this size on the coarser one)."
+            else " (both mixed elements: the step is the tip's coarser mesh, quadratic "
+            "tetrahedra with four elements through the rubber against the cylinder's six "
+            "hexahedra). The tip's mesh study "
+            "below is one level: repeating it with mixed elements is open."
         ),
         "",
         "A probe on the hemisphere's shoulder is hard to see. Probe positions (every 0.25 mm "
