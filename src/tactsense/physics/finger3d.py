@@ -491,19 +491,28 @@ def _lame(youngs_pa, poisson_ratio):
 def _mixed_stiffness(basis, shell: ShellMesh, poisson_ratio, dielectric):
     """The u-p matrix (:func:`mixed_system`) of the rubber, on the dielectric if any,
     restricted to the pressure dofs that carry anything: (matrix, their count)."""
-    lam, mu = _lame(YOUNGS_PA, poisson_ratio)
     pressure_basis = Basis(shell.mesh, ElementHex1(), intorder=4)
+    if dielectric is None:
+        return mixed_layered(basis, pressure_basis, poisson_ratio)
+    top = CORE_M + dielectric.thickness_m
+
+    def rubber(x):  # quadrature points lie inside elements: the interface is a face
+        return (np.hypot(x[1], x[2]) >= top).astype(float)
+
+    return mixed_layered(basis, pressure_basis, poisson_ratio, dielectric, rubber)
+
+
+def mixed_layered(basis, pressure_basis, poisson_ratio, dielectric=None, rubber=None):
+    """The u-p matrix of the skin's rubber (nu ``poisson_ratio``), and of a compressible
+    ``dielectric`` where the indicator ``rubber(x)`` is 0, restricted to the pressure dofs
+    that carry anything: (matrix, their count). Shared by the cylinder and the tip."""
+    lam, mu = _lame(YOUNGS_PA, poisson_ratio)
     if dielectric is None:
         g = _gradient_blocks(basis)
         stiffness = _elasticity({k: 0 * v for k, v in g.items()}, {k: mu * v for k, v in g.items()})
         matrix, keep = mixed_system(stiffness, basis, pressure_basis, lambda x: 0 * x[0] + 1 / lam)
     else:
         soft_lam, soft_mu = _lame(dielectric.youngs_pa, dielectric.poisson_ratio)
-        top = CORE_M + dielectric.thickness_m
-
-        def rubber(x):  # quadrature points lie inside elements: the interface is a face
-            return (np.hypot(x[1], x[2]) >= top).astype(float)
-
         stiffness = _elasticity(
             _gradient_blocks(basis, lambda x: soft_lam * (1 - rubber(x))),
             _gradient_blocks(basis, lambda x: np.where(rubber(x) > 0, mu, soft_mu)),
