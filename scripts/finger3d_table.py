@@ -2,7 +2,7 @@
 
 Run: ``python scripts/finger3d_table.py [--level 1]``. Solves the finite-element model
 of the skin (``tactsense.physics.finger3d``: a thick shell of nu 0.49 bonded to the
-rigid core, triquadratic hexahedra, mesh level 1 of the mesh study in docs/model.md)
+rigid core, triquadratic hexahedra with trilinear pressure, ``finger3d.TABLE_MESH``)
 under the 50-g Hertz probe (a 1.6-mm-radius sphere) on top of the cylinder, and under
 the knife edge of section 4.1 (10 mm around the finger, 0.2 mm wide), and writes the
 radial strain at the ring depth (3.2 mm under the surface) per newton on a grid of
@@ -36,7 +36,18 @@ FOAM = finger3d.Dielectric(0.5e-3, 7.0e4, 0.3)
 
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--level", type=int, default=1, help="mesh level of finger3d.LEVELS")
+    parser.add_argument(
+        "--level",
+        type=int,
+        default=None,
+        help="mesh level of finger3d.LEVELS (default: finger3d.TABLE_MESH)",
+    )
+    parser.add_argument(
+        "--formulation",
+        choices=("mixed", "displacement"),
+        default="mixed",
+        help="finite elements: mixed u-p (default) or displacement only (locks)",
+    )
     parser.add_argument(
         "--foam",
         action="store_true",
@@ -44,7 +55,7 @@ def main(argv=None) -> None:
         "layer's mean strain (docs/model.md, section 3c), to finger3d_probe_foam.npz",
     )
     args = parser.parse_args(argv)
-    spec = finger3d.LEVELS[args.level]
+    spec = finger3d.TABLE_MESH if args.level is None else finger3d.LEVELS[args.level]
     start = time.perf_counter()
     layer = FOAM if args.foam else None
 
@@ -54,17 +65,24 @@ def main(argv=None) -> None:
         return solution.dielectric_strain(x, theta)
 
     pressure, radius = finger3d.hertz_probe(FORCE_N)
-    solution = finger3d.solve_load(pressure, FORCE_N, spec=spec, dielectric=layer)
+    solution = finger3d.solve_load(
+        pressure, FORCE_N, spec=spec, dielectric=layer, formulation=args.formulation
+    )
     x, theta = np.meshgrid(AXIAL_MM * 1e-3, np.radians(ANGLE_DEG), indexing="ij")
     strain = reading(solution, x, theta) / FORCE_N
     # the knife edge of section 4.1 as the twin presses it (a line 10 mm long around the
     # finger, 0.2 mm wide: tactsense.physics.contact.knife_edge)
     knife = finger3d.knife_edge(half_width_m=KNIFE_WIDTH_MM / 2e3, half_arc_m=KNIFE_LENGTH_MM / 2e3)
     knife_strain = reading(
-        finger3d.solve_load(knife, KNIFE_FORCE_N, spec=spec, dielectric=layer), x, theta
+        finger3d.solve_load(
+            knife, KNIFE_FORCE_N, spec=spec, dielectric=layer, formulation=args.formulation
+        ),
+        x,
+        theta,
     )
     OUT.mkdir(parents=True, exist_ok=True)
     path = OUT / ("finger3d_probe_foam.npz" if args.foam else "finger3d_probe.npz")
+    tmp = path.with_name(path.stem + ".tmp.npz")
     extra = {}
     if layer is not None:
         extra = {
@@ -73,7 +91,7 @@ def main(argv=None) -> None:
             "dielectric_poisson_ratio": layer.poisson_ratio,
         }
     np.savez_compressed(
-        path,
+        tmp,
         **extra,
         axial_mm=AXIAL_MM,
         angle_deg=ANGLE_DEG,
@@ -85,7 +103,12 @@ def main(argv=None) -> None:
         poisson_ratio=0.49,
         youngs_modulus_pa=finger3d.YOUNGS_PA,
         contact_radius_mm=radius * 1e3,
-        mesh_level=args.level,
+        mesh_level=-1 if args.level is None else args.level,
+        mesh_n_r=spec.n_r,
+        mesh_n_fine=spec.n_fine,
+        mesh_n_coarse=spec.n_coarse,
+        mesh_fine_mm=spec.fine_m * 1e3,
+        formulation=args.formulation,
         description=(
             (
                 "mean radial strain of the foam dielectric"
@@ -97,6 +120,7 @@ def main(argv=None) -> None:
             "the axial distance and the angle from the load; scripts/finger3d_table.py"
         ),
     )
+    tmp.replace(path)
     print(f"wrote {path}: {strain.shape} in {time.perf_counter() - start:.1f} s; "
           f"peak {strain.min():.4g} per N at the load")  # fmt: skip
 

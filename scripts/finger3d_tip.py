@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from tactsense.physics import finger3d_tip as tip
+from tactsense.physics.finger3d import Dielectric
 
 OUT = Path(__file__).resolve().parents[1] / "src" / "tactsense" / "physics" / "data"
 S_MM = np.round(np.r_[np.arange(tip.APEX_S_M * 1e3, 12.0, 0.25), 12.0], 4)
@@ -42,42 +43,57 @@ FORCE_N = 0.05 * 9.80665
 STRIP_WIDTH_M = 5.1e-3
 
 
-def tip_functional(solution, inner_fraction, n=8):
+FOAM = Dielectric(0.5e-3, 7.0e4, 0.3)
+"""The foam dielectric of section 2.3, as ``scripts/finger3d_table.py --foam`` has it."""
+
+
+def tip_functional(solution, inner_fraction, n=8, layer=None):
     """Mean normal strain over the sector of the end face (radius inner_fraction a to
-    a, half the strip's angle: the half model), 0.65 mm above the face."""
+    a, half the strip's angle: the half model), 0.65 mm above the face; with a dielectric
+    ``layer``, the layer's mean strain there (its top's normal displacement over its
+    thickness, what the capacitor reads)."""
     a = tip.CORE_M
     rho = inner_fraction * a + (np.arange(n) + 0.5) * (1 - inner_fraction) * a / n
     half = STRIP_WIDTH_M / (2 * a)
     theta = (np.arange(n) + 0.5) * half / n
     r, th = np.meshgrid(rho, theta, indexing="ij")
-    x = -(tip.CORE_END_M + tip.PLATE_ABOVE_CORE_M)
+    above = tip.PLATE_ABOVE_CORE_M if layer is None else layer.thickness_m
+    x = -(tip.CORE_END_M + above)
     points = np.stack([np.full(r.size, x), (r * np.sin(th)).ravel(), (r * np.cos(th)).ravel()])
     normals = np.tile([[-1.0], [0.0], [0.0]], (1, r.size))
+    if layer is not None:
+        g = solution.normal_displacement_functional(points, normals, r.ravel() / r.sum())
+        return g / layer.thickness_m
     return solution.normal_strain_functional(points, normals, r.ravel() / r.sum())
 
 
-def row_functional(solution, row_m):
-    """Radial strain at the ring depth over the load's meridian at axial ``row_m``."""
+def row_functional(solution, row_m, layer=None):
+    """Radial strain at the ring depth over the load's meridian at axial ``row_m``; with
+    a dielectric ``layer``, the layer's mean radial strain there."""
+    if layer is not None:
+        top = [[row_m], [0.0], [tip.CORE_M + layer.thickness_m]]
+        g = solution.normal_displacement_functional(top, [[0.0], [0.0], [1.0]])
+        return g / layer.thickness_m
     rho = tip.CORE_M + tip.PLATE_ABOVE_CORE_M
     return solution.normal_strain_functional([[row_m], [0.0], [rho]], [[0.0], [0.0], [1.0]])
 
 
-def solve_level(level, with_tables):
+def solve_level(level, with_tables, formulation="displacement", layer=None):
     start = time.perf_counter()
-    solution = tip.assemble(tip.TIP_LEVELS[level])
+    solution = tip.assemble(tip.TIP_LEVELS[level], formulation=formulation, dielectric=layer)
     s, angle = np.meshgrid(S_MM, ANGLE_DEG, indexing="ij")
     out = {"dofs": solution.n_dofs}
     for name, inner in (("tip", 0.5), ("tip_rim", 0.75)):
-        v = solution.solve(tip_functional(solution, inner))
+        v = solution.solve(tip_functional(solution, inner, layer=layer))
         out[name] = solution.influence(v, s, angle) if with_tables else None
         meridian = solution.influence(v, S_MM, 0 * S_MM)
         k = int(np.argmin(meridian))
         out[f"{name}_peak"] = (S_MM[k], meridian[k])
     if with_tables:
         s_tip, angle_tip = np.meshgrid(S_TIP_MM, ANGLE_DEG, indexing="ij")
-        rows = [solution.solve(row_functional(solution, x * 1e-3)) for x in ROW_MM]
+        rows = [solution.solve(row_functional(solution, x * 1e-3, layer)) for x in ROW_MM]
         out["cylinder"] = np.stack([solution.influence(v, s_tip, angle_tip) for v in rows])
-    row1 = solution.solve(row_functional(solution, 1.1e-3))
+    row1 = solution.solve(row_functional(solution, 1.1e-3, layer))
     out["row1_at_junction"] = solution.influence(row1, 0.0, 0.0).item()
     out["row1_peak"] = solution.influence(row1, 1.1, 0.0).item()
     out["seconds"] = time.perf_counter() - start
@@ -91,14 +107,38 @@ def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--level", type=int, default=1, help="mesh level of TIP_LEVELS")
     parser.add_argument("--study", action="store_true", help="also solve every other level")
+    parser.add_argument(
+        "--formulation",
+        choices=("mixed", "displacement"),
+        default="displacement",
+        help="finite elements: displacement only (the shipped table) or mixed u-p "
+        "(locking-free, docs/model.md section 3a; slower)",
+    )
+    parser.add_argument(
+        "--foam",
+        action="store_true",
+        help="the skin on the foam dielectric (FOAM; mixed elements): what the capacitor "
+        "reads, the layer's mean strain, to finger3d_tip_foam.npz",
+    )
     args = parser.parse_args(argv)
+    layer = FOAM if args.foam else None
+    formulation = "mixed" if args.foam else args.formulation
     levels = list(range(len(tip.TIP_LEVELS))) if args.study else [args.level]
-    study = [solve_level(k, k == args.level) for k in levels]
+    study = [solve_level(k, k == args.level, formulation, layer) for k in levels]
     main_level = study[levels.index(args.level)]
     OUT.mkdir(parents=True, exist_ok=True)
-    path = OUT / "finger3d_tip.npz"
+    path = OUT / ("finger3d_tip_foam.npz" if args.foam else "finger3d_tip.npz")
+    extra = {}
+    if layer is not None:
+        extra = {
+            "dielectric_thickness_mm": layer.thickness_m * 1e3,
+            "dielectric_modulus_pa": layer.youngs_pa,
+            "dielectric_poisson_ratio": layer.poisson_ratio,
+        }
+    tmp = path.with_name(path.stem + ".tmp.npz")
     np.savez_compressed(
-        path,
+        tmp,
+        **extra,
         s_mm=S_MM,
         s_tip_mm=S_TIP_MM,
         angle_deg=ANGLE_DEG,
@@ -115,6 +155,7 @@ def main(argv=None) -> None:
         study_row1_peak=np.array([x["row1_peak"] for x in study]),
         study_row1_at_junction=np.array([x["row1_at_junction"] for x in study]),
         mesh_level=args.level,
+        formulation=formulation,
         poisson_ratio=0.49,
         youngs_modulus_pa=tip.YOUNGS_PA,
         core_end_mm=tip.CORE_END_M * 1e3,
@@ -126,6 +167,7 @@ def main(argv=None) -> None:
             "its tip (tactsense.physics.finger3d_tip); scripts/finger3d_tip.py"
         ),
     )
+    tmp.replace(path)
     print(f"wrote {path}")
 
 

@@ -66,16 +66,17 @@ def flat_layer_profile(xs, force=0.05 * 9.80665, nu=0.49):
 def test_probe_strain_against_a_flat_bonded_layer(coarse_profiles):
     """Under the 50 g probe, along the cylinder (where the skin is straight), the FEM's
     eps_rr at the ring depth against the flat bonded layer of the skin's thickness
-    (``flat_layer_profile``, independent of the FEM): the peak within 10 % (measured
-    -7 % on level 0, +6 % on level 1: the skin is curved around, its radius 3.3 skin
-    thicknesses, and the FE amplitude is not converged, issue 34 item 5), the
-    peak-normalised profile within 0.1 of the peak (measured 0.08 and 0.05), and 12 mm
-    away below 5 % of the peak."""
+    (``flat_layer_profile``, independent of the FEM): the curved skin reads more than the
+    flat layer, at most 25 % more (around the finger the skin narrows toward the core:
+    the ring radius is 0.75 of the surface's, which concentrates the load; measured +5 %
+    on level 0, +12 % on level 1, about +17 % converged, ``docs/model.md`` section 3a),
+    the peak-normalised profile within 0.1 of the peak, and 12 mm away below 5 % of the
+    peak."""
     flat = flat_layer_profile(XS)
     assert flat[0] < 0
     for profile in coarse_profiles:
         assert profile[0] < 0
-        assert profile[0] == pytest.approx(flat[0], rel=0.1)
+        assert 1.0 < profile[0] / flat[0] < 1.25
         assert np.max(np.abs(profile / abs(profile[0]) - flat / abs(flat[0]))) < 0.1
         assert abs(profile[-1]) < 0.05 * abs(profile[0])
 
@@ -83,61 +84,57 @@ def test_probe_strain_against_a_flat_bonded_layer(coarse_profiles):
 def test_mesh_study_shape_converges(coarse_profiles):
     """The peak-normalised profile of levels 0 and 1 agrees within 4 % of the peak.
 
-    (The amplitude converges more slowly, see the slow test.)
+    (The amplitude converges more slowly, see the slow tests.)
     """
     a, b = (p / abs(p[0]) for p in coarse_profiles)
     assert np.max(np.abs(a - b)) < 0.04
 
 
-@pytest.fixture(scope="module")
-def fine_profile():
-    return _probe_profile(f.LEVELS[2], XS)
+def _convergence_script():
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[2] / "scripts" / "finger3d_convergence.py"
+    loader = importlib.util.spec_from_file_location("finger3d_convergence", path)
+    module = importlib.util.module_from_spec(loader)
+    loader.loader.exec_module(module)
+    return module
 
 
-def observed_order(peaks):
-    """Order p of convergence of the peak over the three levels, with the fine zone's
-    real element sizes h ~ 1 / n_fine (6, 9, 12 elements: ratios 1.5 and 1.33, not 2):
-    p solves (h1^p - h2^p) / (h0^p - h1^p) = (P2 - P1) / (P1 - P0); and the
-    the Richardson-extrapolated peak P0 - C h0^p with C = (P0 - P1) / (h0^p - h1^p)."""
-    from scipy.optimize import brentq
-
-    h = 1.0 / np.array([spec.n_fine for spec in f.LEVELS[:3]], float)
-    ratio = (peaks[2] - peaks[1]) / (peaks[1] - peaks[0])
-
-    def mismatch(p):
-        return (h[1] ** p - h[2] ** p) / (h[0] ** p - h[1] ** p) - ratio
-
-    order = brentq(mismatch, 0.05, 8.0)
-    slope = (peaks[0] - peaks[1]) / (h[0] ** order - h[1] ** order)
-    return order, peaks[0] - slope * h[0] ** order
+def test_richardson_recovers_a_known_order_and_limit():
+    """The extrapolation on values ``L + C h^p`` at the study's uneven ratios returns
+    ``p`` and ``L`` (to rounding), and refuses changes that do not shrink."""
+    script = _convergence_script()
+    h = 1.0 / np.array([6.0, 9.0, 12.0])
+    order, limit = script.richardson(h, -0.1 + 0.2 * h**0.8)
+    assert order == pytest.approx(0.8, rel=1e-6) and limit == pytest.approx(-0.1, rel=1e-6)
+    with pytest.raises(ValueError, match="shrink"):
+        script.richardson(h, [1.0, 2.0, 4.0])
 
 
-@pytest.mark.slow
-def test_mesh_study_amplitude_converges(coarse_profiles, fine_profile):
-    """Level 2: the peak's change shrinks (ratio < 0.7) and the shape agrees within 1 %;
-    the peaks converge monotonically at a positive order (measured 0.89 with the fine
-    zone's real ratios, toward -0.0974: level 1 is 22 % low; issue 34 item 5)."""
-    fine = fine_profile
-    p0, p1 = (p[0] for p in coarse_profiles)
-    assert abs(fine[0] - p1) < 0.7 * abs(p1 - p0)
-    assert abs(fine[0] - p1) < 0.1 * abs(fine[0])
-    assert np.max(np.abs(fine / abs(fine[0]) - coarse_profiles[1] / abs(p1))) < 0.01
-    assert p0 > p1 > fine[0]  # monotone, more compressive with each level
-    order, limit = observed_order([p0, p1, fine[0]])
-    assert order > 0.5 and limit < fine[0]
+def test_model_md_convergence_block_is_the_recorded_study():
+    """docs/model.md's mesh study is generated from the recorded solves
+    (docs/data/finger3d_convergence*.json, the script's --solve)."""
+    script = _convergence_script()
+    assert script.block(script.load()) in script.DOC.read_text()
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(
-    strict=True,
-    reason="finding (issue 34 items 5, 7): the ratio < 0.7 above passes with first-order "
-    "convergence (0.5 for p = 1 at these refinement ratios); the peak converges at order "
-    "0.89, not the second order quadratic elements give a smooth solution (the core's "
-    "boundary layer is not resolved)",
-)
-def test_mesh_study_amplitude_converges_at_second_order(coarse_profiles, fine_profile):
-    order, _ = observed_order([coarse_profiles[0][0], coarse_profiles[1][0], fine_profile[0]])
+def test_mixed_amplitude_converges_through_the_skin():
+    """The error of the amplitude lies through the skin: the recorded study's radial
+    family (mixed; surface mesh held; 3, 4, 6 elements through the skin) solved again
+    converges monotonically at an observed order above 1.5 (a smooth solution on quadratic
+    elements; the displacement-only model's old levels gave below 1), and matches the
+    record to 1e-9 (``docs/model.md`` section 3a)."""
+    script = _convergence_script()
+    formulation, meshes, _ = script.FAMILIES["radial"]
+    peaks = [script.solve_peak(formulation, *mesh)["peak"] for mesh in meshes]
+    assert peaks[0] > peaks[1] > peaks[2]
+    order, limit = script.richardson([1.0 / m[0] for m in meshes], peaks)
     assert order > 1.5
+    assert limit < peaks[2]
+    recorded = [r["peak"] for r in script.load()["families"]["radial"]]
+    np.testing.assert_allclose(peaks, recorded, rtol=1e-9)
 
 
 def test_far_cut_does_not_matter(coarse_profiles):
@@ -261,7 +258,13 @@ def test_regression_dielectric_study_is_reproduced():
     case = next(c for c in data["cases"] if c["modulus_pa"] == 7.0e4 and c["poisson_ratio"] == 0.3)
     assert case["thickness_mm"] == 0.5
     layer = f.Dielectric(0.5e-3, 7.0e4, 0.3)
-    sol = f.solve_load(f.knife_edge(), 0.5, spec=f.LEVELS[data["level"]], dielectric=layer)
+    sol = f.solve_load(
+        f.knife_edge(),
+        0.5,
+        spec=f.LEVELS[data["level"]],
+        dielectric=layer,
+        formulation=data.get("formulation", "displacement"),
+    )
     along = sol.dielectric_strain(script.XS, 0 * script.XS)
     full = np.concatenate([along[:0:-1], along])
     depth, nu, _ = script.fit_2d(np.array(data["x_mm"]) * 1e-3, full)

@@ -32,7 +32,17 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy import sparse
 from scipy.sparse.linalg import spsolve
-from skfem import Basis, BilinearForm, ElementHex2, FacetBasis, LinearForm, MeshHex, MeshHex2, asm
+from skfem import (
+    Basis,
+    BilinearForm,
+    ElementHex1,
+    ElementHex2,
+    FacetBasis,
+    LinearForm,
+    MeshHex,
+    MeshHex2,
+    asm,
+)
 from skfem.models.elasticity import lame_parameters
 
 from tactsense._validation import check_choice
@@ -70,6 +80,19 @@ class MeshSpec:
     fine_m: float = 6e-3
     length_m: float = 25e-3
     dielectric_m: float = 0.0
+    radial_growth: float = 1.0
+    """Ratio of each element's thickness to the one below it, from the core out (1:
+    uniform; above 1 the elements thin toward the core, where the strain's gradient
+    through the nearly incompressible skin is steepest: ``docs/model.md`` section 3a)."""
+
+
+def radial_nodes(start_m: float, n: int, growth: float) -> np.ndarray:
+    """``n + 1`` radii [m] from ``start_m`` to the outer surface, each element
+    ``growth`` times as thick as the one below it."""
+    if growth == 1.0:
+        return np.linspace(start_m, OUTER_M, n + 1)
+    steps = growth ** np.arange(n)
+    return start_m + (OUTER_M - start_m) * np.concatenate([[0.0], np.cumsum(steps)]) / steps.sum()
 
 
 @dataclass(frozen=True)
@@ -87,6 +110,11 @@ class Dielectric:
 
 
 LEVELS = (MeshSpec(3, 6, 6, 4e-3), MeshSpec(4, 9, 7, 4e-3), MeshSpec(5, 12, 8, 4e-3))
+"""The mesh study's levels of the displacement-only model (``docs/model.md`` section 3a)."""
+TABLE_MESH = MeshSpec(6, 9, 7, 4e-3)
+"""The mesh of the shipped tables (``scripts/finger3d_table.py``, mixed elements): six
+elements through the skin, where the amplitude's error lies (``scripts/
+finger3d_convergence.py``)."""
 
 
 def _graded(fine, end, n_fine, n_coarse):
@@ -137,9 +165,9 @@ def build_mesh(spec: MeshSpec = LEVELS[0]) -> ShellMesh:
     """
     if spec.dielectric_m > 0:
         top = CORE_M + spec.dielectric_m
-        r = np.concatenate([[CORE_M], np.linspace(top, OUTER_M, spec.n_r + 1)])
+        r = np.concatenate([[CORE_M], radial_nodes(top, spec.n_r, spec.radial_growth)])
     else:
-        r = np.linspace(CORE_M, OUTER_M, spec.n_r + 1)
+        r = radial_nodes(CORE_M, spec.n_r, spec.radial_growth)
     theta = _graded(spec.fine_m / OUTER_M, np.pi, spec.n_fine, spec.n_coarse)
     x = _graded(spec.fine_m, spec.length_m, spec.n_fine, spec.n_coarse)
     box = MeshHex.init_tensor(x, theta, r)
@@ -312,6 +340,51 @@ def _stiffness_layered(basis, rubber, dielectric, top_m):
     return _elasticity(_gradient_blocks(basis, material(0)), _gradient_blocks(basis, material(1)))
 
 
+def _divergence_blocks(basis, pressure_basis, region=None):
+    """``B = [B_x, B_y, B_z]`` with ``B_c[q, a] = int w psi_q d_c(phi_a)`` (``psi``: the
+    pressure's basis, ``w`` the indicator ``region(x)`` of where the pressure lives, or 1):
+    ``B u`` tests ``div u``; shape (pressure dofs, 3 N)."""
+    w_of = (lambda x: 1.0) if region is None else region
+    blocks = [
+        asm(BilinearForm(lambda u, v, w, c=c: w_of(w.x) * v * u.grad[c]), basis, pressure_basis)
+        for c in range(3)
+    ]
+    return sparse.hstack(blocks, format="csr")
+
+
+def mixed_system(stiffness, basis, pressure_basis, inverse_lam, incompressible=None):
+    """The displacement-pressure (u-p) system of nearly incompressible elasticity.
+
+    ``sigma = 2 mu eps(u) - p I`` with ``p = -lam div u`` held weakly on the pressure's
+    own (lower-order, continuous) basis where ``incompressible(x)`` is 1 (everywhere if
+    None): Taylor-Hood, inf-sup stable, so the rubber (nu 0.49, or 0.5 exactly) does not
+    lock as the pure displacement form does (``docs/model.md``, section 3a).
+
+    Parameters
+    ----------
+    stiffness : sparse matrix (3 N, 3 N)
+        The displacement block ``A``: ``2 mu eps(u) : eps(v)`` everywhere, plus
+        ``lam (div u)(div v)`` only where the material is compressible (a dielectric).
+    inverse_lam : callable
+        ``1 / lam`` [1/Pa] at points (3, ...) [m] (0 for nu = 0.5).
+    incompressible : callable, optional
+        Indicator (0 or 1) of the region the pressure lives on, at points (3, ...).
+
+    Returns
+    -------
+    matrix : sparse matrix
+        The symmetric, indefinite ``[[A, -B^T], [-B, -M / lam]]`` over ``[u; p]``.
+    support : ndarray
+        The pressure dofs that carry anything (the others are dropped by the caller).
+    """
+    inside = (lambda x: np.ones(np.shape(x)[1:])) if incompressible is None else incompressible
+    divergence = _divergence_blocks(basis, pressure_basis, inside)
+    mass = asm(BilinearForm(lambda u, v, w: inside(w.x) * inverse_lam(w.x) * u * v), pressure_basis)
+    support = asm(BilinearForm(lambda u, v, w: inside(w.x) * u * v), pressure_basis).diagonal()
+    matrix = sparse.bmat([[stiffness, -divergence.T], [-divergence, -mass]], format="csr")
+    return matrix, np.nonzero(support > 0)[0]
+
+
 def _fixed_dofs(basis, shell: ShellMesh, far_end):
     n = basis.N
     core = basis.get_dofs(facets=shell.core).all()
@@ -337,6 +410,7 @@ def solve_load(
     poisson_ratio=0.49,
     far_end="clamped",
     dielectric: Dielectric | None = None,
+    formulation: str = "mixed",
 ):
     """Solve the quarter shell under a surface pressure shape scaled to ``force_n`` [N].
 
@@ -359,24 +433,35 @@ def solve_load(
         A soft layer of its own material on the core, under the rubber (meshed as one
         element through its thickness); :meth:`Solution.dielectric_strain` then reads
         its mean radial strain, the capacitor's ``dd / d_o``.
+    formulation : {"mixed", "displacement"}
+        ``"mixed"``: triquadratic displacement and trilinear pressure in the rubber
+        (Taylor-Hood, :func:`mixed_system`), free of volumetric locking, so nu may be
+        0.5; ``"displacement"``: triquadratic displacement only, which locks as nu ->
+        0.5 (the model before issue 34: its amplitude converged at order ~0.8 and level
+        1 read about a quarter low, ``docs/model.md`` section 3a).
 
     Returns
     -------
     Solution
     """
     check_choice(far_end, "far_end", ("clamped", "sliding"))
+    check_choice(formulation, "formulation", ("mixed", "displacement"))
     if dielectric is not None:
         spec = replace(spec, dielectric_m=dielectric.thickness_m)
     shell = build_mesh(spec)
     basis = Basis(shell.mesh, ElementHex2(), intorder=4)
-    lam, mu = lame_parameters(YOUNGS_PA, poisson_ratio)
-    if dielectric is None:
-        stiffness = _stiffness(basis, lam, mu)
+    if formulation == "mixed":
+        stiffness, n_pressure = _mixed_stiffness(basis, shell, poisson_ratio, dielectric)
+    elif dielectric is None:
+        stiffness = _stiffness(basis, *lame_parameters(YOUNGS_PA, poisson_ratio))
+        n_pressure = 0
     else:
         soft = lame_parameters(dielectric.youngs_pa, dielectric.poisson_ratio)
         # quadrature points lie inside elements: below the interface only in the layer
         top = CORE_M + dielectric.thickness_m
-        stiffness = _stiffness_layered(basis, (lam, mu), soft, top)
+        rubber = lame_parameters(YOUNGS_PA, poisson_ratio)
+        stiffness = _stiffness_layered(basis, rubber, soft, top)
+        n_pressure = 0
     top = FacetBasis(shell.mesh, ElementHex2(), facets=shell.outer, intorder=6)
 
     def shape(w):
@@ -387,11 +472,57 @@ def solve_load(
     f = np.concatenate(
         [asm(LinearForm(lambda v, w, c=c: -scale * shape(w) * w.n[c] * v), top) for c in range(3)]
     )
+    f = np.concatenate([f, np.zeros(n_pressure)])
     fixed = _fixed_dofs(basis, shell, far_end)
-    u = np.zeros(3 * basis.N)
-    free = np.setdiff1d(np.arange(3 * basis.N), fixed)
+    u = np.zeros(3 * basis.N + n_pressure)
+    free = np.setdiff1d(np.arange(3 * basis.N + n_pressure), fixed)
     u[free] = spsolve(stiffness[free][:, free].tocsc(), f[free])
-    return Solution(basis, u.reshape(3, -1), shell, dielectric is not None)
+    return Solution(basis, u[: 3 * basis.N].reshape(3, -1), shell, dielectric is not None)
+
+
+def _lame(youngs_pa, poisson_ratio):
+    """(lam, mu) [Pa]; lam infinite at nu 0.5 (only the mixed form takes it)."""
+    mu = youngs_pa / (2 * (1 + poisson_ratio))
+    if poisson_ratio >= 0.5:
+        return np.inf, mu
+    return youngs_pa * poisson_ratio / ((1 + poisson_ratio) * (1 - 2 * poisson_ratio)), mu
+
+
+def _mixed_stiffness(basis, shell: ShellMesh, poisson_ratio, dielectric):
+    """The u-p matrix (:func:`mixed_system`) of the rubber, on the dielectric if any,
+    restricted to the pressure dofs that carry anything: (matrix, their count)."""
+    pressure_basis = Basis(shell.mesh, ElementHex1(), intorder=4)
+    if dielectric is None:
+        return mixed_layered(basis, pressure_basis, poisson_ratio)
+    top = CORE_M + dielectric.thickness_m
+
+    def rubber(x):  # quadrature points lie inside elements: the interface is a face
+        return (np.hypot(x[1], x[2]) >= top).astype(float)
+
+    return mixed_layered(basis, pressure_basis, poisson_ratio, dielectric, rubber)
+
+
+def mixed_layered(basis, pressure_basis, poisson_ratio, dielectric=None, rubber=None):
+    """The u-p matrix of the skin's rubber (nu ``poisson_ratio``), and of a compressible
+    ``dielectric`` where the indicator ``rubber(x)`` is 0, restricted to the pressure dofs
+    that carry anything: (matrix, their count). Shared by the cylinder and the tip."""
+    lam, mu = _lame(YOUNGS_PA, poisson_ratio)
+    if dielectric is None:
+        g = _gradient_blocks(basis)
+        stiffness = _elasticity({k: 0 * v for k, v in g.items()}, {k: mu * v for k, v in g.items()})
+        matrix, keep = mixed_system(stiffness, basis, pressure_basis, lambda x: 0 * x[0] + 1 / lam)
+    else:
+        soft_lam, soft_mu = _lame(dielectric.youngs_pa, dielectric.poisson_ratio)
+        stiffness = _elasticity(
+            _gradient_blocks(basis, lambda x: soft_lam * (1 - rubber(x))),
+            _gradient_blocks(basis, lambda x: np.where(rubber(x) > 0, mu, soft_mu)),
+        )
+        matrix, keep = mixed_system(
+            stiffness, basis, pressure_basis, lambda x: rubber(x) / lam, rubber
+        )
+    n_u = 3 * basis.N
+    rows = np.concatenate([np.arange(n_u), n_u + keep])
+    return matrix[rows][:, rows], len(keep)
 
 
 def lame_radial_strain(r, pressure_pa, poisson_ratio, youngs_modulus=YOUNGS_PA):

@@ -46,6 +46,7 @@ FORWARDS = ("twin", "finger3d", "finger3d-foam")
 """The forward models of a finger: the paper's 2-D twin, the 3-D skin's table, or the 3-D
 skin on section 2.3's foam dielectric (what the capacitor reads: the layer's strain)."""
 TABLES = {"finger3d": TABLE, "finger3d-foam": TABLE.with_name("finger3d_probe_foam.npz")}
+TIP_TABLES = {"finger3d": TIP_TABLE, "finger3d-foam": TIP_TABLE.with_name("finger3d_tip_foam.npz")}
 
 
 @functools.lru_cache(maxsize=4)
@@ -137,19 +138,21 @@ def strain_per_newton(
     return np.where(x <= axial[-1], value, 0.0)
 
 
-@functools.lru_cache(maxsize=1)
-def tip_table() -> dict:
-    """The tip's tables (``scripts/finger3d_tip.py``): every array of the file."""
-    with np.load(TIP_TABLE) as data:
+@functools.lru_cache(maxsize=2)
+def tip_table(forward: str = "finger3d") -> dict:
+    """The tip's tables (``scripts/finger3d_tip.py``, with ``--foam`` for
+    ``"finger3d-foam"``): every array of the file."""
+    with np.load(TIP_TABLES[forward]) as data:
         return {k: data[k] if data[k].ndim else data[k].item() for k in data.files}
 
 
-def tip_row_strain_per_newton(s_mm, d_angle_deg, *, plate: str = "tip"):
+def tip_row_strain_per_newton(s_mm, d_angle_deg, *, plate: str = "tip", forward="finger3d"):
     """Mean normal strain of the tip row's tactel per newton of the probe [1/N], the
     probe at surface coordinate ``s_mm`` (apex -19.95 mm to 12 mm; 0 beyond) and
     ``d_angle_deg`` from the tactel; ``plate="tip_rim"``: the outer quarter of the
-    face only (the plate-size sensitivity)."""
-    t = tip_table()
+    face only (the plate-size sensitivity); ``forward="finger3d-foam"``: the skin on the
+    foam, read as the foam layer's mean strain."""
+    t = tip_table(forward)
     s = np.asarray(s_mm, dtype=float)
     values = t[f"{plate}_strain_per_n"]
     value = _bilinear(t["s_mm"], t["angle_deg"], values, s, _angle_offset(d_angle_deg))
@@ -157,8 +160,8 @@ def tip_row_strain_per_newton(s_mm, d_angle_deg, *, plate: str = "tip"):
 
 
 @functools.lru_cache(maxsize=8)
-def _cylinder_from_tip(flexural_length_mm: float, ring_radius_mm: float):
-    t = tip_table()
+def _cylinder_from_tip(flexural_length_mm: float, ring_radius_mm: float, forward="finger3d"):
+    t = tip_table(forward)
     angle, spread = _ring_spread(
         t["angle_deg"], t["cylinder_strain_per_n"].astype(float), flexural_length_mm, ring_radius_mm
     )
@@ -175,8 +178,7 @@ def deflection_batch_3d(spec, states, forward: str = "finger3d") -> np.ndarray:
     tip row, and a knife on the hemisphere, take the 2-D twin's response; so does the
     tangential part of a tilted probe's force (the twin's response to the tilted probe
     less its response to the probe's normal part). ``forward="finger3d-foam"``: the
-    cylinder's table of the skin on the foam dielectric; the tip's tables have no
-    dielectric (the tip row and probes on the tip are those of the solid skin).
+    cylinder's and the tip's tables of the skin on the foam dielectric.
     """
     from tactsense.physics.array_response import deflection_batch
 
@@ -211,17 +213,19 @@ def deflection_batch_3d(spec, states, forward: str = "finger3d") -> np.ndarray:
                 continue
             if contact.alpha_deg != 0.0:  # the tangential share: the twin's, below
                 tilted.append(contact)
-            out[k, ~cylinder] -= normal * tip_row_strain_per_newton(contact.axial_mm, d_angle)
+            out[k, ~cylinder] -= normal * tip_row_strain_per_newton(
+                contact.axial_mm, d_angle, forward=forward
+            )
             if contact.axial_mm >= 0.0:
                 offset = rows_mm[cylinder, None] - contact.axial_mm
                 out[k, cylinder] -= normal * strain_per_newton(
                     offset, d_angle, rings=rings, forward=forward
                 )
             else:
-                near = cylinder & (rows_mm <= tip_table()["row_mm"][-1])
+                near = cylinder & (rows_mm <= tip_table(forward)["row_mm"][-1])
                 for r in np.nonzero(near)[0]:
                     out[k, r] -= normal * _cylinder_row_from_tip(
-                        rows_mm[r], contact.axial_mm, d_angle[0], rings
+                        rows_mm[r], contact.axial_mm, d_angle[0], rings, forward
                     )
         twin_states.append(tuple(twin_part))
         knife_states.append(tuple(knives))
@@ -254,10 +258,10 @@ def deflection_batch_3d(spec, states, forward: str = "finger3d") -> np.ndarray:
     return out
 
 
-def _cylinder_row_from_tip(row_mm, s_mm, d_angle_deg, rings):
+def _cylinder_row_from_tip(row_mm, s_mm, d_angle_deg, rings, forward="finger3d"):
     """One cylinder row's strain (cols,) under a probe on the hemisphere, interpolated
     linearly between the table's rows."""
-    rows, s_grid, angle, spread = _cylinder_from_tip(*rings)
+    rows, s_grid, angle, spread = _cylinder_from_tip(*rings, forward)
     k = int(np.clip(np.searchsorted(rows, row_mm, side="right") - 1, 0, len(rows) - 2))
     w = float(np.clip((row_mm - rows[k]) / (rows[k + 1] - rows[k]), 0.0, 1.0))
     a = _angle_offset(d_angle_deg)

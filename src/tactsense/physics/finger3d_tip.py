@@ -38,6 +38,7 @@ Forward model only: estimation code must never import this module.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import itertools
 from dataclasses import dataclass
@@ -45,11 +46,30 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import sparse
 from scipy.sparse.linalg import splu
-from skfem import Basis, ElementTetP2, FacetBasis, LinearForm, MeshTet, MeshTet2, asm
+from skfem import (
+    Basis,
+    ElementTetP1,
+    ElementTetP2,
+    FacetBasis,
+    LinearForm,
+    MeshTet,
+    MeshTet2,
+    asm,
+)
 from skfem.models.elasticity import lame_parameters
 
 from tactsense._validation import check_choice
-from tactsense.physics.finger3d import CORE_M, OUTER_M, RING_DEPTH_M, YOUNGS_PA, _graded, _stiffness
+from tactsense.physics.finger3d import (
+    CORE_M,
+    OUTER_M,
+    RING_DEPTH_M,
+    YOUNGS_PA,
+    _graded,
+    _lame,
+    _stiffness,
+    mixed_layered,
+    mixed_system,
+)
 
 RUBBER_AT_APEX_M = 10e-3
 """Rubber thickness from the top of the hemisphere to the core (section 3.6) [m]."""
@@ -99,6 +119,36 @@ class TipMeshSpec:
     length_m: float = 25e-3
     core_end_m: float = CORE_END_M
     core: str = "flat"
+    dielectric_m: float = 0.0
+    """Thickness of a layer on the core (cylinder and end face) meshed apart, one element
+    through it, for a dielectric of its own material (``assemble(dielectric=...)``) [m]."""
+
+
+DIELECTRIC_T = 0.1
+"""Grid coordinate ``t`` of the dielectric layer's top (when there is one)."""
+
+
+def _radius(t, r_in, spec: TipMeshSpec):
+    """Distance from the sphere's centre (on the cylinder: from the axis) of grid
+    coordinate ``t`` on a ray that meets the core at ``r_in`` [m]: linear in ``t`` from
+    the core to the skin, or, with a dielectric, from the core to its top over ``t`` in
+    [0, DIELECTRIC_T] and from there to the skin."""
+    if spec.dielectric_m <= 0:
+        return r_in + t * (OUTER_M - r_in)
+    d = spec.dielectric_m
+    low = r_in + d * t / DIELECTRIC_T
+    high = r_in + d + (t - DIELECTRIC_T) / (1 - DIELECTRIC_T) * (OUTER_M - r_in - d)
+    return np.where(t <= DIELECTRIC_T, low, high)
+
+
+def in_dielectric(x, spec: TipMeshSpec) -> np.ndarray:
+    """1 where points ``x`` (3, ...) [m] lie in the dielectric layer on the core, else 0
+    (the layer as the mesh maps it: along the rays of :func:`to_xyz`)."""
+    rho = np.hypot(x[1], x[2])
+    psi = np.clip(np.arctan2(-x[0], rho), 0.0, np.pi / 2)
+    r = np.where(x[0] >= 0, rho, np.hypot(x[0], rho))
+    r_in = np.where(x[0] >= 0, CORE_M, core_radius(psi, spec))
+    return (r < r_in + spec.dielectric_m).astype(float)
 
 
 TIP_LEVELS = (
@@ -170,10 +220,10 @@ def to_xyz(s, theta, t, spec: TipMeshSpec) -> np.ndarray:
     s, theta, t = np.broadcast_arrays(*(np.asarray(q, float) for q in (s, theta, t)))
     psi = np.clip(-s / OUTER_M, 0.0, np.pi / 2)
     r_in = core_radius(psi, spec)
-    r = r_in + t * (OUTER_M - r_in)
+    r = _radius(t, r_in, spec)
     on_tip = s < 0
     x = np.where(on_tip, -r * np.sin(psi), s)
-    rho = np.where(on_tip, r * np.cos(psi), CORE_M + t * (OUTER_M - CORE_M))
+    rho = np.where(on_tip, r * np.cos(psi), _radius(t, CORE_M, spec))
     return np.stack([x, rho * np.sin(theta), rho * np.cos(theta)])
 
 
@@ -212,6 +262,8 @@ def build_tip_mesh(spec: TipMeshSpec = TIP_LEVELS[1]) -> TipMesh:
     s = meridian_nodes(spec)
     theta = angle_nodes(spec, max_deg=spec.max_theta_deg)
     t = np.linspace(0.0, 1.0, spec.n_t + 1)
+    if spec.dielectric_m > 0:
+        t = np.concatenate([[0.0], np.linspace(DIELECTRIC_T, 1.0, spec.n_t + 1)])
     ns, nth, nt = len(s), len(theta), len(t)
     ii, jj, kk = np.meshgrid(np.arange(ns), np.arange(nth), np.arange(nt), indexing="ij")
     index = np.ravel_multi_index((ii, jj, kk), (ns, nth, nt))
@@ -287,6 +339,8 @@ class TipSolution:
     free: np.ndarray
     lu: object
     poisson_ratio: float
+    n_pressure: int = 0
+    """Pressure unknowns after the displacement's (``formulation="mixed"``), else 0."""
 
     @property
     def n_dofs(self) -> int:
@@ -294,9 +348,11 @@ class TipSolution:
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
         """Displacement (3, N) [m] for a load vector (component-major, length 3 N)."""
-        u = np.zeros(self.n_dofs)
-        u[self.free] = self.lu.solve(np.asarray(rhs, float)[self.free])
-        return u.reshape(3, -1)
+        full = np.zeros(self.n_dofs + self.n_pressure)
+        full[: self.n_dofs] = rhs
+        u = np.zeros_like(full)
+        u[self.free] = self.lu.solve(full[self.free])
+        return u[: self.n_dofs].reshape(3, -1)
 
     @functools.cached_property
     def skin(self) -> FacetBasis:
@@ -377,6 +433,15 @@ class TipSolution:
         weights = np.full(n_points, 1.0 / n_points) if weights is None else weights
         return self._normal_strain_matrix(points, normals, step).T @ np.asarray(weights, float)
 
+    def normal_displacement_functional(self, points, normals, weights=None):
+        """The functional ``g`` (length 3 N) of the weighted mean displacement along unit
+        ``normals`` (3, P) at ``points`` (3, P) [m] (equal weights by default)."""
+        n_points = np.shape(points)[1]
+        weights = np.full(n_points, 1.0 / n_points) if weights is None else weights
+        probe = self._probe_matrix(points).T @ sparse.diags(np.asarray(weights, float))
+        normals = np.asarray(normals, float)
+        return np.concatenate([probe @ normals[c] for c in range(3)])
+
     def normal_strain(self, u, points, normals, step=1e-6) -> np.ndarray:
         """Normal strain ``n . (du/dn)`` [-] of displacement ``u`` (3, N) at ``points``."""
         return self._normal_strain_matrix(points, normals, step) @ np.ravel(u)
@@ -420,26 +485,61 @@ class TipSolution:
         return (0.5 * reading / total).reshape(s_mm.shape)
 
 
-def assemble(spec: TipMeshSpec = TIP_LEVELS[1], *, poisson_ratio=0.49, base="clamped"):
+def assemble(
+    spec: TipMeshSpec = TIP_LEVELS[1],
+    *,
+    poisson_ratio=0.49,
+    base="clamped",
+    formulation="displacement",
+    dielectric=None,
+):
     """Mesh, assemble and factorise the half finger.
 
     ``base``: ``"clamped"`` (the finger's base) or ``"sliding"`` (``u_x = 0`` only: with
     ``length_m = 0`` and a spherical core, half a spherical shell, the closed-form check).
+    ``formulation``: ``"displacement"`` (quadratic tetrahedra; the shipped tip table) or
+    ``"mixed"`` (quadratic displacement with linear continuous pressure, Taylor-Hood
+    P2-P1: free of volumetric locking, :func:`~tactsense.physics.finger3d.mixed_system`).
+    ``dielectric``: a :class:`~tactsense.physics.finger3d.Dielectric` on the core (cylinder
+    and end face; mixed elements only), meshed as one element through its thickness.
     """
     check_choice(base, "base", ("clamped", "sliding"))
+    check_choice(formulation, "formulation", ("mixed", "displacement"))
+    if dielectric is not None:
+        if formulation != "mixed":
+            raise ValueError("a dielectric on the tip needs formulation='mixed'")
+        spec = dataclasses.replace(spec, dielectric_m=dielectric.thickness_m)
     tip = build_tip_mesh(spec)
     basis = Basis(tip.mesh, ElementTetP2(), intorder=4)
-    lam, mu = lame_parameters(YOUNGS_PA, poisson_ratio)
-    stiffness = _stiffness(basis, lam, mu)
+    n_pressure = 0
+    if dielectric is not None:
+        stiffness, n_pressure = mixed_layered(
+            basis,
+            Basis(tip.mesh, ElementTetP1(), intorder=4),
+            poisson_ratio,
+            dielectric,
+            lambda x: 1.0 - in_dielectric(x, spec),
+        )
+    elif formulation == "mixed":
+        lam, mu = _lame(YOUNGS_PA, poisson_ratio)
+        stiffness, keep = mixed_system(
+            _stiffness(basis, 0.0, mu),
+            basis,
+            Basis(tip.mesh, ElementTetP1(), intorder=4),
+            lambda x: 0 * x[0] + 1 / lam,
+        )
+        n_pressure = len(keep)
+    else:
+        stiffness = _stiffness(basis, *lame_parameters(YOUNGS_PA, poisson_ratio))
     n = basis.N
     core = basis.get_dofs(facets=tip.core).all()
     end = basis.get_dofs(facets=tip.base).all()
     fixed = [core, core + n, core + 2 * n, basis.get_dofs(facets=tip.sym).all() + n, end]
     if base == "clamped":
         fixed += [end + n, end + 2 * n]
-    free = np.setdiff1d(np.arange(3 * n), np.unique(np.concatenate(fixed)))
+    free = np.setdiff1d(np.arange(3 * n + n_pressure), np.unique(np.concatenate(fixed)))
     lu = splu(stiffness[free][:, free].tocsc())
-    return TipSolution(tip, basis, free, lu, poisson_ratio)
+    return TipSolution(tip, basis, free, lu, poisson_ratio, n_pressure)
 
 
 def sphere_radial_strain(r, pressure_pa, poisson_ratio, youngs_modulus=YOUNGS_PA):
