@@ -210,7 +210,7 @@ def _score(table, n, positions, force_n, pitch) -> Score:
     )
 
 
-def _calibrations(spec, case, layer, gains, rng):
+def _calibrations(spec, case, layer, gains, rng, methods=METHODS):
     """The lab's calibration of the true pad, per estimator: the sweep's gains and
     baseline, then a model-force curve from presses of known loads."""
     g = spec.grid
@@ -227,7 +227,7 @@ def _calibrations(spec, case, layer, gains, rng):
                         for (x, y), f in zip(where, loads, strict=True)])  # fmt: skip
     press_counts = true_counts(spec, presses, case, gains, rng)
     out = {}
-    for method in METHODS:
+    for method in methods:
         found = find_contacts(press_counts, spec, calibration=base, method=method)
         estimated = np.zeros(len(loads))
         np.add.at(estimated, found.frame, np.nan_to_num(found.force_n))
@@ -238,8 +238,8 @@ def _calibrations(spec, case, layer, gains, rng):
     return out
 
 
-def run_case(spec, case: Case, *, n_positions: int = 24, seed: int = 0) -> Row:
-    """One case of the study; see the module."""
+def run_case(spec, case: Case, *, n_positions: int = 24, seed: int = 0, methods=METHODS) -> Row:
+    """One case of the study (``methods``: some of :data:`METHODS`); see the module."""
     rng = np.random.default_rng(seed)
     layer = true_layer(spec, case)
     gains = (
@@ -256,9 +256,9 @@ def run_case(spec, case: Case, *, n_positions: int = 24, seed: int = 0) -> Row:
     frames = true_counts(spec, strain, case, gains, rng)
     baseline = np.median(untouched, axis=0)
     pitch = spec.grid.row_pitch_mm
-    calibrations = _calibrations(spec, case, layer, gains, rng)
+    calibrations = _calibrations(spec, case, layer, gains, rng, methods)
     before, after = {}, {}
-    for method in METHODS:
+    for method in methods:
         found = find_contacts(frames, spec, baseline=baseline, method=method)
         before[method] = _score(found, n_positions, positions, case.force_n, pitch)
         found = find_contacts(frames, spec, calibration=calibrations[method], method=method)
@@ -315,7 +315,7 @@ def markdown_table(rows: list[Row]) -> str:
         "|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
-        for method in METHODS:
+        for method in r.before:
             lines.append(
                 f"| {r.pad} | {r.case.name} | {method} | {_cell(r.before[method])} "
                 f"| {_cell(r.after[method])} |"
