@@ -54,11 +54,12 @@ METHODS = ("fit", "joint")
 PROBE_MM, PROBE_N = 1.6, 0.49
 """The described probe (the scenarios' sphere [mm]) and the reference load [N]."""
 
-CAL_LOADS_N = (0.098, 0.196, 0.49, 0.98, 1.96, 2.94)
-"""Known loads of the calibration presses [N] (10-300 g)."""
-
-CAL_PRESSES = 4
-"""Presses per known load."""
+CAL_LOADS_N = tuple(np.geomspace(0.098, 2.94, 48))
+"""Loads of the calibration presses as a load cell logs them [N]: 48, spread evenly in
+log over 10-300 g (the force curve's 8 bins of 6 presses, as ``tactsense calibrate``
+bins a force log). Not a few discrete weights: the curve's knots are medians per bin,
+and a bin holding one weight only makes a flat step that snaps every estimate near it
+to that weight (a test at that load would then read no error at all)."""
 
 
 @dataclass(frozen=True)
@@ -221,7 +222,7 @@ def _calibrations(spec, case, layer, gains, rng, methods=METHODS):
                       for x, y in centres])  # fmt: skip
     frames = np.concatenate([baseline_frames, true_counts(spec, sweep, case, gains, rng)])
     base = calibrate_array(frames, spec, method="sweep", partial=True)
-    loads = np.repeat(CAL_LOADS_N, CAL_PRESSES)
+    loads = np.array(CAL_LOADS_N)
     where = _interior(spec, len(loads), rng)
     presses = np.stack([taxel_strain(spec, x, y, f, PROBE_MM, layer=layer)
                         for (x, y), f in zip(where, loads, strict=True)])  # fmt: skip
@@ -233,7 +234,7 @@ def _calibrations(spec, case, layer, gains, rng, methods=METHODS):
         np.add.at(estimated, found.frame, np.nan_to_num(found.force_n))
         keep = estimated > 0
         calibration = calibrate_array(frames, spec, method="sweep", partial=True)
-        calibration.force_curve = force_curve(estimated[keep], loads[keep], bins=len(CAL_LOADS_N))
+        calibration.force_curve = force_curve(estimated[keep], loads[keep])
         out[method] = calibration
     return out
 
