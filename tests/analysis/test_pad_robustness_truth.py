@@ -62,3 +62,31 @@ def _doc_row(pad, case, method):
 
 def _numbers(cell):
     return [float(v) for v in re.findall(r"[-+]?\d*\.?\d+", cell)]
+
+
+def test_small_rerun_shows_the_docs_directions():
+    # pad4 (capacitive: information in every taxel), the fixed-probe fit, 6 positions:
+    # the truth as described is estimated near its bound, the twin's gain spread spoils
+    # position and force until the sweep's gains take it out; the doc's rows (12
+    # positions, another draw) must show the same directions
+    spec = load_sensor("pad4")
+    by_name = {c.name: c for c in study.cases(spec)}
+    described = study.run_case(
+        spec, by_name["as described (1.6-mm sphere, 50 g)"], n_positions=6, seed=5,
+        methods=("fit",),
+    ).before["fit"]  # fmt: skip
+    spread = study.run_case(
+        spec, by_name["gain spread (twin's)"], n_positions=6, seed=5, methods=("fit",)
+    )
+    assert described.found_pct == 100.0
+    assert described.position_mean < 0.05 and described.force_median < 5.0
+    before, after = spread.before["fit"], spread.after["fit"]
+    assert before.position_mean > 3 * described.position_mean
+    assert before.force_median > 2 * described.force_median
+    assert after.position_mean < 0.05 and after.force_median < 0.5 * before.force_median
+    doc_described = _doc_row("pad4", "as described (1.6-mm sphere, 50 g)", "fit")
+    doc_spread = _doc_row("pad4", "gain spread (twin's)", "fit")
+    d_pos, s_pos, s_pos_after = (_numbers(doc_described[4])[0], _numbers(doc_spread[4])[0],
+                                 _numbers(doc_spread[7])[0])  # fmt: skip
+    assert s_pos > 3 * d_pos and s_pos_after < 0.5 * s_pos
+    assert _numbers(doc_spread[5])[0] > 2 * _numbers(doc_described[5])[0]

@@ -20,8 +20,9 @@ of the scenarios' 1.6-mm sphere) and ``"joint"`` (each contact's size fitted too
 * **before** calibration: the description as given, the baseline of untouched frames;
 * **after**: the lab's calibration made on the true pad itself, as tactsense offers
   it: the calibration probe (the 1.6-mm sphere, 50 g) pressed on every taxel in turn
-  (``calibrate_array(..., method="sweep")``: gains and baseline), then presses of known
-  loads (10-300 g, the same probe, at random positions) against which a model-force
+  (``calibrate_array(..., method="sweep")``: gains and baseline), then presses logged
+  by a load cell (:data:`CAL_LOADS_N`, the same probe, at random positions) against
+  which a model-force
   curve is fitted (``weight_curve.force_curve`` of the estimator's own forces against
   the known loads, the curve ``tactsense calibrate --force-log`` fits). The calibration
   probe is the described one: the test indenter is not.
