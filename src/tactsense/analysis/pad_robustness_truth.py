@@ -315,7 +315,7 @@ def pad_robustness_truth_study(
 
 def _cell(s: Score) -> str:
     if not np.isfinite(s.position_mean):
-        return "none found"
+        return f"{s.found_pct:.0f} % | - | -"
     return (
         f"{s.found_pct:.0f} % | {s.position_mean:.3f} / {s.position_worst:.3f} "
         f"| {s.force_median:.1f} / {s.force_worst:.0f}"
