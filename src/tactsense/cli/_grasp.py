@@ -110,7 +110,8 @@ def grasp_command(
         typer.Argument(
             help="The robot's skin: a preset ('hand4', 'icub_hand'), a skin TOML or a URDF "
             "with tactile sensors "
-            "(tactsense sensor show SKIN lists its patches, links and joints)."
+            "(tactsense sensor show SKIN lists its patches with their links and poses, and "
+            "its joints with their limits: where to put the object)."
         ),
     ],
     out: Annotated[

@@ -22,6 +22,13 @@ from tactsense.robot import (
     skin_to_toml_string,
 )
 
+SKIN_HELP = (
+    " Or a robot skin: the skin presets 'hand4' (a four-finger hand, 20 patches) and "
+    "'icub_hand' (iCub's five fingertips), a skin TOML or a URDF with several sensors "
+    "(docs/robot.md)."
+)
+"""Appended to ``--sensor``'s help where the command takes a robot skin."""
+
 SKIN_FORMATS = ("toml", "urdf")
 """What ``sensor export --format`` writes a skin as."""
 
@@ -79,15 +86,25 @@ def _rate(patch) -> str:
     return f"{patch.sensor.electronics.scan_rate_hz:g} Hz"
 
 
+def _numbers(values, scale: float) -> str:
+    return ", ".join(f"{v * scale:.4g}" for v in values)
+
+
 def patch_table(skin: RobotSkin) -> Table:
-    """One row per patch (link, kind, taxels, rate, device) and a row of totals."""
+    """One row per patch (link, its pose there: xyz [mm] and rpy [deg], kind, taxels, rate,
+    device) and a row of totals."""
+    import math
+
     table = Table(title=f"{skin.name}: {skin.description}".rstrip(": "))
-    for column in ("patch", "link", "kind", "sensor", "taxels", "rate", "device"):
+    columns = ("patch", "link", "xyz [mm]", "rpy [deg]", "kind", "sensor", "taxels", "rate")
+    for column in (*columns, "device"):
         table.add_column(column, justify="right" if column == "taxels" else "left")
     for patch in skin.patches:
         table.add_row(
             patch.name,
             patch.link,
+            _numbers(patch.origin.xyz_m, 1e3),
+            _numbers(patch.origin.rpy_rad, 180 / math.pi),
             kind_of(patch.sensor).label,
             patch.sensor.name,
             str(patch.n_taxels),
@@ -101,10 +118,33 @@ def patch_table(skin: RobotSkin) -> Table:
         f"{len(skin.links)} links, {len(skin.movable_joints)} moving joints",
         "",
         "",
+        "",
+        "",
         str(skin.n_taxels),
         " / ".join(f"{r:g}" for r in rates) + " Hz",
         f"{len(skin.devices)} devices",
     )
+    return table
+
+
+def joint_table(skin: RobotSkin) -> Table:
+    """One row per moving joint: type, parent, child, axis, limits [rad or m]."""
+    table = Table(title=f"{skin.name}: moving joints (base link {skin.base_link!r})")
+    for column in ("joint", "type", "parent", "child", "axis", "lower", "upper"):
+        table.add_column(column)
+    for joint in skin.joints:
+        if joint.type == "fixed":
+            continue
+        unit = "m" if joint.type == "prismatic" else "rad"
+        table.add_row(
+            joint.name,
+            joint.type,
+            joint.parent,
+            joint.child,
+            _numbers(joint.axis, 1.0),
+            f"{joint.lower:.4g} {unit}",
+            f"{joint.upper:.4g} {unit}",
+        )
     return table
 
 
@@ -116,6 +156,15 @@ def show_skin(value: str, out: Path | None, force: bool) -> None:
         skin = read_skin(value)
         if out is None:
             print_table(patch_table(skin))
+            print_table(joint_table(skin))
+            console.print(
+                "poses: each patch's sensor frame in its link's frame (xyz [mm], URDF "
+                "roll-pitch-yaw [deg]); tactsense.robot's skin.taxels_in_base(joints) places "
+                "every taxel in the base frame",
+                soft_wrap=True,
+                markup=False,
+                highlight=False,
+            )
             return
         text = skin_to_toml_string(skin)
         with atomic_output(out) as temporary:
@@ -229,7 +278,9 @@ def check_skin(path: str | Path) -> None:
 
 def skin_list_table() -> Table:
     """The skin presets: name, patches, taxels, devices, what each is."""
-    table = Table(title="robot skins (tactsense sensor show --sensor NAME lists a skin's patches)")
+    table = Table(
+        title="robot skins (tactsense sensor show NAME lists a skin's patches and joints)"
+    )
     for column in ("name", "patches", "taxels", "devices", "description"):
         table.add_column(column)
     for name, make in SKIN_PRESETS.items():
