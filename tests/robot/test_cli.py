@@ -148,3 +148,28 @@ def test_every_sensor_command_of_the_docs_skin_block_runs(tmp_path, monkeypatch)
     for line in lines:
         result, text = _run(*shlex.split(line)[1:])
         assert result.exit_code == 0, f"{line}: {text}"
+
+
+def test_a_urdf_round_trip_through_the_cli_keeps_the_physics(tmp_path):
+    """Issue 36 trial defect 8: toml -> urdf -> toml gave pad4's patch pad16's physics."""
+    import re
+
+    skin = skin_preset("hand4")
+    urdf, toml = tmp_path / "h.urdf", tmp_path / "h.toml"
+    result, text = _run(
+        "sensor", "export", "--sensor", "hand4", "--format", "urdf", "-o", str(urdf)
+    )
+    assert result.exit_code == 0, text
+    result, text = _run(
+        "sensor", "export", "--sensor", str(urdf), "--format", "toml", "-o", str(toml)
+    )
+    assert result.exit_code == 0 and "warning" not in text, text
+    back = skin_from_toml(toml)
+    for ours, theirs in zip(skin.patches, back.patches, strict=True):
+        assert theirs.sensor.to_dict() == ours.sensor.to_dict(), ours.name
+    plain = tmp_path / "plain.urdf"
+    plain.write_text(
+        re.sub(r"<tactsense:sensor .*?</tactsense:sensor>", "", urdf.read_text(), flags=re.S)
+    )
+    result, text = _run("sensor", "show", str(plain))
+    assert result.exit_code == 0 and "warning:" in text and "taken from presets" in text, text

@@ -77,9 +77,21 @@ def skin_inputs(value: str | Path) -> list[Path]:
 
 def read_skin(value: str | Path) -> RobotSkin:
     """A skin from a preset's name, a skin TOML or a URDF file."""
-    from tactsense.interop.robot_urdf import load_robot_skin
+    import warnings
 
-    return load_robot_skin(value)
+    from tactsense.interop.robot_urdf import UrdfPhysicsWarning, load_robot_skin
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", UrdfPhysicsWarning)
+        skin = load_robot_skin(value)
+    for warning in caught:
+        if issubclass(warning.category, UrdfPhysicsWarning):
+            console.print(f"warning: {warning.message}", soft_wrap=True, markup=False)
+        else:
+            warnings.warn_explicit(
+                warning.message, warning.category, warning.filename, warning.lineno
+            )
+    return skin
 
 
 def _rate(patch) -> str:
