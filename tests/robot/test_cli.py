@@ -173,3 +173,29 @@ def test_a_urdf_round_trip_through_the_cli_keeps_the_physics(tmp_path):
     )
     result, text = _run("sensor", "show", str(plain))
     assert result.exit_code == 0 and "warning:" in text and "taken from presets" in text, text
+
+
+_TWO_SENSORS = (
+    'name = "arm2"\nbase_link = "base"\nlinks = ["base"]\n'
+    '[[sensors]]\nname = "base_pad"\nlink = "base"\nsensor = "pad16"\n{first}\n'
+    '[[sensors]]\nname = "fore_pad"\nlink = "base"\nsensor = "{preset}"\n{second}\n'
+)
+
+
+def test_check_gives_one_line_per_problem_at_its_own_index(tmp_path):
+    """Issue 36 trial defect 11: a problem was printed twice, the second time as
+    "sensors[1]: sensors[0] (...)"; two sensors' problems both as sensors[0]."""
+    path = tmp_path / "skin.toml"
+    path.write_text(_TWO_SENSORS.format(first="", second="", preset="pad5"))
+    result = runner.invoke(app, ["sensor", "check", str(path)], terminal_width=400)
+    lines = [line for line in result.output.splitlines() if "pad5" in line]
+    assert result.exit_code == 2 and len(lines) == 1, result.output
+    assert "sensors[1] (fore_pad)" in lines[0] and "sensors[0]" not in lines[0]
+    path.write_text(
+        _TWO_SENSORS.format(first="xyz_m = [1, 2]", second='xyz_m = "x"', preset="pad4")
+    )
+    result = runner.invoke(app, ["sensor", "check", str(path)], terminal_width=400)
+    lines = [line for line in result.output.splitlines() if "xyz_m" in line]
+    assert result.exit_code == 2 and len(lines) == 2, result.output
+    assert "sensors[0]: xyz_m = [1, 2]" in lines[0] and "sensors[1]: xyz_m = 'x'" in lines[1]
+    assert all(line.count("sensors[") == 1 for line in lines), result.output

@@ -231,9 +231,11 @@ def _sensor_problems(path: Path) -> list[str]:
             "sensors": [{**table, "link": "base", "name": str(table.get("name", i))}],
         }
         try:
-            skin_from_dict(one, source=f"sensors[{i}]", folder=path.parent)
+            skin_from_dict(one, source=str(path), folder=path.parent)
         except TactsenseInputError as error:
-            problems.append(str(error))
+            # the one-sensor skin calls it sensors[0]: give it its place in the file
+            mine, theirs = f"{path}: sensors[0]", f"{path}: sensors[{i}]"
+            problems.append(str(error).replace(mine, theirs, 1))
     return problems
 
 
@@ -274,7 +276,7 @@ def check_skin(path: str | Path) -> None:
         skin = read_skin(text)
     except TactsenseInputError as error:
         message = str(error)
-        for problem in problems:
+        for problem in dict.fromkeys(problems):  # one line per problem, in file order
             if problem not in message:
                 message += f"\n  - {problem}"
         fail(message)
