@@ -199,3 +199,17 @@ def test_check_gives_one_line_per_problem_at_its_own_index(tmp_path):
     assert result.exit_code == 2 and len(lines) == 2, result.output
     assert "sensors[0]: xyz_m = [1, 2]" in lines[0] and "sensors[1]: xyz_m = 'x'" in lines[1]
     assert all(line.count("sensors[") == 1 for line in lines), result.output
+
+
+def test_the_skin_blocks_hand_written_figures_are_the_codes():
+    """docs/robot.md's skin block, outside its generated table: the overlap distance of
+    `sensor check` and hand4's thumb rotation limits are the code's."""
+    from pathlib import Path
+
+    from tactsense.cli._robot_sensor import OVERLAP_M
+
+    doc = (Path(__file__).resolve().parents[2] / "docs" / "robot.md").read_text()
+    block = " ".join(doc[doc.index("<!-- r7-skin -->") : doc.index("<!-- /r7-skin -->")].split())
+    assert f"closer than {OVERLAP_M * 1e3:g} mm" in block
+    (thumb,) = [j for j in skin_preset("hand4").joints if j.name == "thumb_abduction"]
+    assert f"(joint 12, limits {thumb.lower:.3f}-{thumb.upper:.3f} rad)" in block
