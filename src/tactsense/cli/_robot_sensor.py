@@ -9,11 +9,20 @@ from __future__ import annotations
 
 import tomllib
 from pathlib import Path
+from typing import Annotated
 
+import typer
 from rich.table import Table
 
 from tactsense._validation import TactsenseInputError
-from tactsense.cli._common import atomic_output, check_output, console, fail, print_table
+from tactsense.cli._common import (
+    SensorOption,
+    atomic_output,
+    check_output,
+    console,
+    fail,
+    print_table,
+)
 from tactsense.kinds import kind_of
 from tactsense.robot import (
     SKIN_PRESETS,
@@ -28,6 +37,32 @@ SKIN_HELP = (
     "(docs/robot.md)."
 )
 """Appended to ``--sensor``'s help where the command takes a robot skin."""
+
+SkinOrSensorOption = Annotated[
+    str, typer.Option("--sensor", help=SensorOption.__metadata__[0].help + SKIN_HELP)
+]
+"""``--sensor`` of the sensor commands that take a robot skin too."""
+
+WhatArgument = Annotated[
+    str | None,
+    typer.Argument(
+        help="The sensor or robot skin (the same as --sensor): a preset, a skin preset "
+        "(hand4, icub_hand), a sensor or skin TOML, or a URDF.",
+        metavar="SENSOR",
+        show_default=False,
+    ),
+]
+"""``sensor show``'s positional sensor or skin."""
+
+
+def one_sensor(what: str | None, sensor: str) -> str:
+    """The sensor given positionally or by ``--sensor`` (refused when both differ)."""
+    if what is None:
+        return sensor
+    if sensor not in ("initial", what):
+        fail(f"give the sensor once: {what!r} or --sensor {sensor!r}, not both")
+    return what
+
 
 SKIN_FORMATS = ("toml", "urdf")
 """What ``sensor export --format`` writes a skin as."""
@@ -203,8 +238,6 @@ def export_skin(value: str, fmt: str | None, out: Path | None, force: bool) -> N
         else:
             text = skin_to_toml_string(skin)
         if out is None:
-            import typer
-
             typer.echo(text, nl=False)
             return
         with atomic_output(out) as temporary:

@@ -273,27 +273,10 @@ def info(recording: Annotated[Path, typer.Argument(help="HDF5 recording to descr
     print_table(table)
 
 
-# ---- robot skins (r7-skin) ----
-SkinOrSensorOption = Annotated[
-    str,
-    typer.Option("--sensor", help=SensorOption.__metadata__[0].help + _robot_sensor.SKIN_HELP),
-]
-# ---- /r7-skin ----
-
-
 @sensor_app.command("show")
 def sensor_show(
-    # ---- robot skins (r7-skin) ----
-    what: Annotated[
-        str | None,
-        typer.Argument(
-            help="The sensor or robot skin to show (the same as --sensor): a preset, a skin "
-            "preset (hand4, icub_hand), a sensor or skin TOML, or a URDF.",
-            show_default=False,
-        ),
-    ] = None,
-    sensor: SkinOrSensorOption = "initial",
-    # ---- /r7-skin ----
+    what: _robot_sensor.WhatArgument = None,  # r7-skin
+    sensor: _robot_sensor.SkinOrSensorOption = "initial",  # r7-skin
     out: Annotated[
         Path | None, typer.Option("--out", "-o", help="Write the TOML here instead of printing it.")
     ] = None,
@@ -302,14 +285,10 @@ def sensor_show(
     """Print a sensor description as TOML: a starting point for describing your own finger.
 
     A robot skin (a skin preset such as hand4, a skin TOML or a URDF with several sensors):
-    a table of its patches (link, pose in the link: xyz [mm] and rpy [deg], kind, taxels,
-    rate, device) and totals, then its moving joints with their limits; --out writes its
-    TOML. The sensor or skin may be given positionally: 'tactsense sensor show hand4'."""
+    its patches (link, pose: xyz [mm], rpy [deg], kind, taxels, rate, device), totals and
+    moving joints with limits; --out writes its TOML. 'sensor show hand4' = --sensor hand4."""
     # ---- robot skins (r7-skin) ----
-    if what is not None:
-        if sensor != "initial" and sensor != what:
-            fail(f"give the sensor once: {what!r} or --sensor {sensor!r}, not both")
-        sensor = what
+    sensor = _robot_sensor.one_sensor(what, sensor)
     if _robot_sensor.is_skin(sensor):
         return _robot_sensor.show_skin(sensor, out, force)
     # ---- /r7-skin ----
@@ -542,13 +521,11 @@ def sensor_import(
 
 @sensor_app.command("export")
 def sensor_export(
-    sensor: SkinOrSensorOption = "initial",  # r7-skin: the help lists the skin presets
+    sensor: _robot_sensor.SkinOrSensorOption = "initial",  # r7-skin: lists skin presets
     urdf: Annotated[
         bool,
         typer.Option(
-            "--urdf",
-            help="Write the URDF tactile array (the same as --format urdf; one of the two is "
-            "required).",
+            "--urdf", help="Write the URDF tactile array (as --format urdf; one is required)."
         ),
     ] = False,
     out: Annotated[
@@ -571,14 +548,12 @@ def sensor_export(
     ] = None,
     # ---- /r7-skin ----
 ) -> None:
-    """Write a sensor as a URDF tactile description for ROS (RViz's tactile display), or a
-    robot skin as URDF or TOML.
+    """Write a sensor as a URDF tactile description for ROS (RViz's tactile display).
 
-    One sensor: --urdf (or --format urdf). A pad as an <array> (rows along x, columns along
-    y); a finger or a point set as a <taxel idx xyz rpy> list, each taxel on the skin at its
-    real position and normal (a finger: x along it); metres; the data vector is a tactsense
-    frame, row-major. A robot skin: --format toml or urdf (its links, joints and every
-    sensor).
+    A pad as an <array> (rows along x, columns along y); a finger or a point set as a
+    <taxel idx xyz rpy> list, each taxel on the skin at its real position and normal (a
+    finger: x along it); metres; the data vector is a tactsense frame, row-major. A robot
+    skin: --format toml or urdf (its links, joints and every sensor).
     """
     from tactsense.interop.urdf import sensor_to_urdf
 
