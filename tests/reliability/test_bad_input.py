@@ -921,3 +921,44 @@ def test_robot_io_bad_options(robot_workspace, line, names):
 
 
 # ---- /robot export/import (r7-handio) ----
+
+
+# ---- (r7-fixb) ----
+FIXB_BAD_INPUT = [
+    # (command line, what the message must say); DIR: the workspace
+    ("sensor show hand4 --sensor icub_hand", "give the sensor once"),
+    ("sensor show hand4 pad4", "unexpected extra argument"),
+    ("sensor show DIR/fixb_edited.urdf", "not where the URDF's geometry places"),
+    ("sensor export --sensor DIR/fixb_yaml.urdf --format toml --out OUT", "only 'toml' is read"),
+    ("sensor show DIR/fixb_badtoml.urdf", "its <tactsense:sensor> description"),
+    ("grasp hand4 --object sphere --size-mm 40 --pose 36.5,-56.5,-28.5 --out OUT", "nearest patch"),
+]
+
+
+def _fixb_files(folder):
+    from tactsense.interop.robot_urdf import robot_skin_to_urdf
+    from tactsense.robot import Patch, Pose, RobotSkin
+    from tactsense.sensor import preset
+
+    skin = RobotSkin(
+        name="s", base_link="a", links=("a",), joints=(),
+        patches=(Patch("p", preset("pad4"), "a", Pose(), "board"),),
+    )  # fmt: skip
+    text = robot_skin_to_urdf(skin)
+    (folder / "fixb_edited.urdf").write_text(text.replace('rows="4"', 'rows="3"'))
+    (folder / "fixb_yaml.urdf").write_text(text.replace('format="toml"', 'format="yaml"'))
+    (folder / "fixb_badtoml.urdf").write_text(text.replace("[grid]", "[grid"))
+
+
+@pytest.mark.parametrize("line, names", FIXB_BAD_INPUT, ids=[line for line, _ in FIXB_BAD_INPUT])
+def test_fixb_bad_input(workspace, line, names):
+    _fixb_files(workspace)
+    out = workspace / "never_written_fixb"
+    args = line.replace("OUT", str(out)).replace("DIR", str(workspace)).split()
+    result = runner.invoke(app, args)
+    _check(result, names)
+    assert not out.exists()
+    assert not [p for p in workspace.iterdir() if ".partial" in p.name]
+
+
+# ---- /(r7-fixb) ----

@@ -252,3 +252,69 @@ def test_an_array_offset_moves_the_taxels_as_the_toolbox_does(tmp_path):
     np.testing.assert_allclose(skin.patch("pad").taxels_in_link()[0], expected, atol=1e-15)
     # taxel (0, 0) at (0.02 - 0.004, 0 + 0.001, 0) in the finger's frame
     np.testing.assert_allclose(expected[0], [0.016, 0.001, 0.0], atol=1e-15)
+
+
+# ---- r7-fixb: a written URDF keeps each sensor's whole description ----
+
+
+def _arm2():
+    """Two pads of different physics (pad4: capacitive, 4 mm; pad16: resistive) on two
+    links: the trial's arm, where a round trip gave pad4's patch pad16's physics."""
+    import dataclasses
+
+    from tactsense.robot import Joint, Patch, Pose, RobotSkin
+    from tactsense.sensor import preset
+
+    return RobotSkin(
+        name="arm2",
+        base_link="base",
+        links=("base", "fore"),
+        joints=(Joint("elbow", "revolute", "base", "fore", Pose((0.1, 0, 0)), (0, 0, 1), -1, 1),),
+        patches=(
+            Patch("base_pad", dataclasses.replace(preset("pad16")), "base", Pose(), "board_a"),
+            Patch("fore_pad", preset("pad4"), "fore", Pose((0.02, 0, 0.01)), "board_b"),
+        ),
+    )
+
+
+def test_a_round_trip_gives_back_every_sensors_whole_description(tmp_path):
+    import warnings
+
+    import yourdfpy
+    from urdf_parser_py.urdf import URDF
+
+    skin = _arm2()
+    path = write_robot_urdf(skin, tmp_path / "arm2.urdf")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no physics-from-a-preset warning: all is kept
+        back = read_robot_urdf(path)
+    for ours, theirs in zip(skin.patches, back.patches, strict=True):
+        assert theirs.sensor.to_dict() == ours.sensor.to_dict(), ours.name
+    # still a URDF other readers load (they skip tactsense's element)
+    assert len(yourdfpy.URDF.load(str(path)).robot.links) == 2
+    assert len(URDF.from_xml_string(path.read_text()).links) == 2
+
+
+def test_a_urdf_without_tactsense_descriptions_warns_where_physics_come_from(tmp_path):
+    import re
+    import warnings
+
+    from tactsense.interop.robot_urdf import UrdfPhysicsWarning
+
+    path = tmp_path / "plain.urdf"
+    text = robot_skin_to_urdf(_arm2())
+    path.write_text(re.sub(r"<tactsense:sensor .*?</tactsense:sensor>", "", text, flags=re.S))
+    with pytest.warns(UrdfPhysicsWarning, match=r"base_pad, fore_pad from 'pad16'"):
+        read_robot_urdf(path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a preset named for every sensor: no warning
+        read_robot_urdf(path, extends="pad16")
+
+
+def test_an_edited_urdf_geometry_disagreeing_with_the_description_is_refused(tmp_path):
+    path = tmp_path / "edited.urdf"
+    text = robot_skin_to_urdf(_arm2())
+    assert text.count('rows="4"') == 1
+    path.write_text(text.replace('rows="4"', 'rows="3"'))
+    with pytest.raises(UrdfError, match=r"fore_pad.*tactsense:sensor.*not where"):
+        read_robot_urdf(path)

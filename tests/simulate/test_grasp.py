@@ -666,3 +666,65 @@ def test_ctrl_c_in_the_command_leaves_nothing(tmp_path):
     assert process.returncode == 1 and "interrupted" in err, err
     assert "Traceback" not in err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["skin.toml"]
+
+
+# ---- r7-fixb: every example of docs/robot.md's grasp block runs ----
+
+
+def _doc_block(marker: str) -> str:
+    from pathlib import Path
+
+    doc = (Path(__file__).resolve().parents[2] / "docs" / "robot.md").read_text()
+    return doc[doc.index(f"<!-- {marker} -->") : doc.index(f"<!-- /{marker} -->")]
+
+
+def doc_commands(marker: str, command: str) -> list[list[str]]:
+    """The ``tactsense COMMAND ...`` console lines of a docs/robot.md block, as argument
+    lists (comments dropped, the shell prompt ``$`` too), leaving out synopsis lines that
+    hold placeholders (SKIN, RUN, ...)."""
+    import re
+    import shlex
+
+    found = []
+    for line in _doc_block(marker).splitlines():
+        line = line.strip().removeprefix("$ ").split(" #")[0].strip()
+        if not line.startswith(f"tactsense {command}") or re.search(r"\b[A-Z]{2,}\b", line):
+            continue
+        found.append(shlex.split(line)[1:])
+    return found
+
+
+def test_every_grasp_example_in_the_docs_runs(tmp_path, monkeypatch):
+    """Issue 36 trial defect 3: the docs' grasp command and grasp file touched no patch.
+    Each is run here on hand4 (shorter phases: where the object touches does not depend on
+    the time course) and must touch the patches it names."""
+    import re
+
+    monkeypatch.chdir(tmp_path)
+    short = ["--duration-s", "0.02,0.02,0.02,0.02", "--quiet", "--flaws", "none"]
+    commands = doc_commands("r7-grasp", "grasp")
+    assert commands, "no runnable `tactsense grasp` line in the docs"
+    for i, args in enumerate(commands):
+        args = [*args[: args.index("--out")], *short, "--out", f"run{i}"]
+        result = CliRunner().invoke(app, args, terminal_width=200)
+        assert result.exit_code == 0, f"{args}: {result.output}"
+        assert "palm_0" in result.output
+    (block,) = re.findall(r"```toml\n(.*?)```", _doc_block("r7-grasp"), flags=re.S)
+    (tmp_path / "grasp.toml").write_text(re.sub(r"(_s = )[0-9.]+", r"\g<1>0.02", block))
+    args = ["grasp", "hand4", "--grasp", "grasp.toml", "--out", "run_file", "--quiet"]
+    result = CliRunner().invoke(app, args, terminal_width=200)
+    assert result.exit_code == 0, result.output
+    back = read_robot_recording(tmp_path / "run_file")
+    forces = back.streams["palm_0"].scenario["patch_force_n"]
+    # the file commands 2 N on the index finger and 1 N on the palm: both are touched
+    assert sum(v for k, v in forces.items() if k.startswith("index_")) == pytest.approx(2.0)
+    assert sum(v for k, v in forces.items() if k.startswith("palm_")) == pytest.approx(1.0)
+
+
+def test_an_object_touching_nothing_names_the_nearest_patch():
+    from tactsense.robot import skin_preset
+    from tactsense.simulate.grasp import plan_grasp
+
+    grasp = Grasp(object=GraspObject("sphere", (40.0,), Pose(xyz_m=(0.0365, -0.0565, -0.0285))))
+    with pytest.raises(GraspError, match=r"nearest patch is 'palm_2', [0-9.]+ mm.*sensor show"):
+        plan_grasp(skin_preset("hand4"), grasp)

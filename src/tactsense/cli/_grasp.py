@@ -110,7 +110,8 @@ def grasp_command(
         typer.Argument(
             help="The robot's skin: a preset ('hand4', 'icub_hand'), a skin TOML or a URDF "
             "with tactile sensors "
-            "(tactsense sensor show SKIN lists its patches, links and joints)."
+            "(tactsense sensor show SKIN lists its patches with their links and poses, and "
+            "its joints with their limits: where to put the object)."
         ),
     ],
     out: Annotated[
@@ -218,7 +219,7 @@ def grasp_command(
     """Simulate an object (sphere, cylinder or box) grasped by a robot's skin: every patch's
     frames at its own scan rate with its flaws, the contacts' truth in every stream, into a
     robot recording folder (docs/robot.md, "Simulated grasps")."""
-    from tactsense.interop.robot_urdf import load_robot_skin
+    from tactsense.cli import _robot_sensor
     from tactsense.simulate.grasp import (
         fingers,
         grasp_from_toml,
@@ -244,7 +245,7 @@ def grasp_command(
     ]
     if grasp_file is not None and object_options:
         fail(f"--grasp {grasp_file} describes the grasp; drop {', '.join(object_options)}")
-    robot = load_robot_skin(skin)
+    robot = _robot_sensor.read_skin(skin)  # r7-fixb: a URDF's physics warning, one line
     if grasp_file is not None:
         grasp = grasp_from_toml(grasp_file)
     else:

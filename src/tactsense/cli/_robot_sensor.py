@@ -9,11 +9,20 @@ from __future__ import annotations
 
 import tomllib
 from pathlib import Path
+from typing import Annotated
 
+import typer
 from rich.table import Table
 
 from tactsense._validation import TactsenseInputError
-from tactsense.cli._common import atomic_output, check_output, console, fail, print_table
+from tactsense.cli._common import (
+    SensorOption,
+    atomic_output,
+    check_output,
+    console,
+    fail,
+    print_table,
+)
 from tactsense.kinds import kind_of
 from tactsense.robot import (
     SKIN_PRESETS,
@@ -21,6 +30,39 @@ from tactsense.robot import (
     skin_from_dict,
     skin_to_toml_string,
 )
+
+SKIN_HELP = (
+    " Or a robot skin: the skin presets 'hand4' (a four-finger hand, 20 patches) and "
+    "'icub_hand' (iCub's five fingertips), a skin TOML or a URDF with several sensors "
+    "(docs/robot.md)."
+)
+"""Appended to ``--sensor``'s help where the command takes a robot skin."""
+
+SkinOrSensorOption = Annotated[
+    str, typer.Option("--sensor", help=SensorOption.__metadata__[0].help + SKIN_HELP)
+]
+"""``--sensor`` of the sensor commands that take a robot skin too."""
+
+WhatArgument = Annotated[
+    str | None,
+    typer.Argument(
+        help="The sensor or robot skin (the same as --sensor): a preset, a skin preset "
+        "(hand4, icub_hand), a sensor or skin TOML, or a URDF.",
+        metavar="SENSOR",
+        show_default=False,
+    ),
+]
+"""``sensor show``'s positional sensor or skin."""
+
+
+def one_sensor(what: str | None, sensor: str) -> str:
+    """The sensor given positionally or by ``--sensor`` (refused when both differ)."""
+    if what is None:
+        return sensor
+    if sensor not in ("initial", what):
+        fail(f"give the sensor once: {what!r} or --sensor {sensor!r}, not both")
+    return what
+
 
 SKIN_FORMATS = ("toml", "urdf")
 """What ``sensor export --format`` writes a skin as."""
@@ -70,24 +112,46 @@ def skin_inputs(value: str | Path) -> list[Path]:
 
 def read_skin(value: str | Path) -> RobotSkin:
     """A skin from a preset's name, a skin TOML or a URDF file."""
-    from tactsense.interop.robot_urdf import load_robot_skin
+    import warnings
 
-    return load_robot_skin(value)
+    from tactsense.interop.robot_urdf import UrdfPhysicsWarning, load_robot_skin
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", UrdfPhysicsWarning)
+        skin = load_robot_skin(value)
+    for warning in caught:
+        if issubclass(warning.category, UrdfPhysicsWarning):
+            console.print(f"warning: {warning.message}", soft_wrap=True, markup=False)
+        else:
+            warnings.warn_explicit(
+                warning.message, warning.category, warning.filename, warning.lineno
+            )
+    return skin
 
 
 def _rate(patch) -> str:
     return f"{patch.sensor.electronics.scan_rate_hz:g} Hz"
 
 
+def _numbers(values, scale: float) -> str:
+    return ", ".join(f"{v * scale:.4g}" for v in values)
+
+
 def patch_table(skin: RobotSkin) -> Table:
-    """One row per patch (link, kind, taxels, rate, device) and a row of totals."""
+    """One row per patch (link, its pose there: xyz [mm] and rpy [deg], kind, taxels, rate,
+    device) and a row of totals."""
+    import math
+
     table = Table(title=f"{skin.name}: {skin.description}".rstrip(": "))
-    for column in ("patch", "link", "kind", "sensor", "taxels", "rate", "device"):
+    columns = ("patch", "link", "xyz [mm]", "rpy [deg]", "kind", "sensor", "taxels", "rate")
+    for column in (*columns, "device"):
         table.add_column(column, justify="right" if column == "taxels" else "left")
     for patch in skin.patches:
         table.add_row(
             patch.name,
             patch.link,
+            _numbers(patch.origin.xyz_m, 1e3),
+            _numbers(patch.origin.rpy_rad, 180 / math.pi),
             kind_of(patch.sensor).label,
             patch.sensor.name,
             str(patch.n_taxels),
@@ -101,10 +165,33 @@ def patch_table(skin: RobotSkin) -> Table:
         f"{len(skin.links)} links, {len(skin.movable_joints)} moving joints",
         "",
         "",
+        "",
+        "",
         str(skin.n_taxels),
         " / ".join(f"{r:g}" for r in rates) + " Hz",
         f"{len(skin.devices)} devices",
     )
+    return table
+
+
+def joint_table(skin: RobotSkin) -> Table:
+    """One row per moving joint: type, parent, child, axis, limits [rad or m]."""
+    table = Table(title=f"{skin.name}: moving joints (base link {skin.base_link!r})")
+    for column in ("joint", "type", "parent", "child", "axis", "lower", "upper"):
+        table.add_column(column)
+    for joint in skin.joints:
+        if joint.type == "fixed":
+            continue
+        unit = "m" if joint.type == "prismatic" else "rad"
+        table.add_row(
+            joint.name,
+            joint.type,
+            joint.parent,
+            joint.child,
+            _numbers(joint.axis, 1.0),
+            f"{joint.lower:.4g} {unit}",
+            f"{joint.upper:.4g} {unit}",
+        )
     return table
 
 
@@ -116,6 +203,15 @@ def show_skin(value: str, out: Path | None, force: bool) -> None:
         skin = read_skin(value)
         if out is None:
             print_table(patch_table(skin))
+            print_table(joint_table(skin))
+            console.print(
+                "poses: each patch's sensor frame in its link's frame (xyz [mm], URDF "
+                "roll-pitch-yaw [deg]); tactsense.robot's skin.taxels_in_base(joints) places "
+                "every taxel in the base frame",
+                soft_wrap=True,
+                markup=False,
+                highlight=False,
+            )
             return
         text = skin_to_toml_string(skin)
         with atomic_output(out) as temporary:
@@ -142,8 +238,6 @@ def export_skin(value: str, fmt: str | None, out: Path | None, force: bool) -> N
         else:
             text = skin_to_toml_string(skin)
         if out is None:
-            import typer
-
             typer.echo(text, nl=False)
             return
         with atomic_output(out) as temporary:
@@ -170,9 +264,11 @@ def _sensor_problems(path: Path) -> list[str]:
             "sensors": [{**table, "link": "base", "name": str(table.get("name", i))}],
         }
         try:
-            skin_from_dict(one, source=f"sensors[{i}]", folder=path.parent)
+            skin_from_dict(one, source=str(path), folder=path.parent)
         except TactsenseInputError as error:
-            problems.append(str(error))
+            # the one-sensor skin calls it sensors[0]: give it its place in the file
+            mine, theirs = f"{path}: sensors[0]", f"{path}: sensors[{i}]"
+            problems.append(str(error).replace(mine, theirs, 1))
     return problems
 
 
@@ -213,7 +309,7 @@ def check_skin(path: str | Path) -> None:
         skin = read_skin(text)
     except TactsenseInputError as error:
         message = str(error)
-        for problem in problems:
+        for problem in dict.fromkeys(problems):  # one line per problem, in file order
             if problem not in message:
                 message += f"\n  - {problem}"
         fail(message)
@@ -229,7 +325,9 @@ def check_skin(path: str | Path) -> None:
 
 def skin_list_table() -> Table:
     """The skin presets: name, patches, taxels, devices, what each is."""
-    table = Table(title="robot skins (tactsense sensor show --sensor NAME lists a skin's patches)")
+    table = Table(
+        title="robot skins (tactsense sensor show NAME lists a skin's patches and joints)"
+    )
     for column in ("name", "patches", "taxels", "devices", "description"):
         table.add_column(column)
     for name, make in SKIN_PRESETS.items():

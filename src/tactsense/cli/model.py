@@ -275,7 +275,8 @@ def info(recording: Annotated[Path, typer.Argument(help="HDF5 recording to descr
 
 @sensor_app.command("show")
 def sensor_show(
-    sensor: SensorOption = "initial",
+    what: _robot_sensor.WhatArgument = None,  # r7-skin
+    sensor: _robot_sensor.SkinOrSensorOption = "initial",  # r7-skin
     out: Annotated[
         Path | None, typer.Option("--out", "-o", help="Write the TOML here instead of printing it.")
     ] = None,
@@ -284,9 +285,10 @@ def sensor_show(
     """Print a sensor description as TOML: a starting point for describing your own finger.
 
     A robot skin (a skin preset such as hand4, a skin TOML or a URDF with several sensors):
-    a table of its patches (link, kind, taxels, rate, device) and totals; --out writes its
-    TOML."""
+    its patches (link, pose: xyz [mm], rpy [deg], kind, taxels, rate, device), totals and
+    moving joints with limits; --out writes its TOML. 'sensor show hand4' = --sensor hand4."""
     # ---- robot skins (r7-skin) ----
+    sensor = _robot_sensor.one_sensor(what, sensor)
     if _robot_sensor.is_skin(sensor):
         return _robot_sensor.show_skin(sensor, out, force)
     # ---- /r7-skin ----
@@ -519,11 +521,11 @@ def sensor_import(
 
 @sensor_app.command("export")
 def sensor_export(
-    sensor: SensorOption = "initial",
+    sensor: _robot_sensor.SkinOrSensorOption = "initial",  # r7-skin: lists skin presets
     urdf: Annotated[
         bool,
         typer.Option(
-            "--urdf", help="Write the URDF tactile array (the only format so far; required)."
+            "--urdf", help="Write the URDF tactile array (as --format urdf; one is required)."
         ),
     ] = False,
     out: Annotated[

@@ -16,21 +16,26 @@ anything else as a ``<taxel>`` list), its ``channel`` the patch's name (the
 place in URDF: it is kept in a namespaced attribute ``tactsense:device``, which other
 URDF readers ignore.
 
-What a URDF does not hold: a sensor's physics (elastic layer, transduction, electronics
-beyond the scan rate, flaws). Reading takes them from a preset (``extends``), as
-``tactsense sensor import`` does for one sensor.
+What URDF does not hold: a sensor's physics (elastic layer, transduction, electronics
+beyond the scan rate, flaws). The file written here keeps each sensor's whole description
+(its TOML) in a ``<tactsense:sensor format="toml">`` child of its ``<sensor>`` (other
+readers skip it), so a round trip gives it back. A sensor without one takes them from a
+preset (``extends``), as ``tactsense sensor import`` does for one sensor, with an
+:class:`UrdfPhysicsWarning` saying which.
 """
 
 from __future__ import annotations
 
 import math
 import os
+import warnings
 import xml.etree.ElementTree as ET
 from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
 
+from tactsense._validation import TactsenseInputError
 from tactsense.interop.urdf import read_tactile_arrays, read_tactile_taxels, sensor_to_urdf
 from tactsense.kinds import kind_of
 from tactsense.kinds.urdf import UrdfError
@@ -49,6 +54,7 @@ from tactsense.sensor import PRESETS, preset
 
 __all__ = [
     "TACTSENSE_URDF_NS",
+    "UrdfPhysicsWarning",
     "load_robot_skin",
     "read_robot_urdf",
     "robot_skin_to_urdf",
@@ -60,6 +66,16 @@ TACTSENSE_URDF_NS = "https://github.com/tactsense/urdf"
 
 ET.register_namespace("tactsense", TACTSENSE_URDF_NS)
 _DEVICE = f"{{{TACTSENSE_URDF_NS}}}device"
+_SENSOR = f"{{{TACTSENSE_URDF_NS}}}sensor"
+_SAME_PLACE_MM = 1e-6
+"""A sensor's own description must place its taxels where the URDF's geometry does,
+within this [mm] (the geometry is written to 15 significant digits)."""
+
+
+class UrdfPhysicsWarning(UserWarning):
+    """A URDF's sensor without tactsense's own description: its physics (layer,
+    transduction, electronics, flaws) come from a preset."""
+
 
 DEFAULT_EXTENDS = {"array": "pad16", "taxels": "dome12"}
 """The preset a sensor's physics come from when ``extends`` does not name one."""
@@ -172,6 +188,37 @@ def _preset_for(extends, name: str, form: str) -> str:
     return chosen
 
 
+def _names_preset(extends, name: str) -> bool:
+    """Whether ``extends`` names this sensor's preset (one for all, or by name)."""
+    if isinstance(extends, Mapping):
+        return bool(extends.get(name))
+    return bool(extends)
+
+
+def _own_description(element, geometric, where: str):
+    """The sensor's whole description kept in a ``<tactsense:sensor format="toml">``
+    child, checked to place its taxels where the URDF's geometry does."""
+    from tactsense.sensor import SpecBase
+
+    if element.get("format", "toml") != "toml":
+        raise UrdfError(
+            f"{where}: <tactsense:sensor format={element.get('format')!r}>: only 'toml' is read"
+        )
+    try:
+        spec = SpecBase.from_toml_string(element.text or "")
+    except TactsenseInputError as error:
+        raise UrdfError(f"{where}: its <tactsense:sensor> description: {error}") from None
+    mine = np.asarray(spec.taxel_positions_mm(), float)
+    theirs = np.asarray(geometric.taxel_positions_mm(), float)
+    if mine.shape != theirs.shape or not np.allclose(mine, theirs, rtol=0, atol=_SAME_PLACE_MM):
+        raise UrdfError(
+            f"{where}: its <tactsense:sensor> description places {len(mine)} taxels, not where "
+            f"the URDF's geometry places its {len(theirs)} (was one edited?); fix the "
+            "description or remove it (the physics then come from a preset)"
+        )
+    return spec
+
+
 def read_robot_urdf(
     path: str | Path, *, extends: str | Mapping[str, str] | None = None
 ) -> RobotSkin:
@@ -218,6 +265,7 @@ def read_robot_urdf(
     arrays = {a.name: a for a in read_tactile_arrays(path)}
     lists = {t.name: t for t in read_tactile_taxels(path)}
     patches, seen = [], set()
+    from_presets: dict[str, list[str]] = {}
     for element in root.iter():
         if _local(element) != "sensor" or _child(element, "tactile") is None:
             continue
@@ -240,6 +288,11 @@ def read_robot_urdf(
                 f"{where}: a {'<taxel> list' if form == 'taxels' else '<array>'} cannot "
                 f"extend preset {chosen!r} (a {base.kind}); name a preset of a kind that fits"
             )
+        own = element.find(_SENSOR)
+        if own is not None and not _names_preset(extends, name):
+            spec = _own_description(own, spec, where)
+        elif not _names_preset(extends, name):
+            from_presets.setdefault(chosen, []).append(name)
         try:
             origin = _pose(element, where)
             if form == "array":
@@ -255,6 +308,17 @@ def read_robot_urdf(
             )
         except RobotSkinError as error:
             raise UrdfError(f"{source}: {error}") from None
+    if from_presets:
+        listed = "; ".join(f"{', '.join(names)} from {p!r}" for p, names in from_presets.items())
+        warnings.warn(
+            UrdfPhysicsWarning(
+                f"{path}: the URDF gives these sensors' geometry and rate but not their "
+                f"physics (layer, transduction, electronics, flaws), taken from presets: "
+                f"{listed} (name the right ones with extends; a URDF written by tactsense "
+                "keeps each sensor's whole description)"
+            ),
+            stacklevel=2,
+        )
     try:
         return RobotSkin(
             name=robot_name,
@@ -321,6 +385,8 @@ def robot_skin_to_urdf(skin: RobotSkin) -> str:
         origin.set("xyz", _xyz(patch.origin.xyz_m))
         origin.set("rpy", _xyz(patch.origin.rpy_rad))
         _child(sensor, "tactile").set("channel", patch.name)
+        own = ET.SubElement(sensor, _SENSOR, format="toml")  # other readers skip it
+        own.text = "\n" + patch.sensor.to_toml_string()
         root.append(sensor)
     ET.indent(root)
     return '<?xml version="1.0" encoding="utf-8"?>\n' + ET.tostring(root, encoding="unicode") + "\n"

@@ -89,6 +89,21 @@ def joint_state(skin: RobotSkin, joints: Mapping[str, float]) -> dict[str, float
     return state
 
 
+def _nearest_patch(skin: RobotSkin, grasp: Grasp) -> str:
+    """Which patch's taxels come nearest the object's surface, and how far [mm]: a hint
+    for an object that touches nothing."""
+    placed = skin.taxels_in_base(joint_state(skin, grasp.joints))
+    gaps = {
+        name: float(np.min(grasp.object.signed_distance_mm(1e3 * positions)))
+        for name, (positions, _normals) in placed.items()
+        if takes_grasp(skin.patch(name).sensor) and len(positions)
+    }
+    if not gaps:
+        return "no patch takes a grasp"
+    name = min(gaps, key=gaps.get)
+    return f"the nearest patch is {name!r}, {gaps[name]:.1f} mm from its surface"
+
+
 def grasp_contacts(skin: RobotSkin, grasp: Grasp) -> dict[str, PatchContact]:
     """The contact of the object on each patch it touches, in the patch's sensor frame,
     at the grasp's joint state (patches it does not touch are left out)."""
@@ -242,7 +257,8 @@ def plan_grasp(skin: RobotSkin, grasp: Grasp) -> GraspPlan:
     if not contacts:
         raise GraspError(
             f"the {grasp.object.shape} touches no patch of {skin.name!r} at this pose and "
-            "joint state; move it into the hand"
+            f"joint state; move it into the hand ({_nearest_patch(skin, grasp)}; "
+            f"'tactsense sensor show {skin.name}' lists each patch's link and pose)"
         )
     forces = grasp_forces(skin, grasp, contacts)
     scenario = grasp_scenario(skin, grasp, forces)
