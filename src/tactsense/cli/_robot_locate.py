@@ -140,7 +140,13 @@ def run_robot_locate(
                     f"{what} {path} lies inside the robot recording {recording}; an output "
                     "never goes into an input: choose another folder"
                 )
-            check_output(path, force, what=what, inputs=[recording])
+            for source in (joints_csv, joints_bag):  # a bag may be a folder: nothing in it
+                if source is not None and Path(source).is_dir() and inside(path, source):
+                    raise TactsenseInputError(
+                        f"{what} {path} lies inside the input {source}; an output never "
+                        "goes into an input: choose another folder"
+                    )
+            check_output(path, force, what=what, inputs=[recording, joints_csv, joints_bag])
         if Path(wrenches).resolve() == Path(out).resolve():
             raise TactsenseInputError("--wrenches names the same file as --out")
         skin = read_robot_skin(recording)
