@@ -147,3 +147,13 @@ def test_an_output_never_replaces_or_enters_the_joint_bag(run, tmp_path):
                                  "--out", str(folder / "c.parquet")])  # fmt: skip
     assert result.exit_code == 2
     assert "inside the input" in " ".join(result.output.split())
+
+
+def test_the_closing_line_says_the_force_is_a_probes_once(run, tmp_path):
+    """Trial 36 item 4: with contacts found, one note after the summary says the force is
+    a 1.6-mm probe's amplitude and points to --method joint; not on every line."""
+    out = tmp_path / "c.parquet"
+    result = runner.invoke(app, ["locate", str(run), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    text = " ".join(result.output.split())
+    assert text.count("1.6-mm probe") == 1 and "--method joint" in text

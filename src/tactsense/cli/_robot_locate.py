@@ -38,6 +38,13 @@ WRENCHES_HELP = (
     "frame) [default: OUT's name + _wrenches, same format]."
 )
 
+FORCE_CAVEAT = (
+    "note: force_n [N] is the amplitude of a 1.6-mm probe's response ('interpolate'): a "
+    "broad contact (a large object) reads low; for a pad patch's force fitted with the "
+    "contact's size, locate its own stream: tactsense locate RUN/streams/PATCH.h5 "
+    "--method joint (docs/contacts.md says where that can and cannot tell force)"
+)
+
 
 def robot_only_options(joints, joints_csv, joints_bag, joints_topic, wrenches) -> list[str]:
     """The robot recordings' options given (for a single recording's refusal)."""
@@ -183,5 +190,7 @@ def run_robot_locate(
         f"; wrenches in {wrenches}",
         soft_wrap=True, markup=False, highlight=False, emoji=False,
     )  # fmt: skip
+    if rows:
+        console.print(FORCE_CAVEAT, soft_wrap=True, markup=False, highlight=False, emoji=False)
     for line in warnings:
         console.print(f"warning: {line}", soft_wrap=True, markup=False, highlight=False)
