@@ -23,7 +23,8 @@ JOINTS_HELP = (
 )
 JOINTS_CSV_HELP = (
     "Robot recordings: joint states over time, a CSV with a time_s column [s, the "
-    "recording's clock] and one column per joint [rad or m], linearly interpolated to the "
+    "recording's clock: a capture's are Unix seconds on the host clock, a simulation's "
+    "start at 0] and one column per joint [rad or m], linearly interpolated to the "
     "frames' times (held at the ends, with a warning)."
 )
 JOINTS_BAG_HELP = (
