@@ -157,3 +157,27 @@ def test_the_closing_line_says_the_force_is_a_probes_once(run, tmp_path):
     assert result.exit_code == 0, result.output
     text = " ".join(result.output.split())
     assert text.count("1.6-mm probe") == 1 and "--method joint" in text
+
+
+def test_locate_and_exports_contacts_share_frames_on_a_simulated_press(run):
+    """docs/robot.md (trial 36 item 9): on a simulated press (no drift, no dead or
+    saturated taxels) locate RUN/'s estimator and the exports' tracked one find contacts
+    in the same frames of the pressed patch (their values are not claimed equal)."""
+    from tactsense.estimate.robot import locate_robot_recording
+    from tactsense.interop.robot_contacts import iter_patch_contacts
+    from tactsense.io.recording import RecordingReader
+    from tactsense.io.robot_recording import read_robot_skin, stream_path
+
+    hand = locate_robot_recording(run, joints={"j1": 0.0})
+    skin = read_robot_skin(run)
+    touched = 0
+    for patch in skin.patches:
+        with RecordingReader(stream_path(run, patch.name)) as reader:
+            exported = sorted(
+                {int(piece.start + f) for piece in iter_patch_contacts(reader, patch)
+                 for f in piece.frame}
+            )  # fmt: skip
+        mine = hand.contacts["patch"] == patch.name
+        assert sorted(set(hand.contacts["frame"][mine].tolist())) == exported, patch.name
+        touched += len(exported)
+    assert touched == 25  # the pad, pressed from frame 5 of 30
