@@ -109,3 +109,75 @@ def test_locate_takes_the_recordings_own_joint_state(run, tmp_path):
     from_csv = tmp_path / "from_csv.parquet"
     assert runner.invoke(app, ["locate", str(table), "--out", str(from_csv)]).exit_code == 0
     np.testing.assert_allclose(_base_positions(from_csv), _base_positions(explicit), atol=1e-9)
+
+
+# ---- round 7 fixes (r7-fixa) ----
+
+
+@pytest.mark.parametrize("flag", ["--out", "--wrenches"])
+@pytest.mark.parametrize("force", [False, True])
+def test_an_output_never_replaces_the_joint_csv(run, tmp_path, flag, force):
+    """Trial 36 item 1: the joint-state CSV is an input: --out or --wrenches naming it is
+    refused, --force or not, and the file is left as it was."""
+    joints = tmp_path / "j.csv"
+    text = "time_s,j1\n0,0.1\n100,0.1\n"
+    joints.write_text(text)
+    outputs = {"--out": tmp_path / "c.csv", "--wrenches": tmp_path / "w.csv", flag: joints}
+    args = ["locate", str(run), "--joints-csv", str(joints)]
+    args += [part for name, path in outputs.items() for part in (name, str(path))]
+    result = runner.invoke(app, args + (["--force"] if force else []))
+    assert result.exit_code == 2, result.output
+    assert "never replaces an input" in " ".join(result.output.split())
+    assert joints.read_text() == text
+
+
+def test_an_output_never_replaces_or_enters_the_joint_bag(run, tmp_path):
+    """Trial 36 item 1, --joints-bag: a bag file named as --out, or an output inside a
+    rosbag2 bag's folder, is refused before any work."""
+    bag_file = tmp_path / "j.parquet"  # an MCAP file is known by its magic, not its name
+    bag_file.write_bytes(b"\x89MCAP0\r\n")
+    result = runner.invoke(app, ["locate", str(run), "--joints-bag", str(bag_file),
+                                 "--out", str(bag_file), "--force"])  # fmt: skip
+    assert result.exit_code == 2 and "never replaces an input" in result.output
+    assert bag_file.read_bytes() == b"\x89MCAP0\r\n"
+    folder = tmp_path / "bag"
+    folder.mkdir()
+    (folder / "metadata.yaml").write_text("")
+    result = runner.invoke(app, ["locate", str(run), "--joints-bag", str(folder),
+                                 "--out", str(folder / "c.parquet")])  # fmt: skip
+    assert result.exit_code == 2
+    assert "inside the input" in " ".join(result.output.split())
+
+
+def test_the_closing_line_says_the_force_is_a_probes_once(run, tmp_path):
+    """Trial 36 item 4: with contacts found, one note after the summary says the force is
+    a 1.6-mm probe's amplitude and points to --method joint; not on every line."""
+    out = tmp_path / "c.parquet"
+    result = runner.invoke(app, ["locate", str(run), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    text = " ".join(result.output.split())
+    assert text.count("1.6-mm probe") == 1 and "--method joint" in text
+
+
+def test_locate_and_exports_contacts_share_frames_on_a_simulated_press(run):
+    """docs/robot.md (trial 36 item 9): on a simulated press (no drift, no dead or
+    saturated taxels) locate RUN/'s estimator and the exports' tracked one find contacts
+    in the same frames of the pressed patch (their values are not claimed equal)."""
+    from tactsense.estimate.robot import locate_robot_recording
+    from tactsense.interop.robot_contacts import iter_patch_contacts
+    from tactsense.io.recording import RecordingReader
+    from tactsense.io.robot_recording import read_robot_skin, stream_path
+
+    hand = locate_robot_recording(run, joints={"j1": 0.0})
+    skin = read_robot_skin(run)
+    touched = 0
+    for patch in skin.patches:
+        with RecordingReader(stream_path(run, patch.name)) as reader:
+            exported = sorted(
+                {int(piece.start + f) for piece in iter_patch_contacts(reader, patch)
+                 for f in piece.frame}
+            )  # fmt: skip
+        mine = hand.contacts["patch"] == patch.name
+        assert sorted(set(hand.contacts["frame"][mine].tolist())) == exported, patch.name
+        touched += len(exported)
+    assert touched == 25  # the pad, pressed from frame 5 of 30

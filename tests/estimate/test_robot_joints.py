@@ -181,3 +181,38 @@ def test_joint_topic_of_a_plain_mcap_file(tmp_path):
     np.testing.assert_allclose(states.at([3.75], ["j1"]), [[0.5]])
     with pytest.raises(JointStateError, match="no JointState topic '/x'"):
         read_joint_bag(path, "/x")
+
+
+# ---- round 7 fixes (r7-fixa) ----
+
+
+def test_a_readable_mcap_without_a_joint_topic_says_so_not_unreadable(tmp_path):
+    """Trial 36 item 10b: a readable MCAP with no JointState topic is not 'not a readable
+    MCAP file'; the message names what it lacks."""
+    from mcap_ros2.writer import Writer
+
+    path = tmp_path / "other.mcap"
+    with open(path, "wb") as stream:
+        writer = Writer(stream)
+        schema = writer.register_msgdef("std_msgs/msg/String", "string data\n")
+        writer.write_message("/chat", schema, {"data": "hi"}, log_time=1)
+        writer.finish()
+    with pytest.raises(JointStateError) as caught:
+        read_joint_bag(path)
+    message = str(caught.value)
+    assert "not a readable" not in message
+    assert "0 JointState topics (none)" in message
+
+
+def test_coverage_warning_says_the_recordings_clock(tmp_path):
+    """Trial 36 item 14: joint times from 0 against a capture's Unix-second frames: the
+    warning says the recording's span and that a capture's times are Unix seconds."""
+    path = tmp_path / "joints.csv"
+    path.write_text("time_s,j1\n0.0,0.0\n0.3,0.1\n")
+    states = read_joint_csv(path)
+    capture = states.coverage_warnings([1.7e9, 1.7e9 + 1.0])
+    assert len(capture) == 1
+    assert "span [1.7e+09, 1.7e+09] s" in capture[0]
+    assert "Unix seconds on the host clock" in capture[0]
+    simulation = states.coverage_warnings([0.1, 2.0])
+    assert "from 0" in simulation[0] and "Unix" not in simulation[0]

@@ -962,3 +962,29 @@ def test_fixb_bad_input(workspace, line, names):
 
 
 # ---- /(r7-fixb) ----
+# ---- (r7-fixa) ----
+FIXA_BAD = [  # trial 36 item 1: an output never replaces a joint-state input, --force or not
+    ("locate RUN --joints-csv J.csv --out J.csv --force", "never replaces an input"),
+    ("locate RUN --joints-csv J.csv --out OUT --wrenches J.csv --force", "never replaces"),
+    ("locate RUN --joints-bag BAG --out BAG/c.parquet", "inside the input"),
+]
+
+
+@pytest.mark.parametrize("line, names", FIXA_BAD, ids=[line for line, _ in FIXA_BAD])
+def test_fixa_locate_never_replaces_its_joint_input(workspace, handloc_run, line, names):
+    joints = workspace / "fixa_joints.csv"
+    joints.write_text("time_s,j1\n0,0.1\n100,0.1\n")
+    bag = workspace / "fixa_bag"
+    bag.mkdir(exist_ok=True)
+    (bag / "metadata.yaml").write_text("")
+    out = workspace / "never_written_fixa.parquet"
+    args = (
+        line.replace("RUN", str(handloc_run)).replace("J.csv", str(joints))
+        .replace("BAG", str(bag)).replace("OUT", str(out)).split()
+    )  # fmt: skip
+    _check(runner.invoke(app, args), names)
+    assert joints.read_text() == "time_s,j1\n0,0.1\n100,0.1\n"
+    assert not out.exists() and sorted(p.name for p in bag.iterdir()) == ["metadata.yaml"]
+
+
+# ---- /r7-fixa ----

@@ -23,7 +23,8 @@ JOINTS_HELP = (
 )
 JOINTS_CSV_HELP = (
     "Robot recordings: joint states over time, a CSV with a time_s column [s, the "
-    "recording's clock] and one column per joint [rad or m], linearly interpolated to the "
+    "recording's clock: a capture's are Unix seconds on the host clock, a simulation's "
+    "start at 0] and one column per joint [rad or m], linearly interpolated to the "
     "frames' times (held at the ends, with a warning)."
 )
 JOINTS_BAG_HELP = (
@@ -36,6 +37,13 @@ WRENCHES_HELP = (
     "Robot recordings: file for the wrench table (per frame, per link: force [N] and "
     "torque [N mm] about the link origin in its frame; and the grasp's total in the base "
     "frame) [default: OUT's name + _wrenches, same format]."
+)
+
+FORCE_CAVEAT = (
+    "note: force_n [N] is the amplitude of a 1.6-mm probe's response ('interpolate'): a "
+    "broad contact (a large object) reads low; for a pad patch's force fitted with the "
+    "contact's size, locate its own stream: tactsense locate RUN/streams/PATCH.h5 "
+    "--method joint (docs/contacts.md says where that can and cannot tell force)"
 )
 
 
@@ -140,7 +148,13 @@ def run_robot_locate(
                     f"{what} {path} lies inside the robot recording {recording}; an output "
                     "never goes into an input: choose another folder"
                 )
-            check_output(path, force, what=what, inputs=[recording])
+            for source in (joints_csv, joints_bag):  # a bag may be a folder: nothing in it
+                if source is not None and Path(source).is_dir() and inside(path, source):
+                    raise TactsenseInputError(
+                        f"{what} {path} lies inside the input {source}; an output never "
+                        "goes into an input: choose another folder"
+                    )
+            check_output(path, force, what=what, inputs=[recording, joints_csv, joints_bag])
         if Path(wrenches).resolve() == Path(out).resolve():
             raise TactsenseInputError("--wrenches names the same file as --out")
         skin = read_robot_skin(recording)
@@ -177,5 +191,7 @@ def run_robot_locate(
         f"; wrenches in {wrenches}",
         soft_wrap=True, markup=False, highlight=False, emoji=False,
     )  # fmt: skip
+    if rows:
+        console.print(FORCE_CAVEAT, soft_wrap=True, markup=False, highlight=False, emoji=False)
     for line in warnings:
         console.print(f"warning: {line}", soft_wrap=True, markup=False, highlight=False)

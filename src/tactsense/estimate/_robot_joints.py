@@ -117,8 +117,22 @@ class JointStates:
                 lines.append(
                     f"joint {name!r}: {outside} hand frames outside its samples' time span "
                     f"[{t[0]:.6g}, {t[-1]:.6g}] s: its first or last position is held there"
+                    + _clock_hint(time_s)
                 )
         return lines
+
+
+UNIX_SECONDS = 1e8  # [s] times above this are Unix seconds (after 1973), not from 0
+
+
+def _clock_hint(time_s) -> str:
+    """Where the recording's clock starts, for a warning about joint times off its span."""
+    if not len(time_s):
+        return ""
+    span = f"; the recording's hand frames span [{time_s.min():.6g}, {time_s.max():.6g}] s"
+    if time_s.max() > UNIX_SECONDS:
+        return span + " (a capture: Unix seconds on the host clock; time the joints on it)"
+    return span + " (a simulation's or import's clock: from 0)"
 
 
 def read_joint_csv(path: str | Path) -> JointStates:
@@ -213,6 +227,8 @@ def _read_joint_mcap(path: Path, topic: str | None) -> JointStates:
                 stamp = ros.header.stamp.sec + ros.header.stamp.nanosec * 1e-9
                 _add_sample(samples, stamp if stamp > 0 else message.log_time * 1e-9,
                             ros.name, ros.position)  # fmt: skip
+    except JointStateError:
+        raise  # a readable file without the topic asked for says so itself
     except (McapError, ValueError, KeyError, EOFError, OSError) as error:
         raise JointStateError(f"{path} is not a readable MCAP file ({error})") from None
     return JointStates(
@@ -255,6 +271,8 @@ def read_joint_bag(path: str | Path, topic: str | None = None) -> JointStates:
                 stamp = message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
                 _add_sample(samples, stamp if stamp > 0 else log_ns * 1e-9, message.name,
                             message.position)  # fmt: skip
+    except JointStateError:
+        raise
     except AnyReaderError as error:
         raise JointStateError(f"{path} is not a readable rosbag2 bag ({error})") from None
     return JointStates(
