@@ -364,7 +364,9 @@ def contacts_file(
                     progress(start + n, total)
             if writer.rows == 0:  # no contact at all: the file still gets its columns
                 empty, _ = pieces.tracker.update(
-                    find_contacts(np.zeros((0, *sensor.shape)), sensor, counts=False),
+                    find_contacts(
+                        np.zeros((0, *sensor.shape)), sensor, counts=False, method=method
+                    ),  # the same method: its columns (--method joint adds some)
                     first_frame=total,
                 )
                 writer.write_contacts(np.zeros(0), empty)

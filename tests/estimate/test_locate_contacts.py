@@ -124,3 +124,25 @@ def test_a_nan_in_the_baseline_frames_does_not_kill_its_taxel(tmp_path):
     table = pd.read_parquet(tmp_path / "nan.parquet")
     assert len(table) > 0
     assert not (table["flags"] & int(Flag.DEAD_TACTEL)).any()
+
+
+@pytest.mark.parametrize("method", ["interpolate", "joint"])
+def test_a_recording_without_contacts_gets_the_methods_columns(tmp_path, method):
+    """A recording with no contact at all still gets a file with its method's columns
+    (``--method joint`` adds some): a traceback before (trial 36)."""
+    import pyarrow.parquet
+
+    from tactsense.batch import contacts_file
+    from tactsense.io.recording import Recording, write_recording
+    from tactsense.sensor import preset
+
+    spec = preset("pad4")
+    rest = np.full((12, *spec.shape), spec.electronics.nominal_counts, np.uint16)
+    write_recording(
+        tmp_path / "rest.h5",
+        Recording(rest, np.arange(12) * 0.01, np.zeros(spec.shape), spec),
+    )
+    out = tmp_path / f"{method}.parquet"
+    assert contacts_file(tmp_path / "rest.h5", out, method=method)["rows"] == 0
+    columns = pyarrow.parquet.read_schema(out).names
+    assert ("contact_radius_mm" in columns) == (method == "joint")
