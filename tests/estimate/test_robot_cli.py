@@ -55,8 +55,8 @@ def test_locate_csv_and_no_overwrite(run, tmp_path):
 def test_a_folder_read_block_by_block_equals_the_recording_in_memory(run):
     """Blocks of 7 hand frames read from the folder give the tables of the whole
     recording in memory, column for column (the held wrench carried across blocks)."""
-    from tactsense.estimate.robot import locate_robot_recording
     from tactsense.io.robot_recording import read_robot_recording
+    from tactsense.robot_batch import locate_robot_recording
 
     joints = {"j1": 0.3}
     streamed = locate_robot_recording(run, joints=joints, block_frames=7)
@@ -163,10 +163,10 @@ def test_locate_and_exports_contacts_share_frames_on_a_simulated_press(run):
     """docs/robot.md (trial 36 item 9): on a simulated press (no drift, no dead or
     saturated taxels) locate RUN/'s estimator and the exports' tracked one find contacts
     in the same frames of the pressed patch (their values are not claimed equal)."""
-    from tactsense.estimate.robot import locate_robot_recording
     from tactsense.interop.robot_contacts import iter_patch_contacts
     from tactsense.io.recording import RecordingReader
     from tactsense.io.robot_recording import read_robot_skin, stream_path
+    from tactsense.robot_batch import locate_robot_recording
 
     hand = locate_robot_recording(run, joints={"j1": 0.0})
     skin = read_robot_skin(run)

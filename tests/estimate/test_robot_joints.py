@@ -13,9 +13,9 @@ from tactsense.estimate._robot_joints import (
     read_joint_bag,
     read_joint_csv,
 )
-from tactsense.estimate.robot import locate_robot_recording
 from tactsense.io._layout import Recording
 from tactsense.io.robot_recording import RobotRecording
+from tactsense.robot_batch import locate_robot_recording
 from tactsense.simulate import ContactBatch, frames_from_contacts
 from tests.estimate.test_robot_locate import independent_pose, small_skin
 

@@ -16,12 +16,12 @@ from tactsense.estimate.robot import (
     WRENCH_COLUMNS,
     HandLocator,
     hand_frame_grid,
-    locate_robot_recording,
     locate_robot_reference,
 )
 from tactsense.io._layout import Recording
 from tactsense.io.robot_recording import RobotRecording
 from tactsense.robot import Joint, Patch, Pose, RobotSkin, RobotSkinError, skin_preset
+from tactsense.robot_batch import locate_robot_recording
 from tactsense.sensor import preset
 from tactsense.simulate import ContactBatch, frames_from_contacts
 from tests.estimate._robot_sim import hand_frames

@@ -125,8 +125,8 @@ def run_robot_locate(
     single_array_options: dict,
 ) -> None:
     """Locate a robot recording's contacts and write the contacts and wrench tables."""
-    from tactsense.estimate.robot import iter_robot_blocks
     from tactsense.io.robot_recording import read_robot_skin
+    from tactsense.robot_batch import iter_robot_blocks
 
     try:
         unused = [name for name, value in single_array_options.items() if value]
