@@ -306,7 +306,10 @@ def record_skin(options: dict[str, Any]) -> None:
             interrupted = True
         except (TactsenseInputError, FileExistsError) as error:
             sources.close()
-            fail(f"{error}" + ("" if out.exists() else "; nothing written"))
+            text = str(error)
+            if not out.exists() and "nothing written" not in text:
+                text += "; nothing written"
+            fail(text)
     console.print(sources.status_line())
     stopped = f" (stopped by {stopped_by()})" if interrupted else ""
     if not out.exists():
