@@ -214,6 +214,13 @@ def import_robot(
 
     recording, summary = read_robot_bag(source, skin=skin, mapping=pairs)
     write_robot_recording(out, recording, overwrite=force)
+    if summary.get("joint_states_csv"):  # r7-fixc: the exported joint states, given back
+        from tactsense.io.robot_recording import JOINT_STATES_FILE
+
+        partial = Path(out) / f".{JOINT_STATES_FILE}.partial"
+        partial.write_bytes(summary["joint_states_csv"])
+        partial.replace(Path(out) / JOINT_STATES_FILE)
+        console.print(f"{JOINT_STATES_FILE}: the joint states, as exported")
     frames = sum(summary["frames"].values())
     console.print(
         f"wrote {out}: {summary['messages']} TactileState messages read, {frames} frames "

@@ -83,7 +83,22 @@ def _stream_extras(reader) -> dict[str, np.ndarray]:
     ):
         if name in h5:
             out[key] = h5[name][: reader.n_frames]
+    # ---- r7-fixc: what a simulation applied, so an import gives it back ----
+    out["scenario_json"] = np.array(str(h5.attrs.get("scenario_json", "{}")))
+    out["flaws"] = np.array(str(h5.attrs.get("flaws", "")))
+    if "truth" in h5:
+        for key, value in h5["truth"].items():
+            if hasattr(value, "shape"):
+                out[TRUTH_KEY + key] = value[()]
+        for key, value in h5["truth"].attrs.items():
+            out[TRUTH_KEY + key] = np.array(str(value))
     return out
+
+
+JOINTS_ATTACHMENT = "tactsense/joint_states.csv"
+"""The attachment holding a robot recording's ``joint_states.csv`` (r7-fixc)."""
+TRUTH_KEY = "truth/"
+"""Prefix of a stream's truth arrays in its times attachment (r7-fixc)."""
 
 
 def _aligned(path: Path, readers: dict, manifest: dict) -> dict[str, np.ndarray]:
@@ -166,7 +181,12 @@ def export_robot_mcap(
         TACTILE_STATE_MSGDEF,
     )
     from tactsense.io.recording import RecordingReader
-    from tactsense.io.robot_recording import read_manifest, read_robot_skin, stream_path
+    from tactsense.io.robot_recording import (
+        JOINT_STATES_FILE,
+        read_manifest,
+        read_robot_skin,
+        stream_path,
+    )
     from tactsense.robot import skin_to_toml_string
 
     Writer = _writer_class()
@@ -356,6 +376,13 @@ def export_robot_mcap(
                     create_time=0, log_time=0, name=TIMES_ATTACHMENT.format(patch=name),
                     media_type="application/x-npz",
                     data=_npz_bytes(_stream_extras(readers[name])),
+                )  # fmt: skip
+            # r7-fixc: the recording's joint states over time, for an import to give back
+            joints = path / JOINT_STATES_FILE
+            if joints.is_file():
+                raw.add_attachment(
+                    create_time=0, log_time=0, name=JOINTS_ATTACHMENT, media_type="text/csv",
+                    data=joints.read_bytes(),
                 )  # fmt: skip
             writer.finish()
     finally:
