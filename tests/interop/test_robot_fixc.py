@@ -47,3 +47,19 @@ def test_mcap_round_trip_keeps_scenario_truth_and_joint_states(tmp_path):
         for key, value in stream.truth.items():  # stored as they are: bit for bit, NaN too
             assert np.array_equal(np.asarray(got.truth[key]), value, equal_nan=True), key
     assert (back / JOINT_STATES_FILE).read_text() == joints
+
+
+def test_import_of_a_robot_lerobot_export_says_what_import_reads(tmp_path):
+    folder = tmp_path / "run"
+    write(folder, robot_recording())
+    dataset = tmp_path / "ds"
+    result = runner.invoke(
+        app, ["export", str(folder), "--format", "lerobot", "--out", str(dataset)]
+    )
+    assert result.exit_code == 0, result.output
+    for extra in ([], ["--skin", "hand4"]):
+        result = runner.invoke(app, ["import", str(dataset), *extra, "--out", str(tmp_path / "b")])
+        text = " ".join(result.output.split())
+        assert result.exit_code == 2 and "Traceback" not in text, text
+        assert "is a robot LeRobot dataset" in text and "--format mcap" in text, text
+        assert not (tmp_path / "b").exists()

@@ -234,6 +234,34 @@ def import_robot(
         console.print(f"topics of other types skipped: {summary['skipped']}")
 
 
+# ---- a robot LeRobot dataset given to import (r7-fixc) ----
+def refuse_robot_lerobot(source: Path) -> None:
+    """A clear error for a LeRobot dataset with a feature per patch (what ``export RUN/
+    --format lerobot`` writes): import does not read it back (yet)."""
+    import json
+
+    info = Path(source) / "meta" / "info.json"
+    if not info.is_file():
+        return
+    try:
+        features = json.loads(info.read_text()).get("features", {})
+    except (OSError, ValueError, AttributeError):
+        return
+    if not isinstance(features, dict) or not any(
+        str(k).startswith("observation.tactile.") for k in features
+    ):
+        return
+    fail(
+        f"{source} is a robot LeRobot dataset (a feature per patch); import cannot read it "
+        "back: for a robot recording it reads an MCAP file or rosbag2 bag (write one with "
+        "'tactsense export RUN/ --format mcap') or an iCub grasp trial (--skin icub_hand); "
+        "from LeRobot only a single sensor's dataset (one observation.tactile feature)"
+    )
+
+
+# ---- /a robot LeRobot dataset (r7-fixc) ----
+
+
 # ---- info on a robot recording (r7-fixc) ----
 def robot_info(recording: Path) -> None:
     """``tactsense info RUN/``: the skin, each stream (frames, rate, duration), each device

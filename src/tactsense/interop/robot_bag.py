@@ -230,7 +230,7 @@ def read_robot_bag(source: str | Path, *, skin=None, mapping: dict[str, str] | N
     else:
         raise ImportError_(
             f"{source}: expected an MCAP file (.mcap) or a rosbag2 bag (a folder with "
-            "metadata.yaml)"
+            "metadata.yaml), or with --skin icub_hand an iCub grasp trial"
         )
     if not collector.frames:
         raise ImportError_(f"{source}: no TactileState message in it")
