@@ -63,3 +63,17 @@ def test_import_of_a_robot_lerobot_export_says_what_import_reads(tmp_path):
         assert result.exit_code == 2 and "Traceback" not in text, text
         assert "is a robot LeRobot dataset" in text and "--format mcap" in text, text
         assert not (tmp_path / "b").exists()
+
+
+def test_mcap_export_has_a_joint_state_topic_locate_reads(tmp_path):
+    from tactsense.estimate._robot_joints import read_joint_bag
+
+    folder = tmp_path / "run"
+    write(folder, robot_recording())
+    (folder / JOINT_STATES_FILE).write_text("time_s,j1\n0,0.1\n0.4,0.3\n")
+    out = tmp_path / "run.mcap"
+    result = runner.invoke(app, ["export", str(folder), "--out", str(out), "-q"])
+    assert result.exit_code == 0, result.output
+    states = read_joint_bag(out)
+    times, values = states.series["j1"]
+    assert np.allclose(times, [0, 0.4]) and np.allclose(values, [0.1, 0.3])
