@@ -988,3 +988,48 @@ def test_fixa_locate_never_replaces_its_joint_input(workspace, handloc_run, line
 
 
 # ---- /r7-fixa ----
+# ---- (r7-fixc) ----
+FIXC_BAD = [
+    ("record board_a=socket://127.0.0.1:1 board_b=loop:// --out OUT", "add --skin SKIN"),
+    ("record board_a=socket://127.0.0.1:1 --out OUT", "add --skin SKIN"),
+    ("record --skin hand4 loop://", "give --out RUN"),
+    ("emulate --recording RUN", "is a robot recording (a folder): add --skin SKIN"),
+    ("view RUN/streams", "is a folder"),
+]
+
+
+@pytest.mark.parametrize("line, names", FIXC_BAD, ids=[line for line, _ in FIXC_BAD])
+def test_fixc_bad_input(robot_workspace, line, names):
+    folder = robot_workspace
+    out = folder / "never_written_fixc"
+    args = line.replace("RUN", str(folder / "robot_io_run")).replace("OUT", str(out)).split()
+    result = runner.invoke(app, args)
+    _check(result, names)
+    assert not out.exists()
+
+
+def test_fixc_info_describes_a_robot_recording(robot_workspace):
+    run = robot_workspace / "robot_io_run"
+    result = runner.invoke(app, ["info", str(run)])
+    text = " ".join(result.output.split())
+    assert result.exit_code == 0, text
+    assert "a robot recording" in text and "icub_hand" in text and "index_tip" in text
+    # 8 frames at 50 Hz: 0.160 s
+    assert "0.160 s (longest stream)" in text, text
+
+
+def test_fixc_info_duration_counts_from_the_first_frame(tmp_path):
+    spec = ts.fearing1990_initial()
+    recording = ts.simulate(spec, ts.probe_sweep(spec), rng=0)
+    shifted = recording.__class__(
+        frames=recording.frames, time_s=recording.time_s + 90.0,
+        sample_offset_s=recording.sample_offset_s, sensor=recording.sensor,
+    )  # fmt: skip
+    ts.write_recording(tmp_path / "late.h5", shifted)
+    span = float(recording.time_s[-1] - recording.time_s[0]) + spec.scan_period_s
+    result = runner.invoke(app, ["info", str(tmp_path / "late.h5")])
+    assert result.exit_code == 0, result.output
+    assert f"{span:.3f} s at" in result.output, result.output
+
+
+# ---- /(r7-fixc) ----

@@ -214,6 +214,13 @@ def import_robot(
 
     recording, summary = read_robot_bag(source, skin=skin, mapping=pairs)
     write_robot_recording(out, recording, overwrite=force)
+    if summary.get("joint_states_csv"):  # r7-fixc: the exported joint states, given back
+        from tactsense.io.robot_recording import JOINT_STATES_FILE
+
+        partial = Path(out) / f".{JOINT_STATES_FILE}.partial"
+        partial.write_bytes(summary["joint_states_csv"])
+        partial.replace(Path(out) / JOINT_STATES_FILE)
+        console.print(f"{JOINT_STATES_FILE}: the joint states, as exported")
     frames = sum(summary["frames"].values())
     console.print(
         f"wrote {out}: {summary['messages']} TactileState messages read, {frames} frames "
@@ -225,3 +232,90 @@ def import_robot(
         console.print(f"patches without a message: {', '.join(summary['missing'])}")
     if summary["skipped"]:
         console.print(f"topics of other types skipped: {summary['skipped']}")
+
+
+# ---- a robot LeRobot dataset given to import (r7-fixc) ----
+def refuse_robot_lerobot(source: Path) -> None:
+    """A clear error for a LeRobot dataset with a feature per patch (what ``export RUN/
+    --format lerobot`` writes): import does not read it back (yet)."""
+    import json
+
+    info = Path(source) / "meta" / "info.json"
+    if not info.is_file():
+        return
+    try:
+        features = json.loads(info.read_text()).get("features", {})
+    except (OSError, ValueError, AttributeError):
+        return
+    if not isinstance(features, dict) or not any(
+        str(k).startswith("observation.tactile.") for k in features
+    ):
+        return
+    fail(
+        f"{source} is a robot LeRobot dataset (a feature per patch); import cannot read it "
+        "back: for a robot recording it reads an MCAP file or rosbag2 bag (write one with "
+        "'tactsense export RUN/ --format mcap') or an iCub grasp trial (--skin icub_hand); "
+        "from LeRobot only a single sensor's dataset (one observation.tactile feature)"
+    )
+
+
+# ---- /a robot LeRobot dataset (r7-fixc) ----
+
+
+# ---- info on a robot recording (r7-fixc) ----
+def robot_info(recording: Path) -> None:
+    """``tactsense info RUN/``: the skin, each stream (frames, rate, duration), each device
+    (status, losses, clock) and whether the writer closed it."""
+    from rich.table import Table
+
+    from tactsense.io.recording import RecordingReader
+    from tactsense.io.robot_recording import read_manifest, stream_path
+
+    try:
+        manifest = read_manifest(recording)
+    except TactsenseInputError as error:
+        fail(str(error))
+    table = Table(title=f"{recording} (a robot recording)", show_header=False)
+    table.add_row("skin", str(manifest.get("skin", "")))
+    table.add_row("description", str(manifest.get("description", "")))
+    spans = []
+    rows = []
+    for patch in manifest.get("streams", []):
+        try:
+            with RecordingReader(stream_path(recording, patch)) as reader:
+                n, spec = reader.n_frames, reader.sensor
+                times = reader.time_s(0, 1) if n else None
+                last = reader.time_s(n - 1, n) if n else None
+        except TactsenseInputError as error:
+            rows.append((patch, f"unreadable: {error}"))
+            continue
+        # a stream's times are its device clock's, which need not start at 0
+        span = float(last[-1] - times[0]) + spec.scan_period_s if n else 0.0
+        spans.append(span)
+        rows.append(
+            (patch, f"{n} x {spec.shape[0]} x {spec.shape[1]} counts, {span:.3f} s at "
+                    f"{spec.electronics.scan_rate_hz:g} Hz")
+        )  # fmt: skip
+    table.add_row("streams", f"{len(rows)}")
+    table.add_row("duration", f"{max(spans, default=0.0):.3f} s (longest stream)")
+    for patch, text in rows:
+        table.add_row(f"  {patch}", text)
+    devices = manifest.get("devices", {}) or {}
+    table.add_row("devices", f"{len(devices)}")
+    for device, entry in devices.items():
+        losses = entry.get("losses", {}) or {}
+        lost = ", ".join(f"{k} {v}" for k, v in losses.items() if v and k != "frames") or "none"
+        status = str(entry.get("status", ""))
+        if entry.get("dropped_at_s") is not None:
+            at = entry["dropped_at_s"]
+            status += f" (dropped at {at:.3f} s, host clock, Unix: {entry.get('error', '')})"
+        clock = entry.get("clock") or {}
+        drift = f", clock {clock['drift_ppm']:+.1f} ppm" if "drift_ppm" in clock else ""
+        table.add_row(f"  {device}", f"{status}; {losses.get('frames', 0)} frames; losses: "
+                                     f"{lost}{drift}")  # fmt: skip
+    if not manifest.get("closed_cleanly", False):
+        table.add_row("state", "not closed by its writer (killed?): frames up to its last flush")
+    console.print(table)
+
+
+# ---- /info on a robot recording (r7-fixc) ----

@@ -75,12 +75,37 @@ def one_source(sources: list[str], dropout_s: float) -> str:
     """The single source of a command without --skin."""
     if dropout_s != DEFAULT_DROPOUT_S:
         fail("--dropout-s applies with --skin (several devices)")
+    named = [s for s in sources if _names_a_device(s)]
+    if named:
+        fail(
+            f"{named[0]}: DEVICE=SOURCE names a board of a robot skin; add --skin SKIN "
+            "(a preset: hand4, icub_hand; or a skin TOML file)"
+        )
     if len(sources) != 1:
         fail(
             f"{len(sources)} sources given; give one SOURCE, or several with --skin SKIN "
             "(one per device of the skin)"
         )
     return sources[0]
+
+
+def _names_a_device(source: str) -> bool:
+    """Whether ``source`` reads as DEVICE=SOURCE (a board's name, then a source)."""
+    import re
+
+    name, equals, rest = source.partition("=")
+    return bool(equals and rest and re.fullmatch(r"[A-Za-z][\w.-]*", name))
+
+
+def is_robot_folder(path) -> bool:
+    """Whether ``path`` is a robot recording (a folder), for a hint to add --skin."""
+    from tactsense.io.robot_recording import is_robot_recording
+
+    return is_robot_recording(path)
+
+
+def _plural(count: int, word: str) -> str:
+    return f"{count} {word}{'' if count == 1 else 's'}"
 
 
 def _skin(name: str):
@@ -190,6 +215,9 @@ def emulate_skin(ctx: typer.Context, options: dict[str, Any]) -> None:
         )  # fmt: skip
     except TactsenseInputError as error:
         fail(str(error))
+    except KeyboardInterrupt:  # a normal stop, before any device served: nothing to close
+        console.print(f"stopped (by {stopped_by()}) before serving; no device was started")
+        return
     threads = []
     try:
         for i, (device, emulator) in enumerate(emulators.items()):
@@ -213,11 +241,22 @@ def emulate_skin(ctx: typer.Context, options: dict[str, Any]) -> None:
     except (OSError, TactsenseInputError) as error:
         fail(f"cannot serve: {getattr(error, 'strerror', None) or error}")
     finally:
-        for emulator in emulators.values():
-            emulator.stop()
+        _stop_all(emulators)
     for device, emulator in emulators.items():
         log = emulator.log
         console.print(f"{device}: sent {log.frames} frames ({log.delivered_intact} intact)")
+
+
+def _stop_all(emulators) -> None:
+    """Stop every emulator; a second Ctrl-C meanwhile is a normal stop too (emulate writes
+    no file, so there is nothing half-written to report)."""
+    for emulator in emulators.values():
+        while True:
+            try:
+                emulator.stop()
+                break
+            except KeyboardInterrupt:
+                continue
 
 
 # ---- record --skin ----------------------------------------------------------------------
@@ -232,7 +271,13 @@ def record_skin(options: dict[str, Any]) -> None:
         "to --skin (give --duration; each device's description comes from the skin)",
     )
     _check_dropout(options["dropout_s"])
-    duration, out, quiet = options["duration"], Path(options["out"]), options["quiet"]
+    duration, out, quiet = options["duration"], options["out"], options["quiet"]
+    out = Path(out)
+    if out == Path("recording.h5"):  # record's default --out, a file: a skin needs a folder
+        fail(
+            "--skin: give --out RUN, the new robot recording's folder (a stream per patch); "
+            "the default --out recording.h5 is for one device"
+        )
     if duration is not None and not 0 < duration <= 1e7:
         fail(f"--duration must be more than 0 and at most 1e7 [s]; got {duration:g}")
     skin = _skin(options["skin"])
@@ -247,7 +292,7 @@ def record_skin(options: dict[str, Any]) -> None:
         TextColumn("{task.description}"), console=console,
         disable=quiet or not console.is_terminal,
     ) as bar:  # fmt: skip
-        task = bar.add_task(f"recording {len(sources.sources)} devices")
+        task = bar.add_task(f"recording {_plural(len(sources.sources), 'device')}")
 
         def update(_sources, frames: int) -> None:
             written[0] = frames
@@ -261,7 +306,10 @@ def record_skin(options: dict[str, Any]) -> None:
             interrupted = True
         except (TactsenseInputError, FileExistsError) as error:
             sources.close()
-            fail(f"{error}" + ("" if out.exists() else "; nothing written"))
+            text = str(error)
+            if not out.exists() and "nothing written" not in text:
+                text += "; nothing written"
+            fail(text)
     console.print(sources.status_line())
     stopped = f" (stopped by {stopped_by()})" if interrupted else ""
     if not out.exists():
@@ -269,7 +317,8 @@ def record_skin(options: dict[str, Any]) -> None:
         raise typer.Exit(0)
     dropped = [d for d, s in sources.status.items() if s.state == "dropped"]
     console.print(
-        f"wrote {out}{stopped}: {written[0]} frames from {len(sources.sources)} devices"
+        f"wrote {out}{stopped}: {_plural(written[0], 'frame')} from "
+        f"{_plural(len(sources.sources), 'device')}"
         + (f"; dropped out: {', '.join(dropped)}" if dropped else "")
     )
 
@@ -326,7 +375,7 @@ def live_skin(options: dict[str, Any]) -> None:
     finally:
         sources.close()
     stopped = f" (stopped by {stopped_by()})" if interrupted else ""
-    console.print(f"{len(sources.status)} devices{stopped}:\n" + sources.status_line())
+    console.print(f"{_plural(len(sources.status), 'device')}{stopped}:\n" + sources.status_line())
 
 
 def status_record(status, wall_offset_s: float) -> dict[str, Any]:

@@ -133,6 +133,11 @@ def view(
     if len(source) != 1:
         fail("several sources are a robot skin's devices: give --skin SKIN")
     source = source[0]
+    if Path(source).is_dir():  # r7-fixc: a folder is no device nor recording
+        fail(
+            f"{source} is a folder; give a recording (.h5), a robot recording (the folder "
+            "holding robot.json), or a device"
+        )
     # ---- /robot view (r7-hand3d) ----
     foxglove_address = check_foxglove(foxglove)  # r6-fox
     listen = "127.0.0.1" if host is None else host.strip()

@@ -102,7 +102,10 @@ def import_(
     fingertip of an iCub grasp trial.
     """
     # ---- a robot recording (r7-handio) ----
+    from tactsense.cli._robot_io import refuse_robot_lerobot  # r7-fixc
     from tactsense.interop.robot_bag import is_robot_mcap
+
+    refuse_robot_lerobot(source)  # r7-fixc: a robot LeRobot export: say what import reads
 
     if skin is not None or (topic is None and is_robot_mcap(source)):
         from tactsense.cli._robot_io import import_robot

@@ -193,6 +193,8 @@ def emulate(
             f"--speed must be more than 0 and at most 1e6 (a multiple of the scan rate); "
             f"got {speed:g}; 1e6 sends as fast as the line takes them"
         )
+    if recording is not None and robot.is_robot_folder(recording):  # r7-fixc
+        fail(f"--recording {recording} is a robot recording (a folder): add --skin SKIN")
     if recording is not None:
         given = [
             "--" + name.replace("_", "-")
@@ -270,7 +272,8 @@ def record(
         typer.Option(
             "--out",
             "-o",
-            help="New recording: HDF5 (crash-safe), or MCAP (see --format).",
+            help="New recording: HDF5 (crash-safe), or MCAP (see --format); with --skin a new "
+            "folder, required.",
         ),
     ] = Path("recording.h5"),
     record_format: Annotated[

@@ -217,12 +217,21 @@ def write_force_log(recording: Path, path: Path, chunk: int = 65_536) -> int:
 
 
 @app.command()
-def info(recording: Annotated[Path, typer.Argument(help="HDF5 recording to describe.")]) -> None:
+def info(
+    recording: Annotated[
+        Path, typer.Argument(help="HDF5 recording, or a robot recording (a folder), to describe.")
+    ],
+) -> None:
     """Describe a recording: sensor, scenario, frames and their range."""
     import json
 
     from tactsense.io.recording import RecordingReader
+    from tactsense.io.robot_recording import is_robot_recording  # r7-fixc
 
+    if is_robot_recording(recording):  # r7-fixc: a robot recording (a folder)
+        from tactsense.cli._robot_io import robot_info
+
+        return robot_info(recording)
     try:
         # streamed in blocks of the file's chunks: memory stays flat however long it is
         with RecordingReader(recording) as reader:
@@ -237,6 +246,7 @@ def info(recording: Annotated[Path, typer.Argument(help="HDF5 recording to descr
                     finite_seen = True
                     low, high = min(low, frames.min()), max(high, frames.max())
             last = reader.time_s(n - 1, n) if n else np.zeros(0)
+            first = reader.time_s(0, 1) if n else np.zeros(0)  # r7-fixc
             attrs = reader.attrs
             losses = reader.losses
             closed_cleanly = reader.closed_cleanly
@@ -251,7 +261,8 @@ def info(recording: Annotated[Path, typer.Argument(help="HDF5 recording to descr
     table = Table(title=str(recording), show_header=False)
     table.add_row("sensor", spec.name)
     table.add_row("frames", f"{n} x {spec.shape[0]} x {spec.shape[1]} counts")
-    duration = float(last[-1]) + spec.scan_period_s if n else 0.0
+    # r7-fixc: from the first frame (a device clock need not start at 0)
+    duration = float(last[-1] - first[0]) + spec.scan_period_s if n else 0.0
     table.add_row("duration", f"{duration:.3f} s at {spec.electronics.scan_rate_hz:g} Hz")
     if finite_seen:
         counts = f"{low:g} .. {high:g}"

@@ -35,6 +35,7 @@ import numpy as np
 
 from tactsense.interop._build import UNIX_EPOCH_THRESHOLD_S, ImportError_, build_recording
 from tactsense.interop.robot_mcap import (
+    JOINTS_ATTACHMENT,
     LOSSES_PREFIX,
     ROBOT_METADATA,
     TIMES_ATTACHMENT,
@@ -140,6 +141,8 @@ def _read_mcap_file(source: Path, skin, mapping) -> tuple:
                 elif record.name.startswith(LOSSES_PREFIX):
                     losses[record.name[len(LOSSES_PREFIX) :]] = dict(record.metadata)
             for attachment in reader.iter_attachments():
+                if attachment.name == JOINTS_ATTACHMENT:  # r7-fixc
+                    extras[JOINTS_ATTACHMENT] = bytes(attachment.data)
                 prefix, suffix = TIMES_ATTACHMENT.split("{patch}")
                 if attachment.name.startswith(prefix) and attachment.name.endswith(suffix):
                     name = attachment.name[len(prefix) : -len(suffix)]
@@ -227,7 +230,7 @@ def read_robot_bag(source: str | Path, *, skin=None, mapping: dict[str, str] | N
     else:
         raise ImportError_(
             f"{source}: expected an MCAP file (.mcap) or a rosbag2 bag (a folder with "
-            "metadata.yaml)"
+            "metadata.yaml), or with --skin icub_hand an iCub grasp trial"
         )
     if not collector.frames:
         raise ImportError_(f"{source}: no TactileState message in it")
@@ -259,6 +262,7 @@ def read_robot_bag(source: str | Path, *, skin=None, mapping: dict[str, str] | N
                 device_time_us=exact.get("device_time_us"),
                 sequence=exact.get("sequence"),
             )
+            recording = _with_scenario(recording, exact)  # r7-fixc
         streams[name] = recording
     devices = {}
     if stored and stored.get("devices"):
@@ -277,8 +281,33 @@ def read_robot_bag(source: str | Path, *, skin=None, mapping: dict[str, str] | N
         "frames": {name: len(s) for name, s in streams.items()},
         "missing": [p.name for p in collector.skin.patches if p.name not in streams],
         "skipped": skipped,
+        "joint_states_csv": extras.get(JOINTS_ATTACHMENT),  # r7-fixc
     }
     return recording, summary
+
+
+def _with_scenario(recording, exact: dict):
+    """The stream's scenario, flaws and truth as the export stored them (r7-fixc)."""
+    from tactsense.interop.robot_mcap import TRUTH_KEY
+
+    changes = {}
+    if "scenario_json" in exact:
+        try:
+            scenario = json.loads(str(exact["scenario_json"]))
+        except json.JSONDecodeError:
+            scenario = None
+        if isinstance(scenario, dict) and scenario:
+            changes["scenario"] = scenario
+    if "flaws" in exact:
+        changes["flaws"] = tuple(f for f in str(exact["flaws"]).split(",") if f)
+    truth = {
+        key[len(TRUTH_KEY) :]: (str(value) if value.dtype.kind == "U" else value)
+        for key, value in exact.items()
+        if key.startswith(TRUTH_KEY)
+    }
+    if truth:
+        changes["truth"] = truth
+    return dataclasses.replace(recording, **changes) if changes else recording
 
 
 def is_robot_mcap(source: str | Path) -> bool:

@@ -83,7 +83,22 @@ def _stream_extras(reader) -> dict[str, np.ndarray]:
     ):
         if name in h5:
             out[key] = h5[name][: reader.n_frames]
+    # ---- r7-fixc: what a simulation applied, so an import gives it back ----
+    out["scenario_json"] = np.array(str(h5.attrs.get("scenario_json", "{}")))
+    out["flaws"] = np.array(str(h5.attrs.get("flaws", "")))
+    if "truth" in h5:
+        for key, value in h5["truth"].items():
+            if hasattr(value, "shape"):
+                out[TRUTH_KEY + key] = value[()]
+        for key, value in h5["truth"].attrs.items():
+            out[TRUTH_KEY + key] = np.array(str(value))
     return out
+
+
+JOINTS_ATTACHMENT = "tactsense/joint_states.csv"
+"""The attachment holding a robot recording's ``joint_states.csv`` (r7-fixc)."""
+TRUTH_KEY = "truth/"
+"""Prefix of a stream's truth arrays in its times attachment (r7-fixc)."""
 
 
 def _aligned(path: Path, readers: dict, manifest: dict) -> dict[str, np.ndarray]:
@@ -108,6 +123,59 @@ def _aligned(path: Path, readers: dict, manifest: dict) -> dict[str, np.ndarray]
             if times.shape == (reader.n_frames,) and np.all(np.isfinite(times)):
                 out[name] = times
     return out
+
+
+JOINT_STATE_TOPIC = "/joint_states"
+JOINT_STATE_MSGDEF = """std_msgs/Header header
+string[] name
+float64[] position
+float64[] velocity
+float64[] effort
+================================================================================
+MSG: std_msgs/Header
+builtin_interfaces/Time stamp
+string frame_id
+================================================================================
+MSG: builtin_interfaces/Time
+int32 sec
+uint32 nanosec
+"""
+"""sensor_msgs/msg/JointState's definition (ROS 2 common_interfaces) (r7-fixc)."""
+
+
+def _joint_state_topic(writer, raw, table: Path, offset_s: float) -> None:
+    """``joint_states.csv`` (time_s, one column per joint [rad or m]) as
+    sensor_msgs/msg/JointState messages on /joint_states, stamped time_s + ``offset_s``."""
+    from mcap_ros2._dynamic import serialize_dynamic
+
+    kind = "sensor_msgs/msg/JointState"
+    try:
+        data = np.genfromtxt(table, delimiter=",", names=True, dtype=float, ndmin=1)
+    except ValueError:
+        return  # an unreadable table stays an attachment only
+    names = [n for n in (data.dtype.names or ()) if n != "time_s"]
+    if "time_s" not in (data.dtype.names or ()) or not names:
+        return
+    schema = writer.register_msgdef(kind, JOINT_STATE_MSGDEF)
+    encode = serialize_dynamic(kind, JOINT_STATE_MSGDEF)[kind]
+    channel = raw.register_channel(
+        topic=JOINT_STATE_TOPIC, message_encoding="cdr", schema_id=schema.id
+    )
+    for k, row in enumerate(np.atleast_1d(data)):
+        ns = round((float(row["time_s"]) + offset_s) * 1e9)
+        body = {
+            "header": {
+                "stamp": {"sec": ns // 1_000_000_000, "nanosec": ns % 1_000_000_000},
+                "frame_id": "",
+            },
+            "name": names,
+            "position": [float(row[n]) for n in names],
+            "velocity": [],
+            "effort": [],
+        }
+        raw.add_message(
+            channel_id=channel, log_time=ns, publish_time=ns, sequence=k, data=encode(body)
+        )
 
 
 def _npz_bytes(arrays: dict[str, np.ndarray]) -> bytes:
@@ -166,7 +234,12 @@ def export_robot_mcap(
         TACTILE_STATE_MSGDEF,
     )
     from tactsense.io.recording import RecordingReader
-    from tactsense.io.robot_recording import read_manifest, read_robot_skin, stream_path
+    from tactsense.io.robot_recording import (
+        JOINT_STATES_FILE,
+        read_manifest,
+        read_robot_skin,
+        stream_path,
+    )
     from tactsense.robot import skin_to_toml_string
 
     Writer = _writer_class()
@@ -356,6 +429,15 @@ def export_robot_mcap(
                     create_time=0, log_time=0, name=TIMES_ATTACHMENT.format(patch=name),
                     media_type="application/x-npz",
                     data=_npz_bytes(_stream_extras(readers[name])),
+                )  # fmt: skip
+            # r7-fixc: the recording's joint states over time, for an import to give back
+            # and as a sensor_msgs/JointState topic (locate --joints-bag reads it)
+            joints = path / JOINT_STATES_FILE
+            if joints.is_file():
+                _joint_state_topic(writer, raw, joints, offset if clock == "recording" else 0.0)
+                raw.add_attachment(
+                    create_time=0, log_time=0, name=JOINTS_ATTACHMENT, media_type="text/csv",
+                    data=joints.read_bytes(),
                 )  # fmt: skip
             writer.finish()
     finally:

@@ -226,6 +226,9 @@ class RobotSources:
         if timeout_s is not None and not (math.isfinite(timeout_s) and 0 < timeout_s <= 3600):
             raise TactsenseInputError(f"timeout_s must lie in (0, 3600] s; got {timeout_s!r}")
         self.skin = skin
+        self._positional = not isinstance(sources, Mapping) and not any(
+            "=" in str(s) and str(s).partition("=")[0] in skin.devices for s in sources
+        )  # r7-fixc: plain sources, in the skin's device order: checked by IDENT on open
         if not isinstance(sources, Mapping):
             sources = parse_device_sources(skin, list(sources))
         layouts = device_layouts(skin)
@@ -270,6 +273,21 @@ class RobotSources:
             for reader in self._readers.values():
                 reader.close()
             raise
+        if self._positional:  # r7-fixc
+            self._positional = False
+            remapped = self._by_ident()
+            if remapped is not None:
+                for reader in self._readers.values():
+                    reader.close()
+                self._readers = {}
+                self.sources = remapped
+                layouts = device_layouts(self.skin)
+                self.layouts = {d: layouts[d] for d in layouts if d in remapped}
+                self.status = {
+                    d: DeviceStatus(d, str(remapped[d]), layout)
+                    for d, layout in self.layouts.items()
+                }
+                return self.open()
         self._opened = True
         for device in self.layouts:
             thread = threading.Thread(
@@ -279,6 +297,37 @@ class RobotSources:
             self._running += 1
             thread.start()
         return self
+
+    def _by_ident(self) -> dict[str, str] | None:
+        """Plain sources checked against each device's IDENT (``robot_device``, what
+        ``tactsense emulate --skin`` sends): None when they are in order (or a device does
+        not say), else ``{device: source}`` mapped by IDENT; an error when IDENT names a
+        board the skin lacks or two sources name one board."""
+        named = {}
+        for device, reader in self._readers.items():
+            if not hasattr(reader, "_identify"):
+                return None
+            try:
+                reader._identify(1.0)
+            except Exception:  # a device that does not answer: keep the order given
+                return None
+            finally:
+                self.status[device].losses = reader.stats
+            board = reader.identity.get("robot_device")
+            if not isinstance(board, str):
+                return None
+            named[device] = board
+        if all(board == device for device, board in named.items()):
+            return None
+        said = ", ".join(f"{self.sources[d]} is {b}" for d, b in named.items())
+        if len(set(named.values())) != len(named) or not set(named.values()) <= set(
+            self.skin.devices
+        ):
+            raise RobotSourceError(
+                f"by their IDENT, {said}: not one source per board of {self.skin.name!r} "
+                f"({', '.join(self.skin.devices)}); give DEVICE=SOURCE"
+            )
+        return {board: self.sources[device] for device, board in named.items()}
 
     def stop(self) -> None:
         """Ask every device to stop (STOP, then END settles its last losses); frames
