@@ -405,10 +405,9 @@ def test_a_real_capture_of_emulated_devices(tmp_path):
     and the recording comes back bit for bit."""
     emulator = pytest.importorskip("tactsense.stream.robot_emulator")
     recorder = pytest.importorskip("tactsense.stream.robot_recorder")
-    from tactsense.stream.robot import RobotSources
-
     from tactsense.io.robot_recording import aligned_times
     from tactsense.robot import load_skin
+    from tactsense.stream.robot import RobotSources
 
     skin = load_skin("icub_hand")
     emulators = emulator.device_emulators(skin, drift_ppm=50.0, seed=2)

@@ -910,7 +910,8 @@ def test_robot_io_bad_options(robot_workspace, line, names):
     out = folder / "never_written_robot"
     replaced = (
         line.replace("REC", str(folder / "rec.h5")).replace("RUN", str(folder / "robot_io_run"))
-        .replace("MCAP", str(folder / "robot_io.mcap")).replace("TRIAL", str(folder / "robot_io_trial_1.txt"))
+        .replace("MCAP", str(folder / "robot_io.mcap"))
+        .replace("TRIAL", str(folder / "robot_io_trial_1.txt"))
         .replace("OUT", str(out))
     )  # fmt: skip
     result = runner.invoke(app, replaced.split())
