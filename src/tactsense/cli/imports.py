@@ -98,8 +98,8 @@ def import_(
     """Import frames and their times from another tool's file into a recording.
 
     TactileState messages (ROS 2) from MCAP or rosbag2, one stream of an XDF file
-    (LabRecorder), one frame per CSV row, a LeRobot dataset of one sensor written by tactsense, or one
-    fingertip of an iCub grasp trial.
+    (LabRecorder), one frame per CSV row, a LeRobot dataset of one sensor written by
+    tactsense, or one fingertip of an iCub grasp trial.
     """
     # ---- a robot recording (r7-handio) ----
     from tactsense.cli._robot_io import refuse_robot_lerobot  # r7-fixc
