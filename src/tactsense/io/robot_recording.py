@@ -112,13 +112,11 @@ def write_manifest(folder: str | Path, content: dict[str, Any]) -> None:
     os.replace(partial, folder / MANIFEST)
 
 
-def write_robot_recording(
-    path: str | Path, recording: RobotRecording, *, overwrite: bool = False
-) -> Path:
-    """Write a whole robot recording; nothing is left behind if interrupted.
+def check_robot_output(path: str | Path, *, overwrite: bool = False) -> Path:
+    """``path`` as a new robot recording's folder, or the error saying why it cannot be.
 
-    An existing folder is refused unless ``overwrite``; even then only a robot recording is
-    replaced (a folder that is not one is never removed).
+    Its parent must exist; an existing folder is refused unless ``overwrite``, and even
+    then only a robot recording may be replaced (a folder that is not one never is).
     """
     path = Path(path)
     if not path.parent.is_dir():
@@ -131,6 +129,18 @@ def write_robot_recording(
                 f"{path} exists and is not a robot recording; it is not replaced, whatever "
                 "--force says"
             )
+    return path
+
+
+def write_robot_recording(
+    path: str | Path, recording: RobotRecording, *, overwrite: bool = False
+) -> Path:
+    """Write a whole robot recording; nothing is left behind if interrupted.
+
+    An existing folder is refused unless ``overwrite``; even then only a robot recording is
+    replaced (a folder that is not one is never removed).
+    """
+    path = check_robot_output(path, overwrite=overwrite)
     partial = path.with_name(path.name + ".partial")
     if partial.exists():
         shutil.rmtree(partial)
@@ -245,17 +255,8 @@ class RobotRecordingWriter:
         from tactsense.io.recording import RecordingWriter
         from tactsense.physics.transduction import sample_offsets
 
-        path = Path(path)
-        if not path.parent.is_dir():
-            raise RecordingError(f"folder {path.parent} does not exist")
+        path = check_robot_output(path, overwrite=overwrite)
         if path.exists():
-            if not overwrite:
-                raise FileExistsError(f"{path} exists; pass overwrite=True (--force) to replace it")
-            if not is_robot_recording(path):
-                raise RecordingError(
-                    f"{path} exists and is not a robot recording; it is not replaced, whatever "
-                    "--force says"
-                )
             shutil.rmtree(path)
         self.path = path
         self.skin = skin

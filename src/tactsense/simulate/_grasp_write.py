@@ -20,12 +20,12 @@ import h5py
 import numpy as np
 
 from tactsense._version import __version__
-from tactsense.io.recording import FORMAT, FORMAT_VERSION, RecordingError
+from tactsense.io.recording import FORMAT, FORMAT_VERSION
 from tactsense.io.robot_recording import (
     SKIN,
     STREAMS,
     RobotRecording,
-    is_robot_recording,
+    check_robot_output,
     manifest,
     stream_path,
     write_manifest,
@@ -60,17 +60,7 @@ def write_grasp_folder(
     An existing folder is refused unless ``overwrite``, and even then only a robot
     recording is replaced (as :func:`~tactsense.io.robot_recording.write_robot_recording`).
     """
-    path = Path(path)
-    if not path.parent.is_dir():
-        raise RecordingError(f"folder {path.parent} does not exist")
-    if path.exists():
-        if not overwrite:
-            raise FileExistsError(f"{path} exists; pass overwrite=True (--force) to replace it")
-        if not is_robot_recording(path):
-            raise RecordingError(
-                f"{path} exists and is not a robot recording; it is not replaced, whatever "
-                "--force says"
-            )
+    path = check_robot_output(path, overwrite=overwrite)
     skin = plan.skin
     partial = path.with_name(path.name + ".partial")
     if partial.exists():
