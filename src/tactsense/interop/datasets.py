@@ -35,17 +35,16 @@ import numpy as np
 
 from tactsense.interop.lerobot import (
     CHUNKS_SIZE,
-    CODEBASE_VERSION,
     DATA_FILES_SIZE_IN_MB,
     DATA_PATH,
     EPISODES_PATH,
-    VIDEO_FILES_SIZE_IN_MB,
     LeRobotError,
     _hf_features,
     _listed,
     _stats,
     _write_json,
     features_of,
+    lerobot_info,
     write_tasks_parquet,
 )
 from tactsense.simulate.dataset import MAX_CONTACTS, TASKS, DatasetError, DatasetPlan, episodes
@@ -289,21 +288,10 @@ class LeRobotEpisodesWriter:
         pq.write_table(pa.Table.from_pylist(self.episode_rows), episodes_file)
         _write_json(self.folder / "meta" / "stats.json", _listed(self.stats.result()))
         write_tasks_parquet(self.folder / "meta" / "tasks.parquet", list(self.plan.tasks))
-        info = {
-            "codebase_version": CODEBASE_VERSION,
-            "fps": self.fps,
-            "features": self.features,
-            "total_episodes": len(self.episode_rows),
-            "total_frames": self.frames,
-            "total_tasks": len(self.plan.tasks),
-            "chunks_size": CHUNKS_SIZE,
-            "data_files_size_in_mb": DATA_FILES_SIZE_IN_MB,
-            "video_files_size_in_mb": VIDEO_FILES_SIZE_IN_MB,
-            "data_path": DATA_PATH,
-            "video_path": None,
-            "robot_type": None,
-            "splits": {"train": f"0:{len(self.episode_rows)}"},
-        }
+        info = lerobot_info(
+            self.fps, self.features, episodes=len(self.episode_rows), frames=self.frames,
+            tasks=len(self.plan.tasks),
+        )  # fmt: skip
         _write_json(self.folder / "meta" / "info.json", info)
         _write_json(
             self.folder / "meta" / "tactsense.json",

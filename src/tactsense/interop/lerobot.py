@@ -299,21 +299,7 @@ def write_dataset(
 
     write_tasks_parquet(folder / "meta" / "tasks.parquet", [task])
 
-    info = {
-        "codebase_version": CODEBASE_VERSION,
-        "fps": fps,
-        "features": features,
-        "total_episodes": len(starts),
-        "total_frames": n,
-        "total_tasks": 1,
-        "chunks_size": CHUNKS_SIZE,
-        "data_files_size_in_mb": DATA_FILES_SIZE_IN_MB,
-        "video_files_size_in_mb": VIDEO_FILES_SIZE_IN_MB,
-        "data_path": DATA_PATH,
-        "video_path": None,
-        "robot_type": None,
-        "splits": {"train": f"0:{len(starts)}"},
-    }
+    info = lerobot_info(fps, features, episodes=len(starts), frames=n)
     _write_json(folder / "meta" / "info.json", info)
     _write_json(
         folder / "meta" / "tactsense.json",
@@ -486,6 +472,33 @@ def import_lerobot(folder: str | Path, *, sensor=None):
         spec, list(np.concatenate(frames)), np.concatenate(times), source=str(folder),
         description=f"imported from the LeRobot dataset {folder}", losses=losses,
     )  # fmt: skip
+
+
+def lerobot_info(
+    fps: float,
+    features: dict,
+    *,
+    episodes: int,
+    frames: int,
+    tasks: int = 1,
+    robot_type: str | None = None,
+) -> dict:
+    """LeRobot v3's ``meta/info.json``: one data file per chunk, no video, one split."""
+    return {
+        "codebase_version": CODEBASE_VERSION,
+        "fps": fps,
+        "features": features,
+        "total_episodes": episodes,
+        "total_frames": frames,
+        "total_tasks": tasks,
+        "chunks_size": CHUNKS_SIZE,
+        "data_files_size_in_mb": DATA_FILES_SIZE_IN_MB,
+        "video_files_size_in_mb": VIDEO_FILES_SIZE_IN_MB,
+        "data_path": DATA_PATH,
+        "video_path": None,
+        "robot_type": robot_type,
+        "splits": {"train": f"0:{episodes}"},
+    }  # fmt: skip
 
 
 def write_tasks_parquet(path: Path, tasks: list[str]) -> None:

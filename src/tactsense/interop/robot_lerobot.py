@@ -37,18 +37,15 @@ from pathlib import Path
 import numpy as np
 
 from tactsense.interop.lerobot import (
-    CHUNKS_SIZE,
-    CODEBASE_VERSION,
-    DATA_FILES_SIZE_IN_MB,
     DATA_PATH,
     DEFAULT_TASK,
     EPISODES_PATH,
-    VIDEO_FILES_SIZE_IN_MB,
     LeRobotError,
     _hf_features,
     _listed,
     _stats,
     _write_json,
+    lerobot_info,
     write_tasks_parquet,
 )
 
@@ -224,21 +221,7 @@ def export_robot_lerobot(
         write_tasks_parquet(temporary / "meta" / "tasks.parquet", [task])
         _write_json(
             temporary / "meta" / "info.json",
-            {
-                "codebase_version": CODEBASE_VERSION,
-                "fps": fps,
-                "features": features,
-                "total_episodes": len(starts),
-                "total_frames": n,
-                "total_tasks": 1,
-                "chunks_size": CHUNKS_SIZE,
-                "data_files_size_in_mb": DATA_FILES_SIZE_IN_MB,
-                "video_files_size_in_mb": VIDEO_FILES_SIZE_IN_MB,
-                "data_path": DATA_PATH,
-                "video_path": None,
-                "robot_type": skin.name,
-                "splits": {"train": f"0:{len(starts)}"},
-            },
+            lerobot_info(fps, features, episodes=len(starts), frames=n, robot_type=skin.name),
         )
         _write_json(
             temporary / "meta" / "tactsense.json",
