@@ -79,10 +79,11 @@ class Recording:
     def __post_init__(self) -> None:
         frames = np.asarray(self.frames)
         shape = self.sensor.shape
-        if frames.ndim != 3 or frames.shape[1:] != shape:
+        frame_shape = self.sensor.frame_shape
+        if frames.ndim != 1 + len(frame_shape) or frames.shape[1:] != frame_shape:
             raise RecordingError(
-                f"frames have shape {frames.shape}; expected (T, {shape[0]}, {shape[1]}) "
-                f"for sensor {self.sensor.name!r}"
+                f"frames have shape {frames.shape}; expected (T, "
+                f"{', '.join(str(n) for n in frame_shape)}) for sensor {self.sensor.name!r}"
             )
         if np.asarray(self.time_s).shape != (frames.shape[0],):
             raise RecordingError(
@@ -186,8 +187,8 @@ def _write_file(partial: Path, recording: Recording) -> None:
             "frames",
             recording.frames,
             compression="gzip",
-            chunks=(max(1, min(len(recording), 1024)), *recording.sensor.shape),
-            maxshape=(None, *recording.sensor.shape),
+            chunks=(max(1, min(len(recording), 1024)), *recording.sensor.frame_shape),
+            maxshape=(None, *recording.sensor.frame_shape),
         )
         frames.attrs["units"] = "counts"
         frames.attrs["axes"] = "time, row (along the finger, 0 = tip), col (around)"

@@ -88,10 +88,10 @@ class RecordingWriter:
             chunk = max(1, int(chunk_frames))
             self._frames = h5.create_dataset(
                 "frames",
-                (0, rows, cols),
+                (0, *sensor.frame_shape),
                 np.uint16,
-                maxshape=(None, rows, cols),
-                chunks=(chunk, rows, cols),
+                maxshape=(None, *sensor.frame_shape),
+                chunks=(chunk, *sensor.frame_shape),
                 compression="gzip",
                 compression_opts=1,
                 fletcher32=True,

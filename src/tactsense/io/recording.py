@@ -330,10 +330,10 @@ def _validate(path: Path, h5) -> tuple[SensorSpec, int]:
     ]
     n = min(per_frame)  # a killed writer may have flushed one dataset further
     shape = h5["frames"].shape
-    if len(shape) != 3 or shape[1:] != sensor.shape:
+    if len(shape) != 1 + len(sensor.frame_shape) or shape[1:] != sensor.frame_shape:
         raise RecordingError(
-            f"{path}: /frames has shape {shape}; expected (T, {sensor.shape[0]}, "
-            f"{sensor.shape[1]}) for its sensor {sensor.name!r}"
+            f"{path}: /frames has shape {shape}; expected (T, "
+            f"{', '.join(str(n) for n in sensor.frame_shape)}) for its sensor {sensor.name!r}"
         )
     return sensor, n
 

@@ -161,6 +161,16 @@ class Kind:
 
         return deflection_batch_flat(spec, states, self.layer_strain)
 
+    def frame_blocks(self, spec: Any, run: Any, chunk_frames: int) -> Any:
+        """The kind's own chain from contacts to counts for ``simulate``, or None (the
+        default: the elastic deflection times gains through the transducer the spec's
+        ``transduction`` names). A generator of ``(first, last, counts)``, counts of shape
+        ``(last - first, *spec.frame_shape)``, frames ``chunk_frames`` at a time; ``run``
+        holds what the simulation drew (``applied`` states, step ``boundaries`` [s],
+        ``n_frames``, ``offsets`` (each taxel's instant in the scan [s]), ``active`` flaws,
+        ``rng``, ``gains``)."""
+        return None
+
     def elastic_window_alone(self, applied: Any) -> bool:
         """Whether a window of ``applied``'s states takes the path the whole would
         (``elastic_batch``'s ``alone``); a kind with one path: True."""

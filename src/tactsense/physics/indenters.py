@@ -57,16 +57,33 @@ class Indenter:
     force_n: float
     at_taxel: int | None = field(default=None, kw_only=True)
     """Point sets only: (x_mm, y_mm) are in this taxel's tangent plane, from its centre."""
+    shear_x_n: float = field(default=0.0, kw_only=True)
+    """Tangential force the indenter applies to the surface along +x [N] (0: a pure
+    press). Only kinds that sense shear (``Kind.senses_shear``) read it."""
+    shear_y_n: float = field(default=0.0, kw_only=True)
+    """Tangential force the indenter applies to the surface along +y [N]."""
+    friction: float = field(default=1.0, kw_only=True)
+    """Coefficient of friction mu between indenter and skin [-]: the tangential traction
+    is at most mu times the pressure (Cattaneo-Mindlin: slip spreads in from the contact's
+    edge as the tangential force rises, and the whole contact slides at mu times the
+    normal force)."""
 
     kind: ClassVar[str] = "indenter"
 
     def __post_init__(self) -> None:
-        for name in ("x_mm", "y_mm", "force_n"):
+        for name in ("x_mm", "y_mm", "force_n", "shear_x_n", "shear_y_n", "friction"):
             value = getattr(self, name)
             if not (isinstance(value, int | float) and math.isfinite(value)):
                 raise TactsenseInputError(f"{name} must be a finite number; got {value!r}")
         if self.force_n < 0:
             raise TactsenseInputError(f"force_n must be >= 0 (a push); got {self.force_n!r}")
+        if self.friction <= 0:
+            raise TactsenseInputError(f"friction must be > 0; got {self.friction!r}")
+
+    @property
+    def shear_n(self) -> float:
+        """Magnitude of the tangential force [N]."""
+        return math.hypot(self.shear_x_n, self.shear_y_n)
 
     def _shape(self, dx, dy, modulus_star_pa, step_mm):  # pragma: no cover - every kind defines it
         raise NotImplementedError
@@ -139,6 +156,9 @@ class Indenter:
         data = dataclasses.asdict(self)
         if data["at_taxel"] is None:
             del data["at_taxel"]
+        for name, default in (("shear_x_n", 0.0), ("shear_y_n", 0.0), ("friction", 1.0)):
+            if data[name] == default:  # a pure press reads as before
+                del data[name]
         return {"kind": self.kind, **data}
 
 

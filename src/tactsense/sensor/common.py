@@ -249,6 +249,18 @@ class SpecBase:
 
     kind: ClassVar[str]
     SECTIONS: ClassVar[dict[str, type]]
+    components: ClassVar[int] = 1
+    """Numbers each taxel reports per frame: 1 (a scalar: the paper's finger, pads, point
+    sets) or 3 (a three-axis taxel, :mod:`tactsense.sensor.triaxial`)."""
+    component_names: ClassVar[tuple[str, ...]] = ()
+    """Names of a taxel's components, in the order of the frame's last axis (``("x",
+    "y", "z")``); empty for a scalar taxel."""
+
+    @property
+    def frame_shape(self) -> tuple[int, ...]:
+        """Shape of one frame: ``shape`` for scalar taxels, ``shape + (components,)``
+        when each taxel reports several numbers (the component axis is last)."""
+        return tuple(self.shape) if self.components == 1 else (*self.shape, self.components)
 
     def __post_init__(self) -> None:
         problems = self.problems()

@@ -165,6 +165,10 @@ def _prepare(spec, scenario, flaws, rng, gains, forward="twin") -> _Run:
 def _frame_blocks(spec: SensorSpec, run: _Run):
     """Yield ``(first, last, counts)``: the frames ``first`` to ``last`` (exclusive),
     computed :data:`_CHUNK_FRAMES` at a time; memory does not grow with the recording."""
+    own = kind_of(spec).frame_blocks(spec, run, _CHUNK_FRAMES)
+    if own is not None:  # a kind with its own chain (three-axis taxels)
+        yield from own
+        return
     active, rng = run.active, run.rng
     rows, cols = spec.shape
     period = spec.scan_period_s
@@ -296,7 +300,7 @@ def simulate(
     """
     run = _prepare(spec, scenario, flaws, rng, gains, forward)
     dtype = np.uint16 if "quantization" in run.active else np.float64
-    frames = np.empty((run.n_frames, *spec.shape), dtype=dtype)
+    frames = np.empty((run.n_frames, *spec.frame_shape), dtype=dtype)
     for first, last, counts in _frame_blocks(spec, run):
         frames[first:last] = counts
         if progress is not None:

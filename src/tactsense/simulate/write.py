@@ -59,7 +59,7 @@ def simulate_to_file(
     if path.exists():
         raise FileExistsError(f"{path} exists; choose a new name")
     run = _prepare(spec, scenario, flaws, rng, gains, forward)
-    n, shape = run.n_frames, spec.shape
+    n, shape = run.n_frames, spec.frame_shape
     dtype = np.uint16 if "quantization" in run.active else np.float64
     chunk = max(1, min(n, _WRITE_FRAMES))
     try:
