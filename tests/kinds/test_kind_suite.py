@@ -193,7 +193,7 @@ def test_simulate_writes_frames_of_the_sensor_and_the_truth(case, simulated):
     recording = read(simulated)
     assert recording.sensor == case.spec
     assert kind_of(recording.sensor) is case.kind
-    assert recording.frames.shape[1:] == case.spec.shape
+    assert recording.frames.shape[1:] == case.spec.frame_shape
     assert len(recording.frames) > 20
     truth = recording.truth
     for name in case.kind.position_names:
