@@ -382,7 +382,8 @@ def sensor_check(
     layer = kind.design_model == "layer"  # blind spots are mapped with the layer model
     if not layer and probe_g is not None:
         fail(f"--probe-g maps the blind spots of a pad; {spec.name!r} is a {kind.label}")
-    if kind.multi_contact:  # locate's contact threshold
+    # ---- a kind without contact estimation has no locate threshold (r8-triphys) ----
+    if kind.multi_contact and kind.contact_estimation:  # locate's contact threshold
         from tactsense.estimate.contacts import default_threshold, threshold_counts
 
         noise = float(spec.flaws.read_noise_counts)
