@@ -22,22 +22,26 @@ from tactsense.cli._common import (
     same_file,
     sensor_file,
 )
-from tactsense.cli._scenario import (
+from tactsense.cli._scenario import (  # r8-triphys
     AngleOption,
     ColOption,
     DwellOption,
     FlawsOption,
     ForceGOption,
     ForcesGOption,
+    FrictionOption,
     IncrementOption,
     IndenterOption,
     LiftOption,
+    RampOption,
     RepeatsOption,
     RowOption,
     ScenarioKind,
     ScenarioOption,
     SeedOption,
     SeparationOption,
+    ShearAngleOption,
+    ShearRatioOption,
     SizeOption,
     SpeedOption,
     XOption,
@@ -76,6 +80,12 @@ def simulate(
     speed_mm_s: SpeedOption = None,
     angle_deg: AngleOption = None,
     forces_g: ForcesGOption = None,
+    # ---- r8-triphys ----
+    shear_ratio: ShearRatioOption = None,
+    shear_angle_deg: ShearAngleOption = None,
+    friction: FrictionOption = None,
+    ramp_s: RampOption = None,
+    # ---- /r8-triphys ----
     flaws: FlawsOption = "all",
     seed: SeedOption = 0,
     forward: Annotated[
@@ -160,6 +170,8 @@ def simulate(
             speed_mm_s=speed_mm_s,
             angle_deg=angle_deg,
             forces_g=forces_g,
+            shear=dict(shear_ratio=shear_ratio, shear_angle_deg=shear_angle_deg,
+                       friction=friction, ramp_s=ramp_s),  # r8-triphys
         )
         if out.suffix.lower() not in (".h5", ".hdf5"):
             fail(

@@ -94,7 +94,7 @@ class TriaxialKind(Kind):
     array_calibration = False
     design_model = None
     senses_shear = True
-    scenarios = ("press", "hold", "two-probes", "slide", "loads")
+    scenarios = ("press", "shear", "slide-to-slip", "hold", "two-probes", "slide", "loads")
     forwards = ("twin",)
     frame_axes = "time, row, col, component (x, y, z)"
 

@@ -49,7 +49,7 @@ STICK, PARTIAL_SLIP, GROSS_SLIP = 0, 1, 2
 Mindlin's annulus ``c < r < a``), or the whole contact slides."""
 
 
-def slip_state(indenter, modulus_star_pa: float) -> tuple[int, float]:
+def slip_state(indenter) -> tuple[int, float]:
     """A contact's slip state (:data:`STICK`, :data:`PARTIAL_SLIP`, :data:`GROSS_SLIP`)
     and its stick ratio ``c / a`` [-] under its tangential force ``Q`` (``shear_n``).
 
@@ -57,9 +57,10 @@ def slip_state(indenter, modulus_star_pa: float) -> tuple[int, float]:
     stick zone's radius ``c / a = (1 - Q / (mu P))^(1/3)``, partial slip for
     ``0 < Q < mu P``, gross slip at ``Q >= mu P`` (``c = 0``). Any other indenter: no
     partial-slip model (stick, ``c / a = 1``, below ``mu P``; gross slip, ``0``, at it).
-    No tangential force, or no normal force: stick, ``c / a = 1``.
+    No tangential force: stick, ``c / a = 1``; a tangential force without a normal
+    one: gross slip. (``c / a`` depends on ``Q / (mu P)`` alone: the same sphere and
+    modulus set ``a`` and ``c``.)
     """
-    del modulus_star_pa  # c/a depends on Q/(mu P) alone (the same E* sets a and c)
     q, p, mu = indenter.shear_n, indenter.force_n, indenter.friction
     if q == 0.0 or p <= 0.0:
         return (STICK, 1.0) if q == 0.0 else (GROSS_SLIP, 0.0)
@@ -69,6 +70,16 @@ def slip_state(indenter, modulus_star_pa: float) -> tuple[int, float]:
     if getattr(indenter, "kind", "") != "sphere":
         return STICK, 1.0
     return PARTIAL_SLIP, float((1.0 - ratio) ** (1.0 / 3.0))
+
+
+def transmitted_shear_n(indenter) -> tuple[float, float]:
+    """The tangential force (x, y) [N] a contact passes to the skin: its own, limited in
+    size to ``mu P`` (beyond it the contact slides and friction passes ``mu P``)."""
+    q = indenter.shear_n
+    if q == 0.0:
+        return 0.0, 0.0
+    scale = min(1.0, indenter.friction * indenter.force_n / q)
+    return indenter.shear_x_n * scale, indenter.shear_y_n * scale
 
 
 def tangential_traction_pa(indenter, x_mm, y_mm, *, modulus_star_pa: float) -> np.ndarray:
@@ -93,7 +104,7 @@ def tangential_traction_pa(indenter, x_mm, y_mm, *, modulus_star_pa: float) -> n
     q, force, mu = indenter.shear_n, indenter.force_n, indenter.friction
     if q == 0.0 or force <= 0.0:
         return np.zeros_like(p)
-    state, stick = slip_state(indenter, modulus_star_pa)
+    state, stick = slip_state(indenter)
     if state == PARTIAL_SLIP:
         inner = dataclasses.replace(indenter, force_n=force * stick**3)
         return mu * (p - inner.pressure_pa(x_mm, y_mm, modulus_star_pa=modulus_star_pa))
