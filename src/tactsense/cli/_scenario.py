@@ -261,8 +261,15 @@ USES = {
     ScenarioKind.knife: ("row", "col", "increment"),
     # ---- r8-triphys ----
     ScenarioKind.shear: ("x_mm", "y_mm", "force_g", "size_mm", "dwell_s", *SHEAR_OPTIONS),
-    ScenarioKind.slide_to_slip: ("x_mm", "y_mm", "force_g", "size_mm", "speed_mm_s", "dwell_s",
-                                 *SHEAR_OPTIONS),
+    ScenarioKind.slide_to_slip: (
+        "x_mm",
+        "y_mm",
+        "force_g",
+        "size_mm",
+        "speed_mm_s",
+        "dwell_s",
+        *SHEAR_OPTIONS,
+    ),
 }
 """The options each scenario reads (where a kind's differ: ``Kind.scenario_options``, e.g.
 'knife-edge' and 'calibration' on a pad or a point set); any other scenario option given

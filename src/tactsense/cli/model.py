@@ -170,8 +170,12 @@ def simulate(
             speed_mm_s=speed_mm_s,
             angle_deg=angle_deg,
             forces_g=forces_g,
-            shear=dict(shear_ratio=shear_ratio, shear_angle_deg=shear_angle_deg,
-                       friction=friction, ramp_s=ramp_s),  # r8-triphys
+            shear=dict(
+                shear_ratio=shear_ratio,
+                shear_angle_deg=shear_angle_deg,
+                friction=friction,
+                ramp_s=ramp_s,
+            ),  # r8-triphys
         )
         if out.suffix.lower() not in (".h5", ".hdf5"):
             fail(
