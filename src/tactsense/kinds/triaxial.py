@@ -126,6 +126,25 @@ class TriaxialKind(Kind):
     def reads_capacitive(self, spec):
         return False
 
+    def contact_state(self, spec, contacts):
+        """One frame's contacts as indenters that carry their tangential force
+        (``tangential_force_n`` (x, y) [N]), for ``frames_from_contacts``: a sphere (Hertz
+        pressure, Cattaneo-Mindlin traction) or a disc at (x, y) [mm]. The forces given
+        are the forces applied, so the friction is taken as ``max(1, Q / P)``: a
+        tangential force above the normal one is passed whole (gross slip)."""
+        from tactsense.physics.indenters import DiscProbe, SphereProbe
+
+        made = []
+        for c in contacts:
+            cls = SphereProbe if c["shape"] == "sphere" else DiscProbe
+            x, y = c["position_mm"]
+            qx, qy = c.get("tangential_force_n", (0.0, 0.0))
+            force = c["normal_force_n"]
+            friction = max(1.0, float(np.hypot(qx, qy)) / force) if force > 0 else 1.0
+            made.append(cls(x, y, force, radius_mm=c["radius_mm"], shear_x_n=qx,
+                            shear_y_n=qy, friction=friction))  # fmt: skip
+        return tuple(made)
+
     def frame_blocks(self, spec: Any, run: Any, chunk_frames: int):
         """The three-axis chain (``simulate``): :func:`tactsense.physics.triaxial_chain.
         triaxial_frame_blocks` (displacement sampled at each taxel's tick, the layer's
