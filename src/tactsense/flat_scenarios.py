@@ -477,7 +477,7 @@ def slide_to_slip(
     """Press a sphere and ramp a tangential force along ``angle_deg`` over ``ramp_s``
     toward ``shear_ratio`` times the normal force, past ``friction`` (mu): slip spreads
     in from the contact's edge (stick radius ``c/a = (1 - Q/(mu P))^(1/3)``) until, at
-    ``Q = mu P``, the whole contact slides (the onset, ``params['slip_onset_s']`` [s]
+    ``Q = mu P``, the whole contact slides (the onset, ``parameters['slip_onset_s']`` [s]
     from the start); from then friction passes ``mu P`` and the sphere slides at
     ``speed_mm_s`` until the ramp ends, and ``dwell_s`` more, then lifts."""
     _shear_checks(spec, shear_ratio, friction, ramp_s, angle_deg)
