@@ -33,6 +33,13 @@ SOURCES = (
 )
 """Where the presets' numbers come from, and which are assumptions (docs/triaxial.md)."""
 
+BRIEF = (
+    "4.7 mm pitch (uSkin, Tomo et al., IEEE RA-L 2018), MLX90393 Hall sensors at "
+    "0.751 / 1.210 uT per count (its data sheet); magnets, layer and noise assumed "
+    "(docs/triaxial.md)"
+)
+""":data:`SOURCES` in a line, for a preset's description."""
+
 
 def _magnetic_skin(name: str, rows: int, cols: int, description: str) -> TriaxialSpec:
     from tactsense.physics.triaxial import magnet_moment_a_m2
@@ -67,7 +74,7 @@ def mag4x4() -> TriaxialSpec:
     patches): :data:`SOURCES` says where each number comes from."""
     return _magnetic_skin(
         "mag4x4", 4, 4,
-        "4 x 4 magnetic three-axis pad, the class of uSkin's flat patches: " + SOURCES,
+        "4 x 4 magnetic three-axis pad, the class of uSkin's flat patches: " + BRIEF,
     )  # fmt: skip
 
 
@@ -78,7 +85,7 @@ def magtip() -> TriaxialSpec:
     return _magnetic_skin(
         "magtip", 6, 4,
         "6 x 4 magnetic three-axis fingertip laid flat, the class of uSkin's fingertips "
-        "(Tomo et al., IEEE RA-L 3(1), 2018; layout an assumption): " + SOURCES,
+        "(Tomo et al., IEEE RA-L 3(1), 2018; layout assumed): " + BRIEF,
     )  # fmt: skip
 
 
