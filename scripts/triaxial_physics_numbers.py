@@ -214,7 +214,13 @@ def main() -> None:
         "whole contact slides: `q = mu p`, the force passed is mu P. Other indenters: the "
         "traction is the pressure times min(Q, mu P)/P (a rigid flat punch's sticking "
         "traction has the pressure's shape; for a disc, a knife or a stamp an assumption: "
-        "their partial slip is not modelled).",
+        "their partial slip is not modelled). Limits of the model: the contact radius "
+        "is Hertz's on a half space (the layer's thickness ignored, as for the "
+        "pressure); with nu = 0.5 the normal and tangential problems uncouple (Dundurs' "
+        "beta = 0 for a rigid sphere on an incompressible layer), as Cattaneo-Mindlin "
+        "assume; the traction depends on the present Q alone, so a tangential force "
+        "ramped down retraces the loading solution (the reverse slip and hysteresis of "
+        "Mindlin-Deresiewicz unloading are not modelled).",
         "",
         f"- The closed form integrated by quadrature (scipy) gives Q to "
         f"{max(traction['quad']):.1e} (relative) at Q/(mu P) = 0.05-0.99.",

@@ -95,6 +95,11 @@ def tangential_traction_pa(indenter, x_mm, y_mm, *, modulus_star_pa: float) -> n
     (``Q >= mu P``): ``q = mu p``, summing to ``mu P`` (the contact slides; the
     tangential force it passes is limited to that).
 
+    The traction depends on the present ``Q`` alone: a force ramped down retraces the
+    loading solution (Mindlin-Deresiewicz's reverse slip on unloading is not modelled).
+    With ``nu = 0.5`` the normal and tangential problems uncouple (Dundurs' beta = 0),
+    as Cattaneo-Mindlin assume.
+
     Any other indenter: the traction is the pressure times ``min(Q, mu P) / P`` (the
     tangential traction of a rigid flat punch that sticks has the pressure's shape,
     Johnson 1985, ch. 7, with the coupling of normal and tangential loads left out;
