@@ -153,3 +153,36 @@ def test_frames_from_contacts_takes_the_tangential_force(spec):
     applied = kind.contact_state(spec, batch.frame(3))[0]
     assert tri.transmitted_shear_n(applied) == pytest.approx((0.6, 0.0))
     assert math.isclose(applied.friction, 0.6 / FIFTY_GRAMS)
+
+
+def test_simulate_command_writes_the_shear_truth(tmp_path):
+    """``tactsense simulate --scenario slide-to-slip`` with its options: the recording's
+    truth holds the shear (in N), the slip states and the stick ratio per step, and the
+    scenario's parameters the onset."""
+    import h5py
+    from typer.testing import CliRunner
+
+    from tactsense.cli import app
+    from tactsense.io.recording import read_recording
+
+    out = tmp_path / "triphys_slip.h5"
+    args = ["simulate", "--sensor", "magtip", "--scenario", "slide-to-slip", "--shear-ratio",
+            "1.2", "--friction", "0.9", "--ramp-s", "0.4", "--shear-angle-deg", "-90",
+            "--flaws", "none", "-o", str(out)]  # fmt: skip
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 0, result.output
+    rec = read_recording(out)
+    assert rec.frames.shape[1:] == (6, 4, 3)
+    slip = rec.truth["step_slip"]
+    assert set(np.unique(slip)) == {0, 1, 2}
+    with h5py.File(out) as h5:
+        assert h5["truth/step_shear_y_n"].attrs["units"] == "N"
+    q = np.hypot(rec.truth["step_shear_x_n"], rec.truth["step_shear_y_n"])
+    np.testing.assert_allclose(q[slip == 2], 0.9 * FIFTY_GRAMS, rtol=1e-12)
+    assert np.all(rec.truth["step_shear_y_n"] <= 1e-12)  # -90 deg: along -y
+    onset = rec.scenario["parameters"]["slip_onset_s"]
+    assert onset == pytest.approx(0.2 + 0.2 + 0.4 * 0.9 / 1.2, abs=spec_period("magtip") + 1e-9)
+
+
+def spec_period(name):
+    return preset(name).scan_period_s
