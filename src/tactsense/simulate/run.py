@@ -350,9 +350,8 @@ def _truth(spec: SensorSpec, applied: list[tuple], frame_step: np.ndarray) -> di
         "step_contacts_json": json.dumps([[c.to_dict() for c in s] for s in applied]),
     }
     # ---- shear and slip truth (r8-triphys) ----
-    if kind_of(spec).senses_shear and all(
-        hasattr(c, "shear_x_n") for contacts in applied for c in contacts
-    ):
+    pressed = [c for contacts in applied for c in contacts]
+    if kind_of(spec).senses_shear and pressed and all(hasattr(c, "shear_x_n") for c in pressed):
         truth.update(_shear_truth(applied))
     return truth
 
