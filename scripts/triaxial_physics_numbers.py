@@ -272,7 +272,10 @@ def main() -> None:
         "`viscoelastic` (the layer's memory on every displacement component: 10 % delayed "
         "at 50 ms, 5 % creep at 10 s, assumptions), `dead` (0 on all three axes); the "
         "neighbours' fields are the physical crosstalk (`transduction.neighbours`); the "
-        "background field (`earth_field_*_ut`) is always read.",
+        "background field (`earth_field_*_ut`) is always read. `jitter` moves the "
+        "indenters (their tangential force kept); `nonlinearity`, `hysteresis`, `drift` "
+        "and `crosstalk` (the resistive and capacitive chains' habits) do not act on "
+        "this kind.",
         "",
         "**Scenarios.** `simulate --scenario shear` presses a sphere, ramps a tangential "
         f"force to `--shear-ratio` (Q/P, default {shear_scene.parameters['shear_ratio']:g}) "

@@ -8,7 +8,8 @@ memory (the flaw ``viscoelastic``: the delayed elastic response and creep of
 displacement component), the dipole field of all magnets and the background field,
 each sensor's gain (``gain_spread``, all three axes) and offset per axis
 (``gain_spread``: assembly), read noise (``noise``), quantization and the converter's
-range, dead sensors (``dead``: 0 on all three axes).
+range, dead sensors (``dead``: 0 on all three axes). ``nonlinearity``, ``hysteresis``,
+``drift`` and ``crosstalk`` (the capacitive and resistive chains' habits) do not act here.
 """
 
 from __future__ import annotations
