@@ -14,6 +14,7 @@ import numpy as np
 
 from tactsense._version import __version__
 from tactsense.io._layout import FORMAT, FORMAT_VERSION, RecordingError, _checked_dataset
+from tactsense.kinds import kind_of
 from tactsense.sensor import SensorSpec
 
 
@@ -97,7 +98,7 @@ class RecordingWriter:
                 fletcher32=True,
             )
             self._frames.attrs["units"] = "counts"
-            self._frames.attrs["axes"] = "time, row (along the finger, 0 = tip), col (around)"
+            self._frames.attrs["axes"] = kind_of(sensor).frame_axes
             self._time = h5.create_dataset(
                 "time", (0,), float, maxshape=(None,), chunks=(chunk,), fletcher32=True
             )
