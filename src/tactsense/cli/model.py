@@ -223,9 +223,7 @@ class _ComponentRanges:
     def __init__(self, spec):
         self.components = int(spec.components)
         names = tuple(spec.component_names)
-        self.names = (names + tuple(f"c{k}" for k in range(self.components)))[
-            : self.components
-        ]
+        self.names = (names + tuple(f"c{k}" for k in range(self.components)))[: self.components]
         self.low = np.full(self.components, np.inf)
         self.high = np.full(self.components, -np.inf)
 

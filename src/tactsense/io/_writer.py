@@ -74,7 +74,6 @@ class RecordingWriter:
         self._loss_source = losses
         self._buffer: list[tuple] = []
         self._count = 0
-        rows, cols = sensor.shape
         h5 = h5py.File(path, "w", libver="latest")
         try:
             h5.attrs["format"] = FORMAT

@@ -136,8 +136,10 @@ class Emulator:
     ):
         frames = np.asarray(frames)
         frame_shape = tuple(sensor.frame_shape)
-        if frames.ndim != 1 + len(frame_shape) or frames.shape[1:] != frame_shape or (
-            frames.shape[0] == 0
+        if (
+            frames.ndim != 1 + len(frame_shape)
+            or frames.shape[1:] != frame_shape
+            or (frames.shape[0] == 0)
         ):
             raise TactsenseInputError(
                 f"frames have shape {frames.shape}; expected (T > 0, "

@@ -2,8 +2,8 @@
 (``Serial.println`` on an Arduino; ``docs/devices.md``).
 
 A line is rows x cols numbers (rows x cols x components for taxels of several
-components, a taxel's components one after the other), row-major, separated by commas, spaces, tabs or
-semicolons (any mix), optionally after a fixed prefix, ended by ``\\n`` (a ``\\r``
+components, a taxel's components one after the other), row-major, separated by commas,
+spaces, tabs or semicolons (any mix), optionally after a fixed prefix, ended by ``\\n`` (a ``\\r``
 before it is dropped). Blank lines are skipped; the first ``header`` lines are skipped
 too. The lines are split by pyserial's :class:`serial.threaded.Packetizer`.
 """
