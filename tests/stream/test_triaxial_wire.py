@@ -3,8 +3,10 @@ layout assembled independently (struct, zlib, cobs), version-1 frames read uncha
 the emulator and the reader of a three-axis device end to end with every loss counted,
 and the text, marker and JustFloat formats with several values per taxel."""
 
+import re
 import struct
 import zlib
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -265,3 +267,42 @@ def test_the_format_names_its_components_in_its_source():
     assert parse_format("justfloat").spec() == "justfloat"
     marker = parse_format("marker,components=2").spec()
     assert marker.endswith(",components=2") and parse_format(marker).components == 2
+
+
+# ---- docs/protocol.md, "Version 2" ---------------------------------------------------
+
+DOCS = Path(__file__).resolve().parents[2] / "docs" / "protocol.md"
+EXAMPLE_V2 = np.array([[[32768, 32769, 40000]], [[32767, 0, 65535]]])
+
+
+def _section() -> str:
+    text = DOCS.read_text()
+    return text[text.index("## Version 2") : text.index("## Not in version 1")]
+
+
+def test_the_worked_v2_example_is_what_the_code_sends():
+    section = _section()
+    block = re.search(r"<!-- example-frame-v2 -->\s*```text\n(.*?)```", section, re.S)
+    wire = encode_frame(2, 10_000, EXAMPLE_V2)
+    assert bytes.fromhex("".join(block.group(1).split())) == wire
+    # the annotated bytes before COBS, line by line, and the sizes quoted
+    annotated = re.search(r"Before COBS \((\d+) bytes\):\s*```text\n(.*?)```", section, re.S)
+    hex_column = "".join(
+        re.match(r"((?:[0-9a-f]{2} )*)", line + " ").group(1)
+        for line in annotated.group(2).splitlines()
+    )
+    packet = cobs.decode(wire[:-1])
+    assert bytes.fromhex(hex_column) == packet and int(annotated.group(1)) == len(packet)
+    assert re.search(r"On the wire \((\d+) bytes\)", section).group(1) == str(len(wire))
+    crc = re.search(r"CRC-32 0x([0-9a-f]{8})", annotated.group(2)).group(1)
+    assert int(crc, 16) == int.from_bytes(packet[-4:], "little")
+
+
+def test_the_size_of_a_mag4x4_frame_in_the_docs():
+    before, on_wire = re.search(
+        r"A 4x4 three-axis frame \(`mag4x4`\) is (\d+) bytes before COBS and (\d+) on the wire",
+        _section(),
+    ).groups()
+    wire = encode_frame(0, 0, _three_axis_frames(1)[0])
+    assert (int(before), int(on_wire)) == (len(cobs.decode(wire[:-1])), len(wire))
+    assert MAG.frame_shape == (4, 4, 3)
