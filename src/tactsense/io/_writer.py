@@ -149,6 +149,11 @@ class RecordingWriter:
         ``device_time_us`` is the device clock exactly as the frame carried it [us]
         (``/device_time_us``; ``/time`` holds it in seconds, a float).
         """
+        if np.shape(counts) != tuple(self.sensor.frame_shape):
+            raise RecordingError(
+                f"a frame of shape {np.shape(counts)} for sensor {self.sensor.name!r}, whose "
+                f"frames are {tuple(self.sensor.frame_shape)}"
+            )
         self._buffer.append((counts, device_time_s, sequence, host_time_s, int(device_time_us)))
         if time.monotonic() - self._last_flush >= self._interval:
             self.flush()
