@@ -306,3 +306,50 @@ def test_the_size_of_a_mag4x4_frame_in_the_docs():
     wire = encode_frame(0, 0, _three_axis_frames(1)[0])
     assert (int(before), int(on_wire)) == (len(cobs.decode(wire[:-1])), len(wire))
     assert MAG.frame_shape == (4, 4, 3)
+
+
+# ---- the command line: emulate --format ... --components, record, info ---------------
+
+
+def test_emulate_and_record_a_three_axis_text_device(tmp_path):
+    """`emulate --format text --components 3` prints a source that `record --components 3`
+    reads; the recording holds the simulated (T, 4, 4, 3) frames and `info` says so."""
+    import signal
+    import subprocess
+    import sys
+
+    from typer.testing import CliRunner
+
+    from tactsense.cli import app
+    from tactsense.io.recording import read_recording
+
+    simulated = tmp_path / "sim.h5"
+    runner = CliRunner()
+    done = runner.invoke(app, ["simulate", "--sensor", "mag4x4", "-o", str(simulated)])
+    assert done.exit_code == 0, done.output
+    command = [
+        *(sys.executable, "-m", "tactsense.cli", "emulate", "--recording", str(simulated)),
+        *("--format", "text,sep=space", "--components", "3", "--port", "0", "--speed", "1e6"),
+    ]
+    device = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        source = device.stdout.readline().strip()
+        assert source.startswith("text,sep=space,components=3:socket://127.0.0.1:"), source
+        url = source.partition(":")[2]
+        out = tmp_path / "live.h5"
+        result = runner.invoke(
+            app,
+            [
+                *("record", f"text:{url}", "--components", "3", "--sensor", "mag4x4"),
+                *("-o", str(out), "--frames", "40", "--quiet"),
+            ],
+        )
+        assert result.exit_code == 0, result.output
+    finally:
+        device.send_signal(signal.SIGINT)
+        device.wait(10)
+    live = read_recording(out)
+    assert live.frames.shape == (40, 4, 4, 3)
+    np.testing.assert_array_equal(live.frames, read_recording(simulated).frames[:40])
+    info = runner.invoke(app, ["info", str(out)], env={"COLUMNS": "300"})
+    assert "40 x 4 x 4 x 3 counts" in " ".join(info.output.split())
