@@ -134,3 +134,14 @@ def test_info_of_a_scalar_recording_has_no_component_rows(tmp_path):
     text = _info(ts.write_recording(tmp_path / "p.h5", recording))
     assert "frames │ 3 x 16 x 16 counts" in text
     assert "components" not in text
+
+
+def test_the_info_rows_in_docs_recordings_md_are_what_info_prints(tmp_path):
+    import re
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[2] / "docs" / "recordings.md").read_text()
+    block = re.search(r"<!-- info-triaxial -->\s*```text\n(.*?)```", text, re.S).group(1)
+    printed = _info(ts.write_recording(tmp_path / "doc.h5", _recording()))
+    for line in block.strip().splitlines():
+        assert " ".join(line.split()) in printed, line

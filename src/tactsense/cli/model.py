@@ -216,35 +216,6 @@ def write_force_log(recording: Path, path: Path, chunk: int = 65_536) -> int:
         return len(times)
 
 
-class _ComponentRanges:
-    """The finite range of each component of a recording's frames, chunk by chunk
-    (r8-triwire: ``info`` on taxels of several components; nothing for one)."""
-
-    def __init__(self, spec):
-        self.components = int(spec.components)
-        names = tuple(spec.component_names)
-        self.names = (names + tuple(f"c{k}" for k in range(self.components)))[: self.components]
-        self.low = np.full(self.components, np.inf)
-        self.high = np.full(self.components, -np.inf)
-
-    def add(self, frames: np.ndarray) -> None:
-        if self.components == 1 or not frames.size:
-            return
-        values = np.asarray(frames).reshape(-1, self.components)
-        finite = np.isfinite(values)
-        self.low = np.minimum(self.low, np.where(finite, values, np.inf).min(axis=0))
-        self.high = np.maximum(self.high, np.where(finite, values, -np.inf).max(axis=0))
-
-    def text(self) -> str:
-        """``x 29658 .. 33012, y ..., z ...``; empty for one component or no finite one."""
-        if self.components == 1 or not np.isfinite(self.low).any():
-            return ""
-        return ", ".join(
-            f"{name} {lo:g} .. {hi:g}" if np.isfinite(lo) else f"{name} none finite"
-            for name, lo, hi in zip(self.names, self.low, self.high, strict=True)
-        )
-
-
 @app.command()
 def info(
     recording: Annotated[
@@ -254,6 +225,7 @@ def info(
     """Describe a recording: sensor, scenario, frames and their range."""
     import json
 
+    from tactsense.cli._info_components import ComponentRanges  # r8-triwire
     from tactsense.io.recording import RecordingReader
     from tactsense.io.robot_recording import is_robot_recording  # r7-fixc
 
@@ -266,9 +238,7 @@ def info(
         with RecordingReader(recording) as reader:
             n, spec = reader.n_frames, reader.sensor
             low, high, bad, finite_seen = np.inf, -np.inf, 0, False
-            ranges = _ComponentRanges(spec)  # r8-triwire
-            for _, frames, _ in reader.chunks():
-                ranges.add(frames)  # r8-triwire
+            for _, frames, _ in (ranges := ComponentRanges(spec)).watch(reader.chunks()):
                 if frames.dtype.kind == "f":
                     finite = np.isfinite(frames)
                     bad += int(np.count_nonzero(~finite.reshape(len(frames), -1).all(axis=1)))
@@ -291,12 +261,7 @@ def info(
     flaws = [f for f in str(attrs.get("flaws", "")).split(",") if f]
     table = Table(title=str(recording), show_header=False)
     table.add_row("sensor", spec.name)
-    # ---- components per taxel (r8-triwire): frame_shape, the components last ----
-    table.add_row("frames", f"{n} x {' x '.join(map(str, spec.frame_shape))} counts")
-    if spec.components > 1:
-        names = ", ".join(spec.component_names[: spec.components])
-        table.add_row("components", f"{spec.components} per taxel ({names}), the last axis")
-    # ---- /r8-triwire ----
+    table.add_row("frames", f"{n} x {' x '.join(map(str, spec.frame_shape))} counts")  # r8-triwire
     # r7-fixc: from the first frame (a device clock need not start at 0)
     duration = float(last[-1] - first[0]) + spec.scan_period_s if n else 0.0
     table.add_row("duration", f"{duration:.3f} s at {spec.electronics.scan_rate_hz:g} Hz")
@@ -307,8 +272,7 @@ def info(
     else:
         counts = "none (no frames)" if n == 0 else "none finite"
     table.add_row("counts", counts)
-    if ranges.text():  # r8-triwire: each component's range
-        table.add_row("counts by component", ranges.text())
+    ranges.add_rows(table)  # r8-triwire: the components per taxel and each one's range
     if source:
         table.add_row("source", source)
     if losses:
