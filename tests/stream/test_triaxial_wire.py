@@ -353,3 +353,13 @@ def test_emulate_and_record_a_three_axis_text_device(tmp_path):
     np.testing.assert_array_equal(live.frames, read_recording(simulated).frames[:40])
     info = runner.invoke(app, ["info", str(out)], env={"COLUMNS": "300"})
     assert "40 x 4 x 4 x 3 counts" in " ".join(info.output.split())
+
+
+def test_an_ident_whose_components_disagree_with_its_description_is_named():
+    class Liar(Emulator):
+        def identity(self) -> dict:
+            return {**super().identity(), "components": 2}
+
+    emulator = Liar(MAG, _three_axis_frames(3), speed=0)
+    with pytest.raises(StreamError, match=r"says 2 components per taxel, but .* has 3"):
+        _read_all(emulator)

@@ -470,6 +470,13 @@ class StreamReader:
             sensor = SensorSpec.from_toml_string(str(self.identity.get("sensor_toml", "")))
         except SensorSpecError as error:
             raise StreamError(f"{self.url}: the device's sensor description: {error}") from None
+        said = self.identity.get("components", 1)
+        if said != sensor.components:  # IDENT's count against its own description
+            raise StreamError(
+                f"{self.url}: the device says {said!r} components per taxel, but its sensor "
+                f"description {sensor.name!r} has {sensor.components}; fix its IDENT or give "
+                "the sensor (--sensor)"
+            )
         self._ready.clear()  # frames before START belong to nobody's run
         self._last_seq = None
         self._index = -1
