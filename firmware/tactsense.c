@@ -1,5 +1,5 @@
 /*
- * tactsense.c - the tactsense wire protocol, version 1, for the device side.
+ * tactsense.c - the tactsense wire protocol, versions 1 and 2, for the device side.
  * See tactsense.h for the API and docs/protocol.md for the protocol.
  */
 #include "tactsense.h"
@@ -144,7 +144,7 @@ static void put_u64(ts_encoder *e, uint64_t v)
 }
 
 static void enc_begin(ts_encoder *e, uint8_t *buf, size_t cap, ts_write_fn write, void *user,
-                      uint8_t kind)
+                      uint8_t version, uint8_t kind)
 {
     e->buf = buf;
     e->cap = cap;
@@ -156,7 +156,7 @@ static void enc_begin(ts_encoder *e, uint8_t *buf, size_t cap, ts_write_fn write
     e->user = user;
     e->overflow = 0;
     cobs_open(e);
-    put(e, TS_PROTOCOL_VERSION);
+    put(e, version);
     put(e, kind);
 }
 
@@ -179,14 +179,17 @@ static size_t enc_end(ts_encoder *e)
     return e->len;
 }
 
+/* A FRAME's body: version 1 (one reading per taxel, no components byte) or version 2
+   (the components byte, then rows * cols * components readings). */
 static void enc_frame(ts_encoder *e, uint16_t sequence, uint64_t time_us, uint8_t rows,
-                      uint8_t cols, const uint16_t *counts)
+                      uint8_t cols, uint8_t version, uint8_t components, const uint16_t *counts)
 {
-    size_t i, n = (size_t)rows * cols;
+    size_t i, n = (size_t)rows * cols * (version == TS_PROTOCOL_VERSION ? 1u : components);
     put_u16(e, sequence);
     put_u64(e, time_us);
     put(e, rows);
     put(e, cols);
+    if (version != TS_PROTOCOL_VERSION) put(e, components);
     for (i = 0; i < n; i++) put_u16(e, counts[i]);
 }
 
@@ -195,15 +198,28 @@ size_t ts_encode_frame(uint8_t *out, size_t cap, uint16_t sequence, uint64_t dev
 {
     ts_encoder e;
     if (rows == 0 || cols == 0 || counts == NULL) return 0;
-    enc_begin(&e, out, cap, NULL, NULL, TS_FRAME);
-    enc_frame(&e, sequence, device_time_us, rows, cols, counts);
+    enc_begin(&e, out, cap, NULL, NULL, TS_PROTOCOL_VERSION, TS_FRAME);
+    enc_frame(&e, sequence, device_time_us, rows, cols, TS_PROTOCOL_VERSION, 1u, counts);
+    return enc_end(&e);
+}
+
+size_t ts_encode_frame_v2(uint8_t *out, size_t cap, uint16_t sequence, uint64_t device_time_us,
+                          uint8_t rows, uint8_t cols, uint8_t components,
+                          const uint16_t *counts)
+{
+    ts_encoder e;
+    if (rows == 0 || cols == 0 || counts == NULL) return 0;
+    if (components == 0 || components > TS_MAX_COMPONENTS) return 0;
+    enc_begin(&e, out, cap, NULL, NULL, TS_PROTOCOL_VERSION_2, TS_FRAME);
+    enc_frame(&e, sequence, device_time_us, rows, cols, TS_PROTOCOL_VERSION_2, components,
+              counts);
     return enc_end(&e);
 }
 
 size_t ts_encode_end(uint8_t *out, size_t cap, uint16_t last_sequence, uint32_t frames)
 {
     ts_encoder e;
-    enc_begin(&e, out, cap, NULL, NULL, TS_END);
+    enc_begin(&e, out, cap, NULL, NULL, TS_PROTOCOL_VERSION, TS_END);
     put_u16(&e, last_sequence);
     put_u32(&e, frames);
     return enc_end(&e);
@@ -214,7 +230,7 @@ size_t ts_encode_packet(uint8_t *out, size_t cap, uint8_t kind, const uint8_t *b
 {
     ts_encoder e;
     size_t i;
-    enc_begin(&e, out, cap, NULL, NULL, kind);
+    enc_begin(&e, out, cap, NULL, NULL, TS_PROTOCOL_VERSION, kind);
     for (i = 0; i < body_len; i++) put(&e, body[i]);
     return enc_end(&e);
 }
@@ -226,6 +242,7 @@ void ts_init(ts_context *ts, uint8_t rows, uint8_t cols, uint32_t scan_period_ns
 {
     ts->rows = rows;
     ts->cols = cols;
+    ts->components = 1u;
     ts->scan_period_ns = scan_period_ns;
     ts->sequence = 0;
     ts->frames = 0;
@@ -236,6 +253,13 @@ void ts_init(ts_context *ts, uint8_t rows, uint8_t cols, uint32_t scan_period_ns
     ts->enc.user = user;
     ts->rx_len = 0;
     ts->rx_skip = 0;
+}
+
+int ts_set_components(ts_context *ts, uint8_t components)
+{
+    if (components == 0 || components > TS_MAX_COMPONENTS) return -1;
+    ts->components = components;
+    return 0;
 }
 
 uint64_t ts_scan_time_us(const ts_context *ts)
@@ -252,7 +276,10 @@ uint64_t ts_clock_us(ts_context *ts, uint32_t now_us)
 
 void ts_begin(ts_context *ts, uint8_t kind)
 {
-    enc_begin(&ts->enc, ts->block, sizeof ts->block, ts->enc.write, ts->enc.user, kind);
+    uint8_t version = kind == TS_FRAME && ts->components > 1 ? TS_PROTOCOL_VERSION_2
+                                                             : TS_PROTOCOL_VERSION;
+    enc_begin(&ts->enc, ts->block, sizeof ts->block, ts->enc.write, ts->enc.user, version,
+              kind);
 }
 
 void ts_write(ts_context *ts, const uint8_t *data, size_t len)
@@ -275,7 +302,9 @@ static void next_scan(ts_context *ts)
 void ts_send_frame(ts_context *ts, uint64_t device_time_us, const uint16_t *counts)
 {
     ts_begin(ts, TS_FRAME);
-    enc_frame(&ts->enc, ts->sequence, device_time_us, ts->rows, ts->cols, counts);
+    enc_frame(&ts->enc, ts->sequence, device_time_us, ts->rows, ts->cols,
+              ts->components > 1 ? TS_PROTOCOL_VERSION_2 : TS_PROTOCOL_VERSION, ts->components,
+              counts);
     ts_end(ts);
     next_scan(ts);
 }
@@ -362,10 +391,16 @@ void ts_ident_begin(ts_context *ts, const char *device, const char *firmware, co
     put_string_field(ts, "{\"device\":", device);
     put_string_field(ts, ",\"firmware\":", firmware);
     put_string_field(ts, ",\"serial\":", serial);
-    put_text(ts, ",\"protocol\":1,\"rows\":");
+    put_text(ts, ",\"protocol\":");
+    put_decimal(ts, ts->components > 1 ? TS_PROTOCOL_VERSION_2 : TS_PROTOCOL_VERSION);
+    put_text(ts, ",\"rows\":");
     put_decimal(ts, ts->rows);
     put_text(ts, ",\"cols\":");
     put_decimal(ts, ts->cols);
+    if (ts->components > 1) {
+        put_text(ts, ",\"components\":");
+        put_decimal(ts, ts->components);
+    }
     put_text(ts, ",\"frame_rate_hz\":");
     put_decimal(ts, millihertz / 1000u);
     put(&ts->enc, '.');
@@ -413,7 +448,8 @@ uint8_t ts_receive(ts_context *ts, uint8_t byte)
         }
         if (code < 255 && i < n) ts->rx[o++] = 0;
     }
-    if (o < 6 || ts->rx[0] != TS_PROTOCOL_VERSION) return 0;
+    if (o < 6 || (ts->rx[0] != TS_PROTOCOL_VERSION && ts->rx[0] != TS_PROTOCOL_VERSION_2))
+        return 0;
     if (ts->rx[1] != TS_IDENTIFY && ts->rx[1] != TS_START && ts->rx[1] != TS_STOP) return 0;
     crc = ts_crc32(0, ts->rx, o - 4);
     if (crc != ((uint32_t)ts->rx[o - 4] | (uint32_t)ts->rx[o - 3] << 8 |

@@ -1,5 +1,5 @@
 /*
- * tactsense.h - the tactsense wire protocol, version 1, for the device side.
+ * tactsense.h - the tactsense wire protocol, versions 1 and 2, for the device side.
  *
  * A portable C99 encoder of the packets a tactile array sends to tactsense
  * (docs/protocol.md): FRAME, IDENT and END, each CRC-32/ISO-HDLC checked,
@@ -35,6 +35,13 @@
  *         ts_send_frame(&ts, t, counts);  (or ts_drop_frame(&ts) for a scan not sent)
  *
  * See firmware/examples/scan_array/scan_array.ino for a whole sketch.
+ *
+ * Taxels of several components (a three-axis taxel's x, y, z; docs/protocol.md,
+ * "Version 2"): ts_set_components(&ts, 3) after ts_init, and counts then holds
+ * rows * cols * 3 readings, row-major by taxel with the component fastest
+ * (counts[(row * cols + col) * 3 + k], k = 0, 1, 2 for x, y, z); ts_send_frame sends
+ * version-2 FRAMEs and IDENT says "protocol": 2 and "components": 3. Into a buffer:
+ * ts_encode_frame_v2. A device of one component keeps sending version 1.
  */
 #ifndef TACTSENSE_H
 #define TACTSENSE_H
@@ -46,7 +53,9 @@
 extern "C" {
 #endif
 
-#define TS_PROTOCOL_VERSION 1
+#define TS_PROTOCOL_VERSION 1 /* the host's commands, and FRAMEs of one component */
+#define TS_PROTOCOL_VERSION_2 2 /* FRAMEs with a components byte */
+#define TS_MAX_COMPONENTS 4    /* most components a taxel reports in a version-2 FRAME */
 
 /* Packet kinds: device to host below 0x80, host to device from 0x80. */
 #define TS_FRAME 0x01    /* one scan of the array */
@@ -62,6 +71,11 @@ extern "C" {
    started 254 (at least one), then the delimiter. */
 #define TS_WIRE_MAX(n) ((n) + (n) / 254UL + 2UL)
 #define TS_FRAME_WIRE_MAX(rows, cols) TS_WIRE_MAX(TS_FRAME_BYTES(rows, cols))
+/* Bytes of a version-2 FRAME before COBS: header 15, counts, CRC 4. */
+#define TS_FRAME_V2_BYTES(rows, cols, components)                                         \
+    (19UL + 2UL * (unsigned long)(rows) * (unsigned long)(cols) * (unsigned long)(components))
+#define TS_FRAME_V2_WIRE_MAX(rows, cols, components)                                      \
+    TS_WIRE_MAX(TS_FRAME_V2_BYTES(rows, cols, components))
 
 /* Receives the encoded bytes (pieces of one packet, in order). */
 typedef void (*ts_write_fn)(void *user, const uint8_t *data, size_t len);
@@ -92,6 +106,14 @@ uint32_t ts_crc32(uint32_t crc, const uint8_t *data, size_t len);
 size_t ts_encode_frame(uint8_t *out, size_t cap, uint16_t sequence, uint64_t device_time_us,
                        uint8_t rows, uint8_t cols, const uint16_t *counts);
 
+/* A version-2 FRAME: components (1..TS_MAX_COMPONENTS) readings per taxel, counts
+   has rows * cols * components of them, row-major by taxel, the component fastest
+   (counts[(row * cols + col) * components + k]). Returns as ts_encode_frame; 0 also
+   if components is 0 or above TS_MAX_COMPONENTS. */
+size_t ts_encode_frame_v2(uint8_t *out, size_t cap, uint16_t sequence, uint64_t device_time_us,
+                          uint8_t rows, uint8_t cols, uint8_t components,
+                          const uint16_t *counts);
+
 /* An END: the last sequence number used and the frames generated (mod 2^32). */
 size_t ts_encode_end(uint8_t *out, size_t cap, uint16_t last_sequence, uint32_t frames);
 
@@ -106,6 +128,7 @@ size_t ts_encode_packet(uint8_t *out, size_t cap, uint8_t kind, const uint8_t *b
 
 typedef struct {
     uint8_t rows, cols;      /* shape of the array */
+    uint8_t components;      /* readings per taxel: 1 (version-1 FRAMEs) .. 4 */
     uint32_t scan_period_ns; /* one scan period [ns] (7 Hz: 142857143) */
     uint16_t sequence;       /* sequence number of the next scan */
     uint32_t frames;         /* scans since ts_init, sent and dropped (mod 2^32) */
@@ -125,6 +148,11 @@ typedef struct {
 void ts_init(ts_context *ts, uint8_t rows, uint8_t cols, uint32_t scan_period_ns,
              ts_write_fn write, void *user);
 
+/* Readings per taxel, 1..TS_MAX_COMPONENTS (ts_init sets 1): from 2 on, ts_send_frame
+   sends version-2 FRAMEs of rows * cols * components counts and IDENT says
+   "protocol": 2, "components": n. Returns 0, or -1 (unchanged) if out of range. */
+int ts_set_components(ts_context *ts, uint8_t components);
+
 /* Nominal start of the next scan on a clock that advances one scan period per
    scan from 0 at ts_init: round(scans * scan_period_ns / 1000) [us]. */
 uint64_t ts_scan_time_us(const ts_context *ts);
@@ -133,7 +161,8 @@ uint64_t ts_scan_time_us(const ts_context *ts);
    wraps every 71.6 minutes); call it at least once per wrap. */
 uint64_t ts_clock_us(ts_context *ts, uint32_t now_us);
 
-/* Send one FRAME with the next sequence number; counts as ts_encode_frame.
+/* Send one FRAME with the next sequence number; counts as ts_encode_frame (as
+   ts_encode_frame_v2 after ts_set_components with 2 or more).
    device_time_us must increase from frame to frame. */
 void ts_send_frame(ts_context *ts, uint64_t device_time_us, const uint16_t *counts);
 
@@ -147,7 +176,8 @@ void ts_drop_frame(ts_context *ts);
 void ts_send_end(ts_context *ts);
 
 /* Send IDENT, the JSON object {"device", "firmware", "serial", "protocol": 1,
-   "rows", "cols", "frame_rate_hz", "sensor_toml"}; the strings are UTF-8 and
+   "rows", "cols", "frame_rate_hz", "sensor_toml"} ("protocol": 2 and "components"
+   after "cols" for taxels of several components); the strings are UTF-8 and
    escaped here. sensor_toml is the sensor description (tactsense sensor show). */
 void ts_send_ident(ts_context *ts, const char *device, const char *firmware, const char *serial,
                    const char *sensor_toml);
@@ -165,7 +195,7 @@ void ts_write(ts_context *ts, const uint8_t *data, size_t len);
 void ts_end(ts_context *ts);
 
 /* Feed one byte from the host. Returns TS_IDENTIFY, TS_START or TS_STOP when it
-   completes a valid command packet; 0 otherwise (damaged packets, noise and
+   completes a valid command packet (of version 1 or 2); 0 otherwise (damaged packets, noise and
    packets of other kinds are ignored). */
 uint8_t ts_receive(ts_context *ts, uint8_t byte);
 

@@ -5,19 +5,25 @@
  *   ts_driver encode buffer|stream   jobs on stdin -> encoded packets on stdout
  *   ts_driver crc                    CRC-32 of stdin, whole and in pieces, as hex
  *   ts_driver receive                bytes on stdin -> the commands recognised, as hex
- *   ts_driver device FRAMES TOML ROWS COLS PERIOD_NS [AT:COUNT ...]
+ *   ts_driver device FRAMES TOML ROWS COLS PERIOD_NS [AT:COUNT ...] [c=K]
  *                                    a device on stdin/stdout: answers IDENTIFY, on START
  *                                    sends the frames of the file FRAMES (u16 little-endian,
- *                                    row-major), dropping COUNT scans before frame AT, then END
+ *                                    row-major), dropping COUNT scans before frame AT, then END;
+ *                                    c=K: K components per taxel (version-2 FRAMEs)
  *   ts_driver bench buffer|stream ROWS COLS N
  *                                    encode N frames; prints frames/s and a checksum
  *
  * Jobs (little-endian): 'F' u16 sequence, u64 time, u8 rows, u8 cols, u16 counts[rows*cols]
+ *                       'G' u16 sequence, u64 time, u8 rows, u8 cols, u8 components,
+ *                           u16 counts[rows*cols*components] (a version-2 FRAME; in stream
+ *                           mode through ts_set_components and ts_send_frame, so components
+ *                           must be 2 or more there)
  *                       'E' u16 last sequence, u32 frames
  *                       'P' u8 kind, u16 length, body
  *                       'I' or 'J' u8 rows, u8 cols, u32 period [ns], then four strings
  *                           (u16 length, bytes): device, firmware, serial, sensor TOML;
- *                           'I' sends IDENT whole, 'J' in pieces of 7 bytes (stream only)
+ *                           'I' sends IDENT whole, 'J' in pieces of 7 bytes (stream only);
+ *                       'K' u8 components, then as 'I' (IDENT of a device of K components)
  */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
@@ -97,17 +103,21 @@ static size_t buffer_job(char type, uint16_t seq, uint64_t time, uint8_t rows, u
                          const uint16_t *counts, uint8_t kind, const uint8_t *body, size_t len,
                          uint32_t frames)
 {
-    size_t max = TS_WIRE_MAX(TS_FRAME_BYTES(255, 255)), n = 0, pass;
+    /* kind is the components of a 'G' job */
+    size_t max = TS_WIRE_MAX(TS_FRAME_V2_BYTES(255, 255, TS_MAX_COMPONENTS)), n = 0, pass;
     for (pass = 0; pass < 3; pass++) {
         size_t cap = pass == 0 ? max : pass == 1 ? n - 1 : n, got = 0;
         uint8_t *out = malloc(cap ? cap : 1);
         if (!out) fail("out of memory");
         if (type == 'F') got = ts_encode_frame(out, cap, seq, time, rows, cols, counts);
+        if (type == 'G') got = ts_encode_frame_v2(out, cap, seq, time, rows, cols, kind, counts);
         if (type == 'E') got = ts_encode_end(out, cap, seq, frames);
         if (type == 'P') got = ts_encode_packet(out, cap, kind, body, len);
         if (pass == 0) {
             if (got == 0) fail("encoding failed");
             if (type == 'F' && got > TS_FRAME_WIRE_MAX(rows, cols)) fail("TS_FRAME_WIRE_MAX");
+            if (type == 'G' && got > TS_FRAME_V2_WIRE_MAX(rows, cols, kind))
+                fail("TS_FRAME_V2_WIRE_MAX");
             n = got;
         } else if (pass == 1 && got != 0) {
             fail("a buffer one byte short was accepted");
@@ -144,6 +154,23 @@ static int encode(int stream)
                 buffer_job('F', seq, time, rows, cols, counts, 0, NULL, 0, 0);
             }
             free(counts);
+        } else if (type == 'G') {
+            uint16_t seq = (uint16_t)take(2);
+            uint64_t time = (uint64_t)take(8);
+            uint8_t rows = (uint8_t)take(1), cols = (uint8_t)take(1), k = (uint8_t)take(1);
+            size_t i, n = (size_t)rows * cols * k;
+            uint16_t *counts = malloc(2 * n + 2);
+            if (!counts) fail("out of memory");
+            for (i = 0; i < n; i++) counts[i] = (uint16_t)take(2);
+            if (stream) {
+                ts_init(&ts, rows, cols, 1000, to_stdout, NULL);
+                if (ts_set_components(&ts, k) != 0) fail("ts_set_components refused");
+                ts.sequence = seq;
+                ts_send_frame(&ts, time, counts);
+            } else {
+                buffer_job('G', seq, time, rows, cols, counts, k, NULL, 0, 0);
+            }
+            free(counts);
         } else if (type == 'E') {
             uint16_t last = (uint16_t)take(2);
             uint32_t frames = (uint32_t)take(4);
@@ -169,14 +196,16 @@ static int encode(int stream)
             } else {
                 buffer_job('P', 0, 0, 0, 0, NULL, kind, body, len, 0);
             }
-        } else if (type == 'I' || type == 'J') {
+        } else if (type == 'I' || type == 'J' || type == 'K') {
+            uint8_t components = type == 'K' ? (uint8_t)take(1) : 1u;
             uint8_t rows = (uint8_t)take(1), cols = (uint8_t)take(1);
             uint32_t period = (uint32_t)take(4);
             char *device = take_string(), *firmware = take_string(), *serial = take_string();
             char *toml = take_string();
             if (!stream) fail("IDENT is built in stream mode only");
             ts_init(&ts, rows, cols, period, to_stdout, NULL);
-            if (type == 'I') {
+            if (ts_set_components(&ts, components) != 0) fail("ts_set_components refused");
+            if (type != 'J') {
                 ts_send_ident(&ts, device, firmware, serial, toml);
             } else {
                 size_t at = 0, n = strlen(toml);
@@ -235,11 +264,14 @@ static int device(int argc, char **argv)
     uint16_t *frames;
     char *toml;
     size_t n_frames, size, i;
-    uint8_t rows, cols;
-    if (argc < 7) fail("device FRAMES TOML ROWS COLS PERIOD_NS [AT:COUNT ...]");
+    uint8_t rows, cols, components = 1;
+    int a;
+    if (argc < 7) fail("device FRAMES TOML ROWS COLS PERIOD_NS [AT:COUNT ...] [c=K]");
     rows = (uint8_t)atoi(argv[4]);
     cols = (uint8_t)atoi(argv[5]);
-    size = (size_t)rows * cols;
+    for (a = 7; a < argc; a++)
+        if (strncmp(argv[a], "c=", 2) == 0) components = (uint8_t)atoi(argv[a] + 2);
+    size = (size_t)rows * cols * components;
     file = fopen(argv[2], "rb");
     if (!file) fail("cannot open FRAMES");
     read_all(file);
@@ -260,6 +292,7 @@ static int device(int argc, char **argv)
     memcpy(toml, input, input_len);
     toml[input_len] = 0;
     ts_init(&ts, rows, cols, (uint32_t)strtoul(argv[6], NULL, 10), to_stdout, NULL);
+    if (ts_set_components(&ts, components) != 0) fail("c=K: 1 to 4 components");
     for (;;) {
         ssize_t got = read(0, buf, sizeof buf), b;
         if (got < 0 && errno == EINTR) continue;
@@ -270,7 +303,6 @@ static int device(int argc, char **argv)
                 ts_send_ident(&ts, "tactsense C test driver", "1", "c-0001", toml);
             } else if (kind == TS_START) {
                 size_t k;
-                int a;
                 for (k = 0; k <= n_frames; k++) {
                     for (a = 7; a < argc; a++) {
                         unsigned long at, count, c;

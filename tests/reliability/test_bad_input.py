@@ -1060,3 +1060,38 @@ def test_triphys_shear_scenarios_bad_input(tmp_path, line, names):
 
 
 # ---- /(r8-triphys) ----
+
+
+# ---- values per taxel on the line: --components and components=N (r8-triwire) ----
+TRIWIRE_BAD = [
+    ("record loop:// --components 3 --out OUT", "--components applies to text, marker"),
+    ("live loop:// --components 3", "--components applies to text, marker"),
+    ("record text:loop:// --components 5 --out OUT", "--components 5: expected a whole"),
+    ("record text:loop:// --components 0 --out OUT", "--components 0: expected a whole"),
+    ("record justfloat:loop:// --components -1 --out OUT", "--components -1"),
+    ("record text,components=7:loop:// --out OUT", "components='7' must be a whole number"),
+    ("record marker,components=x:loop:// --out OUT", "components='x' must be a whole number"),
+    ("record text,components=1:loop:// --components 3 --out OUT", "disagrees with the source"),
+    (
+        "record text:loop:// --components 3 --sensor pad16 --out OUT",
+        "components=3, but the sensor 'pad16' reports 1 per taxel",
+    ),
+    ("record --skin hand4 loop:// --components 3 --out OUT", "not to --skin"),
+    ("emulate --components 3", "--components applies to another wire format"),
+    ("emulate --format text --components 9", "--components 9: expected a whole"),
+    (
+        "emulate --sensor mag4x4 --format marker,components=1",
+        "components=1, but the sensor 'mag4x4' reports 3 per taxel (x, y, z)",
+    ),
+]
+
+
+@pytest.mark.parametrize("line, names", TRIWIRE_BAD, ids=[line for line, _ in TRIWIRE_BAD])
+def test_triwire_components_bad_input(workspace, line, names):
+    out = workspace / "never_written_triwire.h5"
+    result = runner.invoke(app, line.replace("OUT", str(out)).split())
+    _check(result, names)
+    assert not out.exists()
+
+
+# ---- /values per taxel on the line (r8-triwire) ----

@@ -78,6 +78,12 @@ from tactsense.cli._scenario import (
     run_scenario,
 )
 from tactsense.cli._view_command import view
+from tactsense.cli._wire_components import (  # r8-triwire
+    ComponentsOption,
+    format_with_components,
+    refuse_with_skin,
+    source_with_components,
+)
 from tactsense.estimate.contacts.array_calibration import load_calibration
 from tactsense.kinds import kind_of
 from tactsense.sensor import load_sensor
@@ -173,6 +179,7 @@ def emulate(
     drift_ppm: robot.DriftOption = None,
     clock_offset_s: robot.ClockOffsetOption = None,
     # ---- /r7-capture ----
+    components: ComponentsOption = None,  # r8-triwire
 ) -> None:
     """Play a sensor as a device: frames of the twin (a finger, a pad or a point set) in the
     wire protocol on a pty or TCP; with --skin, a device per board of a robot skin, each on
@@ -188,6 +195,7 @@ def emulate(
 
     if (skin, drift_ppm, clock_offset_s) != (None, None, None):  # r7-capture
         return robot.emulate_skin(ctx, locals())
+    wire_format = format_with_components(wire_format, components)  # r8-triwire
     if not 0 < speed <= 1e6:
         fail(
             f"--speed must be more than 0 and at most 1e6 (a multiple of the scan rate); "
@@ -301,6 +309,7 @@ def record(
     force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
     skin: robot.SkinOption = None,  # ---- r7-capture ----
     dropout_s: robot.DropoutOption = 2.0,  # ---- /r7-capture ----
+    components: ComponentsOption = None,  # r8-triwire
 ) -> None:
     """Record a device's frames as they arrive, until --frames, --duration or Ctrl-C;
     with --skin, several devices into a robot recording (a folder; docs/robot.md).
@@ -312,9 +321,11 @@ def record(
     from tactsense.stream import StreamError
     from tactsense.stream import record as run_record
 
+    refuse_with_skin(skin, components)  # r8-triwire
     if skin is not None:  # r7-capture
         return robot.record_skin(locals())
     source = robot.one_source(source, dropout_s)  # r7-capture
+    source = source_with_components(source, components)  # r8-triwire
     _check_duration(duration)
     if record_format is None:
         mcap = out.suffix.lower() == ".mcap"
@@ -466,6 +477,7 @@ def live(
     # ---- /ROS 2 topics (r6-ros2) ----
     skin: robot.SkinOption = None,  # ---- r7-capture ----
     dropout_s: robot.DropoutOption = 2.0,  # ---- /r7-capture ----
+    components: ComponentsOption = None,  # r8-triwire
 ) -> None:
     """Estimate the contact of every frame as it arrives: position, force, skew, flags and
     latency (from the frame's last byte to its estimate), until --frames, --duration,
@@ -483,9 +495,11 @@ def live(
 
     from tactsense.stream import StreamError
 
+    refuse_with_skin(skin, components)  # r8-triwire
     if skin is not None:  # r7-capture
         return robot.live_skin(locals())
     source = robot.one_source(source, dropout_s)  # r7-capture
+    source = source_with_components(source, components)  # r8-triwire
     _check_duration(duration)
     foxglove_address = check_foxglove(foxglove)  # r6-fox
     if out is not None:

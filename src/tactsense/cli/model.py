@@ -219,6 +219,7 @@ def info(
     """Describe a recording: sensor, scenario, frames and their range."""
     import json
 
+    from tactsense.cli._info_components import ComponentRanges  # r8-triwire
     from tactsense.io.recording import RecordingReader
     from tactsense.io.robot_recording import is_robot_recording  # r7-fixc
 
@@ -231,10 +232,10 @@ def info(
         with RecordingReader(recording) as reader:
             n, spec = reader.n_frames, reader.sensor
             low, high, bad, finite_seen = np.inf, -np.inf, 0, False
-            for _, frames, _ in reader.chunks():
+            for _, frames, _ in (ranges := ComponentRanges(spec)).watch(reader.chunks()):
                 if frames.dtype.kind == "f":
                     finite = np.isfinite(frames)
-                    bad += int(np.count_nonzero(~finite.all(axis=(1, 2))))
+                    bad += int(np.count_nonzero(~finite.reshape(len(frames), -1).all(axis=1)))
                     frames = frames[finite]
                 if frames.size:
                     finite_seen = True
@@ -254,7 +255,7 @@ def info(
     flaws = [f for f in str(attrs.get("flaws", "")).split(",") if f]
     table = Table(title=str(recording), show_header=False)
     table.add_row("sensor", spec.name)
-    table.add_row("frames", f"{n} x {spec.shape[0]} x {spec.shape[1]} counts")
+    table.add_row("frames", f"{n} x {' x '.join(map(str, spec.frame_shape))} counts")  # r8-triwire
     # r7-fixc: from the first frame (a device clock need not start at 0)
     duration = float(last[-1] - first[0]) + spec.scan_period_s if n else 0.0
     table.add_row("duration", f"{duration:.3f} s at {spec.electronics.scan_rate_hz:g} Hz")
@@ -265,6 +266,7 @@ def info(
     else:
         counts = "none (no frames)" if n == 0 else "none finite"
     table.add_row("counts", counts)
+    ranges.add_rows(table)  # r8-triwire: the components per taxel and each one's range
     if source:
         table.add_row("source", source)
     if losses:

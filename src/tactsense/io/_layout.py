@@ -14,6 +14,7 @@ import numpy as np
 
 from tactsense._validation import TactsenseInputError
 from tactsense._version import __version__
+from tactsense.kinds import kind_of
 from tactsense.sensor import SensorSpec
 
 FORMAT = "tactsense-recording"
@@ -30,8 +31,9 @@ class Recording:
 
     Attributes
     ----------
-    frames : ndarray, shape (T, rows, cols)
-        A/D readings [counts].
+    frames : ndarray, shape (T, rows, cols) or (T, rows, cols, components)
+        A/D readings [counts]: ``(T, *sensor.frame_shape)``, the component axis last
+        (x, y, z for a three-axis taxel).
     time_s : ndarray, shape (T,)
         Start of each frame's scan [s].
     sample_offset_s : ndarray, shape (rows, cols)
@@ -191,7 +193,7 @@ def _write_file(partial: Path, recording: Recording) -> None:
             maxshape=(None, *recording.sensor.frame_shape),
         )
         frames.attrs["units"] = "counts"
-        frames.attrs["axes"] = "time, row (along the finger, 0 = tip), col (around)"
+        frames.attrs["axes"] = kind_of(recording.sensor).frame_axes
         time_s = _checked_dataset(h5, "time", np.asarray(recording.time_s, float))
         time_s.attrs["units"] = "s"
         offset = _checked_dataset(h5, "sample_offset", recording.sample_offset_s)

@@ -14,6 +14,7 @@ import numpy as np
 
 from tactsense._version import __version__
 from tactsense.io._layout import FORMAT, FORMAT_VERSION, RecordingError, _checked_dataset
+from tactsense.kinds import kind_of
 from tactsense.sensor import SensorSpec
 
 
@@ -73,7 +74,6 @@ class RecordingWriter:
         self._loss_source = losses
         self._buffer: list[tuple] = []
         self._count = 0
-        rows, cols = sensor.shape
         h5 = h5py.File(path, "w", libver="latest")
         try:
             h5.attrs["format"] = FORMAT
@@ -97,7 +97,7 @@ class RecordingWriter:
                 fletcher32=True,
             )
             self._frames.attrs["units"] = "counts"
-            self._frames.attrs["axes"] = "time, row (along the finger, 0 = tip), col (around)"
+            self._frames.attrs["axes"] = kind_of(sensor).frame_axes
             self._time = h5.create_dataset(
                 "time", (0,), float, maxshape=(None,), chunks=(chunk,), fletcher32=True
             )
@@ -149,6 +149,11 @@ class RecordingWriter:
         ``device_time_us`` is the device clock exactly as the frame carried it [us]
         (``/device_time_us``; ``/time`` holds it in seconds, a float).
         """
+        if np.shape(counts) != tuple(self.sensor.frame_shape):
+            raise RecordingError(
+                f"a frame of shape {np.shape(counts)} for sensor {self.sensor.name!r}, whose "
+                f"frames are {tuple(self.sensor.frame_shape)}"
+            )
         self._buffer.append((counts, device_time_s, sequence, host_time_s, int(device_time_us)))
         if time.monotonic() - self._last_flush >= self._interval:
             self.flush()

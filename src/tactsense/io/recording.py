@@ -5,7 +5,9 @@ Layout of a recording file (format ``tactsense-recording``, version 2)::
     /                    attrs: format, format_version, tactsense_version, created,
                                 sensor_toml, scenario_json, flaws, scan_rate_hz,
                                 source (recorded streams: the URL)
-    /frames              (T, rows, cols) counts       attrs: units = "counts"
+    /frames              (T, rows, cols) counts       attrs: units = "counts", axes
+                         (T, rows, cols, components) for taxels of several components
+                         (the sensor's frame_shape; a three-axis taxel's x, y, z last)
     /time                (T,) frame start time        attrs: units = "s"
     /sample_offset       (rows, cols) sample instant within a frame, attrs: units = "s"
     /gains               (rows, cols) per-tactel gain used by the simulator (optional)
@@ -37,7 +39,10 @@ file ("file is already open for write": the writer's flag is still set); open it
 (Debian/Ubuntu package ``hdf5-tools``), after which any HDF5 reader opens it.
 
 Axis -2 of ``frames`` runs along the finger (row 0 under the tip), axis -1
-around it (``docs/nomenclature.md``).
+around it (``docs/nomenclature.md``); for taxels of several components the rows and
+columns are axes 1 and 2 and the components axis 3 (``frames.attrs["axes"]`` says so,
+from the kind's ``frame_axes``). Files written before the attribute followed the kind
+read unchanged: the shape is checked against the sensor description, not the attribute.
 """
 
 from __future__ import annotations

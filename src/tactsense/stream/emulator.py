@@ -24,6 +24,7 @@ from tactsense._version import __version__
 from tactsense.io.recording import Recording
 from tactsense.sensor import SensorSpec
 from tactsense.stream.protocol import (
+    FRAME_V2,
     ControlPacket,
     Kind,
     PacketSplitter,
@@ -100,8 +101,10 @@ class Emulator:
     Parameters
     ----------
     sensor : SensorSpec
-    frames : ndarray, shape (T, rows, cols)
-        The readings the device sends, in order [counts] (e.g. ``simulate(...).frames``).
+    frames : ndarray, shape (T, rows, cols) or (T, rows, cols, components)
+        The readings the device sends, in order [counts] (e.g. ``simulate(...).frames``):
+        ``(T, *sensor.frame_shape)``. Taxels of several components go out as version-2
+        FRAMEs (``docs/protocol.md``).
     speed : float
         Frames go out at ``speed`` times the sensor's scan rate; 0 sends as fast as the
         line takes them.
@@ -132,10 +135,15 @@ class Emulator:
         wire_format=None,
     ):
         frames = np.asarray(frames)
-        if frames.ndim != 3 or frames.shape[1:] != sensor.shape or frames.shape[0] == 0:
+        frame_shape = tuple(sensor.frame_shape)
+        if (
+            frames.ndim != 1 + len(frame_shape)
+            or frames.shape[1:] != frame_shape
+            or (frames.shape[0] == 0)
+        ):
             raise TactsenseInputError(
-                f"frames have shape {frames.shape}; expected (T > 0, {sensor.shape[0]}, "
-                f"{sensor.shape[1]})"
+                f"frames have shape {frames.shape}; expected (T > 0, "
+                f"{', '.join(map(str, frame_shape))}) for sensor {sensor.name!r}"
             )
         if not (np.isfinite(speed) and speed >= 0):
             raise TactsenseInputError(f"speed must be a finite number >= 0; got {speed!r}")
@@ -144,6 +152,7 @@ class Emulator:
         self.format = wire_format
         if wire_format is not None:
             wire_format.check_shape(sensor.shape)
+            wire_format.check_components(sensor)
             self.frames = wire_format.prepare(self.frames, sensor.electronics.adc_bits)
         self.speed = float(speed)
         self.faults = faults or FaultRates()
@@ -185,17 +194,22 @@ class Emulator:
         return self.sensor.electronics.scan_rate_hz * self.speed
 
     def identity(self) -> dict:
-        """The IDENT body: who the device is and what it measures."""
-        return {
+        """The IDENT body: who the device is and what it measures. A sensor of several
+        components per taxel speaks version 2 and says how many (``components``)."""
+        components = int(self.sensor.components)
+        identity = {
             "device": "tactsense twin",
             "firmware": __version__,
             "serial": self.serial_number,
-            "protocol": 1,
+            "protocol": 1 if components == 1 else FRAME_V2,
             "rows": self.sensor.shape[0],
             "cols": self.sensor.shape[1],
-            "frame_rate_hz": self.frame_rate_hz,
-            "sensor_toml": self.sensor.to_toml_string(),
         }
+        if components > 1:
+            identity["components"] = components
+        identity["frame_rate_hz"] = self.frame_rate_hz
+        identity["sensor_toml"] = self.sensor.to_toml_string()
+        return identity
 
     # ---- frames on the wire ------------------------------------------------------
 

@@ -29,6 +29,7 @@ import serial
 
 from tactsense._validation import TactsenseInputError
 from tactsense.sensor import SensorSpec
+from tactsense.stream.protocol import MAX_COMPONENTS
 from tactsense.stream.reader import (
     ByteClock,
     LossCounters,
@@ -77,6 +78,31 @@ def parse_options(name: str, text: str, allowed: dict[str, str]) -> dict[str, st
     return options
 
 
+def parse_components(name: str, value) -> int | None:
+    """The ``components=N`` option of a format: 1 to 4 values per taxel (None: unset)."""
+    if value is None:
+        return None
+    try:
+        count = int(str(value).strip())
+    except ValueError:
+        count = 0
+    if not 1 <= count <= MAX_COMPONENTS:
+        raise FormatError(
+            f"format {name}: components={value!r} must be a whole number of values per taxel "
+            f"from 1 to {MAX_COMPONENTS} (3 for a three-axis taxel)"
+        )
+    return count
+
+
+def values_text(shape: tuple[int, ...]) -> str:
+    """What a frame of ``shape`` holds, for messages: ``4x4 = 16 tactels`` or
+    ``4x4 tactels x 3 components = 48 values``."""
+    rows, cols = shape[:2]
+    if len(shape) == 2:
+        return f"{rows}x{cols} = {rows * cols} tactels"
+    return f"{rows}x{cols} tactels x {shape[2]} components = {rows * cols * shape[2]} values"
+
+
 class WireFormat:
     """What every format module provides (subclasses fill it in)."""
 
@@ -95,6 +121,26 @@ class WireFormat:
 
     def check_shape(self, shape: tuple[int, int]) -> None:
         """Raise :class:`FormatError` if frames of this shape cannot be carried."""
+
+    components: int | None = None
+    """Values per taxel on the line, from the option ``components=N`` (1..4; a line
+    carries a taxel's components one after the other, the taxels row-major); None:
+    the sensor's (``SensorSpec.components``)."""
+
+    def check_components(self, sensor: SensorSpec) -> None:
+        """Raise :class:`FormatError` if ``components=N`` disagrees with the sensor."""
+        if self.components is None or self.components == sensor.components:
+            return
+        names = ", ".join(sensor.component_names[: sensor.components])
+        raise FormatError(
+            f"format {self.name}: components={self.components}, but the sensor "
+            f"{sensor.name!r} reports {sensor.components} per taxel"
+            f"{f' ({names})' if sensor.components > 1 else ''}; give the sensor of the "
+            f"device (--sensor) or components={sensor.components}"
+        )
+
+    def _components_spec(self) -> str:
+        return "" if self.components is None else f",components={self.components}"
 
     def sensor_as_sent(self, sensor: SensorSpec) -> SensorSpec:
         """The sensor as a device of this format sends it: with samples narrower than its
@@ -314,6 +360,7 @@ class FormatReader:
                 "give the sensor (--sensor: a preset such as pad16, or a TOML file)"
             )
         wire_format.check_shape(sensor.shape)
+        wire_format.check_components(sensor)
         wire_format.check_converter(sensor, self.url)
         self.sensor = sensor
         self.stats = LossCounters()
@@ -325,7 +372,8 @@ class FormatReader:
         self.timeout_s, self.first_frame_timeout_s = stream_timeouts(
             timeout_s, first_frame_timeout_s, self.frame_period_s
         )
-        self._decoder = wire_format.decoder(sensor.shape, self.stats, self.url)
+        # the decoders cut frames of the sensor's frame_shape: (rows, cols[, components])
+        self._decoder = wire_format.decoder(tuple(sensor.frame_shape), self.stats, self.url)
         self._clock = ByteClock()
         self._ready: deque[StreamFrame] = deque()
         self._index = -1
@@ -393,8 +441,8 @@ class FormatReader:
                 raise StreamError(
                     f"{self.url}: the line closed before any frame arrived"
                     f"{'; seen' + seen if seen else ''}; is the device sending "
-                    f"{self.format.name} frames of {self.sensor.shape[0]}x"
-                    f"{self.sensor.shape[1]}?"
+                    f"{self.format.name} frames of "
+                    f"{values_text(tuple(self.sensor.frame_shape))}?"
                 )
             return True
         if not data:
@@ -435,7 +483,7 @@ class FormatReader:
             raise StreamError(
                 f"{self.url}: no frame arrived within {self.first_frame_timeout_s:g} s"
                 f"{'; seen' + seen if seen else ''}; is the device sending "
-                f"{self.format.name} frames of {self.sensor.shape[0]}x{self.sensor.shape[1]}? "
+                f"{self.format.name} frames of {values_text(tuple(self.sensor.frame_shape))}? "
                 "(--timeout sets a longer wait)"
             )
 

@@ -1,4 +1,5 @@
-"""Float frames with a tail marker: rows x cols little-endian float32 values, then the
+"""Float frames with a tail marker: rows x cols little-endian float32 values (x components
+per taxel, component fastest, for taxels of several), then the
 4-byte tail ``00 00 80 7F`` (VOFA+ "JustFloat"; ``docs/devices.md``).
 
 Decoded with :func:`numpy.frombuffer`; framed by
@@ -14,7 +15,14 @@ from typing import ClassVar
 
 import numpy as np
 
-from tactsense.stream.framed import DelimitedFramer, FormatError, WireFormat, parse_hex
+from tactsense.stream.framed import (
+    DelimitedFramer,
+    FormatError,
+    WireFormat,
+    parse_components,
+    parse_hex,
+    values_text,
+)
 from tactsense.stream.reader import LossCounters, StreamError
 
 TAIL = bytes.fromhex("0000807f")
@@ -31,12 +39,23 @@ class JustFloat(WireFormat):
         The tail as hex digits [default ``0000807F``].
     scale : float
         Counts per unit of the values sent [default 1: the values are counts].
+    components : int
+        Values per taxel (1..4; default the sensor's: 3 for a three-axis taxel).
     """
 
     name = "justfloat"
-    options: ClassVar[dict[str, str]] = {"tail": "hex bytes", "scale": "counts per unit"}
+    options: ClassVar[dict[str, str]] = {
+        "tail": "hex bytes",
+        "scale": "counts per unit",
+        "components": "1..4 values per taxel",
+    }
 
-    def __init__(self, tail: str = "0000807F", scale: str | float = 1.0):
+    def __init__(
+        self,
+        tail: str = "0000807F",
+        scale: str | float = 1.0,
+        components: str | int | None = None,
+    ):
         self.tail = parse_hex("format justfloat: tail", str(tail))
         try:
             self.scale = float(scale)
@@ -48,6 +67,7 @@ class JustFloat(WireFormat):
                 "(counts per unit)"
             )
         self.noise_excluded = bytes(set(self.tail))
+        self.components = parse_components("justfloat", components)
 
     def spec(self) -> str:
         parts = ["justfloat"]
@@ -55,7 +75,7 @@ class JustFloat(WireFormat):
             parts.append(f"tail={self.tail.hex().upper()}")
         if self.scale != 1.0:
             parts.append(f"scale={self.scale:g}")
-        return ",".join(parts)
+        return ",".join(parts) + self._components_spec()
 
     def decoder(self, shape, stats: LossCounters, url: str) -> JustFloatDecoder:
         return JustFloatDecoder(self, tuple(shape), stats, url)
@@ -75,7 +95,7 @@ class JustFloatDecoder:
     def __init__(self, fmt: JustFloat, shape, stats: LossCounters, url):
         self.shape, self.url, self.stats, self.scale = shape, url, stats, fmt.scale
         self.framer = DelimitedFramer(
-            fmt.tail, shape[0] * shape[1] * 4, leading=False, stats=stats,
+            fmt.tail, int(np.prod(shape)) * 4, leading=False, stats=stats,
             on_shape=self._shape_error,
         )  # fmt: skip
 
@@ -108,8 +128,7 @@ class JustFloatDecoder:
         return [counts for counts, _ in self.finish_ends()]
 
     def _shape_error(self, size: int) -> None:
-        rows, cols = self.shape
         raise StreamError(
             f"{self.url}: the device sends {size / 4:g} floats between tails, but the sensor "
-            f"has {rows}x{cols} = {rows * cols} tactels; give the sensor of the device (--sensor)"
+            f"has {values_text(self.shape)}; give the sensor of the device (--sensor)"
         )

@@ -1,4 +1,5 @@
 """Marker-framed bytes: a fixed start marker, then rows x cols samples of 8 or 16 bits
+(rows x cols x components for taxels of several components, component fastest)
 (``docs/devices.md``), the framing of several open-hardware piezoresistive pads (e.g.
 ``AA 55`` then one ``uint8`` per taxel, row-major).
 
@@ -13,7 +14,14 @@ from typing import ClassVar
 
 import numpy as np
 
-from tactsense.stream.framed import DelimitedFramer, FormatError, WireFormat, parse_hex
+from tactsense.stream.framed import (
+    DelimitedFramer,
+    FormatError,
+    WireFormat,
+    parse_components,
+    parse_hex,
+    values_text,
+)
 from tactsense.stream.reader import LossCounters, StreamError
 
 ORDERS = {"little": "<", "big": ">"}
@@ -30,6 +38,8 @@ class MarkerFrames(WireFormat):
         Bits per sample [default 8].
     order : {'little', 'big'}
         Byte order of 16-bit samples [default little].
+    components : int
+        Samples per taxel (1..4; default the sensor's: 3 for a three-axis taxel).
     """
 
     name = "marker"
@@ -37,9 +47,16 @@ class MarkerFrames(WireFormat):
         "start": "hex bytes",
         "width": "8|16",
         "order": "little|big",
+        "components": "1..4 values per taxel",
     }
 
-    def __init__(self, start: str = "AA55", width: str | int = 8, order: str = "little"):
+    def __init__(
+        self,
+        start: str = "AA55",
+        width: str | int = 8,
+        order: str = "little",
+        components: str | int | None = None,
+    ):
         self.marker = parse_hex("format marker: start", str(start))
         if str(width).strip() not in ("8", "16"):
             raise FormatError(f"format marker: width={width!r} must be 8 or 16 bits a sample")
@@ -50,10 +67,14 @@ class MarkerFrames(WireFormat):
         self.order = order
         self.dtype = np.dtype(np.uint8) if self.width == 8 else np.dtype(ORDERS[order] + "u2")
         self.noise_excluded = bytes(set(self.marker))
+        self.components = parse_components("marker", components)
 
     def spec(self) -> str:
         order = f",order={self.order}" if self.width == 16 else ""
-        return f"marker,start={self.marker.hex().upper()},width={self.width}{order}"
+        return (
+            f"marker,start={self.marker.hex().upper()},width={self.width}{order}"
+            + self._components_spec()
+        )
 
     def decoder(self, shape, stats: LossCounters, url: str) -> MarkerDecoder:
         return MarkerDecoder(self, tuple(shape), stats, url)
@@ -80,7 +101,7 @@ class MarkerDecoder:
     def __init__(self, fmt: MarkerFrames, shape, stats, url):
         self.shape, self.dtype, self.url = shape, fmt.dtype, url
         self.fmt = fmt
-        length = shape[0] * shape[1] * fmt.dtype.itemsize
+        length = int(np.prod(shape)) * fmt.dtype.itemsize
         self.framer = DelimitedFramer(
             fmt.marker, length, leading=True, stats=stats, on_shape=self._shape_error
         )
@@ -105,10 +126,9 @@ class MarkerDecoder:
         return [counts for counts, _ in self.finish_ends()]
 
     def _shape_error(self, size: int) -> None:
-        rows, cols = self.shape
         samples = size / self.dtype.itemsize
         raise StreamError(
             f"{self.url}: the device sends {samples:g} samples of {self.fmt.width} bits between "
-            f"markers, but the sensor has {rows}x{cols} = {rows * cols} tactels; give the "
-            "sensor of the device (--sensor) or its width"
+            f"markers, but the sensor has {values_text(self.shape)}; give the sensor of the "
+            "device (--sensor) or its width"
         )

@@ -1,4 +1,4 @@
-"""The tactsense wire protocol, version 1: packets, their encoding and their decoding.
+"""The tactsense wire protocol, versions 1 and 2: packets, their encoding and decoding.
 
 Specified for firmware authors in ``docs/protocol.md``; this module is its reference
 implementation. In short: every packet is ``version | kind | body | CRC-32``, COBS-encoded
@@ -11,6 +11,12 @@ Frame packet body (all little-endian)::
     device_time  u64   start of the frame's scan on the device clock [us]
     rows, cols   u8    shape of the array
     counts       u16 x rows*cols, row-major (row 0 = tip row, axis -1 around the finger)
+
+Version 2 adds one FRAME layout, for taxels of several components (a three-axis taxel's
+x, y, z): ``components u8`` (1..4) after ``cols``, then ``rows*cols*components`` counts,
+row-major by taxel with the component fastest (the frame ``(rows, cols, components)``
+flattened in C order). Every other packet is the same in both versions; a version-1
+frame still reads as it always did, and a device of one component may keep sending it.
 
 The CRC is CRC-32/ISO-HDLC (the CRC of zlib, Ethernet and PNG: polynomial 0x04C11DB7,
 reflected, initial value and final XOR 0xFFFFFFFF) of every byte before it, stored
@@ -30,10 +36,19 @@ import numpy as np
 from cobs import cobs
 
 VERSION = 1
+"""The version of the host's commands (every device understands them) and of a FRAME of
+one component per taxel."""
+FRAME_V2 = 2
+"""The version of a FRAME with a ``components`` byte: several components per taxel."""
+VERSIONS = (VERSION, FRAME_V2)
+"""Versions a packet may carry; IDENT and END are laid out alike in both."""
+MAX_COMPONENTS = 4
+"""Most components a taxel may report in a version-2 FRAME."""
 DELIMITER = b"\x00"
 
 _HEAD = struct.Struct("<BB")  # version, kind
 _FRAME = struct.Struct("<BBHQBB")  # version, kind, sequence, device time [us], rows, cols
+_FRAME_V2 = struct.Struct("<BBHQBBB")  # ... rows, cols, components
 _CRC = struct.Struct("<I")
 _END = struct.Struct("<BBHI")  # version, kind, last sequence sent, frames sent (mod 2**32)
 
@@ -72,7 +87,10 @@ class FramePacket:
     sequence: int
     device_time_us: int
     counts: np.ndarray
-    """(rows, cols) uint16 [counts]"""
+    """(rows, cols) uint16 [counts]; (rows, cols, components) from a version-2 frame of
+    more than one component (the component axis last)."""
+    version: int = VERSION
+    """The FRAME layout it came in (1, or 2 with a components byte)."""
 
 
 @dataclass(frozen=True)
@@ -89,22 +107,26 @@ class ControlPacket:
     body: dict
 
 
-def frame_size(rows: int, cols: int) -> int:
-    """Bytes of a frame packet before COBS encoding (header, counts and CRC)."""
-    return _FRAME.size + 2 * rows * cols + _CRC.size
+def frame_size(rows: int, cols: int, components: int = 1) -> int:
+    """Bytes of a frame packet before COBS encoding (header, counts and CRC): version 1
+    for one component per taxel, version 2 (one byte more of header) for several."""
+    head = _FRAME.size if components == 1 else _FRAME_V2.size
+    return head + 2 * rows * cols * components + _CRC.size
 
 
-def encoded_frame_size(rows: int, cols: int) -> int:
+def encoded_frame_size(rows: int, cols: int, components: int = 1) -> int:
     """Fewest bytes a frame takes on the wire: COBS adds at least one byte (at most one
     per 254), plus the delimiter. Exact for frames of up to 254 bytes (10x10 tactels)."""
-    return frame_size(rows, cols) + 2
+    return frame_size(rows, cols, components) + 2
 
 
 def _seal(packet: bytes) -> bytes:
     return cobs.encode(packet + _CRC.pack(zlib.crc32(packet))) + DELIMITER
 
 
-def encode_frame(sequence: int, device_time_us: int, counts: np.ndarray) -> bytes:
+def encode_frame(
+    sequence: int, device_time_us: int, counts: np.ndarray, *, version: int | None = None
+) -> bytes:
     """Encode one frame, delimiter included.
 
     Parameters
@@ -113,16 +135,35 @@ def encode_frame(sequence: int, device_time_us: int, counts: np.ndarray) -> byte
         Frame counter; taken modulo 65536.
     device_time_us : int
         Start of the frame's scan on the device clock [us].
-    counts : ndarray, shape (rows, cols)
-        A/D readings [counts], 0..65535.
+    counts : ndarray, shape (rows, cols) or (rows, cols, components)
+        A/D readings [counts], 0..65535; the component axis last (1..4 components).
+    version : {1, 2}, optional
+        The FRAME layout; default the first that carries the frame: 1 for
+        ``(rows, cols)``, 2 for ``(rows, cols, components)``. A frame of one component
+        may be sent as version 2 (``components`` = 1).
     """
     counts = np.asarray(counts)
-    if counts.ndim != 2 or not (0 < counts.shape[0] < 256 and 0 < counts.shape[1] < 256):
-        raise ValueError(f"counts must be (rows, cols) with 1..255 each; got {counts.shape}")
-    rows, cols = counts.shape
-    head = _FRAME.pack(
-        VERSION, Kind.FRAME, sequence % SEQUENCE_MODULUS, int(device_time_us), rows, cols
-    )
+    if counts.ndim not in (2, 3) or not (0 < counts.shape[0] < 256 and 0 < counts.shape[1] < 256):
+        raise ValueError(
+            f"counts must be (rows, cols) or (rows, cols, components) with 1..255 rows and "
+            f"columns; got {counts.shape}"
+        )
+    components = counts.shape[2] if counts.ndim == 3 else 1
+    if not 1 <= components <= MAX_COMPONENTS:
+        raise ValueError(f"a taxel carries 1..{MAX_COMPONENTS} components; got {components}")
+    if version is None:
+        version = VERSION if counts.ndim == 2 else FRAME_V2
+    if version not in VERSIONS or (version == VERSION and components != 1):
+        raise ValueError(
+            f"version {version} cannot carry {components} components per taxel; "
+            f"version {FRAME_V2} carries 1..{MAX_COMPONENTS}"
+        )
+    rows, cols = counts.shape[:2]
+    sequence, time_us = sequence % SEQUENCE_MODULUS, int(device_time_us)
+    if version == VERSION:
+        head = _FRAME.pack(VERSION, Kind.FRAME, sequence, time_us, rows, cols)
+    else:
+        head = _FRAME_V2.pack(FRAME_V2, Kind.FRAME, sequence, time_us, rows, cols, components)
     return _seal(head + counts.astype("<u2", copy=False).tobytes())
 
 
@@ -142,7 +183,7 @@ def encode_end(last_sequence: int, frames_sent: int) -> bytes:
 def _looks_like_frame(raw: bytes) -> bool:
     # COBS leaves the bytes before the first zero in place after the code byte: a frame
     # starts with (code >= 3, version, FRAME).
-    return len(raw) >= 3 and raw[0] >= 3 and raw[1] == VERSION and raw[2] == Kind.FRAME
+    return len(raw) >= 3 and raw[0] >= 3 and raw[1] in VERSIONS and raw[2] == Kind.FRAME
 
 
 def decode_packet(raw: bytes, expected_frame_bytes: int | None = None):
@@ -174,27 +215,16 @@ def decode_packet(raw: bytes, expected_frame_bytes: int | None = None):
     except cobs.DecodeError:
         reason = "truncated" if framelike and short else "garbage"
         raise ProtocolError(reason, f"not a COBS packet ({len(raw)} bytes)") from None
-    if len(packet) < _HEAD.size + _CRC.size or packet[0] != VERSION:
+    if len(packet) < _HEAD.size + _CRC.size or packet[0] not in VERSIONS:
         reason = "truncated" if framelike else "garbage"
-        raise ProtocolError(reason, f"no version-{VERSION} packet ({len(packet)} bytes)")
+        raise ProtocolError(reason, f"no version-1 or -2 packet ({len(packet)} bytes)")
     body, (crc,) = packet[: -_CRC.size], _CRC.unpack_from(packet, len(packet) - _CRC.size)
     if zlib.crc32(body) != crc:
         reason = "truncated" if framelike and short else "bad_check"
         raise ProtocolError(reason, "CRC-32 mismatch")
     kind = body[1]
     if kind == Kind.FRAME:
-        if len(body) < _FRAME.size:
-            raise ProtocolError("truncated", "frame header cut short")
-        _, _, sequence, device_time, rows, cols = _FRAME.unpack_from(body)
-        if len(body) != _FRAME.size + 2 * rows * cols:
-            raise ProtocolError(
-                "bad_check", f"frame of {rows}x{cols} tactels has {len(body)} bytes"
-            )
-        # a native, writable copy: a read-only view of the packet is another type to
-        # Numba, compiled at the first frame although the estimator was warmed (0.9-2 s)
-        counts = np.frombuffer(body, dtype="<u2", offset=_FRAME.size).astype(np.uint16)
-        counts = counts.reshape(rows, cols)
-        return FramePacket(sequence, device_time, counts)
+        return _decode_frame(body)
     if kind == Kind.END and len(body) == _END.size:
         _, _, last, sent = _END.unpack(body)
         return EndPacket(last, sent)
@@ -206,6 +236,34 @@ def decode_packet(raw: bytes, expected_frame_bytes: int | None = None):
             raise ProtocolError("bad_check", "control packet body is not JSON") from None
         return ControlPacket(Kind(kind), data if isinstance(data, dict) else {})
     raise ProtocolError("garbage", f"unknown packet kind 0x{kind:02x}")
+
+
+def _decode_frame(body: bytes) -> FramePacket:
+    """A FRAME's body (CRC checked): version 1 ``(rows, cols)``, version 2
+    ``(rows, cols, components)`` (``(rows, cols)`` when it carries one component)."""
+    version = body[0]
+    head = _FRAME if version == VERSION else _FRAME_V2
+    if len(body) < head.size:
+        raise ProtocolError("truncated", "frame header cut short")
+    if version == VERSION:
+        _, _, sequence, device_time, rows, cols = head.unpack_from(body)
+        components = 1
+    else:
+        _, _, sequence, device_time, rows, cols, components = head.unpack_from(body)
+        if not 1 <= components <= MAX_COMPONENTS:
+            raise ProtocolError(
+                "bad_check", f"frame of {components} components per taxel (1..{MAX_COMPONENTS})"
+            )
+    if len(body) != head.size + 2 * rows * cols * components:
+        raise ProtocolError(
+            "bad_check",
+            f"frame of {rows}x{cols} tactels x {components} components has {len(body)} bytes",
+        )
+    # a native, writable copy: a read-only view of the packet is another type to
+    # Numba, compiled at the first frame although the estimator was warmed (0.9-2 s)
+    counts = np.frombuffer(body, dtype="<u2", offset=head.size).astype(np.uint16)
+    shape = (rows, cols) if components == 1 else (rows, cols, components)
+    return FramePacket(sequence, device_time, counts.reshape(shape), version)
 
 
 class PacketSplitter:

@@ -183,10 +183,17 @@ class StreamFrame:
     arrival: float
     """Arrival on :func:`time.perf_counter` [s], for latency measurements."""
     counts: np.ndarray
-    """(rows, cols) readings [counts]."""
+    """(rows, cols) readings [counts]; (rows, cols, components) for taxels of several
+    components (the sensor's ``frame_shape``)."""
     device_time_us: int = -1
     """Start of the frame's scan on the device clock, exactly as sent [us] (-1: unknown,
     a frame that did not come over the wire protocol)."""
+
+
+def _shape_text(shape: tuple[int, ...]) -> str:
+    """``4x4 tactels`` or ``4x4 tactels x 3 components``, for messages."""
+    text = f"{shape[0]}x{shape[1]} tactels"
+    return text if len(shape) == 2 else f"{text} x {shape[2]} components"
 
 
 def stream_timeouts(
@@ -294,7 +301,7 @@ class StreamReader:
                 sensor = self._identify(identify_timeout_s)
             self.sensor = sensor
             rows, cols = sensor.shape
-            self._frame_bytes = encoded_frame_size(rows, cols) - 1
+            self._frame_bytes = encoded_frame_size(rows, cols, sensor.components) - 1
             rate = float(self.identity.get("frame_rate_hz") or sensor.electronics.scan_rate_hz)
             self.frame_period_s = 1.0 / rate if rate > 0 else 0.0
             self._scan_period_s = sensor.scan_period_s
@@ -374,11 +381,10 @@ class StreamReader:
             self.identity = packet.body
 
     def _accept(self, packet: FramePacket, end: int) -> None:
-        if self.sensor is not None and packet.counts.shape != self.sensor.shape:
-            rows, cols = packet.counts.shape
+        if self.sensor is not None and packet.counts.shape != self.sensor.frame_shape:
             raise StreamError(
-                f"{self.url}: the device sends frames of {rows}x{cols} tactels, but the "
-                f"sensor {self.sensor.name} has {self.sensor.shape[0]}x{self.sensor.shape[1]}; "
+                f"{self.url}: the device sends frames of {_shape_text(packet.counts.shape)}, "
+                f"but the sensor {self.sensor.name} has {_shape_text(self.sensor.frame_shape)}; "
                 "give the device's own sensor description (--sensor) or fix its IDENT"
             )
         self._received_any = True
@@ -464,6 +470,13 @@ class StreamReader:
             sensor = SensorSpec.from_toml_string(str(self.identity.get("sensor_toml", "")))
         except SensorSpecError as error:
             raise StreamError(f"{self.url}: the device's sensor description: {error}") from None
+        said = self.identity.get("components", 1)
+        if said != sensor.components:  # IDENT's count against its own description
+            raise StreamError(
+                f"{self.url}: the device says {said!r} components per taxel, but its sensor "
+                f"description {sensor.name!r} has {sensor.components}; fix its IDENT or give "
+                "the sensor (--sensor)"
+            )
         self._ready.clear()  # frames before START belong to nobody's run
         self._last_seq = None
         self._index = -1

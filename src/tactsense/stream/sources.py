@@ -15,9 +15,16 @@ from __future__ import annotations
 import re
 
 from tactsense.sensor import SensorSpec
-from tactsense.stream.framed import FormatError, FormatReader, WireFormat, parse_options
+from tactsense.stream.framed import (
+    FormatError,
+    FormatReader,
+    WireFormat,
+    parse_components,
+    parse_options,
+)
 from tactsense.stream.justfloat import JustFloat
 from tactsense.stream.marker import MarkerFrames
+from tactsense.stream.protocol import MAX_COMPONENTS
 from tactsense.stream.reader import StreamReader
 from tactsense.stream.textlines import TextLines
 
@@ -98,3 +105,52 @@ def open_source(
     if wire_format is None:
         return StreamReader(url, sensor=sensor, timeout_s=timeout_s, start=start)
     return FormatReader(url, wire_format, sensor=sensor, timeout_s=timeout_s, start=start)
+
+
+def with_components(source: str, components: int | None) -> str:
+    """The source with its format's ``components=N`` set (``--components N`` of the live
+    commands): unchanged for None.
+
+    Raises :class:`FormatError` for N outside 1..4, for a source of the tactsense
+    protocol (its frames say their components: ``docs/protocol.md``, version 2), and for
+    an N that disagrees with a ``components=`` already in the source.
+    """
+    if components is None:
+        return source
+    wire_format, url = split_source(source)
+    if wire_format is None:
+        raise FormatError(
+            f"--components applies to text, marker and justfloat sources (e.g. "
+            f"text:/dev/ttyACM0); {source} speaks the tactsense protocol, whose frames say "
+            "their components (docs/protocol.md, version 2)"
+        )
+    return f"{_set_components(wire_format, components).spec()}:{url}"
+
+
+def format_with_components(spec: str | None, components: int | None) -> str | None:
+    """A format's name and options (``emulate --format``) with ``components=N`` set."""
+    if components is None:
+        return spec
+    if spec is None:
+        raise FormatError(
+            "--components applies to another wire format (--format text, marker or "
+            "justfloat); the tactsense protocol's frames say their components"
+        )
+    return _set_components(parse_format(spec), components).spec()
+
+
+def _set_components(wire_format: WireFormat, components: int) -> WireFormat:
+    try:
+        count = parse_components(wire_format.name, components)
+    except FormatError:
+        raise FormatError(
+            f"--components {components}: expected a whole number of values per taxel from "
+            f"1 to {MAX_COMPONENTS} (3 for a three-axis taxel)"
+        ) from None
+    if wire_format.components not in (None, count):
+        raise FormatError(
+            f"--components {count} disagrees with the source's components="
+            f"{wire_format.components}; give one of them"
+        )
+    wire_format.components = count
+    return wire_format

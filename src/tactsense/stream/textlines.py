@@ -1,8 +1,9 @@
 """Text lines: one frame per line of numbers, as hand-built arrays print them
 (``Serial.println`` on an Arduino; ``docs/devices.md``).
 
-A line is rows x cols numbers, row-major, separated by commas, spaces, tabs or
-semicolons (any mix), optionally after a fixed prefix, ended by ``\\n`` (a ``\\r``
+A line is rows x cols numbers (rows x cols x components for taxels of several
+components, a taxel's components one after the other), row-major, separated by commas,
+spaces, tabs or semicolons (any mix), optionally after a fixed prefix, ended by ``\\n`` (a ``\\r``
 before it is dropped). Blank lines are skipped; the first ``header`` lines are skipped
 too. The lines are split by pyserial's :class:`serial.threaded.Packetizer`.
 """
@@ -14,7 +15,13 @@ from typing import ClassVar
 import numpy as np
 from serial.threaded import Packetizer
 
-from tactsense.stream.framed import SHAPE_EVIDENCE, FormatError, WireFormat
+from tactsense.stream.framed import (
+    SHAPE_EVIDENCE,
+    FormatError,
+    WireFormat,
+    parse_components,
+    values_text,
+)
 from tactsense.stream.reader import LossCounters, StreamError
 
 SEPARATORS = {"comma": ",", "space": " ", "tab": "\t", "semicolon": ";"}
@@ -37,6 +44,8 @@ class TextLines(WireFormat):
         Every frame line starts with this (stripped; a line without it is garbage).
     header : int
         Lines the device prints first that are not frames (a header row of names).
+    components : int
+        Values per taxel (1..4; default the sensor's: 3 for a three-axis taxel).
     """
 
     name = "text"
@@ -44,10 +53,17 @@ class TextLines(WireFormat):
         "sep": "comma|space|tab|semicolon",
         "prefix": "text",
         "header": "lines",
+        "components": "1..4 values per taxel",
     }
     noise_excluded = bytes(range(0x80))  # line noise: bytes no ASCII parser takes
 
-    def __init__(self, sep: str = "comma", prefix: str = "", header: str | int = 0):
+    def __init__(
+        self,
+        sep: str = "comma",
+        prefix: str = "",
+        header: str | int = 0,
+        components: str | int | None = None,
+    ):
         if sep not in SEPARATORS:
             raise FormatError(
                 f"format text: sep={sep!r} is not a separator; expected one of "
@@ -62,6 +78,7 @@ class TextLines(WireFormat):
         if not prefix.isascii() or "\n" in prefix or "\r" in prefix:
             raise FormatError(f"format text: prefix={prefix!r} must be ASCII on one line")
         self.sep, self.prefix, self.header = sep, prefix, header
+        self.components = parse_components("text", components)
 
     def spec(self) -> str:
         parts = ["text"]
@@ -71,7 +88,7 @@ class TextLines(WireFormat):
             parts.append(f"prefix={self.prefix}")
         if self.header:
             parts.append(f"header={self.header}")
-        return ",".join(parts)
+        return ",".join(parts) + self._components_spec()
 
     def decoder(self, shape, stats: LossCounters, url: str) -> TextDecoder:
         return TextDecoder(shape, stats, url, self.prefix.encode(), self.header)
@@ -101,8 +118,8 @@ class TextDecoder(Packetizer):
 
     def __init__(self, shape, stats: LossCounters, url: str, prefix: bytes, header: int):
         super().__init__()
-        self.shape = tuple(shape)
-        self.size = self.shape[0] * self.shape[1]
+        self.shape = tuple(shape)  # (rows, cols) or (rows, cols, components)
+        self.size = int(np.prod(self.shape))
         self.stats = stats
         self.url = url
         self.prefix = prefix
@@ -215,9 +232,7 @@ class TextDecoder(Packetizer):
         times = times + 1 if size == n else 1
         self._wrong = (n, times)
         if times >= SHAPE_EVIDENCE:
-            rows, cols = self.shape
             raise StreamError(
                 f"{self.url}: the device prints lines of {n} values, but the sensor has "
-                f"{rows}x{cols} = {self.size} tactels; give the sensor of the device "
-                "(--sensor)"
+                f"{values_text(self.shape)}; give the sensor of the device (--sensor)"
             )
