@@ -1,0 +1,62 @@
+"""How a frame's numbers are named and laid out in other tools' files, whatever the number
+of components a taxel reports (``spec.components``: 1 for a scalar taxel, 3 for a
+three-axis one, :mod:`tactsense.sensor.triaxial`).
+
+One rule for every flat form (CSV columns, LSL channels, a flat LeRobot feature, the
+interleaved ``TactileState`` channel): taxels in row-major order, a taxel's components
+together in the order of ``spec.component_names`` (x, y, z: the pad's axes, x along the
+rows, y along the columns, z the outward normal), the component fastest. That is the
+order of ``frames.reshape(n, -1)`` for frames of shape ``(n, *spec.frame_shape)``. A
+value is named ``r<row>c<col>`` for a scalar taxel and ``r<row>c<col><component>``
+(``r0c1x``, ``r0c1y``, ``r0c1z``) for a taxel of several components.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def value_count(spec) -> int:
+    """Numbers in one frame: taxels times components [-]."""
+    return int(spec.n_taxels * spec.components)
+
+
+def value_names(spec) -> list[str]:
+    """The name of each number of a frame, in the flat order (component fastest)."""
+    rows, cols = spec.shape
+    parts = spec.component_names if spec.components > 1 else ("",)
+    return [f"r{r}c{c}{p}" for r in range(rows) for c in range(cols) for p in parts]
+
+
+def describe_values(spec) -> str:
+    """``rows x cols = n taxels`` (with ``x 3 components = m values`` when several), for
+    messages that say what a file should hold."""
+    rows, cols = spec.shape
+    text = f"{rows} x {cols} = {spec.n_taxels} taxels"
+    if spec.components > 1:
+        text += f" x {spec.components} components ({', '.join(spec.component_names)}) = "
+        text += f"{value_count(spec)} values"
+    return text
+
+
+def component_channel_names(spec) -> list[str]:
+    """The ``TactileState`` channel names of a sensor of several components: one channel
+    per component, ``<sensor>/<component>`` (``mag4x4/x``, ``mag4x4/y``, ``mag4x4/z``);
+    for a scalar sensor its own name alone."""
+    if spec.components == 1:
+        return [spec.name]
+    return [f"{spec.name}/{p}" for p in spec.component_names]
+
+
+def split_components(frames, spec) -> np.ndarray:
+    """Frames ``(n, *frame_shape)`` as ``(n, components, rows*cols)``: each component's
+    values in row-major taxel order (one ``TactileState`` channel per component)."""
+    values = np.asarray(frames).reshape(-1, spec.n_taxels, spec.components)
+    return np.ascontiguousarray(np.swapaxes(values, 1, 2))
+
+
+def join_components(per_component, spec) -> np.ndarray:
+    """The inverse of :func:`split_components`: ``(n, components, rows*cols)`` to
+    ``(n, *frame_shape)``."""
+    values = np.asarray(per_component).reshape(-1, spec.components, spec.n_taxels)
+    return np.swapaxes(values, 1, 2).reshape(-1, *spec.frame_shape)
