@@ -60,3 +60,45 @@ def join_components(per_component, spec) -> np.ndarray:
     ``(n, *frame_shape)``."""
     values = np.asarray(per_component).reshape(-1, spec.components, spec.n_taxels)
     return np.swapaxes(values, 1, 2).reshape(-1, *spec.frame_shape)
+
+
+def pick_component_values(channels: list, spec, where: str, get) -> list:
+    """One frame's values (flat order, component fastest) from a ``TactileState``'s
+    channels (``get(channel, "name" | "values")``).
+
+    Either a channel per component, ``<sensor>/<component>`` (as tactsense writes), each
+    of rows x cols values; or one channel (the only one, or the one named as the sensor)
+    of rows x cols x components values, interleaved (component fastest), as a driver that
+    sends a taxel's vector together may publish.
+    """
+    from tactsense.interop._build import ImportError_
+
+    by_name = {get(ch, "name"): ch for ch in channels}
+    wanted = component_channel_names(spec)
+    if all(name in by_name for name in wanted):
+        per = [list(get(by_name[name], "values")) for name in wanted]
+        for name, values in zip(wanted, per, strict=True):
+            if len(values) != spec.n_taxels:
+                rows, cols = spec.shape
+                raise ImportError_(
+                    f"{where}: channel {name!r} has {len(values)} values; {spec.name!r} has "
+                    f"{rows} x {cols} = {spec.n_taxels} taxels"
+                )
+        return join_components(np.asarray(per, dtype=np.float64), spec).ravel().tolist()
+    single = [ch for ch in channels if get(ch, "name") == spec.name]
+    if not single and len(channels) == 1:
+        single = list(channels)
+    if len(single) == 1:
+        values = list(get(single[0], "values"))
+        if len(values) != value_count(spec):
+            raise ImportError_(
+                f"{where}: channel {get(single[0], 'name')!r} has {len(values)} values; "
+                f"{spec.name!r} has {describe_values(spec)} (interleaved, component fastest)"
+            )
+        return values
+    names = ", ".join(repr(get(ch, "name")) for ch in channels)
+    raise ImportError_(
+        f"{where}: a TactileState holds the channels {names}; expected "
+        f"{', '.join(map(repr, wanted))} (one per component) or one channel "
+        f"{spec.name!r} of {value_count(spec)} values (pass --sensor with the sensor's name)"
+    )

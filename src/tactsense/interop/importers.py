@@ -53,6 +53,10 @@ from tactsense.sensor.common import SpecBase
 
 def _pick_values(sensors: list, sensor: SpecBase, where: str) -> list:
     """The values of the ``ChannelFloat32`` for this sensor in one ``TactileState``."""
+    if sensor.components > 1:  # ---- several components a taxel (r8-triinterop) ----
+        from tactsense.interop.components import pick_component_values
+
+        return pick_component_values(sensors, sensor, where, _get)
     if len(sensors) == 1:
         entry = sensors[0]
     else:
@@ -85,6 +89,7 @@ def _ros_sensor(sensor, first_names: list[str], source: Path) -> SpecBase:
     from tactsense.sensor import PRESETS
 
     for name in first_names:
+        name = name.split("/")[0]  # a channel per component: <sensor>/<component>
         if name.removeprefix("fearing1990_") in PRESETS:
             return load_sensor(name)
     raise ImportError_(
