@@ -102,3 +102,10 @@ def pick_component_values(channels: list, spec, where: str, get) -> list:
         f"{', '.join(map(repr, wanted))} (one per component) or one channel "
         f"{spec.name!r} of {value_count(spec)} values (pass --sensor with the sensor's name)"
     )
+
+
+def nested_lists(pa, flat, components: int, taxels: int):
+    """``flat`` float32 values (component fastest) as ``taxels`` lists of ``components``
+    (``list<float32>``): the innermost level of datasets' Array3D storage."""
+    offsets = pa.array(np.arange(0, taxels * components + 1, components, dtype=np.int32))
+    return pa.ListArray.from_arrays(offsets, flat)
