@@ -11,7 +11,10 @@ Outlets (``tactsense live SOURCE --lsl``):
   position [mm] and angle [deg]. ``acquisition/manufacturer``, ``model`` and
   ``serial_number`` name the device; the stream's metadata also holds the whole
   sensor description (TOML) under ``tactsense/sensor_toml``, so an inlet knows the
-  finger without asking.
+  finger without asking. A sensor whose taxels report several components (a three-axis
+  taxel) has one channel per taxel and component, the component fastest (channel
+  ``(r * cols + c) * 3 + k``), labelled ``r3c5x``, ``r3c5y``, ``r3c5z``, each with its
+  ``component`` (x, y, z: the pad's axes) beside the taxel's location, row and column.
 * **contacts**: name ``<sensor>-contacts``, type ``TactileContact``, double channels
   ``axial_mm, angle_deg, force_n, skew, peak_deflection, flags, row, col, latency_ms``
   (NaN without a contact), one sample per frame; each channel has a ``label``, a
@@ -136,10 +139,11 @@ def frames_info(sensor: SensorSpec, identity: dict, rate_hz: float):
     """The ``StreamInfo`` of the frames outlet, with per-channel metadata."""
     pylsl = _pylsl()
     rows, cols = sensor.shape
+    parts = sensor.component_names if sensor.components > 1 else ("",)
     info = pylsl.StreamInfo(
         f"{sensor.name}-frames",
         "Tactile",
-        rows * cols,
+        rows * cols * len(parts),  # a channel per taxel and component
         float(rate_hz),
         pylsl.cf_float32,
         source_id(identity, sensor, "frames"),
@@ -151,20 +155,29 @@ def frames_info(sensor: SensorSpec, identity: dict, rate_hz: float):
     fields = kind_of(sensor).lsl_taxel_fields(sensor)  # a finger: axial_mm, angle_deg
     for r in range(rows):
         for c in range(cols):
-            channel = channels.append_child("channel")
-            channel.append_child_value("label", f"r{r}c{c}")
-            channel.append_child_value("unit", "counts")
-            channel.append_child_value("type", "Tactile")
-            location = channel.append_child("location")
-            for axis, value in zip("XYZ", positions[r * cols + c], strict=True):
-                location.append_child_value(axis, f"{value:.6g}")
-            channel.append_child_value("row", str(r))
-            channel.append_child_value("col", str(c))
-            for field, values in fields.items():
-                channel.append_child_value(field, f"{values[r * cols + c]:.6g}")
+            for part in parts:
+                channel = channels.append_child("channel")
+                channel.append_child_value("label", f"r{r}c{c}{part}")
+                channel.append_child_value("unit", "counts")
+                channel.append_child_value("type", "Tactile")
+                location = channel.append_child("location")
+                for axis, value in zip("XYZ", positions[r * cols + c], strict=True):
+                    location.append_child_value(axis, f"{value:.6g}")
+                channel.append_child_value("row", str(r))
+                channel.append_child_value("col", str(c))
+                if part:
+                    channel.append_child_value("component", part)
+                for field, values in fields.items():
+                    channel.append_child_value(field, f"{values[r * cols + c]:.6g}")
     meta = desc.append_child("tactsense")
     meta.append_child_value("sensor_toml", sensor.to_toml_string())
-    meta.append_child_value("layout", "row-major: channel = row * cols + col")
+    if sensor.components > 1:
+        meta.append_child_value(
+            "layout", f"row-major, component fastest: channel = (row * cols + col) * "
+            f"{sensor.components} + component ({', '.join(sensor.component_names)})",
+        )  # fmt: skip
+    else:
+        meta.append_child_value("layout", "row-major: channel = row * cols + col")
     return info
 
 
@@ -279,10 +292,12 @@ class LslReader:
                 sensor = SensorSpec.from_toml_string(toml)
             except SensorSpecError as error:
                 raise StreamError(f"{self.url}: its sensor description: {error}") from None
-        if info.channel_count() != sensor.shape[0] * sensor.shape[1]:
+        from tactsense.interop.components import describe_values, value_count
+
+        if info.channel_count() != value_count(sensor):  # a channel per taxel and component
             raise StreamError(
                 f"{self.url} has {info.channel_count()} channels; the sensor has "
-                f"{sensor.shape[0]} x {sensor.shape[1]} tactels"
+                f"{describe_values(sensor)}"
             )
         self.sensor = sensor
         rate = info.nominal_srate()
@@ -296,7 +311,7 @@ class LslReader:
     def read_batch(self, max_frames: int, wait_s: float = 0.1) -> list[StreamFrame]:
         """Up to ``max_frames`` frames that have arrived, waiting up to ``wait_s`` for one."""
         samples, stamps = self.inlet.pull_chunk(timeout=wait_s, max_samples=max_frames)
-        shape = self.sensor.shape
+        shape = self.sensor.frame_shape
         batch = []
         for sample, stamp in zip(samples, stamps, strict=True):
             if self._first_stamp is None:

@@ -105,6 +105,13 @@ def export_rerun(
     frames_written = contacts = 0
     with RecordingReader(recording) as reader:
         sensor = reader.sensor
+        if sensor.components > 1:  # ---- several components a taxel (r8-triinterop) ----
+            from tactsense.interop.rerun_components import export_components_rerun
+
+            return export_components_rerun(
+                rr, reader, recording, out, baseline_frames=baseline_frames,
+                value_range=deflection_range, recording_id=recording_id, progress=progress,
+            )  # fmt: skip
         if kind_of(sensor).multi_contact:  # every contact, tracked
             return _export_array(
                 rr, reader, recording, out, calibration=calibration,
