@@ -1,0 +1,394 @@
+"""Three-axis frames in other tools' files (issue 35 item 3), each read back with the other
+tool's own reader: CSV (pyarrow's CSV reader), MCAP (mcap's reader and the mcap_ros2
+decoder; rosbags' CDR from the upstream ``.msg`` texts), LeRobot v3 (pyarrow and JSON
+against LeRobot's layout), LSL (pylsl's inlet), Rerun (rerun.chunk.RrdReader), ROS 2
+live (rosbags' CDR of the publisher's bytes). The twin's mag4x4 press: frames
+``(T, 4, 4, 3)`` in counts."""
+
+from __future__ import annotations
+
+import json
+import time
+import uuid
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+import tactsense as ts
+from tactsense.cli import app
+
+runner = CliRunner()
+
+
+def _expected_names(rows: int, cols: int) -> list[str]:
+    """Written here from the documented rule, not from tactsense's helper: row-major
+    taxels, then x, y, z."""
+    out = []
+    for r in range(rows):
+        for c in range(cols):
+            out += [f"r{r}c{c}x", f"r{r}c{c}y", f"r{r}c{c}z"]
+    return out
+
+
+@pytest.fixture(scope="module")
+def pressed(tmp_path_factory):
+    """A simulated mag4x4 press: its path and recording."""
+    where = tmp_path_factory.mktemp("triinterop")
+    path = where / "press.h5"
+    result = runner.invoke(
+        app, ["simulate", "--sensor", "mag4x4", "--scenario", "press", "-o", str(path)]
+    )
+    assert result.exit_code == 0, result.output
+    rec = ts.read_recording(path)
+    assert rec.frames.shape[1:] == (4, 4, 3)
+    # the press moves every component somewhere (else the checks below prove little)
+    change = rec.frames.astype(float) - rec.frames[0].astype(float)
+    assert all(np.abs(change[..., k]).max() > 5 for k in range(3))
+    return path, rec
+
+
+def _import(source, out, *extra):
+    result = runner.invoke(app, ["import", str(source), "-o", str(out), *extra])
+    assert result.exit_code == 0, result.output
+    return ts.read_recording(out)
+
+
+# ---- CSV --------------------------------------------------------------------------------
+
+
+def test_csv_has_a_column_per_taxel_and_component(tmp_path, pressed):
+    import pyarrow.csv as pacsv
+
+    path, rec = pressed
+    out = tmp_path / "press.csv"
+    result = runner.invoke(app, ["export", str(path), "-o", str(out), "--quiet"])
+    assert result.exit_code == 0, result.output
+    table = pacsv.read_csv(out)
+    assert table.column_names == ["time", *_expected_names(4, 4)]
+    for name, (r, c, k) in (("r0c0x", (0, 0, 0)), ("r2c3y", (2, 3, 1)), ("r3c1z", (3, 1, 2))):
+        np.testing.assert_array_equal(table.column(name).to_numpy(), rec.frames[:, r, c, k])
+    back = _import(out, tmp_path / "back.h5", "--sensor", "mag4x4")
+    np.testing.assert_array_equal(back.frames, rec.frames)
+    assert back.frames.dtype == np.uint16
+
+
+def test_csv_columns_of_another_order_are_refused(tmp_path, pressed):
+    """Two components swapped in the header: the same number of columns, a wrong frame if
+    taken in order; refused with the column named (exit 2, one line)."""
+    path, _ = pressed
+    out = tmp_path / "press.csv"
+    assert runner.invoke(app, ["export", str(path), "-o", str(out), "--quiet"]).exit_code == 0
+    lines = out.read_text().splitlines()
+    lines[0] = lines[0].replace("r0c0x,r0c0y", "r0c0y,r0c0x")
+    out.write_text("\n".join(lines) + "\n")
+    result = runner.invoke(app, ["import", str(out), "--sensor", "mag4x4", "-o",
+                                 str(tmp_path / "x.h5")])  # fmt: skip
+    assert result.exit_code == 2
+    assert "value column 1 is 'r0c0y'; sensor 'mag4x4' names it 'r0c0x'" in result.output
+    assert not (tmp_path / "x.h5").exists()
+
+
+def test_a_scalar_csv_of_the_same_grid_is_refused_with_the_counts(tmp_path):
+    out = tmp_path / "scalar.csv"
+    names = [f"r{r}c{c}" for r in range(4) for c in range(4)]
+    rows = [",".join(["time", *names])] + [
+        ",".join([str(k * 0.01)] + ["32768"] * 16) for k in range(3)
+    ]
+    out.write_text("\n".join(rows) + "\n")
+    result = runner.invoke(app, ["import", str(out), "--sensor", "mag4x4", "-o",
+                                 str(tmp_path / "x.h5")])  # fmt: skip
+    assert result.exit_code == 2
+    assert "16 value columns" in result.output and "= 48 values" in result.output
+
+
+# ---- MCAP: TactileState, a channel per component ------------------------------------------
+
+
+def _mcap_states(path):
+    """(schema text, decoded messages, raw CDR) of the TactileState topic, with mcap's
+    reader and the mcap_ros2 decoder (the definition the file carries)."""
+    from mcap.reader import make_reader
+    from mcap_ros2.decoder import DecoderFactory
+
+    with open(path, "rb") as stream:
+        reader = make_reader(stream, decoder_factories=[DecoderFactory()])
+        decoded = [
+            (schema, message, ros)
+            for schema, _, message, ros in reader.iter_decoded_messages(topics=["/tactile_states"])
+        ]
+    return decoded[0][0].data.decode(), [d[2] for d in decoded], [d[1].data for d in decoded]
+
+
+def test_mcap_tactile_state_has_a_channel_per_component(tmp_path, pressed):
+    from .ros2_subscriber import TACTILE_MSGS, typestore
+
+    path, rec = pressed
+    out = tmp_path / "press.mcap"
+    result = runner.invoke(app, ["export", str(path), "-o", str(out), "--quiet"])
+    assert result.exit_code == 0, result.output
+    assert "no contacts" in result.output
+    schema, states, raws = _mcap_states(out)
+    assert schema.startswith("std_msgs/Header header\nsensor_msgs/ChannelFloat32[] sensors")
+    assert len(states) == len(rec)
+    store = typestore()  # rosbags, from the upstream .msg text
+    assert "sensor_msgs/ChannelFloat32[] sensors" in TACTILE_MSGS["tactile_msgs/msg/TactileState"]
+    for k in (0, len(rec) // 2, len(rec) - 1):
+        names = [ch.name for ch in states[k].sensors]
+        assert names == ["mag4x4/x", "mag4x4/y", "mag4x4/z"]
+        for c, channel in enumerate(states[k].sensors):
+            want = rec.frames[k, :, :, c].ravel().astype(np.float32)  # row-major taxels
+            np.testing.assert_array_equal(np.asarray(channel.values, np.float32), want)
+        again = store.deserialize_cdr(raws[k], "tactile_msgs/msg/TactileState")
+        assert [ch.name for ch in again.sensors] == names
+        assert bytes(store.serialize_cdr(again, "tactile_msgs/msg/TactileState")) == raws[k]
+    back = _import(out, tmp_path / "back.h5", "--sensor", "mag4x4")
+    np.testing.assert_array_equal(back.frames, rec.frames)
+    # and without --sensor: the channels' sensor name is the preset's
+    again = _import(out, tmp_path / "again.h5")
+    assert again.sensor == rec.sensor
+
+
+def test_mcap_fast_writer_makes_the_encoder_bytes(tmp_path, pressed):
+    """The template's bytes (fast) against mcap_ros2's encoder of every message (slow)."""
+    from tactsense.interop.mcap import export_mcap
+
+    path, _ = pressed
+    export_mcap(path, tmp_path / "fast.mcap", fast=True)
+    export_mcap(path, tmp_path / "slow.mcap", fast=False)
+    assert _mcap_states(tmp_path / "fast.mcap")[2] == _mcap_states(tmp_path / "slow.mcap")[2]
+
+
+def _write_single_channel(path, frames, values_per_frame=None):
+    """A driver's TactileState: one channel 'mag4x4' of the taxels' vectors interleaved."""
+    from mcap_ros2.writer import Writer
+
+    from tactsense.interop.ros import TACTILE_STATE, TACTILE_STATE_MSGDEF
+
+    with open(path, "wb") as stream:
+        writer = Writer(stream)
+        schema = writer.register_msgdef(TACTILE_STATE, TACTILE_STATE_MSGDEF)
+        for k, frame in enumerate(frames):
+            values = frame.astype(np.float32).ravel().tolist()[:values_per_frame]
+            ns = 1_000_000_000 + k * 10_000_000
+            message = {
+                "header": {"stamp": {"sec": ns // 10**9, "nanosec": ns % 10**9},
+                           "frame_id": "pad"},
+                "sensors": [{"name": "mag4x4", "values": values}],
+            }  # fmt: skip
+            writer.write_message("/skin", schema, message, log_time=ns, publish_time=ns)
+        writer.finish()
+
+
+def test_mcap_of_one_interleaved_channel_is_read(tmp_path, pressed):
+    _, rec = pressed
+    path = tmp_path / "driver.mcap"
+    _write_single_channel(path, rec.frames[:20])
+    back = _import(path, tmp_path / "back.h5", "--sensor", "mag4x4")
+    np.testing.assert_array_equal(back.frames, rec.frames[:20])
+
+
+def test_mcap_channel_of_a_wrong_length_is_a_one_line_error(tmp_path, pressed):
+    _, rec = pressed
+    path = tmp_path / "short.mcap"
+    _write_single_channel(path, rec.frames[:3], values_per_frame=16)
+    result = runner.invoke(app, ["import", str(path), "--sensor", "mag4x4", "-o",
+                                 str(tmp_path / "x.h5")])  # fmt: skip
+    assert result.exit_code == 2
+    assert "channel 'mag4x4' has 16 values" in result.output
+    assert "x 3 components (x, y, z) = 48 values" in result.output
+
+
+# ---- LeRobot ----------------------------------------------------------------------------
+
+
+def test_lerobot_feature_is_rows_cols_3(tmp_path, pressed):
+    import pyarrow.parquet as pq
+
+    path, rec = pressed
+    out = tmp_path / "dataset"
+    result = runner.invoke(app, ["export", str(path), "--format", "lerobot", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    info = json.loads((out / "meta/info.json").read_text())
+    feature = info["features"]["observation.tactile"]
+    assert feature == {"dtype": "float32", "shape": [4, 4, 3],
+                       "names": ["row", "col", "component"]}  # fmt: skip
+    assert "observation.state" not in info["features"]  # no estimator: no made-up state
+    table = pq.read_table(out / "data/chunk-000/file-000.parquet")
+    hf = json.loads(table.schema.metadata[b"huggingface"])["info"]["features"]
+    assert hf["observation.tactile"] == {"shape": [4, 4, 3], "dtype": "float32",
+                                         "_type": "Array3D"}  # fmt: skip
+    assert set(table.column_names) == set(info["features"])
+    tactile = np.asarray(table.column("observation.tactile").to_pylist())
+    np.testing.assert_array_equal(tactile, rec.frames.astype(np.float32))
+    # LeRobot's statistics take every axis but the last as samples: per component
+    stats = json.loads((out / "meta/stats.json").read_text())["observation.tactile"]
+    flat = rec.frames.reshape(-1, 3).astype(np.float64)
+    np.testing.assert_allclose(stats["mean"], flat.mean(0), rtol=1e-12)
+    np.testing.assert_allclose(stats["max"], flat.max(0))
+    own = json.loads((out / "meta/tactsense.json").read_text())
+    assert own["components"] == ["x", "y", "z"]
+    back = _import(out, tmp_path / "back.h5")
+    np.testing.assert_array_equal(back.frames, rec.frames)
+    assert back.sensor == rec.sensor
+
+
+def test_lerobot_dataset_of_the_wrong_shape_is_refused(tmp_path, pressed):
+    """A three-axis dataset imported as the 16 x 16 pad: both shapes named."""
+    path, _ = pressed
+    out = tmp_path / "dataset"
+    assert runner.invoke(app, ["export", str(path), "--format", "lerobot", "-o",
+                               str(out)]).exit_code == 0  # fmt: skip
+    result = runner.invoke(app, ["import", str(out), "--sensor", "pad16", "-o",
+                                 str(tmp_path / "x.h5")])  # fmt: skip
+    assert result.exit_code == 2
+    assert "[4, 4, 3]" in result.output and "[16, 16]" in result.output
+
+
+# ---- LSL --------------------------------------------------------------------------------
+
+
+def _stream_frames(rec):
+    from tactsense.stream.reader import StreamFrame
+
+    for k, counts in enumerate(rec.frames):
+        yield StreamFrame(k, k, float(rec.time_s[k]), time.time(), time.perf_counter(), counts)
+
+
+def test_lsl_has_a_channel_per_taxel_and_component(pressed):
+    import dataclasses
+
+    from tactsense.interop.lsl import LslOutlets, _pylsl
+
+    pylsl = _pylsl()
+    _, rec = pressed
+    sensor = dataclasses.replace(rec.sensor, name=f"lsltri{uuid.uuid4().hex[:8]}")
+    serial = f"tri-{uuid.uuid4().hex[:6]}"
+    outlets = LslOutlets(sensor, {"serial": serial}, 100.0)
+    try:
+        (found,) = pylsl.resolve_byprop("source_id", f"tactsense:{serial}:frames", 1, 5)
+        inlet = pylsl.StreamInlet(found)
+        info = inlet.info(timeout=5)
+        assert info.channel_count() == 48
+        channel = info.desc().child("channels").child("channel")
+        labels, components = [], []
+        while not channel.empty():
+            labels.append(channel.child_value("label"))
+            components.append(channel.child_value("component"))
+            channel = channel.next_sibling()
+        assert labels == _expected_names(4, 4)
+        assert components == ["x", "y", "z"] * 16
+        inlet.open_stream(timeout=5)
+        time.sleep(0.3)
+        for frame in _stream_frames(rec):
+            outlets.push(frame, None)
+        got, deadline = [], time.time() + 10
+        while len(got) < len(rec) and time.time() < deadline:
+            samples, _ = inlet.pull_chunk(timeout=0.2)
+            got.extend(samples)
+        assert len(got) == len(rec)
+        np.testing.assert_array_equal(np.asarray(got).reshape(-1, 4, 4, 3), rec.frames)
+    finally:
+        outlets.close()
+
+
+# ---- Rerun ------------------------------------------------------------------------------
+
+
+def _rerun_columns(path):
+    from rerun.chunk import RrdReader
+
+    found = {}
+    for chunk in RrdReader(str(path)).stream().to_chunks():
+        batch = chunk.to_record_batch()
+        if "time" not in batch.schema.names:
+            continue
+        times = [t.total_seconds() for t in batch.column("time").to_pylist()]
+        for name in batch.schema.names:
+            if ":" in name:
+                rows = zip(times, batch.column(name).to_pylist(), strict=True)
+                found.setdefault((str(chunk.entity_path), name), []).extend(rows)
+    return {key: sorted(rows, key=lambda row: row[0]) for key, rows in found.items()}
+
+
+def test_rerun_tensor_map_and_arrows(tmp_path, pressed):
+    path, rec = pressed
+    out = tmp_path / "press.rrd"
+    result = runner.invoke(app, ["export", str(path), "-o", str(out), "--quiet"])
+    assert result.exit_code == 0, result.output
+    columns = _rerun_columns(out)
+    baseline = np.median(rec.frames[:5].astype(float), axis=0)
+    change = rec.frames.astype(float) - baseline
+    tensors = columns[("/triaxial/values", "Tensor:data")]
+    assert len(tensors) == len(rec)
+    k = int(np.argmax(np.abs(change[..., :2]).sum(axis=(1, 2, 3))))  # the most sheared
+    tensor = tensors[k][1][0]
+    assert tensor["shape"] == [4, 4, 3]
+    np.testing.assert_array_equal(
+        np.asarray(tensor["buffer"], np.float32).reshape(4, 4, 3), change[k].astype(np.float32)
+    )
+    images = columns[("/triaxial/normal", "Image:buffer")]
+    assert len(images) == len(rec)
+    # the arrows on the map: from each pixel's centre, x (along rows) drawn down the
+    # image, y (along columns) across; the largest of the file one pixel long
+    largest = np.linalg.norm(change[..., :2], axis=-1).max()
+    origins = np.asarray(columns[("/triaxial/normal/shear", "Arrows2D:origins")][k][1])
+    vectors = np.asarray(columns[("/triaxial/normal/shear", "Arrows2D:vectors")][k][1])
+    np.testing.assert_allclose(origins[5], [1 + 0.5, 1 + 0.5])  # taxel (1, 1)
+    want = np.stack([change[k, ..., 1], change[k, ..., 0]], axis=-1).reshape(-1, 2) / largest
+    np.testing.assert_allclose(vectors, want, rtol=1e-6, atol=1e-6)
+    assert np.linalg.norm(vectors, axis=1).max() <= 1 + 1e-6
+    arrows = np.asarray(columns[("/triaxial/shear", "Arrows3D:vectors")][k][1])
+    assert np.allclose(arrows[:, 2], 0) and np.allclose(
+        arrows[:, :2] / np.linalg.norm(arrows[:, :2], axis=1, keepdims=True).clip(1e-12),
+        want[:, ::-1] / np.linalg.norm(want, axis=1, keepdims=True).clip(1e-12),
+        atol=1e-6,
+    )  # the same directions on the pad: (x, y)
+
+
+# ---- ROS 2 live -------------------------------------------------------------------------
+
+
+@pytest.fixture
+def loopback_dds(tmp_path, monkeypatch):
+    pytest.importorskip("cyclonedds")
+    import random
+
+    from tactsense.interop.ros2 import loopback_config
+
+    path = loopback_config(tmp_path)
+    monkeypatch.setenv("CYCLONEDDS_URI", f"file://{path}")
+    monkeypatch.setenv("ROS_DOMAIN_ID", str(random.randint(100, 230)))
+    monkeypatch.delenv("ROS_DISTRO", raising=False)
+
+
+def test_ros2_state_and_image_of_three_components(loopback_dds, pressed):
+    """The publisher's bytes (fast templates) are the serialiser's (slow), and rosbags,
+    from the upstream .msg text, reads a channel per component and a 32FC3 image."""
+    from tactsense.interop.ros2 import Ros2Publisher
+
+    from .ros2_subscriber import typestore
+
+    _, rec = pressed
+    store = typestore()
+    publisher = Ros2Publisher(rec.sensor, node_name="tri", frame_id="pad")
+    try:
+        for frame in list(_stream_frames(rec))[::17]:
+            made = publisher.encode(frame, None)
+            publisher._fast = False  # the serialiser's messages (the straightforward path)
+            reference = publisher.encode(frame, None)
+            publisher._fast = True
+            for topic in ("tactile_states", "tactile_image"):
+                cdr = bytes(reference[topic].serialize())
+                assert made[topic][: len(cdr)] == cdr, topic
+            state = store.deserialize_cdr(made["tactile_states"], "tactile_msgs/msg/TactileState")
+            assert [ch.name for ch in state.sensors] == ["mag4x4/x", "mag4x4/y", "mag4x4/z"]
+            for c, channel in enumerate(state.sensors):
+                want = frame.counts[..., c].ravel().astype(np.float32)
+                np.testing.assert_array_equal(channel.values, want)
+            image = store.deserialize_cdr(made["tactile_image"], "sensor_msgs/msg/Image")
+            assert (image.height, image.width, image.encoding, image.step) == (4, 4, "32FC3", 48)
+            pixels = np.frombuffer(image.data.tobytes(), "<f4").reshape(4, 4, 3)
+            np.testing.assert_array_equal(pixels, frame.counts.astype(np.float32))
+    finally:
+        publisher.close()
