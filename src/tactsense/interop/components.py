@@ -109,3 +109,17 @@ def nested_lists(pa, flat, components: int, taxels: int):
     (``list<float32>``): the innermost level of datasets' Array3D storage."""
     offsets = pa.array(np.arange(0, taxels * components + 1, components, dtype=np.int32))
     return pa.ListArray.from_arrays(offsets, flat)
+
+
+def contact_shear(contacts: list[dict]) -> np.ndarray | None:
+    """The tangential force the object applies [N], ``(k, 3)`` in the sensor's frame
+    (``shear_x_n``, ``shear_y_n``, 0), of a live estimate's contacts when they carry it (a
+    kind that senses shear); else None. A missing or non-finite value counts 0."""
+    if not contacts or not any("shear_x_n" in c for c in contacts):
+        return None
+    out = np.zeros((len(contacts), 3))
+    for k, contact in enumerate(contacts):
+        for axis, name in enumerate(("shear_x_n", "shear_y_n")):
+            value = contact.get(name)
+            out[k, axis] = float(value) if value is not None and np.isfinite(value) else 0.0
+    return out

@@ -426,6 +426,11 @@ class Ros2Publisher:
             force_n = np.array([estimate["force_n"]], dtype=float)
             names = [self.sensor.name]
         force = -force_n[:, None] * normals
+        if self._multi:  # ---- the tangential force of a shear-sensing kind (r8-triinterop)
+            from tactsense.interop.components import contact_shear
+
+            shear = contact_shear(contacts)
+            force = force if shear is None else force + shear
         numbers = np.zeros((len(names), 12), dtype="<f8")
         numbers[:, 0:3], numbers[:, 3:6], numbers[:, 6:9] = points, normals, force
         numbers[:, 9:12] = np.cross(points, force)
