@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 import time
 import uuid
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -292,6 +293,27 @@ def test_lsl_has_a_channel_per_taxel_and_component(pressed):
         outlets.close()
 
 
+def test_xdf_of_the_three_axis_outlet_imports(tmp_path, pressed):
+    """An XDF file (the format's own chunks, written by test_import's minimal writer) whose
+    stream header is the outlet's XML, read with pyxdf: the frames and the sensor back."""
+    from tactsense.interop.lsl import frames_info
+
+    from .test_import import write_xdf
+
+    _, rec = pressed
+    header = frames_info(rec.sensor, {"serial": "tri"}, 100.0).as_xml()
+    stamps = 7000.0 + rec.time_s
+    samples = rec.frames.reshape(len(rec), -1).astype(np.float32)
+    path = tmp_path / "lab.xdf"
+    write_xdf(path, [(3, header, samples, stamps)])
+    back = _import(path, tmp_path / "back.h5")
+    np.testing.assert_array_equal(back.frames, rec.frames)
+    assert back.sensor == rec.sensor
+    result = runner.invoke(app, ["import", str(path), "--sensor", "pad4", "-o",
+                                 str(tmp_path / "x.h5")])  # fmt: skip
+    assert result.exit_code == 2 and "48 channels" in result.output
+
+
 # ---- Rerun ------------------------------------------------------------------------------
 
 
@@ -392,3 +414,46 @@ def test_ros2_state_and_image_of_three_components(loopback_dds, pressed):
             np.testing.assert_array_equal(pixels, frame.counts.astype(np.float32))
     finally:
         publisher.close()
+
+
+def test_ros2_three_axis_frames_reach_another_process(loopback_dds, tmp_path, pressed):
+    """Published over DDS (loopback only) and received by the independent subscriber
+    (tests/interop/ros2_subscriber.py, types from the upstream .msg texts): every frame,
+    a channel per component, decoded with rosbags."""
+    import os
+    import pickle
+    import subprocess
+    import sys
+
+    from tactsense.interop.ros2 import Ros2Publisher
+
+    from .ros2_subscriber import typestore
+
+    _, rec = pressed
+    n = 30
+    namespace = "/test_triaxial/pad"
+    out = tmp_path / "received.pickle"
+    process = subprocess.Popen(
+        [sys.executable, str(Path(__file__).with_name("ros2_subscriber.py")), str(out),
+         "--domain", os.environ["ROS_DOMAIN_ID"], "--namespace", namespace, "--count", str(n),
+         "--seconds", "60"],
+        stdout=subprocess.PIPE, text=True, env=dict(os.environ),
+    )  # fmt: skip
+    assert process.stdout.readline().strip() == "ready"
+    publisher = Ros2Publisher(rec.sensor, namespace=namespace, frame_id="pad")
+    try:
+        assert publisher.wait_for_subscribers(30.0) >= 1
+        for frame in list(_stream_frames(rec))[:n]:
+            publisher.publish(frame, None)
+            time.sleep(0.005)
+    finally:
+        publisher.close()
+    assert process.wait(90) == 0
+    received = pickle.loads(out.read_bytes())["received"]["tactile_states"]
+    assert len(received) == n
+    store = typestore()
+    for k, (*_, raw) in enumerate(received):
+        state = store.deserialize_cdr(raw, "tactile_msgs/msg/TactileState")
+        assert [ch.name for ch in state.sensors] == ["mag4x4/x", "mag4x4/y", "mag4x4/z"]
+        got = np.stack([np.asarray(ch.values) for ch in state.sensors], axis=-1)
+        np.testing.assert_array_equal(got.reshape(4, 4, 3), rec.frames[k].astype(np.float32))
