@@ -200,6 +200,34 @@ def test_mcap_channel_of_a_wrong_length_is_a_one_line_error(tmp_path, pressed):
     assert "x 3 components (x, y, z) = 48 values" in result.output
 
 
+def test_rosbag2_bag_of_a_channel_per_component_imports(tmp_path, pressed):
+    """A bag written by rosbags (sqlite3, as ``ros2 bag record`` writes it), the type from
+    the upstream .msg text, an unrelated sensor beside: the three channels are found by
+    their names, whatever their order in the message."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+
+    from .ros2_subscriber import typestore
+
+    _, rec = pressed
+    store = typestore()
+    kind = "tactile_msgs/msg/TactileState"
+    State, Channel = store.types[kind], store.types["sensor_msgs/msg/ChannelFloat32"]
+    Header, Time = store.types["std_msgs/msg/Header"], store.types["builtin_interfaces/msg/Time"]
+    bag = tmp_path / "bag"
+    with Writer(bag, version=8, storage_plugin=StoragePlugin.SQLITE3) as writer:
+        conn = writer.add_connection("/skin/tactile_states", kind, typestore=store)
+        for k, counts in enumerate(rec.frames):
+            ns = 5 * 10**9 + round(rec.time_s[k] * 1e9)
+            channels = [Channel(f"mag4x4/{p}", counts[..., c].astype(np.float32).ravel())
+                        for c, p in enumerate("xyz")]  # fmt: skip
+            channels = [Channel("glove", np.zeros(5, np.float32)), *channels[::-1]]
+            message = State(Header(Time(ns // 10**9, ns % 10**9), "pad"), channels)
+            writer.write(conn, ns, store.serialize_cdr(message, kind))
+    back = _import(bag, tmp_path / "back.h5")  # the sensor from the channels' name
+    np.testing.assert_array_equal(back.frames, rec.frames)
+    assert back.sensor == rec.sensor
+
+
 # ---- LeRobot ----------------------------------------------------------------------------
 
 
