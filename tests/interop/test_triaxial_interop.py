@@ -485,3 +485,27 @@ def test_ros2_three_axis_frames_reach_another_process(loopback_dds, tmp_path, pr
         assert [ch.name for ch in state.sensors] == ["mag4x4/x", "mag4x4/y", "mag4x4/z"]
         got = np.stack([np.asarray(ch.values) for ch in state.sensors], axis=-1)
         np.testing.assert_array_equal(got.reshape(4, 4, 3), rec.frames[k].astype(np.float32))
+
+
+def test_lerobot_shear_slots_follow_the_contacts_rank():
+    """Each contact's tangential force goes to its rank's slot, 0 in an empty slot; a
+    table without the shear columns is refused (no made-up zeros); a kind without shear
+    gets no columns."""
+    from types import SimpleNamespace
+
+    from tactsense._validation import TactsenseInputError
+    from tactsense.interop.components import shear_state, shear_state_names
+
+    table = SimpleNamespace(
+        frame=np.array([10, 10, 12]), contact=np.array([0, 1, 0]),
+        shear_x_n=np.array([0.5, -0.25, np.nan]), shear_y_n=np.array([0.125, 1.0, 2.0]),
+    )  # fmt: skip
+    state = shear_state(table, 10, 3, 2)
+    names = shear_state_names(2)
+    assert names == ("contact0.shear_x_n", "contact0.shear_y_n",
+                     "contact1.shear_x_n", "contact1.shear_y_n")  # fmt: skip
+    want = np.array([[0.5, 0.125, -0.25, 1.0], [0, 0, 0, 0], [0.0, 2.0, 0, 0]], np.float32)
+    np.testing.assert_array_equal(state, want)
+    with pytest.raises(TactsenseInputError, match="no shear_x_n column"):
+        shear_state(SimpleNamespace(frame=table.frame, contact=table.contact), 10, 3, 2)
+    assert shear_state(SimpleNamespace(), 0, 3, 0).shape == (3, 0)

@@ -123,3 +123,36 @@ def contact_shear(contacts: list[dict]) -> np.ndarray | None:
             value = contact.get(name)
             out[k, axis] = float(value) if value is not None and np.isfinite(value) else 0.0
     return out
+
+
+SHEAR_FIELDS = ("shear_x_n", "shear_y_n")
+"""The tangential force of a contact [N] along the sensor's x and y, as a shear-sensing
+kind's contact table has it."""
+
+
+def shear_state_names(slots: int) -> tuple[str, ...]:
+    """LeRobot ``observation.state`` names of each slot's tangential force:
+    ``contact{k}.shear_x_n``, ``contact{k}.shear_y_n`` [N]."""
+    return tuple(f"contact{k}.{field}" for k in range(slots) for field in SHEAR_FIELDS)
+
+
+def shear_state(table, start: int, n: int, slots: int) -> np.ndarray:
+    """The shear part of ``observation.state`` for ``n`` frames, ``(n, 2 * slots)`` [N],
+    from a contact table whose ``frame`` counts from ``start`` (slot = the contact's rank;
+    0 in an empty slot, as the other slot fields)."""
+    from tactsense._validation import TactsenseInputError
+
+    out = np.zeros((n, 2 * slots), dtype=np.float32)
+    if slots == 0:  # a kind that senses no shear: no columns
+        return out
+    frame = np.asarray(table.frame, dtype=np.int64) - start
+    rank = np.asarray(table.contact, dtype=np.int64)
+    for j, field in enumerate(SHEAR_FIELDS):
+        values = getattr(table, field, None)
+        if values is None:
+            raise TactsenseInputError(
+                f"the contact estimate has no {field} column; a shear-sensing sensor's "
+                "LeRobot state needs the tangential force"
+            )
+        out[frame, rank * 2 + j] = np.nan_to_num(np.asarray(values, dtype=float))
+    return out
