@@ -42,7 +42,7 @@ def export_components_rerun(
     """
     from matplotlib import colormaps
 
-    from tactsense.interop.rerun import _checked_range, _open_stream
+    from tactsense.interop._rerun_common import _checked_range, _open_stream
 
     sensor = reader.sensor
     root = sensor.kind
