@@ -148,7 +148,7 @@ def shear_state(table, start: int, n: int, slots: int) -> np.ndarray:
     frame = np.asarray(table.frame, dtype=np.int64) - start
     rank = np.asarray(table.contact, dtype=np.int64)
     for j, field in enumerate(SHEAR_FIELDS):
-        values = getattr(table, field, None)
+        values = table_column(table, field)
         if values is None:
             raise TactsenseInputError(
                 f"the contact estimate has no {field} column; a shear-sensing sensor's "
@@ -156,3 +156,44 @@ def shear_state(table, start: int, n: int, slots: int) -> np.ndarray:
             )
         out[frame, rank * 2 + j] = np.nan_to_num(np.asarray(values, dtype=float))
     return out
+
+
+def table_column(table, name: str):
+    """A contact table's column ``name``: an attribute, or one of its ``extra`` columns
+    (where the three-axis estimator keeps ``shear_x_n``, ``shear_y_n``); None if absent."""
+    value = getattr(table, name, None)
+    if value is None:
+        value = (getattr(table, "extra", None) or {}).get(name)
+    return value
+
+
+def component_contacts(reader, *, baseline_frames: int, calibration, threshold,
+                       max_contacts: int = 8):  # fmt: skip
+    """The contacts of a recording whose taxels report several components, a piece at a
+    time, ``(start, n, time_s, table, events)`` as ``tactsense.batch.iter_contacts`` gives
+    a pad's: the three-axis estimator's (:mod:`tactsense.estimate.triaxial`, position,
+    normal and tangential force), its table's ``extra`` holding ``shear_x_n`` and
+    ``shear_y_n`` [N]. None when that estimator is not installed (the frames alone are
+    then exported). ``threshold``: the export's ``--threshold``, a fraction of the
+    converter's full scale, as ``locate`` takes it.
+    """
+    try:
+        from tactsense.estimate.triaxial.locate import iter_shear_contacts
+    except ImportError:
+        return None
+    counts = None if threshold is None else threshold * (2**reader.sensor.electronics.adc_bits - 1)
+    return iter_shear_contacts(
+        reader, baseline_frames=baseline_frames, calibration=calibration,
+        threshold_counts=counts, max_contacts=max_contacts,
+    )  # fmt: skip
+
+
+def shear_vectors(table, keep) -> np.ndarray | None:
+    """The contacts' tangential force ``(shear_x_n, shear_y_n, 0)`` [N] in the sensor's
+    frame, the rows ``keep`` of a contact table, when the estimate has it (a kind that
+    senses shear); else None. A non-finite value counts 0."""
+    sx, sy = table_column(table, "shear_x_n"), table_column(table, "shear_y_n")
+    if sx is None or sy is None:
+        return None
+    sx, sy = np.asarray(sx, dtype=float)[keep], np.asarray(sy, dtype=float)[keep]
+    return np.nan_to_num(np.column_stack([sx, sy, np.zeros_like(sx)]))

@@ -363,18 +363,32 @@ def export_lerobot(
             )
         elif kind_of(sensor).multi_contact:  # every contact, tracked, as locate's long table
             from tactsense.batch import iter_contacts
-            from tactsense.interop.components import shear_state, shear_state_names
+            from tactsense.interop.components import (
+                component_contacts,
+                shear_state,
+                shear_state_names,
+            )
 
             # r8-triinterop: each slot's tangential force [N] on a shear-sensing kind
             sheared = MAX_CONTACTS if kind_of(sensor).senses_shear else 0
             state_names = contact_state_names() + shear_state_names(sheared)
-            pieces = (
-                (start, n, time_s, np.hstack([_contacts_state(table, start, n),
-                                              shear_state(table, start, n, sheared)]))
-                for start, n, time_s, table, _ in iter_contacts(
+            found = (
+                component_contacts(reader, baseline_frames=baseline_frames,
+                                   calibration=calibration, threshold=threshold,
+                                   max_contacts=MAX_CONTACTS)
+                if sensor.components > 1
+                else iter_contacts(
                     reader, baseline_frames=baseline_frames, calibration=calibration,
                     threshold=threshold, max_contacts=MAX_CONTACTS, drift_s=drift_s,
                 )
+            )  # fmt: skip
+            if found is None:  # the three-axis estimator is not installed: frames alone
+                state_names = ()
+                found = ((start, len(t), t, None, None) for start, _, t in reader.chunks())
+            pieces = (
+                (start, n, time_s, np.zeros((n, 0)) if table is None else np.hstack(
+                    [_contacts_state(table, start, n), shear_state(table, start, n, sheared)]))
+                for start, n, time_s, table, _ in found
             )  # fmt: skip
         else:  # the one contact of each frame
             state_names = STATE_NAMES

@@ -371,16 +371,6 @@ class McapTactileWriter:
         self._writer.finish()
 
 
-def _shear(table, keep) -> np.ndarray | None:
-    """The contacts' tangential force (shear_x_n, shear_y_n, 0) [N], when the estimate
-    has it (a kind that senses shear); else None."""
-    sx, sy = getattr(table, "shear_x_n", None), getattr(table, "shear_y_n", None)
-    if sx is None or sy is None:
-        return None
-    sx, sy = np.asarray(sx, dtype=float)[keep], np.asarray(sy, dtype=float)[keep]
-    return np.nan_to_num(np.column_stack([sx, sy, np.zeros_like(sx)]))
-
-
 LOSSES_METADATA = "tactsense.losses"
 """Name of the MCAP metadata record that holds a recording's loss counters."""
 
@@ -477,13 +467,24 @@ def export_mcap(
             return frames_only(reader, writer, stamps, progress, host)
         if kind_of(reader.sensor).multi_contact:  # every contact, tracked: one message each
             from tactsense.batch import iter_contacts
+            from tactsense.interop.components import component_contacts, shear_vectors
 
             sensor = reader.sensor
             positions = sensor.taxel_positions_mm()
             taxel_normals = sensor.taxel_normals()
-            pieces = iter_contacts(reader, baseline_frames=baseline_frames,
-                                   calibration=calibration, threshold=threshold,
-                                   drift_s=drift_s)  # fmt: skip
+            if sensor.components > 1:  # r8-triinterop: the three-axis estimator's contacts
+                pieces = component_contacts(
+                    reader, baseline_frames=baseline_frames, calibration=calibration,
+                    threshold=threshold,
+                )  # fmt: skip
+                if pieces is None:  # not installed: the frames alone
+                    from tactsense.interop._state_bytes import frames_only
+
+                    return frames_only(reader, writer, stamps, progress, host)
+            else:
+                pieces = iter_contacts(reader, baseline_frames=baseline_frames,
+                                       calibration=calibration, threshold=threshold,
+                                       drift_s=drift_s)  # fmt: skip
             for start, n, time_s, table, _ in pieces:
                 frames = reader.frames(start, start + n)
                 when = stamps(start, time_s)
@@ -499,7 +500,7 @@ def export_mcap(
                 names = [f"{sensor.name}/{i}" for i in table.id[keep]]
                 writer.contacts_at(
                     when, table.frame[keep] - start, xyz * 1e-3, taxel_normals[nearest],
-                    table.force_n[keep], names, shear_n=_shear(table, keep),
+                    table.force_n[keep], names, shear_n=shear_vectors(table, keep),
                 )  # fmt: skip
                 if progress is not None:
                     progress(start + n, reader.n_frames)

@@ -122,4 +122,3 @@ def _pitch_mm(sensor) -> float:
     gaps = np.linalg.norm(positions[:, None, :] - positions[None, :, :], axis=-1)
     gaps[gaps == 0] = np.inf
     return float(gaps.min())
-
