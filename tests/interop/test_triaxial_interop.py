@@ -7,6 +7,7 @@ live (rosbags' CDR of the publisher's bytes). The twin's mag4x4 press: frames
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import time
 import uuid
@@ -20,6 +21,9 @@ import tactsense as ts
 from tactsense.cli import app
 
 runner = CliRunner()
+ESTIMATOR = importlib.util.find_spec("tactsense.estimate.triaxial") is not None
+"""Whether the three-axis contact estimator (issue 35 item 4) is installed: the exports
+then carry contacts and their shear; else the frames alone."""
 
 
 def _expected_names(rows: int, cols: int) -> list[str]:
@@ -128,7 +132,7 @@ def test_mcap_tactile_state_has_a_channel_per_component(tmp_path, pressed):
     out = tmp_path / "press.mcap"
     result = runner.invoke(app, ["export", str(path), "-o", str(out), "--quiet"])
     assert result.exit_code == 0, result.output
-    assert "no contacts" in result.output
+    assert ("contacts (one TactileContact" if ESTIMATOR else "no contacts") in result.output
     schema, states, raws = _mcap_states(out)
     assert schema.startswith("std_msgs/Header header\nsensor_msgs/ChannelFloat32[] sensors")
     assert len(states) == len(rec)
@@ -242,7 +246,9 @@ def test_lerobot_feature_is_rows_cols_3(tmp_path, pressed):
     feature = info["features"]["observation.tactile"]
     assert feature == {"dtype": "float32", "shape": [4, 4, 3],
                        "names": ["row", "col", "component"]}  # fmt: skip
-    assert "observation.state" not in info["features"]  # no estimator: no made-up state
+    # without the three-axis estimator no made-up state; with it, the slots and their shear
+    assert ("contact0.shear_x_n" in info["features"]["observation.state"]["names"]
+            if ESTIMATOR else "observation.state" not in info["features"])  # fmt: skip
     table = pq.read_table(out / "data/chunk-000/file-000.parquet")
     hf = json.loads(table.schema.metadata[b"huggingface"])["info"]["features"]
     assert hf["observation.tactile"] == {"shape": [4, 4, 3], "dtype": "float32",
@@ -509,3 +515,80 @@ def test_lerobot_shear_slots_follow_the_contacts_rank():
     with pytest.raises(TactsenseInputError, match="no shear_x_n column"):
         shear_state(SimpleNamespace(frame=table.frame, contact=table.contact), 10, 3, 2)
     assert shear_state(SimpleNamespace(), 0, 3, 0).shape == (3, 0)
+
+
+# ---- with the three-axis estimator: contacts with their tangential force --------------
+
+
+@pytest.fixture(scope="module")
+def sheared(tmp_path_factory):
+    """A press at taxel (1, 2), then a tangential force along +x at 0.3 times the normal
+    force, held (below mu = 1: no slip)."""
+    pytest.importorskip("tactsense.estimate.triaxial")
+    from tactsense.physics.indenters import SphereProbe
+    from tactsense.simulate.scenario import Scenario, Step
+
+    spec = ts.preset("mag4x4")
+    x, y, p = spec.x_mm[1], spec.y_mm[2], 0.49
+    period = spec.scan_period_s
+
+    def probe(q):
+        return SphereProbe(x, y, p, radius_mm=1.6, friction=1.0, shear_x_n=q)
+
+    steps = (
+        Step((), 10 * period, "untouched"),
+        Step((probe(0.0),), 10 * period, "pressed"),
+        Step((probe(0.3 * p),), 20 * period, "sheared"),
+        Step((), 5 * period, "lifted"),
+    )
+    rec = ts.simulate(spec, Scenario(steps, "shear-x", "press, shear along +x", {}), rng=3)
+    path = tmp_path_factory.mktemp("sheared") / "sheared.h5"
+    ts.write_recording(path, rec)
+    return path, rec
+
+
+def test_mcap_contacts_carry_the_estimated_shear(tmp_path, sheared):
+    """Each TactileContact's wrench is the estimate's, as 'locate' writes it: force =
+    (shear_x_n, shear_y_n, -force_n) on the pad (normal +z); the sheared frames push +x."""
+    import pyarrow.parquet as pq
+    from mcap.reader import make_reader
+    from mcap_ros2.decoder import DecoderFactory
+
+    path, _ = sheared
+    out, located = tmp_path / "sheared.mcap", tmp_path / "located.parquet"
+    result = runner.invoke(app, ["export", str(path), "-o", str(out), "--quiet"])
+    assert result.exit_code == 0, result.output
+    result = runner.invoke(app, ["locate", str(path), "-o", str(located)])
+    assert result.exit_code == 0, result.output
+    table = pq.read_table(located).to_pylist()
+    with open(out, "rb") as stream:
+        reader = make_reader(stream, decoder_factories=[DecoderFactory()])
+        contacts = [ros for *_, ros in reader.iter_decoded_messages(topics=["/tactile_contacts"])]
+    rows = [r for r in table if np.isfinite(r["force_n"])]
+    assert len(contacts) == len(rows) > 10
+    for got, want in zip(contacts, rows, strict=True):
+        f = got.wrench.force
+        assert got.name == f"mag4x4/{want['id']}"
+        assert [f.x, f.y, f.z] == [want["shear_x_n"], want["shear_y_n"], -want["force_n"]]
+    held = [r["shear_x_n"] for r in rows if r["frame"] >= 25]
+    assert held and np.median(held) > 0.05  # +x shear, seen as +x
+
+
+def test_lerobot_state_carries_the_estimated_shear(tmp_path, sheared):
+    import pyarrow.parquet as pq
+
+    path, _ = sheared
+    out = tmp_path / "dataset"
+    result = runner.invoke(app, ["export", str(path), "--format", "lerobot", "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    names = json.loads((out / "meta/info.json").read_text())["features"]["observation.state"][
+        "names"
+    ]
+    state = np.asarray(
+        pq.read_table(out / "data/chunk-000/file-000.parquet").column("observation.state")
+        .to_pylist()
+    )  # fmt: skip
+    present = state[:, names.index("contact0.present")] == 1
+    shear_x = state[:, names.index("contact0.shear_x_n")]
+    assert present.sum() > 10 and np.median(shear_x[present][-10:]) > 0.05
+    assert np.all(shear_x[~present] == 0)
