@@ -592,3 +592,45 @@ def test_lerobot_state_carries_the_estimated_shear(tmp_path, sheared):
     shear_x = state[:, names.index("contact0.shear_x_n")]
     assert present.sum() > 10 and np.median(shear_x[present][-10:]) > 0.05
     assert np.all(shear_x[~present] == 0)
+
+
+def test_lsl_contact_slots_carry_the_shear(pressed):
+    """A shear-sensing sensor's contacts outlet: each slot's tangential force after its
+    force (c<k>_shear_x_n, c<k>_shear_y_n [N]), read by pylsl's inlet; NaN in empty slots."""
+    import dataclasses
+
+    from tactsense.interop.lsl import SLOTS, LslOutlets, _pylsl
+
+    pylsl = _pylsl()
+    _, rec = pressed
+    sensor = dataclasses.replace(rec.sensor, name=f"lslshear{uuid.uuid4().hex[:8]}")
+    serial = f"shear-{uuid.uuid4().hex[:6]}"
+    outlets = LslOutlets(sensor, {"serial": serial}, 100.0)
+    try:
+        (found,) = pylsl.resolve_byprop("source_id", f"tactsense:{serial}:contacts", 1, 5)
+        inlet = pylsl.StreamInlet(found)
+        channel = inlet.info(timeout=5).desc().child("channels").child("channel")
+        labels, units = [], []
+        while not channel.empty():
+            labels.append(channel.child_value("label"))
+            units.append(channel.child_value("unit"))
+            channel = channel.next_sibling()
+        assert len(labels) == 4 + 7 * SLOTS
+        assert labels[4:11] == ["c0_id", "c0_x_mm", "c0_y_mm", "c0_z_mm", "c0_force_n",
+                                "c0_shear_x_n", "c0_shear_y_n"]  # fmt: skip
+        assert units[9:11] == ["N", "N"]
+        inlet.open_stream(timeout=5)
+        time.sleep(0.3)
+        contact = {"id": 7, "x_mm": 4.7, "y_mm": 9.4, "z_mm": 0.0, "force_n": 0.5,
+                   "shear_x_n": 0.125, "shear_y_n": -0.0625}  # fmt: skip
+        estimate = {"n_contacts": 1, "force_n": 0.5, "flags": 0, "latency_ms": 1.0,
+                    "contacts": [contact]}  # fmt: skip
+        frame = next(_stream_frames(rec))
+        got, deadline = [], time.time() + 10
+        outlets.push(frame, estimate)
+        while not got and time.time() < deadline:
+            got, _ = inlet.pull_chunk(timeout=0.2)
+        assert got[0][4:11] == [7, 4.7, 9.4, 0.0, 0.5, 0.125, -0.0625]
+        assert np.isnan(got[0][11:]).all()
+    finally:
+        outlets.close()

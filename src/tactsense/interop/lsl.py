@@ -25,7 +25,9 @@ width instead: ``n_contacts, force_n, flags, latency_ms`` (the frame: how many c
 their summed force [N], the flags of the frame, the latency) then :data:`SLOTS` slots of
 ``id, x_mm, y_mm, z_mm, force_n`` (slot ``k``'s channels are labelled ``c<k>_id`` ...),
 filled in the order of the estimate (largest force first), NaN in the slots left over;
-a contact keeps its ``id`` from frame to frame, not its slot (:data:`SLOT_CHANNELS`).
+a contact keeps its ``id`` from frame to frame, not its slot (:data:`SLOT_CHANNELS`). A
+kind that senses shear (three-axis taxels) has two more channels per slot after these,
+``c<k>_shear_x_n``, ``c<k>_shear_y_n``: the contact's tangential force [N].
 
 Both carry a ``source_id`` made from the device's serial number (``tactsense:<serial>:
 frames``), so a consumer recovers the stream after the device or tactsense restarts.
@@ -90,14 +92,26 @@ SLOT_CHANNELS = SLOT_FRAME + tuple(f"c{k}_{name}" for k in range(SLOTS) for name
 """Channels of the fixed-width contacts outlet of a pad or point set."""
 
 
-def slot_sample(estimate: dict) -> list[float]:
-    """One sample of the fixed-width contacts outlet from a :class:`LiveContacts` estimate."""
+SHEAR_SLOT_FIELDS = ("shear_x_n", "shear_y_n")
+"""A shear-sensing kind's slot fields after :data:`SLOT_FIELDS`: the contact's tangential
+force along the sensor's x and y [N] (r8-triinterop)."""
+
+
+def slot_sample(estimate: dict, fields: tuple[str, ...] = SLOT_FIELDS) -> list[float]:
+    """One sample of the fixed-width contacts outlet from a :class:`LiveContacts` estimate
+    (``fields`` of each slot: :data:`SLOT_FIELDS`, and :data:`SHEAR_SLOT_FIELDS` after
+    them for a kind that senses shear)."""
     sample = [float(estimate[name]) for name in SLOT_FRAME]
     contacts = estimate["contacts"][:SLOTS]
     for contact in contacts:
-        sample += [float(contact[name]) for name in SLOT_FIELDS]
-    sample += [float("nan")] * (len(SLOT_FIELDS) * (SLOTS - len(contacts)))
+        sample += [_slot_number(contact.get(name)) for name in fields]
+    sample += [float("nan")] * (len(fields) * (SLOTS - len(contacts)))
     return sample
+
+
+def _slot_number(value) -> float:
+    """A slot's number; NaN for a value the estimate has not (None)."""
+    return float("nan") if value is None else float(value)
 
 
 def _acquisition(desc, identity: dict) -> None:
@@ -181,12 +195,15 @@ def frames_info(sensor: SensorSpec, identity: dict, rate_hz: float):
     return info
 
 
-def _slot_channels():
-    """(label, unit, type) of each channel of the fixed-width contacts outlet."""
+def _slot_channels(shear: bool = False):
+    """(label, unit, type) of each channel of the fixed-width contacts outlet (with each
+    slot's tangential force [N] for a kind that senses shear)."""
     out = list(zip(SLOT_FRAME, SLOT_FRAME_UNITS, SLOT_FRAME_TYPES, strict=True))
+    fields = list(zip(SLOT_FIELDS, SLOT_UNITS, SLOT_TYPES, strict=True))
+    if shear:
+        fields += [(name, "N", "Force") for name in SHEAR_SLOT_FIELDS]
     for k in range(SLOTS):
-        out += [(f"c{k}_{n}", u, t) for n, u, t in zip(SLOT_FIELDS, SLOT_UNITS, SLOT_TYPES,
-                                                         strict=True)]  # fmt: skip
+        out += [(f"c{k}_{n}", u, t) for n, u, t in fields]
     return out
 
 
@@ -195,8 +212,9 @@ def contacts_info(sensor: SensorSpec, identity: dict, rate_hz: float):
     of a pad's or point set's contacts."""
     pylsl = _pylsl()
     slots = kind_of(sensor).multi_contact  # several contacts a frame, tracked: slots
+    shear = bool(kind_of(sensor).senses_shear)
     if slots:
-        described = _slot_channels()
+        described = _slot_channels(shear)
     else:
         described = list(zip(CONTACT_CHANNELS, CONTACT_UNITS, CONTACT_TYPES, strict=True))
     info = pylsl.StreamInfo(
@@ -214,7 +232,8 @@ def contacts_info(sensor: SensorSpec, identity: dict, rate_hz: float):
         meta.append_child_value("slots", str(SLOTS))
         meta.append_child_value(
             "layout", "n_contacts, force_n, flags, latency_ms, then per slot k: "
-            "c<k>_id, c<k>_x_mm, c<k>_y_mm, c<k>_z_mm, c<k>_force_n (NaN when empty)",
+            "c<k>_id, c<k>_x_mm, c<k>_y_mm, c<k>_z_mm, c<k>_force_n"
+            + (", c<k>_shear_x_n, c<k>_shear_y_n" if shear else "") + " (NaN when empty)",
         )  # fmt: skip
     channels = desc.append_child("channels")
     for name, unit, kind in described:
@@ -233,6 +252,9 @@ class LslOutlets:
         identity = identity or {}
         rate = float(rate_hz or sensor.electronics.scan_rate_hz)
         self.sensor = sensor
+        self._slot_fields = SLOT_FIELDS + (
+            SHEAR_SLOT_FIELDS if kind_of(sensor).senses_shear else ()
+        )
         self.frames = pylsl.StreamOutlet(frames_info(sensor, identity, rate))
         self.contacts = pylsl.StreamOutlet(contacts_info(sensor, identity, rate))
         self._clock = pylsl.local_clock
@@ -244,7 +266,7 @@ class LslOutlets:
         self.frames.push_sample(np.asarray(frame.counts, dtype=np.float32).ravel(), stamp)
         if estimate is not None:
             if "contacts" in estimate:
-                sample = slot_sample(estimate)
+                sample = slot_sample(estimate, self._slot_fields)
             else:
                 sample = [float(estimate[name]) for name in CONTACT_CHANNELS]
             self.contacts.push_sample(sample, stamp)
