@@ -1095,3 +1095,41 @@ def test_triwire_components_bad_input(workspace, line, names):
 
 
 # ---- /values per taxel on the line (r8-triwire) ----
+
+
+# ---- three-axis frames in other tools' files (r8-triinterop) ----
+def _triinterop_files(folder):
+    """Files of three-axis frames that cannot be imported as mag4x4 (4 x 4 taxels x 3)."""
+    names = [f"r{r}c{c}{p}" for r in range(4) for c in range(4) for p in "xyz"]
+    row = ",".join(["32768"] * 48)
+    good = [",".join(["time", *names])] + [f"{k * 0.01},{row}" for k in range(3)]
+    (folder / "triinterop_swapped.csv").write_text(
+        "\n".join([good[0].replace("r1c2x,r1c2y", "r1c2y,r1c2x"), *good[1:]]) + "\n"
+    )
+    scalar = [",".join(["time", *(f"r{r}c{c}" for r in range(4) for c in range(4))])]
+    scalar += [f"{k * 0.01}," + ",".join(["1"] * 16) for k in range(3)]
+    (folder / "triinterop_scalar.csv").write_text("\n".join(scalar) + "\n")
+    short = [*good[:2], good[2].rsplit(",", 1)[0]]
+    (folder / "triinterop_short_row.csv").write_text("\n".join(short) + "\n")
+
+
+TRIINTEROP_BAD = [
+    ("import DIR/triinterop_swapped.csv --sensor mag4x4 -o OUT",
+     "value column 19 is 'r1c2y'; sensor 'mag4x4' names it 'r1c2x'"),
+    ("import DIR/triinterop_scalar.csv --sensor mag4x4 -o OUT",
+     "16 value columns; sensor 'mag4x4' has 4 x 4 = 16 taxels x 3 components (x, y, z) = 48 "
+     "values"),
+    ("import DIR/triinterop_short_row.csv --sensor mag4x4 -o OUT", "line 3: 48 fields"),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize("line, names", TRIINTEROP_BAD, ids=[line for line, _ in TRIINTEROP_BAD])
+def test_triinterop_bad_three_axis_files(workspace, line, names):
+    _triinterop_files(workspace)
+    out = workspace / "never_written_triinterop.h5"
+    args = line.replace("DIR", str(workspace)).replace("OUT", str(out)).split()
+    _check(runner.invoke(app, args), names)
+    assert not out.exists()
+
+
+# ---- /three-axis frames in other tools' files (r8-triinterop) ----

@@ -201,6 +201,12 @@ def export(
     except (TactsenseInputError, FileExistsError) as error:
         fail(str(error))
     clock = f", {counts['clock']} clock" if "clock" in counts else ""
+    if counts.get("contacts", 0) is None:  # ---- frames only (r8-triinterop) ----
+        console.print(
+            f"wrote {out}: {counts['frames']} frames, no contacts (sensor kind "
+            f"{counts['kind']!r} has no contact estimator; {export_format.value}{clock})"
+        )
+        return
     if kind_of(counts.get("kind", "finger")).multi_contact:  # every contact of every frame
         what = (
             "one TactileContact per contact per frame, named <sensor>/<id>; "
@@ -264,6 +270,8 @@ def _export_lerobot(recording, out, calibration, baseline_frames, threshold, epi
         if not kind_of(counts.get("kind", "finger")).multi_contact
         else f"{counts['contacts']} contacts"
     )
+    if counts.get("contacts", 0) is None:  # ---- frames only (r8-triinterop) ----
+        contacts = f"no contacts (sensor kind {counts['kind']!r} has no contact estimator)"
     console.print(
         f"wrote {out}: {counts['frames']} frames in {counts['episodes']} episodes at "
         f"{counts['fps']} fps, {contacts} (lerobot)"

@@ -30,8 +30,7 @@ def _sensor(sensor, source: Path, what: str) -> SpecBase:
 
 
 def _frames_array(values: list, sensor: SpecBase) -> np.ndarray:
-    rows, cols = sensor.shape
-    frames = np.asarray(values, dtype=np.float64).reshape(-1, rows, cols)
+    frames = np.asarray(values, dtype=np.float64).reshape(-1, *sensor.frame_shape)
     whole = np.all(np.isfinite(frames)) and np.all(frames == np.rint(frames))
     if whole and frames.size and frames.min() >= 0 and frames.max() <= 65535:
         return frames.astype(np.uint16)

@@ -3,7 +3,9 @@
 One header line, then one frame per row: ``time`` (the frame's time on the device
 clock [s]), ``host_time`` when the recording holds the host's arrival times (Unix time
 [s]; a recorded stream), then the taxels' readings in row-major order, named
-``r<row>c<col>`` (a point set: ``r0c<k>``, its taxels in the sensor's order). Counts
+``r<row>c<col>`` (a point set: ``r0c<k>``, its taxels in the sensor's order); a taxel of
+several components (a three-axis taxel) has a column per component, ``r<row>c<col>x``,
+``...y``, ``...z``, together and in that order (:mod:`tactsense.interop.components`). Counts
 are written as integers; a recording of fractional counts with 17 significant digits
 (a float64 reads back equal), a lost reading as ``nan``. Times with 17 significant
 digits. The file holds frames only: the sensor is given again on import (``--sensor``).
@@ -22,9 +24,17 @@ the recording's host times."""
 
 
 def taxel_columns(shape: tuple[int, int]) -> list[str]:
-    """The names of a frame's columns, row-major: ``r<row>c<col>``."""
+    """The names of a scalar frame's columns, row-major: ``r<row>c<col>``."""
     rows, cols = shape
     return [f"r{r}c{c}" for r in range(rows) for c in range(cols)]
+
+
+def value_columns(sensor) -> list[str]:
+    """The names of a frame's columns for this sensor: ``r<row>c<col>`` per taxel, or
+    ``r<row>c<col><component>`` per taxel and component (component fastest)."""
+    from tactsense.interop.components import value_names
+
+    return value_names(sensor)
 
 
 def export_csv(recording: str | Path, out: str | Path, *, progress=None) -> dict:
@@ -38,7 +48,7 @@ def export_csv(recording: str | Path, out: str | Path, *, progress=None) -> dict
     with RecordingReader(recording) as reader, open(out, "w", encoding="utf-8") as stream:
         sensor = reader.sensor
         host = reader.has_host_time
-        names = [TIME_COLUMN, *([HOST_TIME_COLUMN] if host else []), *taxel_columns(sensor.shape)]
+        names = [TIME_COLUMN, *([HOST_TIME_COLUMN] if host else []), *value_columns(sensor)]
         stream.write(",".join(names) + "\n")
         written = 0
         for start, frames, time_s in reader.chunks():

@@ -258,9 +258,12 @@ class FoxgloveLive:
         )
         names = [f"{self.sensor.name}/{c['id']}" for c in kept]
         force = np.array([c["force_n"] for c in kept], dtype=float)
+        from tactsense.interop.components import contact_shear  # r8-triinterop
+
         writer.contacts_at(
-            [t], np.zeros(len(kept), int), xyz * 1e-3, self._normals[nearest], force, names
-        )
+            [t], np.zeros(len(kept), int), xyz * 1e-3, self._normals[nearest], force, names,
+            shear_n=contact_shear(kept),
+        )  # fmt: skip
         self.frames += 1
         self.contacts += len(kept)
 

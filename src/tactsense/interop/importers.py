@@ -34,6 +34,7 @@ import csv
 import dataclasses
 import errno
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -52,6 +53,10 @@ from tactsense.sensor.common import SpecBase
 
 def _pick_values(sensors: list, sensor: SpecBase, where: str) -> list:
     """The values of the ``ChannelFloat32`` for this sensor in one ``TactileState``."""
+    if sensor.components > 1:  # ---- several components a taxel (r8-triinterop) ----
+        from tactsense.interop.components import pick_component_values
+
+        return pick_component_values(sensors, sensor, where, _get)
     if len(sensors) == 1:
         entry = sensors[0]
     else:
@@ -84,6 +89,7 @@ def _ros_sensor(sensor, first_names: list[str], source: Path) -> SpecBase:
     from tactsense.sensor import PRESETS
 
     for name in first_names:
+        name = name.split("/")[0]  # a channel per component: <sensor>/<component>
         if name.removeprefix("fearing1990_") in PRESETS:
             return load_sensor(name)
     raise ImportError_(
@@ -333,14 +339,15 @@ def read_xdf(source: Path, *, sensor=None, stream: str | None = None):
         raise ImportError_(f"{source}: stream {name!r} holds strings; expected numbers")
     series = np.asarray(series, dtype=np.float64)
     channels = int(_xdf_text(info, "channel_count") or (series.shape[1] if series.ndim == 2 else 0))
-    rows, cols = spec.shape
-    if channels != rows * cols:
+    from tactsense.interop.components import describe_values, value_count
+
+    if channels != value_count(spec):  # one channel per taxel and component
         raise ImportError_(
             f"{source}: stream {name!r} has {channels} channels; sensor {spec.name!r} has "
-            f"{rows} x {cols} = {rows * cols} taxels"
+            f"{describe_values(spec)}"
         )
     return build_recording(
-        spec, series.reshape(-1, rows * cols), picked["time_stamps"], source=str(source),
+        spec, series.reshape(-1, channels), picked["time_stamps"], source=str(source),
         description=f"imported from {source} (stream {name!r})",
     )  # fmt: skip
 
@@ -359,10 +366,10 @@ def read_csv(source: Path, *, sensor=None, time_column: str = "time"):
     the estimators wrong rates and the tracker wrong velocities; sort the file or fix
     its times). A byte-order mark (Excel's "CSV UTF-8") is skipped.
     """
+    from tactsense.interop.components import describe_values, value_count
     from tactsense.interop.csvfile import HOST_TIME_COLUMN
 
     spec = _sensor(sensor, source, "a CSV file")
-    rows, cols = spec.shape
     frames, stamps, hosts = [], [], []
     try:
         # utf-8-sig: the byte-order mark Excel writes before the header is not a name
@@ -381,11 +388,13 @@ def read_csv(source: Path, *, sensor=None, time_column: str = "time"):
             t = header.index(time_column)
             h = header.index(HOST_TIME_COLUMN) if HOST_TIME_COLUMN in header else None
             times = 1 if h is None else 2
-            if len(header) - times != rows * cols:
+            if len(header) - times != value_count(spec):
                 raise ImportError_(
                     f"{source}: {len(header) - times} value columns; sensor {spec.name!r} has "
-                    f"{rows} x {cols} = {rows * cols} taxels"
+                    f"{describe_values(spec)}"
                 )
+            _check_value_names([n for k, n in enumerate(header) if k not in (t, h)], spec,
+                               source)  # fmt: skip
             previous = None
             for line, row in enumerate(reader, start=2):
                 if not row:
@@ -429,6 +438,28 @@ def read_csv(source: Path, *, sensor=None, time_column: str = "time"):
     if hosts:  # the host's arrival times, as the recording that was exported had them
         recording = dataclasses.replace(recording, host_time_s=np.asarray(hosts, float))
     return recording
+
+
+_TACTSENSE_NAME = re.compile(r"r\d+c\d+[a-z]?")
+
+
+def _check_value_names(names: list[str], spec: SpecBase, source: Path) -> None:
+    """Columns named as tactsense names them (``r<row>c<col>``, ``r<row>c<col><component>``)
+    must be this sensor's, in its order: a file of another shape or of other components
+    with the same number of values would otherwise import as a wrong frame. Columns
+    named otherwise are taken in their order (a lab's own file)."""
+    from tactsense.interop.components import value_names
+
+    if not names or not all(_TACTSENSE_NAME.fullmatch(n) for n in names):
+        return
+    expected = value_names(spec)
+    if names != expected:
+        first = next(k for k, (a, b) in enumerate(zip(names, expected, strict=True)) if a != b)
+        raise ImportError_(
+            f"{source}: value column {first + 1} is {names[first]!r}; sensor {spec.name!r} "
+            f"names it {expected[first]!r} (the file is of another sensor, or its columns "
+            "are reordered)"
+        )
 
 
 # ---- dispatch -------------------------------------------------------------------------

@@ -90,20 +90,22 @@ def _pyarrow():
     return pa, pq
 
 
-def features_of(shape: tuple[int, int], state_names=STATE_NAMES) -> dict:
-    """The ``features`` of ``meta/info.json`` for a sensor of this frame shape."""
-    rows, cols = shape
-    return {
-        "observation.tactile": {
-            "dtype": "float32",
-            "shape": [rows, cols],
-            "names": ["row", "col"],
-        },
+def features_of(shape: tuple[int, ...], state_names=STATE_NAMES) -> dict:
+    """The ``features`` of ``meta/info.json`` for a sensor of this frame shape: ``(rows,
+    cols)``, or ``(rows, cols, components)`` for taxels of several components (names
+    ``row``, ``col``, ``component``; the components in the sensor's order, x, y, z).
+    Without ``state_names`` (a kind that estimates no contacts) no ``observation.state``."""
+    axes = ["row", "col", "component"][: len(shape)]
+    state = {
         "observation.state": {
             "dtype": "float32",
             "shape": [len(state_names)],
             "names": list(state_names),
-        },
+        }
+    }
+    return {
+        "observation.tactile": {"dtype": "float32", "shape": list(shape), "names": axes},
+        **(state if len(state_names) else {}),
         "frame_time": {"dtype": "float64", "shape": [1], "names": None},
         "timestamp": {"dtype": "float32", "shape": [1], "names": None},
         "frame_index": {"dtype": "int64", "shape": [1], "names": None},
@@ -126,8 +128,8 @@ def _hf_features(features: dict) -> dict:
                 "length": shape[0],
                 "_type": "Sequence",
             }
-        else:
-            out[key] = {"shape": list(shape), "dtype": ft["dtype"], "_type": "Array2D"}
+        else:  # datasets' Array2D, Array3D (a frame of three-axis taxels)
+            out[key] = {"shape": list(shape), "dtype": ft["dtype"], "_type": f"Array{len(shape)}D"}
     return out
 
 
@@ -233,7 +235,7 @@ def write_dataset(
         frame_index[s:stop] = np.arange(stop - s)
     timestamp = (frame_index / fps).astype(np.float32)
     tactile = np.asarray(frames, dtype=np.float32)
-    features = features_of((rows, cols), state_names)
+    features = features_of(tuple(sensor.frame_shape), state_names)
     state = np.asarray(state, dtype=np.float32)
     if state.shape != (n, len(state_names)):
         raise LeRobotError(
@@ -241,7 +243,7 @@ def write_dataset(
         )
     columns = {
         "observation.tactile": tactile,
-        "observation.state": np.asarray(state, dtype=np.float32),
+        **({"observation.state": state} if len(state_names) else {}),
         "frame_time": np.asarray(frame_time, dtype=np.float64),
         "timestamp": timestamp,
         "frame_index": frame_index,
@@ -252,16 +254,21 @@ def write_dataset(
 
     # data/chunk-000/file-000.parquet, with the datasets.Features LeRobot loads it with
     flat = pa.array(tactile.reshape(-1), type=pa.float32())
+    if sensor.components > 1:  # ---- r8-triinterop: list<list<list<float32>>>, Array3D ----
+        from tactsense.interop.components import nested_lists
+
+        flat = nested_lists(pa, flat, sensor.components, n * rows * cols)
     inner = pa.FixedSizeListArray.from_arrays(flat, cols)
     arrays = {
         "observation.tactile": pa.ListArray.from_arrays(
             pa.array(np.arange(0, n * rows + 1, rows, dtype=np.int32)),
-            inner.cast(pa.list_(pa.float32())),
-        ),
-        "observation.state": pa.FixedSizeListArray.from_arrays(
-            pa.array(columns["observation.state"].reshape(-1)), len(state_names)
+            inner.cast(pa.list_(flat.type)),
         ),
     }
+    if len(state_names):
+        arrays["observation.state"] = pa.FixedSizeListArray.from_arrays(
+            pa.array(columns["observation.state"].reshape(-1)), len(state_names)
+        )
     for key in ("frame_time", "timestamp", "frame_index", "episode_index", "index", "task_index"):
         arrays[key] = pa.array(columns[key])
     metadata = {"huggingface": json.dumps({"info": {"features": _hf_features(features)}})}
@@ -307,6 +314,7 @@ def write_dataset(
             "sensor_toml": sensor.to_toml_string(),
             "scan_rate_hz": float(sensor.electronics.scan_rate_hz),
             "frame_time_units": "s",
+            **({"components": list(sensor.component_names)} if sensor.components > 1 else {}),
             **(extra or {}),
         },
     )
@@ -347,16 +355,40 @@ def export_lerobot(
     with RecordingReader(recording) as reader:
         sensor = reader.sensor
         losses = reader.losses
-        if kind_of(sensor).multi_contact:  # every contact, tracked, as locate's long table
-            from tactsense.batch import iter_contacts
-
-            state_names = contact_state_names()
+        if not kind_of(sensor).contact_estimation:  # ---- r8-triinterop: frames alone ----
+            state_names = ()
             pieces = (
-                (start, n, time_s, _contacts_state(table, start, n))
-                for start, n, time_s, table, _ in iter_contacts(
+                (start, len(time_s), time_s, np.zeros((len(time_s), 0)))
+                for start, _, time_s in reader.chunks()
+            )
+        elif kind_of(sensor).multi_contact:  # every contact, tracked, as locate's long table
+            from tactsense.batch import iter_contacts
+            from tactsense.interop.components import (
+                component_contacts,
+                shear_state,
+                shear_state_names,
+            )
+
+            # r8-triinterop: each slot's tangential force [N] on a shear-sensing kind
+            sheared = MAX_CONTACTS if kind_of(sensor).senses_shear else 0
+            state_names = contact_state_names() + shear_state_names(sheared)
+            found = (
+                component_contacts(reader, baseline_frames=baseline_frames,
+                                   calibration=calibration, threshold=threshold,
+                                   max_contacts=MAX_CONTACTS)
+                if sensor.components > 1
+                else iter_contacts(
                     reader, baseline_frames=baseline_frames, calibration=calibration,
                     threshold=threshold, max_contacts=MAX_CONTACTS, drift_s=drift_s,
                 )
+            )  # fmt: skip
+            if found is None:  # the three-axis estimator is not installed: frames alone
+                state_names = ()
+                found = ((start, len(t), t, None, None) for start, _, t in reader.chunks())
+            pieces = (
+                (start, n, time_s, np.zeros((n, 0)) if table is None else np.hstack(
+                    [_contacts_state(table, start, n), shear_state(table, start, n, sheared)]))
+                for start, n, time_s, table, _ in found
             )  # fmt: skip
         else:  # the one contact of each frame
             state_names = STATE_NAMES
@@ -396,7 +428,8 @@ def export_lerobot(
         shutil.rmtree(temporary, ignore_errors=True)
         raise
     # a finger: frames with a contact; a pad or a point set: contacts over all frames
-    return {**counts, "contacts": int(state[:, 0].sum()), "kind": sensor.kind}
+    contacts = int(state[:, 0].sum()) if state.shape[1] else None  # None: not estimated
+    return {**counts, "contacts": contacts, "kind": sensor.kind}
 
 
 def import_lerobot(folder: str | Path, *, sensor=None):
@@ -446,10 +479,10 @@ def import_lerobot(folder: str | Path, *, sensor=None):
             spec = load_sensor(sensor)
         except SensorSpecError as error:
             raise LeRobotError(f"--sensor: {error}") from None
-    if shape != tuple(spec.shape):
+    if shape != tuple(spec.frame_shape):
         raise LeRobotError(
             f"{folder}: observation.tactile has shape {list(shape)}; sensor {spec.name!r} "
-            f"has {list(spec.shape)}"
+            f"has {list(spec.frame_shape)}"
         )
     paths = sorted((folder / "data").glob("*/*.parquet"))
     if not paths:
@@ -463,7 +496,7 @@ def import_lerobot(folder: str | Path, *, sensor=None):
         if "index" in table.column_names:
             table = table.sort_by("index")
         tactile = np.asarray(table.column("observation.tactile").to_pylist(), dtype=np.float64)
-        frames.append(tactile.reshape(-1, *spec.shape))
+        frames.append(tactile.reshape(-1, *spec.frame_shape))
         if "frame_time" in table.column_names:
             times.append(table.column("frame_time").to_numpy())
         else:

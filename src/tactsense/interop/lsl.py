@@ -11,7 +11,10 @@ Outlets (``tactsense live SOURCE --lsl``):
   position [mm] and angle [deg]. ``acquisition/manufacturer``, ``model`` and
   ``serial_number`` name the device; the stream's metadata also holds the whole
   sensor description (TOML) under ``tactsense/sensor_toml``, so an inlet knows the
-  finger without asking.
+  finger without asking. A sensor whose taxels report several components (a three-axis
+  taxel) has one channel per taxel and component, the component fastest (channel
+  ``(r * cols + c) * 3 + k``), labelled ``r3c5x``, ``r3c5y``, ``r3c5z``, each with its
+  ``component`` (x, y, z: the pad's axes) beside the taxel's location, row and column.
 * **contacts**: name ``<sensor>-contacts``, type ``TactileContact``, double channels
   ``axial_mm, angle_deg, force_n, skew, peak_deflection, flags, row, col, latency_ms``
   (NaN without a contact), one sample per frame; each channel has a ``label``, a
@@ -22,7 +25,9 @@ width instead: ``n_contacts, force_n, flags, latency_ms`` (the frame: how many c
 their summed force [N], the flags of the frame, the latency) then :data:`SLOTS` slots of
 ``id, x_mm, y_mm, z_mm, force_n`` (slot ``k``'s channels are labelled ``c<k>_id`` ...),
 filled in the order of the estimate (largest force first), NaN in the slots left over;
-a contact keeps its ``id`` from frame to frame, not its slot (:data:`SLOT_CHANNELS`).
+a contact keeps its ``id`` from frame to frame, not its slot (:data:`SLOT_CHANNELS`). A
+kind that senses shear (three-axis taxels) has two more channels per slot after these,
+``c<k>_shear_x_n``, ``c<k>_shear_y_n``: the contact's tangential force [N].
 
 Both carry a ``source_id`` made from the device's serial number (``tactsense:<serial>:
 frames``), so a consumer recovers the stream after the device or tactsense restarts.
@@ -87,14 +92,26 @@ SLOT_CHANNELS = SLOT_FRAME + tuple(f"c{k}_{name}" for k in range(SLOTS) for name
 """Channels of the fixed-width contacts outlet of a pad or point set."""
 
 
-def slot_sample(estimate: dict) -> list[float]:
-    """One sample of the fixed-width contacts outlet from a :class:`LiveContacts` estimate."""
+SHEAR_SLOT_FIELDS = ("shear_x_n", "shear_y_n")
+"""A shear-sensing kind's slot fields after :data:`SLOT_FIELDS`: the contact's tangential
+force along the sensor's x and y [N] (r8-triinterop)."""
+
+
+def slot_sample(estimate: dict, fields: tuple[str, ...] = SLOT_FIELDS) -> list[float]:
+    """One sample of the fixed-width contacts outlet from a :class:`LiveContacts` estimate
+    (``fields`` of each slot: :data:`SLOT_FIELDS`, and :data:`SHEAR_SLOT_FIELDS` after
+    them for a kind that senses shear)."""
     sample = [float(estimate[name]) for name in SLOT_FRAME]
     contacts = estimate["contacts"][:SLOTS]
     for contact in contacts:
-        sample += [float(contact[name]) for name in SLOT_FIELDS]
-    sample += [float("nan")] * (len(SLOT_FIELDS) * (SLOTS - len(contacts)))
+        sample += [_slot_number(contact.get(name)) for name in fields]
+    sample += [float("nan")] * (len(fields) * (SLOTS - len(contacts)))
     return sample
+
+
+def _slot_number(value) -> float:
+    """A slot's number; NaN for a value the estimate has not (None)."""
+    return float("nan") if value is None else float(value)
 
 
 def _acquisition(desc, identity: dict) -> None:
@@ -136,10 +153,11 @@ def frames_info(sensor: SensorSpec, identity: dict, rate_hz: float):
     """The ``StreamInfo`` of the frames outlet, with per-channel metadata."""
     pylsl = _pylsl()
     rows, cols = sensor.shape
+    parts = sensor.component_names if sensor.components > 1 else ("",)
     info = pylsl.StreamInfo(
         f"{sensor.name}-frames",
         "Tactile",
-        rows * cols,
+        rows * cols * len(parts),  # a channel per taxel and component
         float(rate_hz),
         pylsl.cf_float32,
         source_id(identity, sensor, "frames"),
@@ -151,29 +169,41 @@ def frames_info(sensor: SensorSpec, identity: dict, rate_hz: float):
     fields = kind_of(sensor).lsl_taxel_fields(sensor)  # a finger: axial_mm, angle_deg
     for r in range(rows):
         for c in range(cols):
-            channel = channels.append_child("channel")
-            channel.append_child_value("label", f"r{r}c{c}")
-            channel.append_child_value("unit", "counts")
-            channel.append_child_value("type", "Tactile")
-            location = channel.append_child("location")
-            for axis, value in zip("XYZ", positions[r * cols + c], strict=True):
-                location.append_child_value(axis, f"{value:.6g}")
-            channel.append_child_value("row", str(r))
-            channel.append_child_value("col", str(c))
-            for field, values in fields.items():
-                channel.append_child_value(field, f"{values[r * cols + c]:.6g}")
+            for part in parts:
+                channel = channels.append_child("channel")
+                channel.append_child_value("label", f"r{r}c{c}{part}")
+                channel.append_child_value("unit", "counts")
+                channel.append_child_value("type", "Tactile")
+                location = channel.append_child("location")
+                for axis, value in zip("XYZ", positions[r * cols + c], strict=True):
+                    location.append_child_value(axis, f"{value:.6g}")
+                channel.append_child_value("row", str(r))
+                channel.append_child_value("col", str(c))
+                if part:
+                    channel.append_child_value("component", part)
+                for field, values in fields.items():
+                    channel.append_child_value(field, f"{values[r * cols + c]:.6g}")
     meta = desc.append_child("tactsense")
     meta.append_child_value("sensor_toml", sensor.to_toml_string())
-    meta.append_child_value("layout", "row-major: channel = row * cols + col")
+    if sensor.components > 1:
+        meta.append_child_value(
+            "layout", f"row-major, component fastest: channel = (row * cols + col) * "
+            f"{sensor.components} + component ({', '.join(sensor.component_names)})",
+        )  # fmt: skip
+    else:
+        meta.append_child_value("layout", "row-major: channel = row * cols + col")
     return info
 
 
-def _slot_channels():
-    """(label, unit, type) of each channel of the fixed-width contacts outlet."""
+def _slot_channels(shear: bool = False):
+    """(label, unit, type) of each channel of the fixed-width contacts outlet (with each
+    slot's tangential force [N] for a kind that senses shear)."""
     out = list(zip(SLOT_FRAME, SLOT_FRAME_UNITS, SLOT_FRAME_TYPES, strict=True))
+    fields = list(zip(SLOT_FIELDS, SLOT_UNITS, SLOT_TYPES, strict=True))
+    if shear:
+        fields += [(name, "N", "Force") for name in SHEAR_SLOT_FIELDS]
     for k in range(SLOTS):
-        out += [(f"c{k}_{n}", u, t) for n, u, t in zip(SLOT_FIELDS, SLOT_UNITS, SLOT_TYPES,
-                                                         strict=True)]  # fmt: skip
+        out += [(f"c{k}_{n}", u, t) for n, u, t in fields]
     return out
 
 
@@ -182,8 +212,9 @@ def contacts_info(sensor: SensorSpec, identity: dict, rate_hz: float):
     of a pad's or point set's contacts."""
     pylsl = _pylsl()
     slots = kind_of(sensor).multi_contact  # several contacts a frame, tracked: slots
+    shear = bool(kind_of(sensor).senses_shear)
     if slots:
-        described = _slot_channels()
+        described = _slot_channels(shear)
     else:
         described = list(zip(CONTACT_CHANNELS, CONTACT_UNITS, CONTACT_TYPES, strict=True))
     info = pylsl.StreamInfo(
@@ -201,7 +232,8 @@ def contacts_info(sensor: SensorSpec, identity: dict, rate_hz: float):
         meta.append_child_value("slots", str(SLOTS))
         meta.append_child_value(
             "layout", "n_contacts, force_n, flags, latency_ms, then per slot k: "
-            "c<k>_id, c<k>_x_mm, c<k>_y_mm, c<k>_z_mm, c<k>_force_n (NaN when empty)",
+            "c<k>_id, c<k>_x_mm, c<k>_y_mm, c<k>_z_mm, c<k>_force_n"
+            + (", c<k>_shear_x_n, c<k>_shear_y_n" if shear else "") + " (NaN when empty)",
         )  # fmt: skip
     channels = desc.append_child("channels")
     for name, unit, kind in described:
@@ -220,6 +252,9 @@ class LslOutlets:
         identity = identity or {}
         rate = float(rate_hz or sensor.electronics.scan_rate_hz)
         self.sensor = sensor
+        self._slot_fields = SLOT_FIELDS + (
+            SHEAR_SLOT_FIELDS if kind_of(sensor).senses_shear else ()
+        )
         self.frames = pylsl.StreamOutlet(frames_info(sensor, identity, rate))
         self.contacts = pylsl.StreamOutlet(contacts_info(sensor, identity, rate))
         self._clock = pylsl.local_clock
@@ -231,7 +266,7 @@ class LslOutlets:
         self.frames.push_sample(np.asarray(frame.counts, dtype=np.float32).ravel(), stamp)
         if estimate is not None:
             if "contacts" in estimate:
-                sample = slot_sample(estimate)
+                sample = slot_sample(estimate, self._slot_fields)
             else:
                 sample = [float(estimate[name]) for name in CONTACT_CHANNELS]
             self.contacts.push_sample(sample, stamp)
@@ -279,10 +314,12 @@ class LslReader:
                 sensor = SensorSpec.from_toml_string(toml)
             except SensorSpecError as error:
                 raise StreamError(f"{self.url}: its sensor description: {error}") from None
-        if info.channel_count() != sensor.shape[0] * sensor.shape[1]:
+        from tactsense.interop.components import describe_values, value_count
+
+        if info.channel_count() != value_count(sensor):  # a channel per taxel and component
             raise StreamError(
                 f"{self.url} has {info.channel_count()} channels; the sensor has "
-                f"{sensor.shape[0]} x {sensor.shape[1]} tactels"
+                f"{describe_values(sensor)}"
             )
         self.sensor = sensor
         rate = info.nominal_srate()
@@ -296,7 +333,7 @@ class LslReader:
     def read_batch(self, max_frames: int, wait_s: float = 0.1) -> list[StreamFrame]:
         """Up to ``max_frames`` frames that have arrived, waiting up to ``wait_s`` for one."""
         samples, stamps = self.inlet.pull_chunk(timeout=wait_s, max_samples=max_frames)
-        shape = self.sensor.shape
+        shape = self.sensor.frame_shape
         batch = []
         for sample, stamp in zip(samples, stamps, strict=True):
             if self._first_stamp is None:

@@ -74,6 +74,10 @@ class _Template:
         values = np.ascontiguousarray(values, dtype=self.dtype.newbyteorder("<"))
         return b"".join((self.head, _STAMP.pack(sec, nanosec), self.middle, values.tobytes()))
 
+    def after_stamp(self, values) -> bytes:
+        """The message's bytes after its stamp (``values`` of ``dtype``, little-endian)."""
+        return self.middle + values.tobytes()
+
 
 class _ContactBytes:
     """The CDR bytes of ``TactileContact`` messages and ``TactileContacts`` lists of them,
@@ -204,6 +208,10 @@ class McapTactileWriter:
                 TACTILE_CONTACTS
             ]
             self._state_bytes = _Template(encode_state, state, cells, np.float32)
+            if sensor.components > 1:  # ---- a channel per component (r8-triinterop) ----
+                from tactsense.interop._state_bytes import ComponentStateBytes
+
+                self._state_bytes = ComponentStateBytes(encode_state, sensor, frame_id)
             self._contact_bytes = _ContactBytes(encode_contact, encode_lists, contact)
         self.frames = 0
         self.contacts = 0
@@ -246,13 +254,13 @@ class McapTactileWriter:
             return
         channel = self._channel(STATES_TOPIC, self._state)
         values = np.asarray(counts, dtype="<f4").reshape(len(time_s), -1)
-        head, middle = self._state_bytes.head, self._state_bytes.middle
+        head, after_stamp = self._state_bytes.head, self._state_bytes.after_stamp
         for k in range(len(time_s)):
             ns = round(float(time_s[k]) * 1e9)
             stamp = _STAMP.pack(ns // 1_000_000_000, ns % 1_000_000_000)
             self._raw.add_message(
                 channel_id=channel, log_time=ns, publish_time=ns, sequence=int(sequence[k]),
-                data=b"".join((head, stamp, middle, values[k].tobytes())),
+                data=b"".join((head, stamp, after_stamp(values[k]))),
             )  # fmt: skip
         self.frames += len(time_s)
 
@@ -266,7 +274,9 @@ class McapTactileWriter:
         )
         self.contacts_at(time_s, chosen, points, normals, np.asarray(force_n, dtype=float)[chosen])
 
-    def contacts_at(self, time_s, frame, points_m, normals, force_n, names=None) -> None:
+    def contacts_at(
+        self, time_s, frame, points_m, normals, force_n, names=None, shear_n=None
+    ) -> None:
         """The contacts of consecutive frames.
 
         One ``TactileContact`` per row (``/tactile_contacts``) and one ``TactileContacts``
@@ -288,6 +298,9 @@ class McapTactileWriter:
         names : sequence of k str, optional
             The contacts' unique names (within a frame); default the sensor's name (a
             finger's one contact).
+        shear_n : (k, 3) array, optional
+            The tangential force the object applies [N] in the sensor's frame (a sensor
+            that senses shear), added to the wrench's force.
         """
         time_s = np.asarray(time_s, dtype=float)
         frame = np.asarray(frame, dtype=np.int64)
@@ -299,6 +312,9 @@ class McapTactileWriter:
         if names is None:
             names = [self.sensor.name] * len(frame)
         force = -force_n[:, None] * normals
+        if shear_n is not None:
+            shear = np.asarray(shear_n, dtype=float).reshape(-1, 3)
+            force = force + shear
         numbers = np.zeros((len(frame), 12), dtype="<f8")
         numbers[:, 0:3], numbers[:, 3:6], numbers[:, 6:9] = points, normals, force
         numbers[:, 9:12] = np.cross(points, force)  # about the frame's origin [N m]
@@ -324,7 +340,8 @@ class McapTactileWriter:
             else:
                 messages = [
                     tactile_contact(self.sensor, float(time_s[f]), points[i], normals[i],
-                                    force_n[i], self.frame_id, name=names[i])
+                                    force_n[i], self.frame_id, name=names[i],
+                                    shear_n=None if shear_n is None else shear[i])
                     for i in rows
                 ]  # fmt: skip
                 for message in messages:
@@ -444,15 +461,30 @@ def export_mcap(
         )
         if reader.losses:
             writer.losses(reader.losses)
+        if not kind_of(reader.sensor).contact_estimation:  # ---- r8-triinterop ----
+            from tactsense.interop._state_bytes import frames_only
+
+            return frames_only(reader, writer, stamps, progress, host)
         if kind_of(reader.sensor).multi_contact:  # every contact, tracked: one message each
             from tactsense.batch import iter_contacts
+            from tactsense.interop.components import component_contacts, shear_vectors
 
             sensor = reader.sensor
             positions = sensor.taxel_positions_mm()
             taxel_normals = sensor.taxel_normals()
-            pieces = iter_contacts(reader, baseline_frames=baseline_frames,
-                                   calibration=calibration, threshold=threshold,
-                                   drift_s=drift_s)  # fmt: skip
+            if sensor.components > 1:  # r8-triinterop: the three-axis estimator's contacts
+                pieces = component_contacts(
+                    reader, baseline_frames=baseline_frames, calibration=calibration,
+                    threshold=threshold,
+                )  # fmt: skip
+                if pieces is None:  # not installed: the frames alone
+                    from tactsense.interop._state_bytes import frames_only
+
+                    return frames_only(reader, writer, stamps, progress, host)
+            else:
+                pieces = iter_contacts(reader, baseline_frames=baseline_frames,
+                                       calibration=calibration, threshold=threshold,
+                                       drift_s=drift_s)  # fmt: skip
             for start, n, time_s, table, _ in pieces:
                 frames = reader.frames(start, start + n)
                 when = stamps(start, time_s)
@@ -468,7 +500,7 @@ def export_mcap(
                 names = [f"{sensor.name}/{i}" for i in table.id[keep]]
                 writer.contacts_at(
                     when, table.frame[keep] - start, xyz * 1e-3, taxel_normals[nearest],
-                    table.force_n[keep], names,
+                    table.force_n[keep], names, shear_n=shear_vectors(table, keep),
                 )  # fmt: skip
                 if progress is not None:
                     progress(start + n, reader.n_frames)

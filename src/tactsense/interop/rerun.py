@@ -47,6 +47,7 @@ from pathlib import Path
 import numpy as np
 
 from tactsense._validation import TactsenseInputError
+from tactsense.interop._rerun_common import _checked_range, _open_stream
 from tactsense.kinds import kind_of
 
 
@@ -105,6 +106,13 @@ def export_rerun(
     frames_written = contacts = 0
     with RecordingReader(recording) as reader:
         sensor = reader.sensor
+        if sensor.components > 1:  # ---- several components a taxel (r8-triinterop) ----
+            from tactsense.interop.rerun_components import export_components_rerun
+
+            return export_components_rerun(
+                rr, reader, recording, out, baseline_frames=baseline_frames,
+                value_range=deflection_range, recording_id=recording_id, progress=progress,
+            )  # fmt: skip
         if kind_of(sensor).multi_contact:  # every contact, tracked
             return _export_array(
                 rr, reader, recording, out, calibration=calibration,
@@ -273,26 +281,3 @@ def _export_array(
         "frames": frames_written, "contacts": contacts, "recording_id": recording_id,
         "deflection_range": (low, high), "kind": sensor.kind,
     }  # fmt: skip
-
-
-def _checked_range(what: str, value_range) -> tuple[float, float]:
-    """``(low, high)`` of a colour scale, refused unless finite with low < high."""
-    low, high = map(float, value_range)
-    if not (np.isfinite(low) and np.isfinite(high) and high > low):
-        raise TactsenseInputError(
-            f"{what} range ({low}, {high}) must be two finite numbers, low < high"
-        )
-    return low, high
-
-
-def _open_stream(rr, out, recording, recording_id: str, **properties):
-    """A Rerun stream saved to ``out``, named after the recording, with the recording
-    property ``tactsense`` (its id, source and ``properties``)."""
-    stream = rr.RecordingStream("tactsense", recording_id=recording_id)
-    stream.save(str(out))
-    stream.send_recording_name(Path(recording).stem)
-    stream.send_property(
-        "tactsense",
-        rr.AnyValues(recording_id=recording_id, source=str(recording), **properties),
-    )
-    return stream

@@ -109,7 +109,14 @@ def stamp(time_s: float) -> dict:
 
 
 def tactile_state(sensor: SensorSpec, counts, time_s: float, frame_id: str = "finger") -> dict:
-    """One ``TactileState`` of one frame: the finger's counts, row-major."""
+    """One ``TactileState`` of one frame: the sensor's counts, row-major; a sensor of
+    several components (three-axis taxels) has a channel per component, named
+    ``<sensor>/<component>`` (:mod:`tactsense.interop.components`)."""
+    if sensor.components > 1:  # ---- a channel per component (r8-triinterop) ----
+        from tactsense.interop._state_bytes import state_message
+
+        when = stamp(time_s)
+        return state_message(sensor, when["sec"], when["nanosec"], np.ravel(counts), frame_id)
     return {
         "header": {"stamp": stamp(time_s), "frame_id": frame_id},
         "sensors": [
@@ -135,6 +142,7 @@ def tactile_contact(
     force_n: float,
     frame_id: str = "finger",
     name: str | None = None,
+    shear_n=None,
 ) -> dict:
     """One ``TactileContact``: where, the normal, and the wrench the object applies.
 
@@ -142,9 +150,12 @@ def tactile_contact(
     ("represented in reference frame, not in contact point frame"): the force, and the
     torque of that force about the frame's origin, ``position x force`` [N m], as the
     toolbox's contact merger writes it. ``name``: the contact's unique name (default the
-    sensor's, for a finger's one contact).
+    sensor's, for a finger's one contact). ``shear_n``: the tangential force the object
+    applies [N], (3,) in the reference frame, added to the force (three-axis taxels).
     """
     force = -float(force_n) * np.asarray(normal, dtype=float)
+    if shear_n is not None:  # the tangential force [N] of a sensor that senses shear
+        force = force + np.asarray(shear_n, dtype=float)
     torque = np.cross(np.asarray(point_m, dtype=float), force)
     return {
         "header": {"stamp": stamp(time_s), "frame_id": frame_id},

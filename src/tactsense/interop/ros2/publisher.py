@@ -14,11 +14,15 @@ Per sensor, under the node's namespace (default ``/<sensor name>``):
 =====================  ===============================  =====================================
 topic                  type                             what
 =====================  ===============================  =====================================
-``tactile_states``     ``tactile_msgs/msg/TactileState``     the frame's counts, row-major
+``tactile_states``     ``tactile_msgs/msg/TactileState``     the frame's counts, row-major (a
+                                                        channel per component, ``<sensor>/x``,
+                                                        ``/y``, ``/z``, for three-axis taxels)
 ``contact_states``     ``tactile_msgs/msg/TactileContacts``  every contact of the frame (may be
                                                         empty), each named ``<sensor>/<id>``
 ``tactile_image``      ``sensor_msgs/msg/Image``             the counts as a rows x cols
-                                                        ``32FC1`` image
+                                                        ``32FC1`` image (``32FC3``, the
+                                                        channels x, y, z, for three-axis
+                                                        taxels)
 ``wrench``             ``geometry_msgs/msg/WrenchStamped``   the total force of the contacts [N]
                                                         and its torque about the frame's
                                                         origin [N m]
@@ -38,6 +42,7 @@ import struct
 import numpy as np
 
 from tactsense._validation import TactsenseInputError
+from tactsense.interop._state_bytes import ComponentStateBytes, state_message
 from tactsense.interop.mcap import _ContactBytes
 from tactsense.interop.ros import contact_geometry
 from tactsense.interop.ros2.config import resolve_config
@@ -176,6 +181,28 @@ class _StampedBytes:
         return _padded(b"".join((self.head, _STAMP.pack(sec, nanosec), self.middle, tail)))
 
 
+class _ComponentStates:
+    """``encode(sec, nanosec, tail)`` of a ``TactileState`` of several channels, from a
+    :class:`~tactsense.interop._state_bytes.ComponentStateBytes` (checked against the
+    serialiser's bytes when made)."""
+
+    def __init__(self, template):
+        self.template = template
+
+    def encode(self, sec: int, nanosec: int, tail: bytes) -> bytes:
+        values = np.frombuffer(tail, dtype="<f4")
+        return _padded(self.template.encode(sec, nanosec, values))
+
+
+def _state_of(m, message: dict):
+    """A ``TactileState`` (Cyclone DDS's class) of the encoder's dictionary."""
+    stamp = message["header"]["stamp"]
+    return m.TactileState(
+        m.Header(m.Time(stamp["sec"], stamp["nanosec"]), message["header"]["frame_id"]),
+        [m.ChannelFloat32(ch["name"], list(ch["values"])) for ch in message["sensors"]],
+    )
+
+
 def _padded(data: bytes) -> bytes:
     """What Cyclone DDS's writer sends: the CDR padded to a multiple of 4 bytes."""
     return data + b"\0" * (-len(data) % 4)
@@ -309,15 +336,21 @@ class Ros2Publisher:
     def _build_templates(self, m) -> None:
         rows, cols = self.sensor.shape
         header = {"frame_id": self.frame_id}
+        # ---- taxels of several components (r8-triinterop): a TactileState channel per
+        # component (<sensor>/x, /y, /z), the image 32FC3 (a pixel's channels x, y, z) ----
+        parts = self.sensor.components
 
         def state(sec, nanosec, tail):
-            values = np.frombuffer(tail, dtype="<f4").tolist()
-            return m.TactileState(m.Header(m.Time(sec, nanosec), **header),
-                                  [m.ChannelFloat32(self.sensor.name, values)])  # fmt: skip
+            values = np.frombuffer(tail, dtype="<f4")
+            if parts > 1:
+                return _state_of(m, state_message(self.sensor, sec, nanosec, values,
+                                                  self.frame_id))  # fmt: skip
+            channel = m.ChannelFloat32(self.sensor.name, values.tolist())
+            return m.TactileState(m.Header(m.Time(sec, nanosec), **header), [channel])
 
         def image(sec, nanosec, tail):
-            return m.Image(m.Header(m.Time(sec, nanosec), **header), rows, cols, "32FC1", 0,
-                           4 * cols, list(tail))  # fmt: skip
+            return m.Image(m.Header(m.Time(sec, nanosec), **header), rows, cols,
+                           f"32FC{parts}", 0, 4 * cols * parts, list(tail))  # fmt: skip
 
         def wrench(sec, nanosec, tail):
             f, t = np.frombuffer(tail, dtype="<f8").reshape(2, 3).tolist()
@@ -333,7 +366,7 @@ class Ros2Publisher:
 
         self._make = {"tactile_states": state, "tactile_image": image, "wrench": wrench}
         self._make_contact = contact
-        cells = rows * cols
+        cells = rows * cols * parts
 
         def serialize(message):
             return bytes(message.serialize())
@@ -343,13 +376,21 @@ class Ros2Publisher:
             return first.tobytes(), (-first[::-1] - 0.5).astype(dtype).tobytes()
 
         self._templates = {
-            "tactile_states": _StampedBytes(serialize, state, *probes(cells, "<f4")),
+            "tactile_states": (
+                _StampedBytes(serialize, state, *probes(cells, "<f4")) if parts == 1 else None
+            ),
             "tactile_image": _StampedBytes(serialize, image, *probes(cells, "<f4")),
             "wrench": _StampedBytes(serialize, wrench, *probes(6, "<f8")),
         }
         self._contacts = _ContactBytes(
             serialize, lambda d: serialize(m.TactileContacts(d["contacts"])), contact
         )
+        if parts > 1:  # the channels' values are not trailing: a template of each part
+            self._templates["tactile_states"] = _ComponentStates(
+                ComponentStateBytes(
+                    lambda d: _padded(serialize(_state_of(m, d))), self.sensor, self.frame_id
+                )
+            )
 
     def contact_numbers(self, estimate: dict | None) -> tuple[list[str], np.ndarray]:
         """The contacts of one estimate as names and rows of twelve numbers: position [m],
@@ -385,6 +426,11 @@ class Ros2Publisher:
             force_n = np.array([estimate["force_n"]], dtype=float)
             names = [self.sensor.name]
         force = -force_n[:, None] * normals
+        if self._multi:  # ---- the tangential force of a shear-sensing kind (r8-triinterop)
+            from tactsense.interop.components import contact_shear
+
+            shear = contact_shear(contacts)
+            force = force if shear is None else force + shear
         numbers = np.zeros((len(names), 12), dtype="<f8")
         numbers[:, 0:3], numbers[:, 3:6], numbers[:, 6:9] = points, normals, force
         numbers[:, 9:12] = np.cross(points, force)
