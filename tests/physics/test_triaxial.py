@@ -302,3 +302,23 @@ def test_a_press_pushes_the_magnet_toward_its_sensor_and_raises_bz():
     change = tri.dipole_field_t(spec, d) - tri.dipole_field_t(spec, np.zeros_like(d))
     assert change[1, 1, 2] > 0
     assert modulus_star_pa(spec.layer) == pytest.approx(E_STAR)
+
+
+@settings(max_examples=15, deadline=None)
+@given(angle=st.floats(-180, 180), ratio=st.floats(0.05, 0.9))
+def test_the_magnet_under_a_contact_moves_along_its_tangential_force(angle, ratio):
+    """The shear's added displacement of the magnet under the contact points along the
+    force (the pad's response to x and y tractions is the same turned by 90 deg on the
+    square grid, and a contact centred on a taxel loads it symmetrically): 1e-6 deg."""
+    spec = preset("mag4x4")
+    centre = (spec.grid.row_pitch_mm, spec.grid.col_pitch_mm)
+    q = ratio * P
+    pressed = SphereProbe(*centre, P, radius_mm=1.6)
+    pushed = dataclasses.replace(
+        pressed,
+        shear_x_n=q * math.cos(math.radians(angle)),
+        shear_y_n=q * math.sin(math.radians(angle)),
+    )
+    d = tri.magnet_displacement(spec, [pushed]) - tri.magnet_displacement(spec, [pressed])
+    moved = math.degrees(math.atan2(d[1, 1, 1], d[1, 1, 0]))
+    assert abs((moved - angle + 180) % 360 - 180) < 1e-6
