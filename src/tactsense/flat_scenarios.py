@@ -184,7 +184,9 @@ def slide(
     settle_s: float = 0.2,
 ) -> Scenario:
     """A sphere sliding at constant force from ``start_mm`` to ``end_mm`` (default: across the
-    middle of the pad along y), moved in steps of ``increment_mm``."""
+    middle of the pad along y), moved in steps of ``increment_mm``; on a kind that senses
+    shear (a three-axis pad) it drags the skin with the friction of gross slip, mu P
+    (mu = 1), along its motion."""
     check_positive(speed_mm_s, "speed_mm_s")
     check_positive(increment_mm, "increment_mm")
     cx, _ = centre_mm(spec)
@@ -203,10 +205,14 @@ def slide(
     n = max(1, math.ceil(length / increment_mm))
     dwell = (length / n) / speed_mm_s if length > 0 else 0.1
     steps = _settle(settle_s)
+    # a kind that senses shear feels the friction the sliding sphere drags the skin with:
+    # mu P (mu = 1) along the motion, gross slip (r8-triphys)
+    drag = force_n * (end - start) / length if length > 0 and kind_of(spec).senses_shear else (0, 0)
     for k in range(n + 1):
         x, y = start + (end - start) * k / n
-        steps.append(Step((SphereProbe(float(x), float(y), force_n, radius_mm=size_mm),), dwell,
-                          f"slide {k}"))  # fmt: skip
+        sphere = SphereProbe(float(x), float(y), force_n, radius_mm=size_mm,
+                             shear_x_n=float(drag[0]), shear_y_n=float(drag[1]))  # fmt: skip
+        steps.append(Step((sphere,), dwell, f"slide {k}"))
     steps.append(Step((), 0.2, "lifted"))
     return Scenario(
         tuple(steps),

@@ -302,3 +302,53 @@ def test_a_press_pushes_the_magnet_toward_its_sensor_and_raises_bz():
     change = tri.dipole_field_t(spec, d) - tri.dipole_field_t(spec, np.zeros_like(d))
     assert change[1, 1, 2] > 0
     assert modulus_star_pa(spec.layer) == pytest.approx(E_STAR)
+
+
+@settings(max_examples=15, deadline=None)
+@given(angle=st.floats(-180, 180), ratio=st.floats(0.05, 0.9))
+def test_the_magnet_under_a_contact_moves_along_its_tangential_force(angle, ratio):
+    """The shear's added displacement of the magnet under the contact points along the
+    force (the pad's response to x and y tractions is the same turned by 90 deg on the
+    square grid, and a contact centred on a taxel loads it symmetrically): 1e-6 deg."""
+    spec = preset("mag4x4")
+    centre = (spec.grid.row_pitch_mm, spec.grid.col_pitch_mm)
+    q = ratio * P
+    pressed = SphereProbe(*centre, P, radius_mm=1.6)
+    pushed = dataclasses.replace(
+        pressed,
+        shear_x_n=q * math.cos(math.radians(angle)),
+        shear_y_n=q * math.sin(math.radians(angle)),
+    )
+    d = tri.magnet_displacement(spec, [pushed]) - tri.magnet_displacement(spec, [pressed])
+    moved = math.degrees(math.atan2(d[1, 1, 1], d[1, 1, 0]))
+    assert abs((moved - angle + 180) % 360 - 180) < 1e-6
+
+
+def test_windowed_tractions_are_the_whole_grids():
+    """Each indenter's load evaluated on the cells it reaches (the default) equals the
+    whole grid's evaluation to 1e-12 of its peak, for every indenter kind, sheared,
+    on the pad, near its edge and partly off the grid (where the missing part stays
+    missing)."""
+    from tactsense.physics import indenters as ind
+    from tactsense.physics.pad_response import _pad_grid
+
+    spec = preset("mag4x4")
+    x, y, *_ = _pad_grid(spec)
+    cases = [
+        ind.SphereProbe(5, 5, 0.5, shear_x_n=0.1),
+        ind.SphereProbe(-7.9, 5, 0.5, radius_mm=9, shear_y_n=0.3),
+        ind.SphereProbe(19, 19, 0.5, radius_mm=3, shear_x_n=0.2),
+        ind.DiscProbe(14, 0.2, 0.3, radius_mm=2, shear_x_n=0.1),
+        ind.FlatPunch(3, 3, 1.0, radius_mm=3, shear_x_n=0.2),
+        ind.KnifeEdge(7, 7, 1.0, length_mm=10, angle_deg=30, shear_y_n=0.2),
+        ind.SquareStamp(7, 7, 1, side_mm=5, angle_deg=20, shear_x_n=0.5),
+        ind.CylinderProbe(7, 7, 1, length_mm=10, angle_deg=45, shear_x_n=0.1),
+    ]
+    for indenter in cases:
+        windowed = tri.traction_maps(spec, [indenter], x, y)
+        whole = tri.traction_maps(spec, [indenter], x, y, window=False)
+        for a, b in zip(windowed, whole, strict=True):
+            assert np.max(np.abs(a - b)) <= 1e-12 * max(np.max(np.abs(b)), 1e-30), indenter
+    both = tri.traction_maps(spec, cases[:2], x, y)
+    np.testing.assert_allclose(both[0], sum(tri.traction_maps(spec, [c], x, y)[0]
+                                            for c in cases[:2]), rtol=1e-12)  # fmt: skip

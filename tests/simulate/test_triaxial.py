@@ -186,3 +186,17 @@ def test_simulate_command_writes_the_shear_truth(tmp_path):
 
 def spec_period(name):
     return preset(name).scan_period_s
+
+
+def test_a_slide_drags_a_three_axis_skin_but_not_a_pads_contacts(spec):
+    """'slide' on a kind that senses shear: friction mu P (mu = 1) along the motion, gross
+    slip in every touching step; on a pad the contacts stay pure presses."""
+    from tactsense.flat_scenarios import slide
+
+    rec = simulate(spec, slide(spec), flaws="none", rng=0)
+    touching = rec.truth["step_n_contacts"] > 0
+    assert np.all(rec.truth["step_slip"][touching] == 2)
+    np.testing.assert_allclose(rec.truth["step_shear_y_n"][touching], FIFTY_GRAMS, rtol=1e-12)
+    np.testing.assert_allclose(rec.truth["step_shear_x_n"][touching], 0.0, atol=1e-15)
+    pad = preset("pad16")
+    assert all(c.shear_n == 0 for step in slide(pad).steps for c in step.contacts)
