@@ -1057,6 +1057,9 @@ TRIWIRE_BAD = [
         "emulate --sensor mag4x4 --format marker,components=1",
         "components=1, but the sensor 'mag4x4' reports 3 per taxel (x, y, z)",
     ),
+    ("record text,offset=1.5:loop:// --out OUT", "offset='1.5' must be whole counts"),
+    ("record justfloat,offset=-70000:loop:// --out OUT", "offset='-70000' must be whole"),
+    ("emulate --format marker,signed=maybe", "signed='maybe' must be no or yes"),
 ]
 
 
