@@ -91,6 +91,26 @@ def test_a_v1_frame_reads_unchanged():
     assert encode_frame(1, 142857, packet.counts) == wire + b"\x00"
 
 
+def test_a_v1_byte_stream_of_round_7_reads_unchanged():
+    """Bytes the encoder of round 7 wrote (stored in triwire_v1_stream.hex, made before
+    version 2 existed), read by today's StreamReader over loop://: every frame, its
+    sequence across the wrap, its device time and its counts; END settles no loss."""
+    text = Path(__file__).with_name("triwire_v1_stream.hex").read_text()
+    wire = bytes.fromhex(" ".join(line for line in text.splitlines() if not line.startswith("#")))
+    counts = np.random.default_rng(2026).integers(0, 65536, (12, 3, 5))
+    counts[0], counts[1] = 0, 65535
+    sensor = PAD.replace(grid__rows=3, grid__cols=5)
+    stream = StreamReader("loop://", sensor=sensor, start=False, timeout_s=0.05)
+    stream.port.write(wire)
+    frames = list(stream.frames(max_frames=12))
+    assert [f.sequence for f in frames] == [(65530 + k) % 65536 for k in range(12)]
+    assert [f.device_time_us for f in frames] == [1_000_000 + 10_000 * k for k in range(12)]
+    np.testing.assert_array_equal(np.stack([f.counts for f in frames]), counts)
+    assert stream.stats.as_dict() == LossCounters(frames=12).as_dict()
+    packets = [decode_packet(raw) for raw in wire.split(b"\x00")[:-1]]
+    assert all(p.version == 1 for p in packets[:12])
+
+
 def test_one_component_may_be_sent_as_v2():
     counts = np.full((2, 2), 7, np.uint16)
     wire = encode_frame(0, 0, counts, version=2)
