@@ -91,6 +91,26 @@ def test_a_v1_frame_reads_unchanged():
     assert encode_frame(1, 142857, packet.counts) == wire + b"\x00"
 
 
+def test_a_v1_byte_stream_of_round_7_reads_unchanged():
+    """Bytes the encoder of round 7 wrote (stored in triwire_v1_stream.hex, made before
+    version 2 existed), read by today's StreamReader over loop://: every frame, its
+    sequence across the wrap, its device time and its counts; END settles no loss."""
+    text = Path(__file__).with_name("triwire_v1_stream.hex").read_text()
+    wire = bytes.fromhex(" ".join(line for line in text.splitlines() if not line.startswith("#")))
+    counts = np.random.default_rng(2026).integers(0, 65536, (12, 3, 5))
+    counts[0], counts[1] = 0, 65535
+    sensor = PAD.replace(grid__rows=3, grid__cols=5)
+    stream = StreamReader("loop://", sensor=sensor, start=False, timeout_s=0.05)
+    stream.port.write(wire)
+    frames = list(stream.frames(max_frames=12))
+    assert [f.sequence for f in frames] == [(65530 + k) % 65536 for k in range(12)]
+    assert [f.device_time_us for f in frames] == [1_000_000 + 10_000 * k for k in range(12)]
+    np.testing.assert_array_equal(np.stack([f.counts for f in frames]), counts)
+    assert stream.stats.as_dict() == LossCounters(frames=12).as_dict()
+    packets = [decode_packet(raw) for raw in wire.split(b"\x00")[:-1]]
+    assert all(p.version == 1 for p in packets[:12])
+
+
 def test_one_component_may_be_sent_as_v2():
     counts = np.full((2, 2), 7, np.uint16)
     wire = encode_frame(0, 0, counts, version=2)
@@ -221,6 +241,66 @@ def test_formats_carry_three_components_bit_identical(spec):
         emulator.stop()
     assert stream.stats.as_dict() == LossCounters(frames=len(sent)).as_dict()
     np.testing.assert_array_equal(np.stack([f.counts for f in got]), sent)
+
+
+SIGNED = [
+    "text,offset=32768",
+    "justfloat,offset=32768,scale=0.25",
+    "marker,width=16,signed=yes",
+    "marker,width=16,order=big,signed=yes",
+]
+
+
+@pytest.mark.parametrize("spec", SIGNED)
+def test_signed_readings_arrive_as_offset_binary_counts(spec):
+    """A magnetometer's signed readings on the line, offset-binary counts in the file:
+    the emulator sends count - 32768 (scaled, for JustFloat), the reader adds it back."""
+    sent = _three_axis_frames(60, seed=5)
+    sent[0, 0, 0] = [0, 32768, 65535]  # the extremes: -32768, 0 and 32767 on the line
+    fmt = parse_format(spec)
+    emulator = Emulator(MAG, sent, speed=0, wire_format=fmt, rng=1)
+    _, port = emulator.start_tcp()
+    try:
+        with open_source(f"{fmt.spec()}:socket://127.0.0.1:{port}", sensor=MAG) as stream:
+            got = list(stream.frames())
+    finally:
+        emulator.stop()
+    assert stream.stats.as_dict() == LossCounters(frames=len(sent)).as_dict()
+    np.testing.assert_array_equal(np.stack([f.counts for f in got]), sent)
+
+
+def test_signed_values_by_hand():
+    # one taxel of three components, x y z = -5, 0, 7 on the line (sensor 1x1x3)
+    tiny = MAG.replace(grid__rows=1, grid__cols=1).frame_shape
+    text = parse_format("text,offset=32768").decoder(tiny, LossCounters(), "t")
+    np.testing.assert_array_equal(text.feed(b"-5,0,7\n")[0], [[[32763, 32768, 32775]]])
+    marker = parse_format("marker,width=16,signed=yes").decoder(tiny, LossCounters(), "m")
+    data = b"\xaa\x55" + np.array([-5, 0, 7], "<i2").tobytes()
+    np.testing.assert_array_equal(marker.feed(data * 2)[0], [[[32763, 32768, 32775]]])
+    floats = parse_format("justfloat,offset=32768,scale=10").decoder(tiny, LossCounters(), "f")
+    data = np.array([-0.5, 0.0, 0.7], "<f4").tobytes() + b"\x00\x00\x80\x7f"
+    np.testing.assert_array_equal(floats.feed(data)[0], [[[32763, 32768, 32775]]])
+
+
+def test_a_signed_value_below_the_offset_is_no_count():
+    tiny = MAG.replace(grid__rows=1, grid__cols=1).frame_shape
+    stats = LossCounters()
+    text = parse_format("text,offset=100").decoder(tiny, stats, "t")
+    assert text.feed(b"-101,0,1\n-100,0,1\n") and stats.garbage == 1
+
+
+@pytest.mark.parametrize(
+    "spec, said",
+    [
+        ("text,offset=1.5", "offset='1.5' must be whole counts"),
+        ("justfloat,offset=70000", "offset='70000' must be whole counts"),
+        ("text,offset=x", "offset='x'"),
+        ("marker,signed=maybe", "signed='maybe' must be no or yes"),
+    ],
+)
+def test_bad_offsets_and_signs_are_refused(spec, said):
+    with pytest.raises(FormatError, match=re.escape(said)):
+        parse_format(spec)
 
 
 def test_a_text_line_holds_each_taxels_components_in_turn():

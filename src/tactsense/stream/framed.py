@@ -94,6 +94,21 @@ def parse_components(name: str, value) -> int | None:
     return count
 
 
+def parse_offset(name: str, value) -> int:
+    """The ``offset=N`` option of a format: whole counts added to every value, -65535 to
+    65535 (32768 puts a signed reading's zero at the middle of a 16-bit converter)."""
+    try:
+        number = float(str(value).strip())
+    except ValueError:
+        number = float("nan")
+    if not (np.isfinite(number) and number == int(number) and abs(number) <= 65535):
+        raise FormatError(
+            f"format {name}: offset={value!r} must be whole counts from -65535 to 65535 "
+            "(e.g. 32768 for signed readings on a 16-bit converter)"
+        )
+    return int(number)
+
+
 def values_text(shape: tuple[int, ...]) -> str:
     """What a frame of ``shape`` holds, for messages: ``4x4 = 16 tactels`` or
     ``4x4 tactels x 3 components = 48 values``."""

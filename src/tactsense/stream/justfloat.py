@@ -21,6 +21,7 @@ from tactsense.stream.framed import (
     WireFormat,
     parse_components,
     parse_hex,
+    parse_offset,
     values_text,
 )
 from tactsense.stream.reader import LossCounters, StreamError
@@ -41,6 +42,10 @@ class JustFloat(WireFormat):
         Counts per unit of the values sent [default 1: the values are counts].
     components : int
         Values per taxel (1..4; default the sensor's: 3 for a three-axis taxel).
+    offset : int
+        Counts added after scaling (-65535..65535; default 0): counts =
+        value * scale + offset, so that signed readings (a magnetometer's field in uT)
+        become offset-binary counts (32768 at zero on a 16-bit converter).
     """
 
     name = "justfloat"
@@ -48,6 +53,7 @@ class JustFloat(WireFormat):
         "tail": "hex bytes",
         "scale": "counts per unit",
         "components": "1..4 values per taxel",
+        "offset": "counts added",
     }
 
     def __init__(
@@ -55,6 +61,7 @@ class JustFloat(WireFormat):
         tail: str = "0000807F",
         scale: str | float = 1.0,
         components: str | int | None = None,
+        offset: str | int = 0,
     ):
         self.tail = parse_hex("format justfloat: tail", str(tail))
         try:
@@ -68,6 +75,7 @@ class JustFloat(WireFormat):
             )
         self.noise_excluded = bytes(set(self.tail))
         self.components = parse_components("justfloat", components)
+        self.offset = parse_offset("justfloat", offset)
 
     def spec(self) -> str:
         parts = ["justfloat"]
@@ -75,6 +83,8 @@ class JustFloat(WireFormat):
             parts.append(f"tail={self.tail.hex().upper()}")
         if self.scale != 1.0:
             parts.append(f"scale={self.scale:g}")
+        if self.offset:
+            parts.append(f"offset={self.offset}")
         return ",".join(parts) + self._components_spec()
 
     def decoder(self, shape, stats: LossCounters, url: str) -> JustFloatDecoder:
@@ -83,7 +93,8 @@ class JustFloat(WireFormat):
     # ---- the emulator's side ------------------------------------------------------
 
     def encode(self, counts: np.ndarray) -> bytes:
-        return (counts / self.scale).astype(FLOAT).tobytes() + self.tail
+        values = (np.asarray(counts, np.float64) - self.offset) / self.scale
+        return values.astype(FLOAT).tobytes() + self.tail
 
     def truncate(self, wire: bytes, rng: np.random.Generator) -> bytes:
         """Fewer values than a frame's, then the tail."""
@@ -94,6 +105,7 @@ class JustFloat(WireFormat):
 class JustFloatDecoder:
     def __init__(self, fmt: JustFloat, shape, stats: LossCounters, url):
         self.shape, self.url, self.stats, self.scale = shape, url, stats, fmt.scale
+        self.offset = fmt.offset
         self.framer = DelimitedFramer(
             fmt.tail, int(np.prod(shape)) * 4, leading=False, stats=stats,
             on_shape=self._shape_error,
@@ -103,7 +115,7 @@ class JustFloatDecoder:
         if not raws:
             return []
         values = np.frombuffer(b"".join(raw for raw, _ in raws), FLOAT).reshape(len(raws), -1)
-        values = values.astype(np.float64) * self.scale
+        values = values.astype(np.float64) * self.scale + self.offset
         with np.errstate(invalid="ignore"):  # the range is checked before rounding
             good = np.isfinite(values).all(1) & (values >= 0).all(1) & (values <= 65535).all(1)
         bad = int(len(raws) - good.sum())

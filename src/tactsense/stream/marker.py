@@ -40,6 +40,9 @@ class MarkerFrames(WireFormat):
         Byte order of 16-bit samples [default little].
     components : int
         Samples per taxel (1..4; default the sensor's: 3 for a three-axis taxel).
+    signed : {'no', 'yes'}
+        Two's-complement samples (a magnetometer's signed field): read as offset-binary
+        counts, sample + 2**(width - 1) [default no].
     """
 
     name = "marker"
@@ -48,6 +51,7 @@ class MarkerFrames(WireFormat):
         "width": "8|16",
         "order": "little|big",
         "components": "1..4 values per taxel",
+        "signed": "no|yes",
     }
 
     def __init__(
@@ -56,6 +60,7 @@ class MarkerFrames(WireFormat):
         width: str | int = 8,
         order: str = "little",
         components: str | int | None = None,
+        signed: str = "no",
     ):
         self.marker = parse_hex("format marker: start", str(start))
         if str(width).strip() not in ("8", "16"):
@@ -65,14 +70,22 @@ class MarkerFrames(WireFormat):
         if order not in ORDERS:
             raise FormatError(f"format marker: order={order!r} must be little or big")
         self.order = order
-        self.dtype = np.dtype(np.uint8) if self.width == 8 else np.dtype(ORDERS[order] + "u2")
+        if str(signed).strip().lower() not in ("no", "yes"):
+            raise FormatError(f"format marker: signed={signed!r} must be no or yes")
+        self.signed = str(signed).strip().lower() == "yes"
+        kind = "i" if self.signed else "u"
+        byte_order = "" if self.width == 8 else ORDERS[order]
+        self.dtype = np.dtype(f"{byte_order}{kind}{self.width // 8}")
+        self.zero = 1 << (self.width - 1) if self.signed else 0
+        """The count of a sample 0 (offset binary): 2**(width - 1) for signed samples."""
         self.noise_excluded = bytes(set(self.marker))
         self.components = parse_components("marker", components)
 
     def spec(self) -> str:
         order = f",order={self.order}" if self.width == 16 else ""
+        signed = ",signed=yes" if self.signed else ""
         return (
-            f"marker,start={self.marker.hex().upper()},width={self.width}{order}"
+            f"marker,start={self.marker.hex().upper()},width={self.width}{order}{signed}"
             + self._components_spec()
         )
 
@@ -90,7 +103,7 @@ class MarkerFrames(WireFormat):
         return (frames >> shift).astype(np.uint16)
 
     def encode(self, counts: np.ndarray) -> bytes:
-        return self.marker + counts.astype(self.dtype).tobytes()
+        return self.marker + (np.asarray(counts, np.int64) - self.zero).astype(self.dtype).tobytes()
 
     def truncate(self, wire: bytes, rng: np.random.Generator) -> bytes:
         """The marker and the first samples, fewer than a frame's."""
@@ -99,7 +112,7 @@ class MarkerFrames(WireFormat):
 
 class MarkerDecoder:
     def __init__(self, fmt: MarkerFrames, shape, stats, url):
-        self.shape, self.dtype, self.url = shape, fmt.dtype, url
+        self.shape, self.dtype, self.url, self.zero = shape, fmt.dtype, url, fmt.zero
         self.fmt = fmt
         length = int(np.prod(shape)) * fmt.dtype.itemsize
         self.framer = DelimitedFramer(
@@ -109,7 +122,8 @@ class MarkerDecoder:
     def _frames(self, raws):
         if not raws:
             return []
-        joined = np.frombuffer(b"".join(raw for raw, _ in raws), self.dtype).astype(np.uint16)
+        joined = np.frombuffer(b"".join(raw for raw, _ in raws), self.dtype)
+        joined = (joined.astype(np.int32) + self.zero).astype(np.uint16)  # offset binary
         return list(zip(joined.reshape(-1, *self.shape), (end for _, end in raws), strict=True))
 
     def feed_ends(self, data: bytes) -> list[tuple[np.ndarray, int]]:

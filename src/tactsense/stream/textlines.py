@@ -20,6 +20,7 @@ from tactsense.stream.framed import (
     FormatError,
     WireFormat,
     parse_components,
+    parse_offset,
     values_text,
 )
 from tactsense.stream.reader import LossCounters, StreamError
@@ -46,6 +47,9 @@ class TextLines(WireFormat):
         Lines the device prints first that are not frames (a header row of names).
     components : int
         Values per taxel (1..4; default the sensor's: 3 for a three-axis taxel).
+    offset : int
+        Counts added to every value (-65535..65535; default 0): 32768 reads the signed
+        readings of a magnetometer as offset-binary counts of a 16-bit converter.
     """
 
     name = "text"
@@ -54,6 +58,7 @@ class TextLines(WireFormat):
         "prefix": "text",
         "header": "lines",
         "components": "1..4 values per taxel",
+        "offset": "counts added",
     }
     noise_excluded = bytes(range(0x80))  # line noise: bytes no ASCII parser takes
 
@@ -63,6 +68,7 @@ class TextLines(WireFormat):
         prefix: str = "",
         header: str | int = 0,
         components: str | int | None = None,
+        offset: str | int = 0,
     ):
         if sep not in SEPARATORS:
             raise FormatError(
@@ -79,6 +85,7 @@ class TextLines(WireFormat):
             raise FormatError(f"format text: prefix={prefix!r} must be ASCII on one line")
         self.sep, self.prefix, self.header = sep, prefix, header
         self.components = parse_components("text", components)
+        self.offset = parse_offset("text", offset)
 
     def spec(self) -> str:
         parts = ["text"]
@@ -88,10 +95,12 @@ class TextLines(WireFormat):
             parts.append(f"prefix={self.prefix}")
         if self.header:
             parts.append(f"header={self.header}")
+        if self.offset:
+            parts.append(f"offset={self.offset}")
         return ",".join(parts) + self._components_spec()
 
     def decoder(self, shape, stats: LossCounters, url: str) -> TextDecoder:
-        return TextDecoder(shape, stats, url, self.prefix.encode(), self.header)
+        return TextDecoder(shape, stats, url, self.prefix.encode(), self.header, self.offset)
 
     # ---- the emulator's side ------------------------------------------------------
 
@@ -100,7 +109,8 @@ class TextLines(WireFormat):
 
     def encode(self, counts: np.ndarray) -> bytes:
         sep = SEPARATORS[self.sep]
-        return (self.prefix + sep.join(map(str, counts.ravel().tolist())) + "\r\n").encode()
+        values = (np.asarray(counts, np.int64) - self.offset).ravel().tolist()
+        return (self.prefix + sep.join(map(str, values)) + "\r\n").encode()
 
     def truncate(self, wire: bytes, rng: np.random.Generator) -> bytes:
         """The line cut before its last separator (at least one value lost)."""
@@ -116,8 +126,11 @@ class TextDecoder(Packetizer):
 
     TERMINATOR = b"\n"
 
-    def __init__(self, shape, stats: LossCounters, url: str, prefix: bytes, header: int):
+    def __init__(
+        self, shape, stats: LossCounters, url: str, prefix: bytes, header: int, offset: int = 0
+    ):
         super().__init__()
+        self.offset = offset
         self.shape = tuple(shape)  # (rows, cols) or (rows, cols, components)
         self.size = int(np.prod(self.shape))
         self.stats = stats
@@ -217,7 +230,9 @@ class TextDecoder(Packetizer):
             values = np.stack(rows)
         counts = np.rint(values)
         with np.errstate(invalid="ignore"):
-            good = (counts == values).all(1) & (counts >= 0).all(1) & (counts <= 65535).all(1)
+            whole = (counts == values).all(1)
+            counts += self.offset  # offset=N: signed readings as offset-binary counts
+            good = whole & (counts >= 0).all(1) & (counts <= 65535).all(1)
         for (_, size, _), ok in zip(pending, good, strict=True):
             if not ok:
                 self._garbage(size)
