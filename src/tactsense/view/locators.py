@@ -17,6 +17,7 @@ from tactsense.kinds import kind_of, kinds
 from tactsense.sensor import SpecBase
 from tactsense.stream.live import LiveContacts, LiveLocator
 from tactsense.stream.reader import StreamFrame
+from tactsense.view.vectors import VectorReading, is_vector
 
 
 def _capacitive_deflection(counts, baseline, sensor) -> np.ndarray:
@@ -124,7 +125,21 @@ def view_locator(
 ):
     """What the view runs on each frame of ``sensor``: a contact locator where one exists
     for its kind, else :class:`DeflectionOnly` (which takes no calibration yet).
-    ``threshold`` None: the sensor's default (0.005 on the finger)."""
+    ``threshold`` None: the sensor's default (0.005 on the finger). A sensor whose
+    taxels have several components (a three-axis pad) gets its estimator (or none)
+    wrapped in :class:`~tactsense.view.vectors.VectorReading`: the map and the arrows."""
+    # ---- taxels of several components (r8-triview) ----
+    if is_vector(sensor):
+        inner = None
+        if estimates(sensor) or calibration is not None:
+            inner = _estimator(sensor, calibration, baseline_frames, threshold,
+                               frame_period_s, baseline)  # fmt: skip
+        return VectorReading(sensor, inner, baseline_frames=baseline_frames, baseline=baseline)
+    # ---- /taxels of several components (r8-triview) ----
+    return _estimator(sensor, calibration, baseline_frames, threshold, frame_period_s, baseline)
+
+
+def _estimator(sensor, calibration, baseline_frames, threshold, frame_period_s, baseline):
     locator = live_estimator(sensor)
     if locator is LiveContacts:
         return LiveContacts(
