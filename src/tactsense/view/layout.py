@@ -213,8 +213,6 @@ def layout_message(sensor: SpecBase, source: dict) -> dict:
         "multi_contact": multi_contact(sensor),
     }
     message.update(DRAWINGS.get(kind_of(sensor).view_drawing, _points_geometry)(sensor))
-    if is_vector(sensor):  # r8-triview: the normal component as the map, arrows
-        message.update(vector_layout(sensor))
     message.update(
         {
             "full_scale": int(2**sensor.electronics.adc_bits - 1),
@@ -224,4 +222,6 @@ def layout_message(sensor: SpecBase, source: dict) -> dict:
             "source": source,
         }
     )
+    if is_vector(sensor):  # r8-triview: the normal component as the map, arrows
+        message.update(vector_layout(sensor))
     return message

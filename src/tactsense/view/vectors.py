@@ -237,6 +237,17 @@ def decorate_frame(message: dict, locator, sensor) -> None:
         contact["shear_u_n"], contact["shear_v_n"] = round(float(u), 6), round(float(v), 6)
 
 
+DIVERGING = "RdBu_r"
+"""Matplotlib colour map of a normal change that goes both ways: blue below 0 (a magnet
+beside a press, lifted or pushed aside), white at 0, red above (pressed toward its sensor)."""
+
+
+def _lut(name: str) -> list:
+    from matplotlib import colormaps
+
+    return (colormaps[name](np.linspace(0.0, 1.0, 256))[:, :3] * 255).round().astype(int).tolist()
+
+
 def vector_layout(sensor) -> dict:
     """What the layout message says of a sensor of several components: which component
     the map shows and in what unit, whether arrows are drawn, and the smallest arrow
@@ -260,6 +271,8 @@ def vector_layout(sensor) -> dict:
             ),
             "arrow_floor": floor,
         },
+        # the normal change goes both ways: a diverging map, 0 in its middle
+        "colormap": {"name": DIVERGING, "lut": _lut(DIVERGING)},
         # counts mode: the dots in counts of the normal component, no surface
         "transduction": {
             "kind": sensor.transduction.kind,

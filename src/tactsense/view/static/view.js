@@ -133,7 +133,10 @@ function scale(frame) {
     if (hi - lo < 1) hi = lo + 1;
     return [lo, hi, "counts"];
   }
-  return [0, state.vmax, state.layout.vector ? state.layout.vector.map_label : "deflection [-]"];
+  // a taxel of several components: its normal change goes both ways (a press over a magnet
+  // raises it, beside one lowers it), on a diverging map centred on 0
+  if (state.layout.vector) return [-state.vmax, state.vmax, state.layout.vector.map_label];
+  return [0, state.vmax, "deflection [-]"];
 }
 
 function colour(value, lo, hi) {
@@ -683,7 +686,9 @@ function drawTraces(now) {
   const T = state.traces;
   forcePlot.setData([T.t, T.force]);
   const word = state.layout && state.layout.geometry === "plane" ? "taxel" : "tactel";
-  const title = state.selected ? `${word} (${state.selected[0]}, ${state.selected[1]}) [${state.units}]` : `${word}: click one on the map`;
+  const V = state.layout && state.layout.vector;
+  const units = V && state.units !== "counts" ? V.map_label : state.units;
+  const title = state.selected ? `${word} (${state.selected[0]}, ${state.selected[1]}) [${units}]` : `${word}: click one on the map`;
   tactelPlot.root.querySelector(".u-title").textContent = title;
   tactelPlot.setData([T.t, T.tactel]);
 }
@@ -762,7 +767,8 @@ function onFrame(f, fromHistory) {
   state.latest = f;
   if (f.deflection) {
     let peak = 0;
-    for (const row of f.deflection) for (const v of row) peak = Math.max(peak, v);
+    const size = state.layout.vector ? Math.abs : (v) => v;
+    for (const row of f.deflection) for (const v of row) peak = Math.max(peak, size(v));
     state.vmax = Math.max(0.01, peak, state.vmax * 0.995);
   }
   if (state.layout.vector) updateArrowScale(f);
