@@ -144,6 +144,8 @@ class TriaxialKind(Kind):
     contact_estimation = True
     """Contacts are estimated (:mod:`tactsense.estimate.triaxial`: position, normal and
     tangential force, slip)."""
+    if "calibration" not in scenarios:  # the normal sweep of 'calibrate'
+        scenarios = (*scenarios, "calibration")
     array_calibration = False
     """Its calibration is the three-axis one (a 3x3 matrix per taxel,
     :mod:`tactsense.estimate.triaxial.calibration`), not a pad's gains and force curve."""
