@@ -171,9 +171,10 @@ def calibrate(
         from tactsense.cli import _triaxial
 
         if _triaxial.vector_taxels(sensor):
-            for name, value in (("--steps", steps), ("--knife", knife), ("--knife-log", knife_log),
-                                ("--force-log", force_log), ("--loads", loads),
-                                ("--press", press or None), ("--threshold", threshold)):  # fmt: skip
+            given = (("--steps", steps), ("--knife", knife), ("--knife-log", knife_log),
+                     ("--force-log", force_log), ("--loads", loads),
+                     ("--press", press or None), ("--threshold", threshold))  # fmt: skip
+            for name, value in given:
                 if value is not None:
                     raise TactsenseInputError(
                         f"{name} is not for three-axis sensors; {sweep} holds one: give the "
@@ -185,8 +186,7 @@ def calibrate(
             return
         if shear_sweep:
             raise TactsenseInputError(
-                f"--shear-sweep is for three-axis sensors; {sweep} holds a "
-                f"{kind_of(kind).label}"
+                f"--shear-sweep is for three-axis sensors; {sweep} holds a {kind_of(kind).label}"
             )
         # ---- /r8-triest ----
         if kind_of(kind).array_calibration:  # else the paper's finger calibration
