@@ -139,7 +139,6 @@ class TriaxialKind(Kind):
             counts[:, dead] = 0.0
             yield first, last, counts
 
-
     # ---- three-axis estimation (r8-triest) -----------------------------------------
     contact_estimation = True
     """Contacts are estimated (:mod:`tactsense.estimate.triaxial`: position, normal and
@@ -151,7 +150,12 @@ class TriaxialKind(Kind):
     :mod:`tactsense.estimate.triaxial.calibration`), not a pad's gains and force curve."""
 
     def shear_response(
-        self, spec, positions_mm, *, force_n: float = 0.49, shear_ratio: float = 0.25,
+        self,
+        spec,
+        positions_mm,
+        *,
+        force_n: float = 0.49,
+        shear_ratio: float = 0.25,
         size_mm: float = 1.6,
     ) -> np.ndarray:
         """The change of every taxel's reading [counts/N] per newton of normal force and
@@ -173,16 +177,12 @@ class TriaxialKind(Kind):
         rest = dipole_field_t(spec, np.zeros((*spec.shape, 3)))
         out = np.empty((len(positions), 3, *spec.shape, 3))
         for k, (x, y) in enumerate(positions):
-            loads = (
-                {},
-                {"shear_x_n": shear},
-                {"shear_y_n": shear},
-            )
-            disp = np.stack([
-                magnet_displacement(spec, [SphereProbe(x, y, force_n, radius_mm=size_mm,
-                                                       friction=100.0, **load)])
+            loads = ({}, {"shear_x_n": shear}, {"shear_y_n": shear})
+            probes = [
+                SphereProbe(x, y, force_n, radius_mm=size_mm, friction=100.0, **load)
                 for load in loads
-            ])  # fmt: skip
+            ]
+            disp = np.stack([magnet_displacement(spec, [probe]) for probe in probes])
             field = dipole_field_t(spec, disp) / spec.lsb_t
             out[k, 0] = (field[0] - rest / spec.lsb_t) / force_n
             out[k, 1] = (field[1] - field[0]) / shear
@@ -190,5 +190,6 @@ class TriaxialKind(Kind):
         return out
 
     # ---- /r8-triest ----
+
 
 KIND: Any = TriaxialKind()
