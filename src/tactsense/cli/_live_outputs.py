@@ -57,6 +57,16 @@ LIVE_CONTACT_COLUMNS = (
 )  # fmt: skip
 """Columns of ``live --format csv`` on a pad or a point set: one row per contact."""
 
+SHEAR_COLUMNS = (
+    "shear_x_n", "shear_y_n", "shear_n", "shear_angle_deg", "shear_ratio", "slip_state",
+    "stick_ratio", "friction", "slip_onset_s", "slip_detected_s",
+)  # fmt: skip
+"""More columns of ``live --format csv`` on a three-axis pad (r8-triview): each contact's
+tangential force along x and y, its size [N], direction [deg] from +x toward +y, ratio to
+the normal force [-], slip (``stick``, ``partial``, ``gross``), stick ratio c/a [-],
+friction coefficient [-], slip onset and its detection [s]
+(:mod:`tactsense.estimate.triaxial.live`)."""
+
 
 def _contact_rows(estimate: dict, fields) -> list[dict]:
     """The CSV rows of one frame's contacts (one row with n_contacts 0 when none)."""
@@ -132,15 +142,20 @@ def write_estimates(stream, reader, locator, *, output_format, multi, frames, du
     from tactsense.stream.live import CONTACT_FIELDS, FIELDS
 
     writer = None
+    contact_fields = CONTACT_FIELDS
+    if int(getattr(reader.sensor, "components", 1)) > 1:  # r8-triview: shear and slip
+        contact_fields = (*CONTACT_FIELDS, *SHEAR_COLUMNS)
     if output_format is LiveFormat.csv:
         fields = LIVE_CONTACT_COLUMNS if multi else FIELDS
+        if contact_fields is not CONTACT_FIELDS:  # r8-triview
+            fields = (*LIVE_CONTACT_COLUMNS, *SHEAR_COLUMNS)
         writer = csv.DictWriter(stream, fieldnames=fields, lineterminator="\n")
         writer.writeheader()
     steps = _FrameSteps()
     for frame in reader.frames(max_frames=frames, duration_s=duration):
         with steps:
             _one_frame(frame, stream, writer, locator, outlets, rezero, multi, latencies,
-                       CONTACT_FIELDS)  # fmt: skip
+                       contact_fields)  # fmt: skip
             used[0] += 1
 
 

@@ -171,6 +171,19 @@ def _locator_for(
     kind = kind_of(spec)
     if not kind.contact_estimation:
         raise kind.unsupported(spec, "live contact estimation")
+    # ---- taxels of several components (r8-triview): contacts with shear and slip ----
+    if int(getattr(spec, "components", 1)) > 1:
+        from tactsense.estimate.triaxial import LiveShearContacts
+
+        options = contact_options or {}
+        return LiveShearContacts(
+            spec,
+            baseline_frames=baseline_frames,
+            calibration=calibration,
+            max_contacts=options.get("max_contacts", 8),
+            keep_deflection=keep_deflection,
+        )
+    # ---- /taxels of several components (r8-triview) ----
     if kind.multi_contact:
         return LiveContacts(
             spec,

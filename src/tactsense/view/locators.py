@@ -96,9 +96,19 @@ def live_estimator(sensor: SpecBase) -> type | None:
     return _estimator_of(kind_of(sensor))
 
 
+def _vector_kind(kind) -> bool:
+    """Whether a kind's taxels report several components (its sensors' frames end with a
+    component axis: ``SpecBase.components``)."""
+    return int(getattr(kind.spec_class, "components", 1)) > 1
+
+
 def _estimator_of(kind) -> type | None:
     if not kind.contact_estimation:
         return None
+    if _vector_kind(kind):  # r8-triview: taxels of several components: shear and slip
+        from tactsense.estimate.triaxial import LiveShearContacts
+
+        return LiveShearContacts
     return LiveContacts if kind.multi_contact else LiveLocator
 
 
@@ -111,7 +121,7 @@ def estimates(sensor: SpecBase) -> bool:
 def multi_contact(sensor: SpecBase) -> bool:
     """Whether the view tracks several contacts a frame on ``sensor`` (pads, point sets),
     drawn on the plane of its taxels, rather than the finger's one."""
-    return live_estimator(sensor) is LiveContacts
+    return live_estimator(sensor) is not None and bool(kind_of(sensor).multi_contact)
 
 
 def view_locator(
@@ -141,6 +151,15 @@ def view_locator(
 
 def _estimator(sensor, calibration, baseline_frames, threshold, frame_period_s, baseline):
     locator = live_estimator(sensor)
+    if locator is not None and _vector_kind(kind_of(sensor)):  # r8-triview
+        # (--threshold is a pad's fraction of the reading: the shear estimator's own
+        # threshold in counts applies)
+        return locator(
+            sensor,
+            baseline_frames=baseline_frames,
+            baseline=baseline,
+            calibration=calibration,
+        )
     if locator is LiveContacts:
         return LiveContacts(
             sensor,

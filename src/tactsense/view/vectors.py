@@ -173,6 +173,10 @@ class VectorReading:
     def __call__(self, frame: StreamFrame):
         counts = np.asarray(frame.counts, dtype=float)
         estimate = self.inner(frame) if self.inner is not None else None
+        if self._baseline is None and getattr(self.inner, "baseline", None) is not None:
+            # the estimator's (a calibration's, or its first frames): one baseline
+            self._baseline = np.asarray(self.inner.baseline, dtype=float)
+            self._collected = []
         if self._baseline is None:
             self._collected.append(counts)
             if len(self._collected) >= self._baseline_frames:
@@ -229,7 +233,8 @@ def decorate_frame(message: dict, locator, sensor) -> None:
         return
     e_u, e_v = plane_axes(sensor)
     for contact in estimate.get("contacts") or []:
-        contact["slip_state"] = slip_state(contact.get("slip"))
+        given = contact.get("slip_state")
+        contact["slip_state"] = slip_state(contact.get("slip") if given is None else given)
         x, y = contact.get("shear_x_n"), contact.get("shear_y_n")
         if x is None or y is None:
             continue
