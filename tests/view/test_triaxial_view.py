@@ -278,9 +278,9 @@ def test_browser_arrows_point_where_the_shear_pushes(page, tmp_path, shear):  # 
 
 
 class _Contacts:
-    """A stand-in for the three-axis contact estimator (issue 35 item 4, another part):
-    one contact at the pad's centre with the shear and slip it is given, so the page's
-    drawing of an estimate's fields is tested before the estimator exists."""
+    """A stand-in for the three-axis contact estimator: one contact at the pad's centre
+    with the shear and slip it is given, so that every slip state's drawing is tested
+    whatever the estimator finds on a given recording."""
 
     calibration = None
 
@@ -304,15 +304,8 @@ class _Contacts:
         }  # fmt: skip
 
 
-@pytest.mark.parametrize("slip", ["partial", "gross"])
-def test_browser_draws_a_contacts_shear_and_marks_its_slip(page, tmp_path, monkeypatch, slip):  # noqa: F811
-    import tactsense.view.feed as feed_module
-    import tactsense.view.layout as layout_module
-
-    # the layout and the feed treat the pad as tracking contacts, as they will once its
-    # kind estimates them
-    monkeypatch.setattr(layout_module, "multi_contact", lambda sensor: True)
-    monkeypatch.setattr(feed_module, "multi_contact", lambda sensor: True)
+@pytest.mark.parametrize("slip", ["stick", "partial", "gross"])
+def test_browser_draws_a_contacts_shear_and_marks_its_slip(page, tmp_path, slip):  # noqa: F811
     spec = preset("mag4x4")
     shear = (-0.25, 0.1)
     _sheared(spec, shear, tmp_path / "shear.h5")
@@ -336,4 +329,30 @@ def test_browser_draws_a_contacts_shear_and_marks_its_slip(page, tmp_path, monke
     assert "shear [N]" in headers and "dir [deg]" in headers
     assert row[4] == f"{math.hypot(*shear):.4f}"
     assert row[5] == f"{_angle_deg(*shear):.1f}"
-    assert row[6] == ("partial slip" if slip == "partial" else "gross slip")
+    assert row[6] == {"stick": "stick", "partial": "partial slip", "gross": "gross slip"}[slip]
+
+
+def test_browser_draws_the_estimated_shear_of_the_kinds_estimator(page, tmp_path):  # noqa: F811
+    # the three-axis kind's own estimator (estimate.triaxial): the contact's arrow points
+    # where the simulated shear pushes, within the issue's 5 deg, and carries its slip
+    spec = preset("mag4x4")
+    shear = (0.1, -0.1)  # Q/P = 0.28 at 0.5 N
+    _sheared(spec, shear, tmp_path / "shear.h5", force_n=0.5)
+    server = _serve(tmp_path / "shear.h5")
+    try:
+        page.goto(server.url)
+        _wait_ended(page)
+        said = page.evaluate(
+            "() => { const s = window.tactsenseView;"
+            " return {marks: s.shearMarks, contacts: s.latest.estimate.contacts,"
+            " multi: s.layout.multi_contact, note: s.layout.estimation}; }"
+        )
+    finally:
+        server.stop()
+    assert said["multi"] and said["note"] is None
+    assert len(said["marks"]) == len(said["contacts"]) >= 1
+    k = max(range(len(said["contacts"])), key=lambda i: said["contacts"][i]["force_n"])
+    m, contact = said["marks"][k], said["contacts"][k]
+    drawn = _angle_deg(m["x1"] - m["x0"], m["y0"] - m["y1"])
+    assert _off_deg(drawn, _angle_deg(*shear)) < 5.0
+    assert m["slip"] == contact["slip_state"] and m["slip"] in ("stick", "partial", "gross")
