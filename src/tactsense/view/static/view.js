@@ -687,8 +687,8 @@ function drawTraces(now) {
   forcePlot.setData([T.t, T.force]);
   const word = state.layout && state.layout.geometry === "plane" ? "taxel" : "tactel";
   const V = state.layout && state.layout.vector;
-  const units = V && state.units !== "counts" ? V.map_label : state.units;
-  const title = state.selected ? `${word} (${state.selected[0]}, ${state.selected[1]}) [${units}]` : `${word}: click one on the map`;
+  const units = V && state.units !== "counts" ? `: ${V.map_label}` : ` [${state.units}]`;
+  const title = state.selected ? `${word} (${state.selected[0]}, ${state.selected[1]})${units}` : `${word}: click one on the map`;
   tactelPlot.root.querySelector(".u-title").textContent = title;
   tactelPlot.setData([T.t, T.tactel]);
 }
