@@ -1034,3 +1034,23 @@ def test_fixc_info_duration_counts_from_the_first_frame(tmp_path):
 
 
 # ---- /(r7-fixc) ----
+
+
+# ---- three-axis pads in view (r8-triview) ----
+TRIVIEW_BAD = [
+    # a scalar pad's fractional threshold does not apply to a three-axis pad's contacts
+    ("view TRIVIEW_REC --threshold 0.01", "leave --threshold out"),
+]
+
+
+@pytest.mark.parametrize("line, names", TRIVIEW_BAD, ids=[line for line, _ in TRIVIEW_BAD])
+def test_triview_bad_options(tmp_path, line, names):
+    spec = ts.preset("mag4x4")
+    rec = tmp_path / "triview_rec.h5"
+    scenario = ts.Scenario((ts.Step((), 0.1),))
+    ts.write_recording(rec, ts.simulate(spec, scenario, rng=0))
+    result = runner.invoke(app, line.replace("TRIVIEW_REC", str(rec)).split())
+    _check(result, names)
+
+
+# ---- /three-axis pads in view (r8-triview) ----

@@ -90,3 +90,17 @@ def test_live_csv_has_the_shear_columns(pushed):
     assert math.isclose(float(last["shear_n"]), math.hypot(x, y), rel_tol=1e-6)
     assert last["slip_state"] in ("stick", "partial", "gross")
     assert np.isfinite(float(last["shear_angle_deg"]))
+
+
+@pytest.mark.parametrize(
+    "threshold, options, said",
+    [(0.01, {}, "--threshold is a fraction"),
+     (None, {"method": "joint"}, "--method 'joint' applies to scalar pads")],
+)  # fmt: skip
+def test_live_refuses_a_scalar_pads_options_on_a_three_axis_pad(threshold, options, said):
+    from tactsense._validation import TactsenseInputError
+
+    with pytest.raises(TactsenseInputError, match=said) as error:
+        _locator_for(preset("mag4x4"), None, 5, threshold, keep_deflection=False,
+                     contact_options=options)  # fmt: skip
+    assert "\n" not in str(error.value)

@@ -356,3 +356,10 @@ def test_browser_draws_the_estimated_shear_of_the_kinds_estimator(page, tmp_path
     drawn = _angle_deg(m["x1"] - m["x0"], m["y0"] - m["y1"])
     assert _off_deg(drawn, _angle_deg(*shear)) < 5.0
     assert m["slip"] == contact["slip_state"] and m["slip"] in ("stick", "partial", "gross")
+
+
+def test_view_refuses_a_scalar_threshold_on_a_three_axis_pad():
+    from tactsense._validation import TactsenseInputError
+
+    with pytest.raises(TactsenseInputError, match="leave --threshold out"):
+        view_locator(preset("mag4x4"), threshold=0.01)

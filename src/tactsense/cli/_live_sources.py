@@ -176,6 +176,17 @@ def _locator_for(
         from tactsense.estimate.triaxial import LiveShearContacts
 
         options = contact_options or {}
+        if threshold is not None:
+            raise TactsenseInputError(
+                f"--threshold is a fraction of a scalar taxel's reading; {spec.name!r} has "
+                f"{spec.components} components a taxel and its contacts' own threshold: "
+                "leave --threshold out"
+            )
+        if options.get("method", "interpolate") != "interpolate":
+            raise TactsenseInputError(
+                f"--method {options['method']!r} applies to scalar pads; {spec.name!r}'s "
+                "contacts are fitted with their shear (leave --method out)"
+            )
         return LiveShearContacts(
             spec,
             baseline_frames=baseline_frames,

@@ -140,6 +140,12 @@ def view_locator(
     wrapped in :class:`~tactsense.view.vectors.VectorReading`: the map and the arrows."""
     # ---- taxels of several components (r8-triview) ----
     if is_vector(sensor):
+        if threshold is not None:
+            raise TactsenseInputError(
+                f"--threshold is a fraction of a scalar taxel's reading; {sensor.name!r} has "
+                f"{sensor.components} components a taxel and its contacts' own threshold: "
+                "leave --threshold out"
+            )
         inner = None
         if estimates(sensor) or calibration is not None:
             inner = _estimator(sensor, calibration, baseline_frames, threshold,
