@@ -363,3 +363,40 @@ def test_view_refuses_a_scalar_threshold_on_a_three_axis_pad():
 
     with pytest.raises(TactsenseInputError, match="leave --threshold out"):
         view_locator(preset("mag4x4"), threshold=0.01)
+
+
+def test_browser_a_three_axis_device_live(page, tmp_path):  # noqa: F811
+    # `view DEVICE`: the twin emulated as a three-axis device (version-2 FRAMEs of the
+    # wire protocol, docs/protocol.md), read by the stream reader, shown with its arrows
+    from tactsense.stream import Emulator, StreamReader, protocol
+    from tactsense.view import LiveFeed
+
+    if not hasattr(protocol, "FRAME_V2"):
+        pytest.skip("the wire's three-component FRAMEs (docs/protocol.md version 2) not here")
+    spec = preset("mag4x4")
+    rec = _sheared(spec, (0.3, 0.0), force_n=0.5)
+    emulator = Emulator.from_recording(rec, repeat=True)
+    _, port = emulator.start_tcp()
+    reader = StreamReader(f"socket://127.0.0.1:{port}", start=False)
+    server = ViewServer(LiveFeed(reader, view_locator(reader.sensor, baseline_frames=5)))
+    server.start()
+    try:
+        page.goto(server.url)
+        page.wait_for_function(
+            "() => { const s = window.tactsenseView; return s.latest && s.latest.tangential"
+            " && s.latest.estimate && s.latest.estimate.n_contacts > 0"
+            " && s.drawnIndex === s.lastIndex && s.shearMarks.length > 0; }",
+            timeout=30000,
+        )
+        said = page.evaluate(
+            "() => { const s = window.tactsenseView;"
+            " return {arrows: s.arrowMarks.length, shear: s.shearMarks,"
+            " shape: [s.latest.counts.length, s.latest.counts[0].length,"
+            " s.latest.counts[0][0].length]}; }"
+        )
+    finally:
+        server.stop()
+        emulator.stop()
+    assert said["shape"] == [4, 4, 3] and said["arrows"] == 16
+    m = said["shear"][0]
+    assert _off_deg(_angle_deg(m["x1"] - m["x0"], m["y0"] - m["y1"]), 0.0) < 5.0
