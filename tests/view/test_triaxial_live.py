@@ -104,3 +104,12 @@ def test_live_refuses_a_scalar_pads_options_on_a_three_axis_pad(threshold, optio
         _locator_for(preset("mag4x4"), None, 5, threshold, keep_deflection=False,
                      contact_options=options)  # fmt: skip
     assert "\n" not in str(error.value)
+
+
+def test_live_jsonl_is_strict_json(pushed):
+    # no NaN token anywhere, the contacts' fields included (a stick ratio not yet known)
+    def refuse(token):
+        raise AssertionError(f"{token} in live's JSON")
+
+    for line in _run(pushed, LiveFormat.jsonl).splitlines():
+        json.loads(line, parse_constant=refuse)

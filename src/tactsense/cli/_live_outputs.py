@@ -159,6 +159,18 @@ def write_estimates(stream, reader, locator, *, output_format, multi, frames, du
             used[0] += 1
 
 
+def _finite(value):
+    """JSON has no NaN: None for a value that does not exist, in the contacts' dicts too
+    (a three-axis contact's stick ratio before it is known, r8-triview)."""
+    if isinstance(value, float) and not np.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {k: _finite(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_finite(v) for v in value]
+    return value
+
+
 def _one_frame(frame, stream, writer, locator, outlets, rezero, multi, latencies, fields):
     """Estimate one frame, give it to ``outlets``, write its line; its latency goes to
     ``latencies`` once the line is written."""
@@ -172,11 +184,7 @@ def _one_frame(frame, stream, writer, locator, outlets, rezero, multi, latencies
     if estimate is None:
         return
     if writer is None:
-        clean = {
-            k: (None if isinstance(v, float) and not np.isfinite(v) else v)
-            for k, v in estimate.items()
-        }
-        stream.write(json.dumps(clean) + "\n")
+        stream.write(json.dumps(_finite(estimate), allow_nan=False) + "\n")
     elif multi:
         for row in _contact_rows(estimate, fields):
             writer.writerow(row)

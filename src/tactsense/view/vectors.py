@@ -231,7 +231,9 @@ def decorate_frame(message: dict, locator, sensor) -> None:
     estimate = message.get("estimate")
     if not estimate:
         return
-    e_u, e_v = plane_axes(sensor)
+    e_u, e_v = getattr(locator, "e_u", None), getattr(locator, "e_v", None)
+    if e_u is None or e_v is None:
+        e_u, e_v = plane_axes(sensor)
     for contact in estimate.get("contacts") or []:
         given = contact.get("slip_state")
         contact["slip_state"] = slip_state(contact.get("slip") if given is None else given)
