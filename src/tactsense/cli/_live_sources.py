@@ -187,6 +187,9 @@ def _locator_for(
                 f"--method {options['method']!r} applies to scalar pads; {spec.name!r}'s "
                 "contacts are fitted with their shear (leave --method out)"
             )
+        from tactsense.view.vectors import warmed
+
+        warmed(LiveShearContacts, spec)  # its tables built before the line opens
         return LiveShearContacts(
             spec,
             baseline_frames=baseline_frames,

@@ -17,7 +17,7 @@ from tactsense.kinds import kind_of, kinds
 from tactsense.sensor import SpecBase
 from tactsense.stream.live import LiveContacts, LiveLocator
 from tactsense.stream.reader import StreamFrame
-from tactsense.view.vectors import VectorReading, is_vector
+from tactsense.view.vectors import VectorReading, is_vector, warmed
 
 
 def _capacitive_deflection(counts, baseline, sensor) -> np.ndarray:
@@ -160,6 +160,7 @@ def _estimator(sensor, calibration, baseline_frames, threshold, frame_period_s, 
     if locator is not None and _vector_kind(kind_of(sensor)):  # r8-triview
         # (--threshold is a pad's fraction of the reading: the shear estimator's own
         # threshold in counts applies)
+        warmed(locator, sensor)
         return locator(
             sensor,
             baseline_frames=baseline_frames,

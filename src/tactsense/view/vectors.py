@@ -300,3 +300,15 @@ def baseline_of(frames, n_frames: int) -> np.ndarray:
             f"need {n_frames} untouched frames for a baseline; got frames of shape {frames.shape}"
         )
     return np.nanmedian(frames[:n_frames], axis=0)
+
+
+def warmed(estimator_class, sensor) -> None:
+    """Run a contact estimator of taxels of several components once, on an untouched
+    frame, before the stream starts: its first estimate builds the sensor's response
+    table (seconds on a three-axis pad; cached per sensor description), which would
+    otherwise hold the first real frames back and leave a live stream behind."""
+    import time
+
+    rest = np.full(tuple(sensor.frame_shape), float(sensor.electronics.nominal_counts))
+    estimator = estimator_class(sensor, baseline_frames=1, baseline=rest)
+    estimator(StreamFrame(0, 0, 0.0, 0.0, time.perf_counter(), rest))
