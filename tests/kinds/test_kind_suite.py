@@ -277,12 +277,12 @@ def test_calibrate_or_say_there_is_none(case, simulated):
 VIEW = textwrap.dedent(
     """
     import json, sys, time
-    from tactsense.estimate.finger.deflection import baseline_from
     from tactsense.view.feed import RecordingFeed, view_locator
+    from tactsense.view.vectors import baseline_of  # r8-triview: any frame shape
 
     def locator_for(spec, file):
         start = file.frames(0, 5)
-        return view_locator(spec, baseline=baseline_from(start, min(5, len(start))))
+        return view_locator(spec, baseline=baseline_of(start, min(5, len(start))))
 
     feed = RecordingFeed(sys.argv[1], locator_for, speed=1e6)
     layout = feed.layout()

@@ -1034,6 +1034,54 @@ def test_fixc_info_duration_counts_from_the_first_frame(tmp_path):
 
 
 # ---- /(r7-fixc) ----
+
+
+# ---- three-axis frames in other tools' files (r8-triinterop) ----
+def _triinterop_files(folder):
+    """Files of three-axis frames that cannot be imported as mag4x4 (4 x 4 taxels x 3)."""
+    names = [f"r{r}c{c}{p}" for r in range(4) for c in range(4) for p in "xyz"]
+    row = ",".join(["32768"] * 48)
+    good = [",".join(["time", *names])] + [f"{k * 0.01},{row}" for k in range(3)]
+    (folder / "triinterop_swapped.csv").write_text(
+        "\n".join([good[0].replace("r1c2x,r1c2y", "r1c2y,r1c2x"), *good[1:]]) + "\n"
+    )
+    scalar = [",".join(["time", *(f"r{r}c{c}" for r in range(4) for c in range(4))])]
+    scalar += [f"{k * 0.01}," + ",".join(["1"] * 16) for k in range(3)]
+    (folder / "triinterop_scalar.csv").write_text("\n".join(scalar) + "\n")
+    short = [*good[:2], good[2].rsplit(",", 1)[0]]
+    (folder / "triinterop_short_row.csv").write_text("\n".join(short) + "\n")
+    if not (folder / "triinterop_press.h5").exists():  # a three-axis recording
+        from tactsense import flat_scenarios as fs
+
+        spec = ts.preset("mag4x4")
+        ts.write_recording(folder / "triinterop_press.h5",
+                           ts.simulate(spec, fs.press(spec), rng=0))  # fmt: skip
+
+
+TRIINTEROP_BAD = [
+    ("import DIR/triinterop_swapped.csv --sensor mag4x4 -o OUT",
+     "value column 19 is 'r1c2y'; sensor 'mag4x4' names it 'r1c2x'"),
+    ("import DIR/triinterop_scalar.csv --sensor mag4x4 -o OUT",
+     "16 value columns; sensor 'mag4x4' has 4 x 4 = 16 taxels x 3 components (x, y, z) = 48 "
+     "values"),
+    ("import DIR/triinterop_short_row.csv --sensor mag4x4 -o OUT", "line 3: 48 fields"),
+    ("export DIR/triinterop_press.h5 -o OUT.rrd --threshold 0.01",
+     "--calibration and --threshold apply to contacts; the Rerun file of 'mag4x4'"),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize("line, names", TRIINTEROP_BAD, ids=[line for line, _ in TRIINTEROP_BAD])
+def test_triinterop_bad_three_axis_files(workspace, line, names):
+    _triinterop_files(workspace)
+    out = workspace / "never_written_triinterop.h5"
+    args = line.replace("DIR", str(workspace)).replace("OUT", str(out)).split()
+    _check(runner.invoke(app, args), names)
+    assert not out.exists() and not out.with_suffix(".h5.rrd").exists()
+
+
+# ---- /three-axis frames in other tools' files (r8-triinterop) ----
+
+
 # ---- (r8-triphys) ----
 TRIPHYS_BAD = [  # the shear scenarios' options (issue 35 item 5)
     ("simulate --sensor mag4x4 --scenario shear --shear-ratio 1.2 -o OUT", "friction"),
@@ -1100,39 +1148,21 @@ def test_triwire_components_bad_input(workspace, line, names):
 # ---- /values per taxel on the line (r8-triwire) ----
 
 
-# ---- three-axis frames in other tools' files (r8-triinterop) ----
-def _triinterop_files(folder):
-    """Files of three-axis frames that cannot be imported as mag4x4 (4 x 4 taxels x 3)."""
-    names = [f"r{r}c{c}{p}" for r in range(4) for c in range(4) for p in "xyz"]
-    row = ",".join(["32768"] * 48)
-    good = [",".join(["time", *names])] + [f"{k * 0.01},{row}" for k in range(3)]
-    (folder / "triinterop_swapped.csv").write_text(
-        "\n".join([good[0].replace("r1c2x,r1c2y", "r1c2y,r1c2x"), *good[1:]]) + "\n"
-    )
-    scalar = [",".join(["time", *(f"r{r}c{c}" for r in range(4) for c in range(4))])]
-    scalar += [f"{k * 0.01}," + ",".join(["1"] * 16) for k in range(3)]
-    (folder / "triinterop_scalar.csv").write_text("\n".join(scalar) + "\n")
-    short = [*good[:2], good[2].rsplit(",", 1)[0]]
-    (folder / "triinterop_short_row.csv").write_text("\n".join(short) + "\n")
+# ---- three-axis pads in view (r8-triview) ----
+TRIVIEW_BAD = [
+    # a scalar pad's fractional threshold does not apply to a three-axis pad's contacts
+    ("view TRIVIEW_REC --threshold 0.01", "leave --threshold out"),
+]
 
 
-TRIINTEROP_BAD = [
-    ("import DIR/triinterop_swapped.csv --sensor mag4x4 -o OUT",
-     "value column 19 is 'r1c2y'; sensor 'mag4x4' names it 'r1c2x'"),
-    ("import DIR/triinterop_scalar.csv --sensor mag4x4 -o OUT",
-     "16 value columns; sensor 'mag4x4' has 4 x 4 = 16 taxels x 3 components (x, y, z) = 48 "
-     "values"),
-    ("import DIR/triinterop_short_row.csv --sensor mag4x4 -o OUT", "line 3: 48 fields"),
-]  # fmt: skip
+@pytest.mark.parametrize("line, names", TRIVIEW_BAD, ids=[line for line, _ in TRIVIEW_BAD])
+def test_triview_bad_options(tmp_path, line, names):
+    spec = ts.preset("mag4x4")
+    rec = tmp_path / "triview_rec.h5"
+    scenario = ts.Scenario((ts.Step((), 0.1),))
+    ts.write_recording(rec, ts.simulate(spec, scenario, rng=0))
+    result = runner.invoke(app, line.replace("TRIVIEW_REC", str(rec)).split())
+    _check(result, names)
 
 
-@pytest.mark.parametrize("line, names", TRIINTEROP_BAD, ids=[line for line, _ in TRIINTEROP_BAD])
-def test_triinterop_bad_three_axis_files(workspace, line, names):
-    _triinterop_files(workspace)
-    out = workspace / "never_written_triinterop.h5"
-    args = line.replace("DIR", str(workspace)).replace("OUT", str(out)).split()
-    _check(runner.invoke(app, args), names)
-    assert not out.exists()
-
-
-# ---- /three-axis frames in other tools' files (r8-triinterop) ----
+# ---- /three-axis pads in view (r8-triview) ----

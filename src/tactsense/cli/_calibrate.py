@@ -130,6 +130,19 @@ def calibrate(
         ),
     ] = None,
     force: Annotated[bool, typer.Option("--force", help="Replace OUT if it exists.")] = False,
+    # ---- three-axis taxels (r8-triest) ----
+    shear_sweep: Annotated[
+        list[Path] | None,
+        typer.Option(
+            "--shear-sweep",
+            help="Three-axis sensors: a recording of tangential loads under known loads "
+            "(the probe pressed on the taxels and pushed along x, or along y); give it "
+            "once per sweep, with SWEEP the normal sweep (a probe pressed on every taxel, "
+            "simulate --scenario calibration). Every taxel's 3x3 matrix is fitted to "
+            "all of them (docs/triaxial.md).",
+        ),
+    ] = None,
+    # ---- /r8-triest ----
 ) -> None:
     """Build a calibration (gains, baseline, dead/weak/noisy tactels, creep, model fit).
 
@@ -153,6 +166,29 @@ def calibrate(
 
         with RecordingReader(sweep) as reader:
             kind = reader.sensor.kind
+            # ---- three-axis taxels (r8-triest) ----
+            sensor = reader.sensor
+        from tactsense.cli import _triaxial
+
+        if _triaxial.vector_taxels(sensor):
+            given = (("--steps", steps), ("--knife", knife), ("--knife-log", knife_log),
+                     ("--force-log", force_log), ("--loads", loads),
+                     ("--press", press or None), ("--threshold", threshold))  # fmt: skip
+            for name, value in given:
+                if value is not None:
+                    raise TactsenseInputError(
+                        f"{name} is not for three-axis sensors; {sweep} holds one: give the "
+                        "normal sweep and --shear-sweep recordings"
+                    )
+            check_output(out, force, inputs=[sweep, *(shear_sweep or [])])
+            _triaxial.calibrate_shear(sweep, out, sensor=sensor, shear_sweeps=shear_sweep or [],
+                                      baseline_frames=baseline_frames)  # fmt: skip
+            return
+        if shear_sweep:
+            raise TactsenseInputError(
+                f"--shear-sweep is for three-axis sensors; {sweep} holds a {kind_of(kind).label}"
+            )
+        # ---- /r8-triest ----
         if kind_of(kind).array_calibration:  # else the paper's finger calibration
             for name, value in (("--steps", steps), ("--knife", knife), ("--knife-log", knife_log)):
                 if value is not None:

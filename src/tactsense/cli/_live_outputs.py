@@ -57,6 +57,16 @@ LIVE_CONTACT_COLUMNS = (
 )  # fmt: skip
 """Columns of ``live --format csv`` on a pad or a point set: one row per contact."""
 
+SHEAR_COLUMNS = (
+    "shear_x_n", "shear_y_n", "shear_n", "shear_angle_deg", "shear_ratio", "slip_state",
+    "stick_ratio", "friction", "slip_onset_s", "slip_detected_s",
+)  # fmt: skip
+"""More columns of ``live --format csv`` on a three-axis pad (r8-triview): each contact's
+tangential force along x and y, its size [N], direction [deg] from +x toward +y, ratio to
+the normal force [-], slip (``stick``, ``partial``, ``gross``), stick ratio c/a [-],
+friction coefficient [-], slip onset and its detection [s]
+(:mod:`tactsense.estimate.triaxial.live`)."""
+
 
 def _contact_rows(estimate: dict, fields) -> list[dict]:
     """The CSV rows of one frame's contacts (one row with n_contacts 0 when none)."""
@@ -132,16 +142,33 @@ def write_estimates(stream, reader, locator, *, output_format, multi, frames, du
     from tactsense.stream.live import CONTACT_FIELDS, FIELDS
 
     writer = None
+    contact_fields = CONTACT_FIELDS
+    if int(getattr(reader.sensor, "components", 1)) > 1:  # r8-triview: shear and slip
+        contact_fields = (*CONTACT_FIELDS, *SHEAR_COLUMNS)
     if output_format is LiveFormat.csv:
         fields = LIVE_CONTACT_COLUMNS if multi else FIELDS
+        if contact_fields is not CONTACT_FIELDS:  # r8-triview
+            fields = (*LIVE_CONTACT_COLUMNS, *SHEAR_COLUMNS)
         writer = csv.DictWriter(stream, fieldnames=fields, lineterminator="\n")
         writer.writeheader()
     steps = _FrameSteps()
     for frame in reader.frames(max_frames=frames, duration_s=duration):
         with steps:
             _one_frame(frame, stream, writer, locator, outlets, rezero, multi, latencies,
-                       CONTACT_FIELDS)  # fmt: skip
+                       contact_fields)  # fmt: skip
             used[0] += 1
+
+
+def _finite(value):
+    """JSON has no NaN: None for a value that does not exist, in the contacts' dicts too
+    (a three-axis contact's stick ratio before it is known, r8-triview)."""
+    if isinstance(value, float) and not np.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {k: _finite(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_finite(v) for v in value]
+    return value
 
 
 def _one_frame(frame, stream, writer, locator, outlets, rezero, multi, latencies, fields):
@@ -157,11 +184,7 @@ def _one_frame(frame, stream, writer, locator, outlets, rezero, multi, latencies
     if estimate is None:
         return
     if writer is None:
-        clean = {
-            k: (None if isinstance(v, float) and not np.isfinite(v) else v)
-            for k, v in estimate.items()
-        }
-        stream.write(json.dumps(clean) + "\n")
+        stream.write(json.dumps(_finite(estimate), allow_nan=False) + "\n")
     elif multi:
         for row in _contact_rows(estimate, fields):
             writer.writerow(row)

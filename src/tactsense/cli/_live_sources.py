@@ -171,6 +171,33 @@ def _locator_for(
     kind = kind_of(spec)
     if not kind.contact_estimation:
         raise kind.unsupported(spec, "live contact estimation")
+    # ---- taxels of several components (r8-triview): contacts with shear and slip ----
+    if int(getattr(spec, "components", 1)) > 1:
+        from tactsense.estimate.triaxial import LiveShearContacts
+
+        options = contact_options or {}
+        if threshold is not None:
+            raise TactsenseInputError(
+                f"--threshold is a fraction of a scalar taxel's reading; {spec.name!r} has "
+                f"{spec.components} components a taxel and its contacts' own threshold: "
+                "leave --threshold out"
+            )
+        if options.get("method", "interpolate") != "interpolate":
+            raise TactsenseInputError(
+                f"--method {options['method']!r} applies to scalar pads; {spec.name!r}'s "
+                "contacts are fitted with their shear (leave --method out)"
+            )
+        from tactsense.view.vectors import warmed
+
+        warmed(LiveShearContacts, spec)  # its tables built before the line opens
+        return LiveShearContacts(
+            spec,
+            baseline_frames=baseline_frames,
+            calibration=calibration,
+            max_contacts=options.get("max_contacts", 8),
+            keep_deflection=keep_deflection,
+        )
+    # ---- /taxels of several components (r8-triview) ----
     if kind.multi_contact:
         return LiveContacts(
             spec,

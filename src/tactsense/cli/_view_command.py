@@ -112,9 +112,9 @@ def view(
     """
     import webbrowser
 
-    from tactsense.estimate.finger.deflection import baseline_from
     from tactsense.view import LiveFeed, RecordingFeed, ViewServer, view_locator
     from tactsense.view.server import is_loopback
+    from tactsense.view.vectors import baseline_of  # r8-triview: any frame shape
 
     # ---- robot view (r7-hand3d): a robot recording or a skin's devices, in 3-D ----
     if is_robot_view(source, skin):
@@ -162,7 +162,7 @@ def view(
                 if cal is not None:
                     return view_locator(spec, calibration=cal, threshold=threshold)
                 start = file.frames(0, baseline_frames)
-                base = baseline_from(start, min(baseline_frames, len(start)))
+                base = baseline_of(start, min(baseline_frames, len(start)))  # r8-triview
                 return view_locator(spec, baseline=base, threshold=threshold)
 
             feed = RecordingFeed(path, locator_for, speed=speed)

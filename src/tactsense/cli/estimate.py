@@ -13,6 +13,7 @@ import typer
 
 from tactsense._validation import TactsenseInputError
 from tactsense.cli import _robot_locate as _robot  # r7-handloc: robot recordings
+from tactsense.cli import _triaxial  # r8-triest: three-axis taxels
 from tactsense.cli._batch import batch
 from tactsense.cli._calibrate import calibrate
 from tactsense.cli._common import (
@@ -182,6 +183,11 @@ def locate(
     ] = None,
     wrenches: Annotated[Path | None, typer.Option("--wrenches", help=_robot.WRENCHES_HELP)] = None,
     # ---- /r7-handloc ----
+    # ---- three-axis taxels (r8-triest) ----
+    friction: Annotated[
+        float | None, typer.Option("--friction", help=_triaxial.FRICTION_HELP)
+    ] = None,
+    # ---- /r8-triest ----
 ) -> None:
     """Locate the contact in every frame: position, force, skew and quality flags.
 
@@ -224,6 +230,26 @@ def locate(
             raise TactsenseInputError(f"--method {method!r}: expected one of {', '.join(METHODS)}")
         with RecordingReader(recording) as reader:
             sensor = reader.sensor
+        # ---- three-axis taxels (r8-triest) ----
+        if _triaxial.vector_taxels(sensor):
+            calibrated = None
+            if calibration is not None:
+                from tactsense.estimate.contacts.array_calibration import load_calibration
+
+                calibrated = load_calibration(calibration, sensor)
+            _triaxial.locate_shear(
+                recording, out, force, quiet, sensor=sensor, calibration=calibrated,
+                threshold=threshold, baseline_frames=baseline_frames,
+                max_contacts=max_contacts, chunk_frames=chunk_frames, friction=friction,
+                method=method,
+            )  # fmt: skip
+            return
+        if friction is not None:
+            raise TactsenseInputError(
+                f"--friction applies to three-axis sensors; {sensor.name!r} reads one "
+                "component a taxel"
+            )
+        # ---- /r8-triest ----
         calibrated = None
         if calibration is not None:
             from tactsense.estimate.contacts.array_calibration import load_calibration

@@ -55,6 +55,8 @@ _CONTACT_TYPES = {
     "slip": pa.bool_(),
     "event": pa.string(),
     "flag_names": pa.string(),
+    # ---- three-axis slip (r8-triest) ----
+    "slip_state": pa.string(),
 }
 """Types of the long table's columns that are not float64 (every other column, such as
 ``x_mm``, ``force_n`` or a finger's ``axial_mm``, is float64)."""

@@ -97,8 +97,6 @@ class TriaxialKind(Kind):
     image_grid = True
     multi_contact = True
     view_drawing = "grid"
-    contact_estimation = False  # until the three-axis estimator lands (issue 35 item 4)
-    array_calibration = False
     design_model = None
     senses_shear = True
     scenarios = ("press", "shear", "slide-to-slip", "hold", "two-probes", "slide", "loads")
@@ -161,6 +159,58 @@ class TriaxialKind(Kind):
         from tactsense.physics.triaxial_chain import triaxial_frame_blocks
 
         return triaxial_frame_blocks(self, spec, run, chunk_frames)
+
+    # ---- three-axis estimation (r8-triest) -----------------------------------------
+    contact_estimation = True
+    """Contacts are estimated (:mod:`tactsense.estimate.triaxial`: position, normal and
+    tangential force, slip)."""
+    if "calibration" not in scenarios:  # the normal sweep of 'calibrate'
+        scenarios = (*scenarios, "calibration")
+    array_calibration = False
+    """Its calibration is the three-axis one (a 3x3 matrix per taxel,
+    :mod:`tactsense.estimate.triaxial.calibration`), not a pad's gains and force curve."""
+
+    def shear_response(
+        self,
+        spec,
+        positions_mm,
+        *,
+        force_n: float = 0.49,
+        shear_ratio: float = 0.25,
+        size_mm: float = 1.6,
+    ) -> np.ndarray:
+        """The change of every taxel's reading [counts/N] per newton of normal force and
+        per newton of tangential force along x and along y, for a sphere of ``size_mm``
+        at each of ``positions_mm`` (P, 2) [mm]: shape (P, 3, rows, cols, 3), load 0 the
+        normal force, 1 the tangential along x, 2 along y; the last axis the field
+        components x, y, z.
+
+        Differences of the kind's forward model (magnet displacement, then the dipole
+        fields, no gains, no noise) about a press of ``force_n`` [N]: the normal response
+        from rest to the press, the tangential ones from the press to the press with a
+        tangential force of ``shear_ratio`` times it (friction high enough that nothing
+        slips), so that the field's curvature about the loaded state is taken in."""
+        from tactsense.physics.indenters import SphereProbe
+        from tactsense.physics.triaxial import dipole_field_t, magnet_displacement
+
+        positions = np.asarray(positions_mm, dtype=float).reshape(-1, 2)
+        shear = shear_ratio * force_n
+        rest = dipole_field_t(spec, np.zeros((*spec.shape, 3)))
+        out = np.empty((len(positions), 3, *spec.shape, 3))
+        for k, (x, y) in enumerate(positions):
+            loads = ({}, {"shear_x_n": shear}, {"shear_y_n": shear})
+            probes = [
+                SphereProbe(x, y, force_n, radius_mm=size_mm, friction=100.0, **load)
+                for load in loads
+            ]
+            disp = np.stack([magnet_displacement(spec, [probe]) for probe in probes])
+            field = dipole_field_t(spec, disp) / spec.lsb_t
+            out[k, 0] = (field[0] - rest / spec.lsb_t) / force_n
+            out[k, 1] = (field[1] - field[0]) / shear
+            out[k, 2] = (field[2] - field[0]) / shear
+        return out
+
+    # ---- /r8-triest ----
 
 
 KIND: Any = TriaxialKind()

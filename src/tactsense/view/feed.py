@@ -39,6 +39,7 @@ from tactsense.view.locators import (  # noqa: F401 - re-exported: their home wa
     multi_contact,
     view_locator,
 )
+from tactsense.view.vectors import decorate_frame, is_vector
 
 HISTORY_S = 20.0
 """Seconds of recent frames a page receives when it connects (for its time traces)."""
@@ -146,6 +147,8 @@ class Feed:
                 p = np.array([v if v is not None else 0.0 for v in xyz], dtype=float)
                 contact["u_mm"] = round(float(p @ e_u), 4)
                 contact["v_mm"] = round(float(p @ e_v), 4)
+        if is_vector(self.sensor):  # r8-triview: the taxels' arrows, contacts' shear, slip
+            decorate_frame(message, self.locator, self.sensor)
         return message
 
     def _emit(self, message: dict, *, keep: bool = True) -> None:

@@ -22,6 +22,8 @@ from tactsense.kinds import kind_of
 from tactsense.sensor import SensorSpec, SpecBase
 from tactsense.stream.reader import LOSS_KINDS
 from tactsense.view.locators import estimates, multi_contact
+from tactsense.view.plane import project_points
+from tactsense.view.vectors import is_vector, vector_layout
 
 SURFACE_STEPS = 9
 """Points of the interpolated surface per tactel spacing, along and around: the centres
@@ -90,6 +92,8 @@ def _flat_weights(n: int) -> tuple[np.ndarray, np.ndarray]:
 def _transduction(sensor) -> dict:
     """How a reading follows from the deflection (the page's counts mode needs it)."""
     t = sensor.transduction
+    if is_vector(sensor):  # r8-triview: vector_layout says it
+        return {"kind": t.kind, "counts_per_strain": 1.0, "falling": False}
     return {
         "kind": t.kind,
         "counts_per_strain": float(t.counts_per_strain),
@@ -127,45 +131,6 @@ def _pad_geometry(sensor) -> dict:
             "w_rows": np.round(w_x, 6).tolist(),
             "w_cols": np.round(w_y, 6).tolist(),
         },
-    }
-
-
-def project_points(positions_mm: np.ndarray, normals: np.ndarray) -> dict:
-    """Taxels projected onto the plane normal to their mean normal, seen from outside.
-
-    An orthographic projection along the mean outward normal ``m`` (``+z`` when the
-    normals cancel out): ``u = p . e_u``, ``v = p . e_v`` with ``e_u`` the direction of
-    ``+x`` in that plane (``+y`` when ``m`` is along ``x``) and ``e_v = m x e_u``. When
-    ``m`` is ``+z`` this is simply ``(x, y)``. Distances within the plane are true [mm];
-    distances along a curved surface shrink by the cosine of its slope.
-
-    Parameters
-    ----------
-    positions_mm : ndarray, shape (N, 3)
-        Taxel surface points [mm].
-    normals : ndarray, shape (N, 3)
-        Outward unit normals [-].
-
-    Returns
-    -------
-    dict
-        ``u_mm``, ``v_mm`` (N,) [mm], the unit vectors ``normal``, ``e_u``, ``e_v`` [-].
-    """
-    positions = np.asarray(positions_mm, dtype=float).reshape(-1, 3)
-    mean = np.asarray(normals, dtype=float).reshape(-1, 3).sum(axis=0)
-    size = float(np.linalg.norm(mean))
-    m = mean / size if size > 1e-6 * len(positions) else np.array([0.0, 0.0, 1.0])
-    e_u = np.array([1.0, 0.0, 0.0]) - m[0] * m
-    if np.linalg.norm(e_u) < 1e-6:
-        e_u = np.array([0.0, 1.0, 0.0]) - m[1] * m
-    e_u /= np.linalg.norm(e_u)
-    e_v = np.cross(m, e_u)
-    return {
-        "u_mm": positions @ e_u,
-        "v_mm": positions @ e_v,
-        "normal": m,
-        "e_u": e_u,
-        "e_v": e_v,
     }
 
 
@@ -257,4 +222,6 @@ def layout_message(sensor: SpecBase, source: dict) -> dict:
             "source": source,
         }
     )
+    if is_vector(sensor):  # r8-triview: the normal component as the map, arrows
+        message.update(vector_layout(sensor))
     return message

@@ -17,6 +17,7 @@ from tactsense.kinds import kind_of, kinds
 from tactsense.sensor import SpecBase
 from tactsense.stream.live import LiveContacts, LiveLocator
 from tactsense.stream.reader import StreamFrame
+from tactsense.view.vectors import VectorReading, is_vector, warmed
 
 
 def _capacitive_deflection(counts, baseline, sensor) -> np.ndarray:
@@ -95,9 +96,19 @@ def live_estimator(sensor: SpecBase) -> type | None:
     return _estimator_of(kind_of(sensor))
 
 
+def _vector_kind(kind) -> bool:
+    """Whether a kind's taxels report several components (its sensors' frames end with a
+    component axis: ``SpecBase.components``)."""
+    return int(getattr(kind.spec_class, "components", 1)) > 1
+
+
 def _estimator_of(kind) -> type | None:
     if not kind.contact_estimation:
         return None
+    if _vector_kind(kind):  # r8-triview: taxels of several components: shear and slip
+        from tactsense.estimate.triaxial import LiveShearContacts
+
+        return LiveShearContacts
     return LiveContacts if kind.multi_contact else LiveLocator
 
 
@@ -110,7 +121,7 @@ def estimates(sensor: SpecBase) -> bool:
 def multi_contact(sensor: SpecBase) -> bool:
     """Whether the view tracks several contacts a frame on ``sensor`` (pads, point sets),
     drawn on the plane of its taxels, rather than the finger's one."""
-    return live_estimator(sensor) is LiveContacts
+    return live_estimator(sensor) is not None and bool(kind_of(sensor).multi_contact)
 
 
 def view_locator(
@@ -124,8 +135,38 @@ def view_locator(
 ):
     """What the view runs on each frame of ``sensor``: a contact locator where one exists
     for its kind, else :class:`DeflectionOnly` (which takes no calibration yet).
-    ``threshold`` None: the sensor's default (0.005 on the finger)."""
+    ``threshold`` None: the sensor's default (0.005 on the finger). A sensor whose
+    taxels have several components (a three-axis pad) gets its estimator (or none)
+    wrapped in :class:`~tactsense.view.vectors.VectorReading`: the map and the arrows."""
+    # ---- taxels of several components (r8-triview) ----
+    if is_vector(sensor):
+        if threshold is not None:
+            raise TactsenseInputError(
+                f"--threshold is a fraction of a scalar taxel's reading; {sensor.name!r} has "
+                f"{sensor.components} components a taxel and its contacts' own threshold: "
+                "leave --threshold out"
+            )
+        inner = None
+        if estimates(sensor) or calibration is not None:
+            inner = _estimator(sensor, calibration, baseline_frames, threshold,
+                               frame_period_s, baseline)  # fmt: skip
+        return VectorReading(sensor, inner, baseline_frames=baseline_frames, baseline=baseline)
+    # ---- /taxels of several components (r8-triview) ----
+    return _estimator(sensor, calibration, baseline_frames, threshold, frame_period_s, baseline)
+
+
+def _estimator(sensor, calibration, baseline_frames, threshold, frame_period_s, baseline):
     locator = live_estimator(sensor)
+    if locator is not None and _vector_kind(kind_of(sensor)):  # r8-triview
+        # (--threshold is a pad's fraction of the reading: the shear estimator's own
+        # threshold in counts applies)
+        warmed(locator, sensor)
+        return locator(
+            sensor,
+            baseline_frames=baseline_frames,
+            baseline=baseline,
+            calibration=calibration,
+        )
     if locator is LiveContacts:
         return LiveContacts(
             sensor,

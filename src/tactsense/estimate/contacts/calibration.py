@@ -252,6 +252,21 @@ def load_calibration(path: str | Path, sensor=None):
         data = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, json.JSONDecodeError):
         data = None  # the finger's loader says what is wrong with the file
+    # ---- three-axis calibration (r8-triest) ----
+    from tactsense.estimate.triaxial.calibration import TriaxialCalibration, is_triaxial_calibration
+
+    if is_triaxial_calibration(data):
+        calibration = TriaxialCalibration.from_dict(data, source=str(path))
+        if sensor is not None:
+            calibration.check_sensor(sensor)
+        return calibration
+    if sensor is not None and int(getattr(sensor, "components", 1)) > 1:
+        raise ArrayCalibrationError(
+            f"{path} is not a three-axis calibration; {sensor.name!r} reads "
+            f"{sensor.components} components a taxel: calibrate it with 'tactsense "
+            "calibrate' on its own sweeps"
+        )
+    # ---- /r8-triest ----
     if isinstance(data, dict) and data.get("format") == FORMAT:
         calibration = ArrayCalibration.from_dict(data, source=str(path))
         if sensor is not None:

@@ -37,6 +37,10 @@ const state = {
   labels: [],             // the axes' labels as drawn: text and box [canvas px]
   dirty: false,
   traces: { t: [], force: [], tactel: [] },
+  showArrows: true,       // three-axis taxels: the tangential arrows (shear.js)
+  tmax: 0,                // their scale, a decaying running maximum [the layout's unit]
+  arrowMarks: [],         // canvas pixels of each taxel's arrow (for tests)
+  shearMarks: [],         // canvas pixels of each contact's shear arrow and its slip
 };
 window.tactsenseView = state;
 
@@ -112,23 +116,26 @@ function tactelAt(px, py) {
 // ---- values and colours -----------------------------------------------------------
 
 function values(frame) {
-  if (state.units === "counts" || !frame.deflection) return frame.counts;
+  if (state.units === "counts" || !frame.deflection) return countsOf(frame);
   return frame.deflection;
 }
 
 // what the tactel trace shows: nothing in deflection while the baseline is collected
 function traceValues(frame) {
-  if (state.units === "counts") return frame.counts;
+  if (state.units === "counts") return countsOf(frame);
   return frame.deflection;
 }
 
 function scale(frame) {
   if (state.units === "counts" || !frame.deflection) {
     let lo = Infinity, hi = -Infinity;
-    for (const row of frame.counts) for (const v of row) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
+    for (const row of countsOf(frame)) for (const v of row) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
     if (hi - lo < 1) hi = lo + 1;
     return [lo, hi, "counts"];
   }
+  // a taxel of several components: its normal change goes both ways (a press over a magnet
+  // raises it, beside one lowers it), on a diverging map centred on 0
+  if (state.layout.vector) return [-state.vmax, state.vmax, state.layout.vector.map_label];
   return [0, state.vmax, "deflection [-]"];
 }
 
@@ -443,7 +450,10 @@ function drawPlane(frame) {
   if (!frame) { drawPlaneAxes(); return; }
   const z = values(frame);
   const [lo, hi, unit] = scale(frame);
-  if (L.surface && state.showSurface && frame.deflection) drawPlaneSurface(frame, lo, hi);
+  // (a taxel of several components: no surface in counts, which follow no one law)
+  const surface = L.surface && state.showSurface && frame.deflection
+    && !(L.vector && state.units === "counts");
+  if (surface) drawPlaneSurface(frame, lo, hi);
   for (let r = 0; r < L.rows; r++) {
     for (let c = 0; c < L.cols; c++) {
       const [x, y] = planeCentre(r, c);
@@ -457,6 +467,7 @@ function drawPlane(frame) {
       ctx.stroke();
     }
   }
+  drawTaxelArrows(frame);
   drawPlaneAxes();
   drawColourBar(lo, hi, unit, m.left + m.width, m.height);
   if (state.showMarker && L.multi_contact) drawPlaneContacts();
@@ -470,6 +481,7 @@ const TRACK_COLOURS = ["#ffffff", "#ffeb3b", "#ff80ab", "#80d8ff", "#b9f6ca", "#
 function drawPlaneContacts() {
   const est = state.latest && state.latest.estimate;
   state.contactMarks = [];
+  state.shearMarks = [];
   ctx.save();
   for (const [id, track] of state.tracks) {
     const colour = TRACK_COLOURS[id % TRACK_COLOURS.length];
@@ -497,6 +509,7 @@ function drawPlaneContacts() {
     ctx.fillStyle = TRACK_COLOURS[c.id % TRACK_COLOURS.length];
     ctx.fillText(`#${c.id}`, x + size + 3, y - size);
     state.contactMarks.push({ id: c.id, x, y });
+    if (state.layout.vector) drawContactShear(c, x, y, size);
   }
   ctx.restore();
 }
@@ -559,8 +572,8 @@ function showContacts(est) {
   body.replaceChildren();
   for (const c of (est && est.contacts) || []) {
     const tr = document.createElement("tr");
-    for (const text of [`#${c.id}`, fixed(c.x_mm, 2), fixed(c.y_mm, 2), fixed(c.force_n, 4),
-      c.slip ? "slip" : ""]) {
+    const tail = state.layout.vector ? shearCells(c) : [c.slip ? "slip" : ""];
+    for (const text of [`#${c.id}`, fixed(c.x_mm, 2), fixed(c.y_mm, 2), fixed(c.force_n, 4), ...tail]) {
       const td = document.createElement("td");
       td.textContent = text;
       tr.appendChild(td);
@@ -673,7 +686,9 @@ function drawTraces(now) {
   const T = state.traces;
   forcePlot.setData([T.t, T.force]);
   const word = state.layout && state.layout.geometry === "plane" ? "taxel" : "tactel";
-  const title = state.selected ? `${word} (${state.selected[0]}, ${state.selected[1]}) [${state.units}]` : `${word}: click one on the map`;
+  const V = state.layout && state.layout.vector;
+  const units = V && state.units !== "counts" ? `: ${V.map_label}` : ` [${state.units}]`;
+  const title = state.selected ? `${word} (${state.selected[0]}, ${state.selected[1]})${units}` : `${word}: click one on the map`;
   tactelPlot.root.querySelector(".u-title").textContent = title;
   tactelPlot.setData([T.t, T.tactel]);
 }
@@ -697,6 +712,7 @@ function onLayout(L) {
   $("no-estimation").textContent = L.estimation || "";
   $("force-trace").hidden = Boolean(L.estimation);
   $("show-marker").parentElement.hidden = Boolean(L.estimation);
+  onVectorLayout(L);
   if (L.geometry === "plane") {
     state.plane = planeFrame();
     canvas.width = state.plane.left + state.plane.width + MARGIN.bar + 40;
@@ -705,7 +721,10 @@ function onLayout(L) {
     $("hint").textContent = "Click a taxel to follow it in the trace below. "
       + `${L.projection[0].toUpperCase()}${L.projection.slice(1)}; `
       + (L.surface ? "the surface is the windowed-sinc interpolation of the deflection, not wrapped at the edges."
-        : "no surface between scattered taxels, dots only.");
+        : "no surface between scattered taxels, dots only.")
+      + (L.vector ? ` The map is the ${L.vector.map_label}; `
+        + (L.vector.arrow_label ? `each arrow the ${L.vector.arrow_label} at its taxel, where the surface is pushed.` : "")
+        : "");
     $("show-surface").parentElement.hidden = !L.surface;
   } else {
     const width = cylinderLeft() + cylinderRows() * CELL + MARGIN.bar + 40;
@@ -748,9 +767,11 @@ function onFrame(f, fromHistory) {
   state.latest = f;
   if (f.deflection) {
     let peak = 0;
-    for (const row of f.deflection) for (const v of row) peak = Math.max(peak, v);
+    const size = state.layout.vector ? Math.abs : (v) => v;
+    for (const row of f.deflection) for (const v of row) peak = Math.max(peak, size(v));
     state.vmax = Math.max(0.01, peak, state.vmax * 0.995);
   }
+  if (state.layout.vector) updateArrowScale(f);
   const est = f.estimate;
   const touching = est && isContact(est);
   if (state.layout.multi_contact) updateTracks(f);
@@ -828,6 +849,7 @@ document.querySelectorAll('input[name="units"]').forEach((el) =>
   el.addEventListener("change", () => { state.units = el.value; refillTactelTrace(); state.dirty = true; }));
 $("show-surface").addEventListener("change", (e) => { state.showSurface = e.target.checked; state.dirty = true; });
 $("show-marker").addEventListener("change", (e) => { state.showMarker = e.target.checked; state.dirty = true; });
+$("show-arrows").addEventListener("change", (e) => { state.showArrows = e.target.checked; state.dirty = true; });
 canvas.addEventListener("click", (e) => {
   if (!state.layout) return;
   const rect = canvas.getBoundingClientRect();

@@ -1,0 +1,174 @@
+"""A three-axis recording's contacts, piece by piece: found, tracked, slip followed,
+written as the long table (``tactsense locate``)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import numpy as np
+
+from tactsense._validation import TactsenseInputError
+from tactsense.estimate.results import ContactTable, Flag
+
+SLIP_COLUMNS = ("slip_state", "stick_ratio", "friction", "slip_onset_s", "slip_detected_s")
+"""The columns :class:`~tactsense.estimate.triaxial.slip.SlipMonitor` adds."""
+
+
+def check_friction(friction: float | None) -> float | None:
+    """``friction`` checked: None or a coefficient in [0.05, 5] [-]."""
+    if friction is None:
+        return None
+    if not (isinstance(friction, int | float) and math.isfinite(friction)
+            and 0.05 <= friction <= 5.0):  # fmt: skip
+        raise TactsenseInputError(f"--friction must be a coefficient in 0.05-5; got {friction!r}")
+    return float(friction)
+
+
+class ShearPipeline:
+    """Frames in, tracked contacts with their shear and slip out; state (tracks, slip)
+    carried from call to call.
+
+    Parameters
+    ----------
+    sensor : a three-axis sensor description
+    baseline : array_like (rows, cols, 3)
+        Rest readings [counts] (a calibration's when one is given).
+    calibration : TriaxialCalibration, optional
+    threshold_counts : float, optional
+        :func:`~tactsense.estimate.triaxial.fit.default_threshold_counts`.
+    friction : float, optional
+        The friction coefficient [-] for the slip states; None: found per contact.
+    max_contacts : int
+    dead : array_like of bool (rows, cols), optional
+    """
+
+    def __init__(self, sensor, baseline, *, calibration=None, threshold_counts=None,
+                 friction=None, max_contacts: int = 8, dead=None):  # fmt: skip
+        from tactsense.estimate.contacts.track import ContactTracker
+        from tactsense.estimate.triaxial.slip import SlipMonitor
+
+        self.sensor = sensor
+        self.baseline = np.asarray(baseline, dtype=float)
+        self.calibration = calibration
+        self.threshold_counts = threshold_counts
+        self.max_contacts = max_contacts
+        self.dead = dead
+        self.tracker = ContactTracker(sensor.scan_period_s)
+        self.slip = SlipMonitor(sensor.scan_period_s, check_friction(friction))
+
+    def __call__(self, frames, first_frame: int = 0):
+        """``(table, events)`` of ``frames`` (N, rows, cols, 3) [counts]: the tracked
+        contacts with the shear and slip columns."""
+        from tactsense.estimate.triaxial.fit import find_shear_contacts
+
+        table = find_shear_contacts(
+            frames, self.sensor, baseline=self.baseline, calibration=self.calibration,
+            threshold_counts=self.threshold_counts, max_contacts=self.max_contacts,
+            first_frame=first_frame, dead=self.dead,
+        )  # fmt: skip
+        tracked, events = self.tracker.update(table, first_frame=first_frame)
+        columns = self.slip.update(
+            tracked.frame, tracked.id, tracked.extra["shear_ratio"], tracked.x_mm,
+            tracked.y_mm, tracked.extra["shear_angle_deg"],
+        )  # fmt: skip
+        tracked.extra.update(columns)
+        tracked.slip = np.asarray(columns["slip_state"] == "gross", dtype=bool)
+        if len(tracked):
+            self.slip.forget(np.unique(tracked.id[tracked.frame == tracked.frame.max()]))
+        return tracked, events
+
+
+def iter_shear_contacts(reader, *, baseline_frames: int = 5, calibration=None,
+                        threshold_counts=None, friction=None, max_contacts: int = 8,
+                        chunk_frames: int | None = None) -> Iterator:  # fmt: skip
+    """``(start, n, time_s, table, events)`` of an open recording, a piece at a time."""
+    sensor = reader.sensor
+    if calibration is not None:
+        calibration.check_sensor(sensor)
+        baseline = calibration.baseline
+    else:
+        if reader.n_frames < baseline_frames:
+            raise TactsenseInputError(
+                f"{reader.path} has {reader.n_frames} frames; need {baseline_frames} "
+                "untouched frames at the start for the baseline"
+            )
+        baseline = np.nanmedian(reader.frames(0, baseline_frames).astype(float), axis=0)
+    pipeline = ShearPipeline(sensor, baseline, calibration=calibration,
+                             threshold_counts=threshold_counts, friction=friction,
+                             max_contacts=max_contacts)  # fmt: skip
+    for start, frames, time_s in reader.chunks(chunk_frames):
+        table, events = pipeline(frames, first_frame=start)
+        yield start, len(frames), time_s, table, events
+
+
+def empty_table(sensor) -> ContactTable:
+    """A tracked table with no row but every column (the file's columns when nothing
+    was touched)."""
+    pipeline = ShearPipeline(sensor, np.zeros(sensor.frame_shape))
+    table, _ = pipeline(np.zeros((0, *sensor.frame_shape)))
+    return table
+
+
+def shear_contacts_file(
+    recording: str | Path,
+    out: str | Path,
+    *,
+    baseline_frames: int = 5,
+    calibration=None,
+    threshold_counts: float | None = None,
+    friction: float | None = None,
+    max_contacts: int = 8,
+    chunk_frames: int | None = None,
+    events_path: str | Path | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> dict:
+    """Every contact of a three-axis recording, tracked, with shear and slip, written
+    as the long table (CSV, Parquet or HDF5 by extension; bounded memory).
+
+    Returns a summary: ``frames``, ``rows``, ``frames_with_contact``, ``ids``, ``most``,
+    ``saturated``, ``force_max_n`` and ``shear_max_n`` [N], ``gross_slips`` (contacts
+    that slipped) and ``births``/``deaths``/``merges``/``splits``.
+    """
+    from tactsense.estimate.output import ContactsWriter, output_format
+    from tactsense.io.recording import RecordingReader
+
+    output_format(out)
+    check_friction(friction)
+    counts = {"births": 0, "deaths": 0, "merges": 0, "splits": 0}
+    frames_with = most = saturated = 0
+    force_max = shear_max = float("nan")
+    slipped: set[int] = set()
+    with RecordingReader(recording) as reader:
+        sensor = reader.sensor
+        total = reader.n_frames
+        pieces = iter_shear_contacts(
+            reader, baseline_frames=baseline_frames, calibration=calibration,
+            threshold_counts=threshold_counts, friction=friction,
+            max_contacts=max_contacts, chunk_frames=chunk_frames,
+        )  # fmt: skip
+        with ContactsWriter(out, events_path=events_path) as writer:
+            if progress is not None:
+                progress(0, total)
+            ids = 0
+            for start, n, time_s, tracked, events in pieces:
+                writer.write_contacts(np.asarray(time_s)[tracked.frame - start], tracked, events)
+                per_frame = np.bincount(tracked.frame - start, minlength=n)
+                frames_with += int(np.count_nonzero(per_frame))
+                most = max(most, int(per_frame.max(initial=0)))
+                saturated += int(np.count_nonzero(tracked.flags & int(Flag.SATURATED)))
+                if len(tracked):
+                    force_max = float(np.fmax(force_max, np.nanmax(tracked.force_n)))
+                    shear_max = float(np.fmax(shear_max, np.nanmax(tracked.extra["shear_n"])))
+                    slipped.update(int(i) for i in tracked.id[tracked.slip])
+                    ids = max(ids, int(tracked.id.max()) + 1)
+                for e in events:
+                    counts[e.kind + "s"] += 1
+                if progress is not None:
+                    progress(start + n, total)
+            if writer.rows == 0:
+                writer.write_contacts(np.zeros(0), empty_table(sensor))
+    return {"frames": total, "rows": writer.rows, "frames_with_contact": frames_with,
+            "ids": ids, "most": most, "saturated": saturated, "force_max_n": force_max,
+            "shear_max_n": shear_max, "gross_slips": len(slipped), **counts}  # fmt: skip

@@ -1,0 +1,164 @@
+"""Slip of each tracked contact from its tangential/normal force ratio over time.
+
+Cattaneo-Mindlin (Johnson 1985, section 7.2): a sphere pressed with ``P`` and loaded
+tangentially with ``Q < mu P`` sticks over a central disc of radius
+``c = a (1 - Q / (mu P))^(1/3)`` and slips on the annulus outside it (incipient slip,
+spreading in from the edge as ``Q`` grows); at ``Q = mu P`` the stick disc vanishes and
+the whole contact slides (gross slip), the tangential force staying at ``mu P``.
+
+What the taxels show of it is the ratio ``Q / P`` a contact carries. With the friction
+coefficient known (``friction``), the state follows from the ratio: ``stick`` below
+:data:`STICK_RATIO` (no tangential load worth the name), ``partial`` up to ``mu`` less a
+margin, ``gross`` beyond; the stick ratio ``c/a`` is Cattaneo-Mindlin's. Without it, a
+contact's gross slip is found where its ratio stops rising while it carries a tangential
+load and the contact starts to move along its tangential force: the ratio rose by more
+than :data:`RISE` a frame over the frames before and has risen by less than a quarter of
+that since (the plateau at ``mu``), and the contact has moved more than
+:data:`SLIDE_MM` along the tangential force since the plateau began (a hold below ``mu``
+is a plateau too, but nothing slides). The onset is dated back to the plateau's first
+frame, and from then on the contact's ``mu`` is the ratio there. The detection itself
+comes at least :data:`PLATEAU_FRAMES` frames after the onset it dates (the
+``slip_detected_s`` column says when).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+
+import numpy as np
+
+SLIP_STATES = ("stick", "partial", "gross")
+"""The slip of a contact: no tangential load; incipient (partial) slip; gross slip."""
+
+STICK_RATIO = 0.03
+"""Tangential/normal force ratio below which a contact counts as sticking [-] (the
+noise of the ratio on the twin is about 0.01)."""
+
+MARGIN = 0.04
+"""A ratio within this share of ``mu`` of it counts as gross slip [-]."""
+
+RISE = 0.002
+"""Least rise of the ratio per frame [-/frame] for the frames before a plateau."""
+
+PLATEAU_FRAMES = 3
+"""Frames of a plateau that declare gross slip (the detection's delay) [frames]."""
+
+SLIDE_MM = 0.1
+"""Movement along the tangential force that tells a slide from a hold [mm]."""
+
+HISTORY = 24
+"""Frames of each contact's ratio kept [frames]."""
+
+
+class SlipMonitor:
+    """Slip of every tracked contact, frame after frame (its state carries across pieces).
+
+    Parameters
+    ----------
+    frame_period_s : float
+        Time between frames [s].
+    friction : float, optional
+        Coefficient of friction between the skin and what touches it [-]; None: found
+        per contact at its first gross slip.
+    """
+
+    def __init__(self, frame_period_s: float, friction: float | None = None):
+        self.period = float(frame_period_s)
+        self.friction = None if friction is None else float(friction)
+        self._tracks: dict[int, dict] = {}
+
+    def _track(self, ident: int) -> dict:
+        track = self._tracks.get(ident)
+        if track is None:
+            track = {"ratio": deque(maxlen=HISTORY), "frames": deque(maxlen=HISTORY),
+                     "xy": deque(maxlen=HISTORY),
+                     "mu": self.friction, "gross": False, "onset": math.nan,
+                     "detected": math.nan}  # fmt: skip
+            self._tracks[ident] = track
+        return track
+
+    def update(self, frame, ids, ratio, x_mm, y_mm, angle_deg) -> dict[str, np.ndarray]:
+        """The slip columns of a tracked table's rows (in frame order): each row's
+        frame, id, tangential/normal ratio [-], position [mm] and tangential force's
+        direction [deg].
+
+        Returns ``slip_state`` (one of :data:`SLIP_STATES`), ``stick_ratio`` (c/a [-],
+        NaN where ``mu`` is not known yet), ``friction`` (the ``mu`` used [-], NaN if
+        unknown), ``slip_onset_s`` (time of the contact's latest gross-slip onset [s],
+        NaN before any), ``slip_detected_s`` (when that onset was detected [s]).
+        """
+        n = len(ids)
+        state = np.empty(n, dtype=object)
+        stick, mu_out = np.full(n, np.nan), np.full(n, np.nan)
+        onset, detected = np.full(n, np.nan), np.full(n, np.nan)
+        for k in range(n):
+            track = self._track(int(ids[k]))
+            rho = float(ratio[k]) if np.isfinite(ratio[k]) else 0.0
+            f = int(frame[k])
+            if track["frames"] and f != track["frames"][-1] + 1:  # a gap: start over
+                track["ratio"].clear()
+                track["frames"].clear()
+                track["xy"].clear()
+            track["ratio"].append(rho)
+            track["frames"].append(f)
+            track["xy"].append((float(x_mm[k]), float(y_mm[k])))
+            mu = track["mu"]
+            if mu is None:
+                start = self._plateau(track["ratio"], track["xy"], float(angle_deg[k]))
+                if start is not None:
+                    plateau = list(track["ratio"])[start:]
+                    track["mu"] = mu = float(np.mean(plateau))
+                    track["gross"] = True
+                    track["onset"] = track["frames"][start] * self.period
+                    track["detected"] = f * self.period
+            else:
+                gross = rho >= mu * (1.0 - MARGIN)
+                if gross and not track["gross"]:
+                    track["onset"] = track["detected"] = f * self.period
+                if not gross and track["gross"] and rho >= mu * (1.0 - 3 * MARGIN):
+                    gross = True  # hysteresis: noise about mu does not end a slide
+                track["gross"] = gross
+            if track["gross"]:
+                state[k] = "gross"
+            elif rho >= STICK_RATIO:
+                state[k] = "partial"
+            else:
+                state[k] = "stick"
+            if mu is not None:
+                mu_out[k] = mu
+                stick[k] = 0.0 if track["gross"] else (1.0 - min(rho / mu, 1.0)) ** (1 / 3)
+            onset[k], detected[k] = track["onset"], track["detected"]
+        return {"slip_state": state, "stick_ratio": stick, "friction": mu_out,
+                "slip_onset_s": onset, "slip_detected_s": detected}  # fmt: skip
+
+    @staticmethod
+    def _plateau(ratios, xy, angle_deg: float) -> int | None:
+        """Index in ``ratios`` where a plateau after a rise begins, along which the
+        contact slid, or None."""
+        r = np.asarray(ratios, dtype=float)
+        p = PLATEAU_FRAMES
+        if len(r) < 2 * p + 1 or r[-1] < 2 * STICK_RATIO:
+            return None
+        along = np.array([math.cos(math.radians(angle_deg)), math.sin(math.radians(angle_deg))])
+        moved = np.asarray(xy, dtype=float) @ along
+        for start in range(len(r) - p - 1, p - 1, -1):  # the latest plateau first
+            before = (r[start] - r[start - p]) / p
+            if before <= RISE:
+                continue
+            since = r[start:] - r[start]
+            if np.abs(since).max() < 0.25 * before * max(len(since) - 1, 1) and (
+                moved[-1] - moved[start] > SLIDE_MM
+            ):
+                while start > 1 and r[start] - r[start - 1] < 0.5 * before:
+                    start -= 1  # back to the knee: the last frame that still rose
+                return start
+            return None
+        return None
+
+    def forget(self, alive_ids) -> None:
+        """Drop the tracks of contacts no longer alive."""
+        alive = {int(i) for i in alive_ids}
+        for ident in list(self._tracks):
+            if ident not in alive:
+                del self._tracks[ident]
