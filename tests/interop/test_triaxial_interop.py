@@ -73,7 +73,11 @@ def test_csv_has_a_column_per_taxel_and_component(tmp_path, pressed):
     assert table.column_names == ["time", *_expected_names(4, 4)]
     for name, (r, c, k) in (("r0c0x", (0, 0, 0)), ("r2c3y", (2, 3, 1)), ("r3c1z", (3, 1, 2))):
         np.testing.assert_array_equal(table.column(name).to_numpy(), rec.frames[:, r, c, k])
-    back = _import(out, tmp_path / "back.h5", "--sensor", "mag4x4")
+    result = runner.invoke(app, ["import", str(out), "--sensor", "mag4x4", "-o",
+                                 str(tmp_path / "back.h5")])  # fmt: skip
+    assert result.exit_code == 0, result.output
+    assert f"{len(rec)} frames of mag4x4 (4 x 4 x 3 components)" in result.output
+    back = ts.read_recording(tmp_path / "back.h5")
     np.testing.assert_array_equal(back.frames, rec.frames)
     assert back.frames.dtype == np.uint16
 
