@@ -638,3 +638,42 @@ def test_lsl_contact_slots_carry_the_shear(pressed):
         assert np.isnan(got[0][11:]).all()
     finally:
         outlets.close()
+
+
+def test_record_from_a_three_axis_lsl_outlet(tmp_path, pressed):
+    """``record lsl:NAME``: the sensor from the outlet's own description, the frames
+    (T, 4, 4, 3) as pushed."""
+    import dataclasses
+    import threading
+
+    from tactsense.interop.lsl import LslOutlets
+
+    _, rec = pressed
+    sensor = dataclasses.replace(rec.sensor, name=f"lslrec{uuid.uuid4().hex[:8]}")
+    outlets = LslOutlets(sensor, {"serial": uuid.uuid4().hex[:6]}, 100.0)
+    stop = threading.Event()
+
+    def push():
+        time.sleep(1.0)  # the recorder resolves and opens the inlet first
+        for frame in _stream_frames(rec):
+            if stop.is_set():
+                return
+            outlets.push(frame, None)
+            time.sleep(1 / 200)
+
+    pusher = threading.Thread(target=push, daemon=True)
+    pusher.start()
+    out = tmp_path / "from_lsl.h5"
+    try:
+        result = runner.invoke(
+            app, ["record", f"lsl:{sensor.name}-frames", "--frames", str(len(rec)), "--out",
+                  str(out), "--duration", "30"],
+        )  # fmt: skip
+    finally:
+        stop.set()
+        pusher.join(5)
+        outlets.close()
+    assert result.exit_code == 0, result.output
+    got = ts.read_recording(out)
+    assert got.sensor == sensor
+    np.testing.assert_array_equal(got.frames, rec.frames)
