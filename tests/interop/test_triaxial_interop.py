@@ -677,3 +677,22 @@ def test_record_from_a_three_axis_lsl_outlet(tmp_path, pressed):
     got = ts.read_recording(out)
     assert got.sensor == sensor
     np.testing.assert_array_equal(got.frames, rec.frames)
+
+
+@pytest.mark.parametrize("form", ["mcap", "lerobot"])
+def test_frames_alone_refuse_the_options_of_contacts(tmp_path, pressed, monkeypatch, form):
+    """Without a contact estimator (none installed: monkeypatched away where it is) the
+    export writes the frames alone and refuses --threshold rather than ignore it."""
+    from tactsense._validation import TactsenseInputError
+    from tactsense.interop import components
+    from tactsense.interop.lerobot import export_lerobot
+    from tactsense.interop.mcap import export_mcap
+
+    monkeypatch.setattr(components, "component_contacts", lambda *a, **k: None)
+    path, _ = pressed
+    run = export_mcap if form == "mcap" else export_lerobot
+    with pytest.raises(TactsenseInputError, match="apply to contacts; no contact estimator"):
+        run(path, tmp_path / f"out.{form}", threshold=0.01)
+    assert not (tmp_path / f"out.{form}").is_dir()
+    summary = run(path, tmp_path / f"frames.{form}")
+    assert summary["contacts"] is None
