@@ -696,3 +696,39 @@ def test_frames_alone_refuse_the_options_of_contacts(tmp_path, pressed, monkeypa
     assert not (tmp_path / f"out.{form}").is_dir()
     summary = run(path, tmp_path / f"frames.{form}")
     assert summary["contacts"] is None
+
+
+def test_ros2_live_contacts_carry_the_live_shear(loopback_dds, sheared):
+    """The live three-axis estimate's contacts, published: each TactileContact's wrench
+    force is (shear_x_n, shear_y_n, -force_n) of the estimate (rosbags decodes it)."""
+    from tactsense.interop.ros2 import Ros2Publisher
+
+    from .ros2_subscriber import typestore
+
+    _, rec = sheared
+    store = typestore()
+    estimator = pytest.importorskip("tactsense.estimate.triaxial")
+    live = estimator.LiveShearContacts(rec.sensor, baseline_frames=5)
+    publisher = Ros2Publisher(rec.sensor, node_name="trishear", frame_id="pad")
+    compared = 0
+    try:
+        for frame in _stream_frames(rec):
+            estimate = live(frame)
+            if estimate is None:
+                continue
+            raw = publisher.encode(frame, estimate)["contact_states"]
+            message = store.deserialize_cdr(raw, "tactile_msgs/msg/TactileContacts")
+            kept = [
+                c
+                for c in estimate["contacts"]
+                if all(np.isfinite(c[k]) for k in ("x_mm", "y_mm", "z_mm", "force_n"))
+            ]
+            assert len(message.contacts) == len(kept)
+            for got, want in zip(message.contacts, kept, strict=True):
+                f = got.wrench.force
+                assert [f.x, f.y, f.z] == [want["shear_x_n"], want["shear_y_n"],
+                                           -want["force_n"]]  # fmt: skip
+                compared += 1
+    finally:
+        publisher.close()
+    assert compared > 10
