@@ -679,7 +679,7 @@ def test_record_from_a_three_axis_lsl_outlet(tmp_path, pressed):
     np.testing.assert_array_equal(got.frames, rec.frames)
 
 
-@pytest.mark.parametrize("form", ["mcap", "lerobot"])
+@pytest.mark.parametrize("form", ["mcap", "lerobot", "rrd"])
 def test_frames_alone_refuse_the_options_of_contacts(tmp_path, pressed, monkeypatch, form):
     """Without a contact estimator (none installed: monkeypatched away where it is) the
     export writes the frames alone and refuses --threshold rather than ignore it."""
@@ -687,10 +687,11 @@ def test_frames_alone_refuse_the_options_of_contacts(tmp_path, pressed, monkeypa
     from tactsense.interop import components
     from tactsense.interop.lerobot import export_lerobot
     from tactsense.interop.mcap import export_mcap
+    from tactsense.interop.rerun import export_rerun
 
     monkeypatch.setattr(components, "component_contacts", lambda *a, **k: None)
     path, _ = pressed
-    run = export_mcap if form == "mcap" else export_lerobot
+    run = {"mcap": export_mcap, "lerobot": export_lerobot, "rrd": export_rerun}[form]
     with pytest.raises(TactsenseInputError, match="apply to contacts; no contact estimator"):
         run(path, tmp_path / f"out.{form}", threshold=0.01)
     assert not (tmp_path / f"out.{form}").is_dir()
@@ -732,3 +733,37 @@ def test_ros2_live_contacts_carry_the_live_shear(loopback_dds, sheared):
     finally:
         publisher.close()
     assert compared > 10
+
+
+def test_rerun_contacts_and_their_shear(tmp_path, sheared):
+    """With the three-axis estimator: each frame's contacts in the Rerun file are
+    'locate''s (positions [mm], ids), each with an arrow of its tangential force at
+    SHEAR_MM_PER_N (rerun.chunk.RrdReader)."""
+    import pyarrow.parquet as pq
+
+    from tactsense.interop.rerun_components import SHEAR_MM_PER_N
+
+    path, rec = sheared
+    out, located = tmp_path / "sheared.rrd", tmp_path / "located.parquet"
+    result = runner.invoke(app, ["export", str(path), "-o", str(out), "--quiet"])
+    assert result.exit_code == 0, result.output
+    assert runner.invoke(app, ["locate", str(path), "-o", str(located)]).exit_code == 0
+    rows = [r for r in pq.read_table(located).to_pylist() if np.isfinite(r["x_mm"])]
+    columns = _rerun_columns(out)
+    points = columns[("/triaxial/contacts", "Points3D:positions")]
+    arrows = columns[("/triaxial/contact_shear", "Arrows3D:vectors")]
+    time_of = {round(t, 9): k for k, t in enumerate(rec.time_s)}
+    by_frame = {}
+    for r in rows:
+        by_frame.setdefault(r["frame"], []).append(r)
+    got = [(time_of[round(t, 9)], v) for t, v in points if v]
+    assert len(got) == len(by_frame) > 10
+    for (k, positions), (_, vectors) in zip(got, [a for a in arrows if a[1]], strict=True):
+        want = sorted(by_frame[k], key=lambda r: r["contact"])
+        np.testing.assert_allclose(
+            positions, [[r["x_mm"], r["y_mm"], r["z_mm"]] for r in want], rtol=1e-6, atol=1e-5
+        )
+        np.testing.assert_allclose(
+            vectors, [[r["shear_x_n"] * SHEAR_MM_PER_N, r["shear_y_n"] * SHEAR_MM_PER_N, 0]
+                      for r in want], rtol=1e-5, atol=1e-5,
+        )  # fmt: skip

@@ -109,15 +109,10 @@ def export_rerun(
         if sensor.components > 1:  # ---- several components a taxel (r8-triinterop) ----
             from tactsense.interop.rerun_components import export_components_rerun
 
-            if calibration is not None or threshold is not None:
-                raise TactsenseInputError(
-                    f"--calibration and --threshold apply to contacts; the Rerun file of "
-                    f"{sensor.name!r} (several components a taxel) holds its frames only"
-                )
-
             return export_components_rerun(
                 rr, reader, recording, out, baseline_frames=baseline_frames,
                 value_range=deflection_range, recording_id=recording_id, progress=progress,
+                calibration=calibration, threshold=threshold,
             )  # fmt: skip
         if kind_of(sensor).multi_contact:  # every contact, tracked
             return _export_array(
