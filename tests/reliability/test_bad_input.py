@@ -1050,12 +1050,6 @@ def _triinterop_files(folder):
     (folder / "triinterop_scalar.csv").write_text("\n".join(scalar) + "\n")
     short = [*good[:2], good[2].rsplit(",", 1)[0]]
     (folder / "triinterop_short_row.csv").write_text("\n".join(short) + "\n")
-    if not (folder / "triinterop_press.h5").exists():  # a three-axis recording
-        from tactsense import flat_scenarios as fs
-
-        spec = ts.preset("mag4x4")
-        ts.write_recording(folder / "triinterop_press.h5",
-                           ts.simulate(spec, fs.press(spec), rng=0))  # fmt: skip
 
 
 TRIINTEROP_BAD = [
@@ -1065,8 +1059,6 @@ TRIINTEROP_BAD = [
      "16 value columns; sensor 'mag4x4' has 4 x 4 = 16 taxels x 3 components (x, y, z) = 48 "
      "values"),
     ("import DIR/triinterop_short_row.csv --sensor mag4x4 -o OUT", "line 3: 48 fields"),
-    ("export DIR/triinterop_press.h5 -o OUT.rrd --threshold 0.01",
-     "--calibration and --threshold apply to contacts; the Rerun file of 'mag4x4'"),
 ]  # fmt: skip
 
 
@@ -1076,7 +1068,7 @@ def test_triinterop_bad_three_axis_files(workspace, line, names):
     out = workspace / "never_written_triinterop.h5"
     args = line.replace("DIR", str(workspace)).replace("OUT", str(out)).split()
     _check(runner.invoke(app, args), names)
-    assert not out.exists() and not out.with_suffix(".h5.rrd").exists()
+    assert not out.exists()
 
 
 # ---- /three-axis frames in other tools' files (r8-triinterop) ----
