@@ -7,8 +7,8 @@ with the ring of taxels around it (less other groups' taxels), is fitted with th
 kind's response (:mod:`.response`): for a position ``p`` the change is
 ``N R_n(p) + Q_x R_x(p) + Q_y R_y(p)``, linear in the loads, so the loads are a linear
 least-squares solution at each node of the response grid and the position is the node
-of least residual, refined by a parabola through its neighbours along each axis
-(variable projection). The tangential force's magnitude and direction follow.
+of least residual, refined by a simplex search over the response's cubic spline
+between nodes (variable projection). The tangential force's magnitude and direction follow.
 
 The normal force cannot come from a sum over the taxels: an incompressible layer
 (nu = 0.5) bonded to a rigid base moves as much material up beside a contact as down
@@ -21,7 +21,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy import ndimage
+from scipy import ndimage, optimize
 
 from tactsense._validation import TactsenseInputError
 from tactsense.estimate.results import ContactTable, Flag
@@ -177,30 +177,27 @@ def _fit_group(change, window, own, table, sensor):
     if not np.isfinite(residual).any():
         return None
     bi, bj = np.unravel_index(int(np.argmin(residual)), shape)
+    x0, y0 = table.x_mm[i0 + bi], table.y_mm[j0 + bj]
     hx, hy = table.step_mm
-    x = table.x_mm[i0 + bi] + hx * _vertex(residual[max(bi - 1, 0) : bi + 2, bj], bi)
-    y = table.y_mm[j0 + bj] + hy * _vertex(residual[bi, max(bj - 1, 0) : bj + 2], bj)
-    response = table.at(x, y)[:, pick]
-    (load,), (res,) = _solve(response[None], m)
-    if load[0] <= 0:
+
+    def solved(p):
+        loads_, res_ = _solve(table.at(p[0], p[1], pick)[None], m)
+        return loads_[0], float(res_[0])
+
+    best = optimize.minimize(
+        lambda p: solved(p)[1], np.array([x0, y0]), method="Nelder-Mead",
+        options={"initial_simplex": [[x0, y0], [x0 + 0.5 * hx, y0], [x0, y0 + 0.5 * hy]],
+                 "xatol": 1e-3, "fatol": 1e-6 * max(float(m @ m), 1e-12), "maxiter": 200},
+    )  # fmt: skip
+    x, y = (float(v) for v in best.x)
+    load, res = solved(best.x)
+    if load[0] <= 0 or res > residual[bi, bj]:
         load, res = loads.reshape(*shape, 3)[bi, bj], residual[bi, bj]
-        x, y = table.x_mm[i0 + bi], table.y_mm[j0 + bj]
+        x, y = x0, y0
     noise = max(float(getattr(sensor.flaws, "read_noise_counts", 0.0) or 0.0), 1.0)
     return {"x_mm": float(x), "y_mm": float(y), "force_n": float(load[0]),
             "shear_x_n": float(load[1]), "shear_y_n": float(load[2]),
             "residual": math.sqrt(max(float(res), 0.0) / max(len(m), 1)) / noise}  # fmt: skip
-
-
-def _vertex(values: np.ndarray, centre: int) -> float:
-    """Offset [nodes] of a parabola's vertex through three residuals about the least,
-    in [-0.5, 0.5]; 0 at the grid's edge or where the residuals are not convex."""
-    if len(values) != 3 or centre == 0 or not np.isfinite(values).all():
-        return 0.0
-    left, mid, right = values
-    curvature = left - 2.0 * mid + right
-    if curvature <= 0:
-        return 0.0
-    return float(np.clip(0.5 * (left - right) / curvature, -0.5, 0.5))
 
 
 def _append(out, frame, rank, fit, own, size, railed, flags, sensor) -> None:
