@@ -47,6 +47,10 @@ PLATEAU_FRAMES = 3
 SLIDE_MM = 0.1
 """Movement along the tangential force that tells a slide from a hold [mm]."""
 
+MIN_FORCE_N = 0.02
+"""Normal force below which a contact's ratio means nothing (a lift's last frames, where
+noise over a vanishing force reads as any ratio): it counts as unloaded [N]."""
+
 HISTORY = 24
 """Frames of each contact's ratio kept [frames]."""
 
@@ -78,10 +82,11 @@ class SlipMonitor:
             self._tracks[ident] = track
         return track
 
-    def update(self, frame, ids, ratio, x_mm, y_mm, angle_deg) -> dict[str, np.ndarray]:
+    def update(self, frame, ids, ratio, x_mm, y_mm, angle_deg, force_n) -> dict[str, np.ndarray]:
         """The slip columns of a tracked table's rows (in frame order): each row's
-        frame, id, tangential/normal ratio [-], position [mm] and tangential force's
-        direction [deg].
+        frame, id, tangential/normal ratio [-], position [mm], tangential force's
+        direction [deg] and normal force [N] (below :data:`MIN_FORCE_N` the contact
+        counts as unloaded).
 
         Returns ``slip_state`` (one of :data:`SLIP_STATES`), ``stick_ratio`` (c/a [-],
         NaN where ``mu`` is not known yet), ``friction`` (the ``mu`` used [-], NaN if
@@ -94,7 +99,8 @@ class SlipMonitor:
         onset, detected = np.full(n, np.nan), np.full(n, np.nan)
         for k in range(n):
             track = self._track(int(ids[k]))
-            rho = float(ratio[k]) if np.isfinite(ratio[k]) else 0.0
+            loaded = np.isfinite(ratio[k]) and force_n[k] >= MIN_FORCE_N
+            rho = float(ratio[k]) if loaded else 0.0
             f = int(frame[k])
             if track["frames"] and f != track["frames"][-1] + 1:  # a gap: start over
                 track["ratio"].clear()
