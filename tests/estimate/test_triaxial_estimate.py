@@ -211,18 +211,31 @@ def test_a_hold_below_mu_never_slips(spec, calibration, friction):
 
 
 def test_slip_states_follow_cattaneo_mindlin():
-    """With mu known: stick below the stick ratio, partial below mu, gross at mu; the stick
-    ratio c/a = (1 - Q/(mu P))^(1/3) (Johnson 1985, eq. 7.40)."""
+    """With mu known: stick below the stick ratio, partial below mu, gross at mu for two
+    frames running (dated to the first); the stick ratio c/a = (1 - Q/(mu P))^(1/3)
+    (Johnson 1985, eq. 7.40)."""
     monitor = SlipMonitor(0.01, friction=0.5)
-    ratios = np.array([0.0, 0.01, 0.1, 0.25, 0.4, 0.49, 0.5, 0.3])
+    ratios = np.array([0.0, 0.01, 0.1, 0.25, 0.4, 0.49, 0.5, 0.3, 0.49, 0.2])
     n = len(ratios)
-    out = monitor.update(np.arange(n), np.zeros(n, int), ratios, np.zeros(n), np.zeros(n),
-                         np.zeros(n), np.full(n, 0.5))  # fmt: skip
-    assert list(out["slip_state"]) == ["stick", "stick", "partial", "partial", "partial",
-                                       "gross", "gross", "partial"]  # fmt: skip
+    out = monitor.update(
+        np.arange(n),
+        np.zeros(n, int),
+        ratios,
+        np.zeros(n),
+        np.zeros(n),
+        np.zeros(n),
+        np.full(n, 0.5),
+    )
+    assert list(out["slip_state"]) == [
+        "stick", "stick", "partial", "partial", "partial", "partial", "gross", "partial",
+        "partial", "partial",
+    ]  # fmt: skip
     np.testing.assert_allclose(out["stick_ratio"][3], (1 - 0.25 / 0.5) ** (1 / 3))
-    assert out["stick_ratio"][5] == 0.0
-    np.testing.assert_allclose(out["slip_onset_s"][5:], 0.05)
+    np.testing.assert_allclose(out["stick_ratio"][5], (1 - 0.49 / 0.5) ** (1 / 3))
+    assert out["stick_ratio"][6] == 0.0
+    np.testing.assert_allclose(out["slip_onset_s"][6:], 0.05)
+    np.testing.assert_allclose(out["slip_detected_s"][6:], 0.06)
+    assert np.isnan(out["slip_onset_s"][:6]).all()
 
 
 def test_live_gives_the_numbers_locate_gives(spec, calibration):
