@@ -291,3 +291,23 @@ def test_locate_writes_the_shear_columns(tmp_path, spec):
     held = [r for r in rows if r["slip_state"] == "gross"]
     assert all(abs(float(r["shear_angle_deg"]) - 45.0) < 5.0 for r in held)
     assert "contacts slipped" in " ".join(done.output.split())
+
+
+def test_the_docs_state_the_estimators_constants():
+    """docs/triaxial.md's r8-triest block names the constants the code uses."""
+    from pathlib import Path
+
+    from tactsense.estimate.triaxial import fit, response, slip
+
+    doc = (Path(__file__).resolve().parents[2] / "docs" / "triaxial.md").read_text()
+    block = doc[doc.index("<!-- r8-triest -->") : doc.index("<!-- /r8-triest -->")]
+    words = {2: "two", 3: "three", 4: "four", 6: "six", 8: "8"}
+    assert f"{words[response.N_SUB]} nodes a pitch" in block
+    assert f"less {slip.MARGIN * 100:g} %" in block
+    assert f"{words[slip.CONFIRM]} frames running" in block
+    assert f"more than {slip.SLIDE_MM:g} mm" in block
+    spec = preset("mag4x4")
+    assert fit.default_threshold_counts(spec) == pytest.approx(
+        8 * math.sqrt(3) * spec.flaws.read_noise_counts
+    )
+    assert "8 read noises times sqrt(3), at least 10 counts" in block

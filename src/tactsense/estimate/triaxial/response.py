@@ -5,8 +5,8 @@ runs the simulator): the change of every taxel's three components [counts/N] per
 of normal force and of tangential force along x and y, for the scenarios' probe (a
 1.6-mm sphere) at each node of a grid of positions that covers the pad a half pitch
 beyond its outer taxels, ``n_sub`` nodes per pitch. Between nodes the response is a
-cubic B-spline through them (4 % of the largest value at 4 nodes a pitch on ``mag4x4``,
-1 % at 6, against the kind's own response at random places; bilinear: 17 % and 9 %).
+cubic B-spline through them, within 2 % of the largest value of the kind's own response
+at random places (``tests/estimate/test_triaxial_estimate.py``).
 """
 
 from __future__ import annotations
