@@ -184,7 +184,9 @@ def slide(
     settle_s: float = 0.2,
 ) -> Scenario:
     """A sphere sliding at constant force from ``start_mm`` to ``end_mm`` (default: across the
-    middle of the pad along y), moved in steps of ``increment_mm``."""
+    middle of the pad along y), moved in steps of ``increment_mm``; on a kind that senses
+    shear (a three-axis pad) it drags the skin with the friction of gross slip, mu P
+    (mu = 1), along its motion."""
     check_positive(speed_mm_s, "speed_mm_s")
     check_positive(increment_mm, "increment_mm")
     cx, _ = centre_mm(spec)
@@ -203,10 +205,14 @@ def slide(
     n = max(1, math.ceil(length / increment_mm))
     dwell = (length / n) / speed_mm_s if length > 0 else 0.1
     steps = _settle(settle_s)
+    # a kind that senses shear feels the friction the sliding sphere drags the skin with:
+    # mu P (mu = 1) along the motion, gross slip (r8-triphys)
+    drag = force_n * (end - start) / length if length > 0 and kind_of(spec).senses_shear else (0, 0)
     for k in range(n + 1):
         x, y = start + (end - start) * k / n
-        steps.append(Step((SphereProbe(float(x), float(y), force_n, radius_mm=size_mm),), dwell,
-                          f"slide {k}"))  # fmt: skip
+        sphere = SphereProbe(float(x), float(y), force_n, radius_mm=size_mm,
+                             shear_x_n=float(drag[0]), shear_y_n=float(drag[1]))  # fmt: skip
+        steps.append(Step((sphere,), dwell, f"slide {k}"))
     steps.append(Step((), 0.2, "lifted"))
     return Scenario(
         tuple(steps),
@@ -391,6 +397,147 @@ def loads(
     )  # fmt: skip
 
 
+# ---- shear and slip on three-axis taxels (r8-triphys) ----
+def _ramp_steps(spec, ramp_s: float) -> tuple[int, float]:
+    """A ramp over ``ramp_s`` [s] cut into steps of one scan period (at least one):
+    (number of steps, duration of each [s]), so that the truth resolves every frame."""
+    n = max(1, math.ceil(ramp_s / spec.scan_period_s - 1e-9))
+    return n, ramp_s / n
+
+
+def _shear_checks(spec, shear_ratio, friction, ramp_s, angle_deg) -> None:
+    check_positive(ramp_s, "ramp_s")
+    check_positive(friction, "friction")
+    check_positive(shear_ratio, "shear_ratio")
+    if not math.isfinite(angle_deg):
+        raise TactsenseInputError(f"angle_deg must be a finite number; got {angle_deg!r}")
+
+
+def shear(
+    spec,
+    *,
+    x_mm: float | None = None,
+    y_mm: float | None = None,
+    force_n: float = FIFTY_GRAMS,
+    size_mm: float = 1.6,
+    shear_ratio: float = 0.3,
+    angle_deg: float = 0.0,
+    friction: float = 1.0,
+    ramp_s: float = 0.5,
+    dwell_s: float = 0.5,
+    settle_s: float = 0.2,
+) -> Scenario:
+    """Press a sphere, ramp a tangential force along ``angle_deg`` (from x [deg]) up to
+    ``shear_ratio`` times the normal force (below ``friction``: the contact sticks at its
+    centre while slip spreads in from its edge, Cattaneo-Mindlin), hold it ``dwell_s``,
+    ramp it back down, lift. Ramps are ``ramp_s`` long, in steps of one scan period."""
+    _shear_checks(spec, shear_ratio, friction, ramp_s, angle_deg)
+    check_positive(dwell_s, "dwell_s")
+    if shear_ratio >= friction:
+        raise TactsenseInputError(
+            f"shear_ratio {shear_ratio:g} is at or above the friction {friction:g}: the "
+            "contact would slide; 'shear' holds below it (use 'slide-to-slip' to slide)"
+        )
+    cx, cy = centre_mm(spec)
+    x, y = (cx if x_mm is None else x_mm), (cy if y_mm is None else y_mm)
+    _check_on(spec, x, y, "sphere")
+    ux, uy = math.cos(math.radians(angle_deg)), math.sin(math.radians(angle_deg))
+    n, each = _ramp_steps(spec, ramp_s)
+
+    def sheared(fraction: float) -> SphereProbe:
+        q = fraction * shear_ratio * force_n
+        return SphereProbe(x, y, force_n, radius_mm=size_mm, shear_x_n=q * ux,
+                           shear_y_n=q * uy, friction=friction)  # fmt: skip
+
+    steps = [*_settle(settle_s), Step((sheared(0.0),), 0.2, "pressed")]
+    steps += [Step((sheared(k / n),), each, f"shear up {k}") for k in range(1, n + 1)]
+    steps.append(Step((sheared(1.0),), dwell_s, "shear held"))
+    steps += [Step((sheared(k / n),), each, f"shear down {k}") for k in range(n - 1, -1, -1)]
+    steps.append(Step((), 0.2, "lifted"))
+    return Scenario(
+        tuple(steps),
+        "shear",
+        f"{size_mm:g}-mm sphere pressed with {force_n:g} N at ({x:g}, {y:g}) mm, sheared "
+        f"to Q/P = {shear_ratio:g} at {angle_deg:g} deg (mu = {friction:g})",
+        {"x_mm": x, "y_mm": y, "force_n": force_n, "size_mm": size_mm,
+         "shear_ratio": shear_ratio, "angle_deg": angle_deg, "friction": friction,
+         "ramp_s": ramp_s, "dwell_s": dwell_s},
+    )  # fmt: skip
+
+
+def slide_to_slip(
+    spec,
+    *,
+    x_mm: float | None = None,
+    y_mm: float | None = None,
+    force_n: float = FIFTY_GRAMS,
+    size_mm: float = 1.6,
+    shear_ratio: float = 1.5,
+    angle_deg: float = 0.0,
+    friction: float = 1.0,
+    ramp_s: float = 1.0,
+    speed_mm_s: float = 2.0,
+    dwell_s: float = 0.3,
+    settle_s: float = 0.2,
+) -> Scenario:
+    """Press a sphere and ramp a tangential force along ``angle_deg`` over ``ramp_s``
+    toward ``shear_ratio`` times the normal force, past ``friction`` (mu): slip spreads
+    in from the contact's edge (stick radius ``c/a = (1 - Q/(mu P))^(1/3)``) until, at
+    ``Q = mu P``, the whole contact slides (the onset, ``parameters['slip_onset_s']`` [s]
+    from the start); from then friction passes ``mu P`` and the sphere slides at
+    ``speed_mm_s`` until the ramp ends, and ``dwell_s`` more, then lifts."""
+    _shear_checks(spec, shear_ratio, friction, ramp_s, angle_deg)
+    check_positive(speed_mm_s, "speed_mm_s")
+    if dwell_s < 0:
+        raise TactsenseInputError(f"dwell_s must be >= 0; got {dwell_s!r}")
+    if shear_ratio <= friction:
+        raise TactsenseInputError(
+            f"shear_ratio {shear_ratio:g} does not exceed the friction {friction:g}: the "
+            "contact would never slip; give a ratio above it (or use 'shear')"
+        )
+    cx, cy = centre_mm(spec)
+    x, y = (cx if x_mm is None else x_mm), (cy if y_mm is None else y_mm)
+    _check_on(spec, x, y, "sphere")
+    ux, uy = math.cos(math.radians(angle_deg)), math.sin(math.radians(angle_deg))
+    n, each = _ramp_steps(spec, ramp_s)
+    n_slide = max(0, math.ceil(dwell_s / each - 1e-9))
+    limit = friction * force_n
+    steps = _settle(settle_s)
+    press_s = 0.2
+    steps.append(Step((SphereProbe(x, y, force_n, radius_mm=size_mm, friction=friction),),
+                      press_s, "pressed"))  # fmt: skip
+    onset_s = None
+    travelled = 0.0
+    for k in range(1, n + n_slide + 1):
+        q = min(shear_ratio * force_n * k / n, shear_ratio * force_n)
+        if q >= limit:  # gross slip: friction passes mu P, the sphere slides
+            if onset_s is None:
+                onset_s = sum(step.duration_s for step in steps)
+            else:
+                travelled += speed_mm_s * each
+            q = limit
+        px, py = x + travelled * ux, y + travelled * uy
+        _check_on(spec, px, py, "the sliding sphere")
+        steps.append(Step((SphereProbe(px, py, force_n, radius_mm=size_mm, shear_x_n=q * ux,
+                                       shear_y_n=q * uy, friction=friction),),
+                          each, f"shear {k}" if k <= n else f"sliding {k - n}"))  # fmt: skip
+    steps.append(Step((), 0.2, "lifted"))
+    return Scenario(
+        tuple(steps),
+        "slide-to-slip",
+        f"{size_mm:g}-mm sphere pressed with {force_n:g} N at ({x:g}, {y:g}) mm, tangential "
+        f"force ramped to Q/P = {shear_ratio:g} at {angle_deg:g} deg past mu = {friction:g}: "
+        f"gross slip from {onset_s:.4g} s, sliding at {speed_mm_s:g} mm/s",
+        {"x_mm": x, "y_mm": y, "force_n": force_n, "size_mm": size_mm,
+         "shear_ratio": shear_ratio, "angle_deg": angle_deg, "friction": friction,
+         "ramp_s": ramp_s, "speed_mm_s": speed_mm_s, "dwell_s": dwell_s,
+         "slip_onset_s": onset_s},
+    )  # fmt: skip
+
+
+# ---- /shear and slip (r8-triphys) ----
+
+
 SCENARIOS = {
     "press": press,
     "hold": hold,
@@ -401,5 +548,8 @@ SCENARIOS = {
     "punch": punch,
     "calibration": raster,
     "loads": loads,
+    # ---- r8-triphys ----
+    "shear": shear,
+    "slide-to-slip": slide_to_slip,
 }
 """Scenario builders for pads and point sets, by the name ``--scenario`` takes."""

@@ -1092,3 +1092,31 @@ def test_triest_bad_input(triest_workspace, line, names):
 
 
 # ---- /r8-triest ----
+
+
+# ---- (r8-triphys) ----
+TRIPHYS_BAD = [  # the shear scenarios' options (issue 35 item 5)
+    ("simulate --sensor mag4x4 --scenario shear --shear-ratio 1.2 -o OUT", "friction"),
+    ("simulate --sensor mag4x4 --scenario shear --shear-ratio 0", "--shear-ratio"),
+    ("simulate --sensor mag4x4 --scenario shear --shear-ratio 11 -o OUT", "--shear-ratio"),
+    ("simulate --sensor mag4x4 --scenario slide-to-slip --shear-ratio 0.5 -o OUT", "never slip"),
+    ("simulate --sensor mag4x4 --scenario shear --friction 0 -o OUT", "--friction"),
+    ("simulate --sensor mag4x4 --scenario shear --ramp-s 0.001 -o OUT", "scan period"),
+    ("simulate --sensor mag4x4 --scenario shear --shear-angle-deg 400 -o OUT", "--shear-angle"),
+    ("simulate --sensor mag4x4 --scenario press --shear-ratio 0.3 -o OUT", "does not apply"),
+    ("simulate --sensor mag4x4 --scenario shear --separation-mm 3 -o OUT", "does not apply"),
+    ("simulate --sensor pad16 --scenario shear -o OUT", "three-axis pad"),
+    ("simulate --sensor mag4x4 --scenario sweep-axial -o OUT", "--scenario sweep-axial"),
+    ("simulate --sensor mag4x4 --scenario slide-to-slip --speed-mm-s 500 -o OUT", "off the"),
+]
+
+
+@pytest.mark.parametrize("line, names", TRIPHYS_BAD, ids=[line for line, _ in TRIPHYS_BAD])
+def test_triphys_shear_scenarios_bad_input(tmp_path, line, names):
+    out = tmp_path / "triphys_never_written.h5"
+    result = runner.invoke(app, line.replace("OUT", str(out)).split())
+    _check(result, names)
+    assert not out.exists()
+
+
+# ---- /(r8-triphys) ----

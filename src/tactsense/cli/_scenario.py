@@ -30,6 +30,9 @@ class ScenarioKind(StrEnum):
     sweep = "sweep"
     punch = "punch"
     loads = "loads"
+    # ---- r8-triphys ----
+    shear = "shear"
+    slide_to_slip = "slide-to-slip"
 
 
 ScenarioOption = Annotated[
@@ -49,7 +52,9 @@ ScenarioOption = Annotated[
         "sphere on every taxel in turn (for 'calibrate'), 'loads' presses a sphere with "
         "each of --forces-g in turn, lifted between (a box of weights, or a load cell: "
         "for 'calibrate --force-log', with the log --force-log writes or a CSV of the "
-        "masses in order)."
+        "masses in order). A three-axis pad also: 'shear' presses a sphere and ramps a "
+        "tangential force to --shear-ratio, holds and releases it, 'slide-to-slip' ramps "
+        "it past --friction until the contact slides (docs/triaxial.md)."
     ),
 ]
 XOption = Annotated[
@@ -170,6 +175,38 @@ RepeatsOption = Annotated[
     typer.Option(min=1, max=1_000_000, help="Applications for 'repeated' [default: 100]."),
 ]
 
+# ---- shear and slip options (r8-triphys) ----
+ShearRatioOption = Annotated[
+    float | None,
+    typer.Option("--shear-ratio", min=1e-3, max=10.0,
+                 help="'shear' and 'slide-to-slip': the tangential force ramped to, over the "
+                 "normal force (Q/P) [-], 0.001-10; 'shear' below --friction, "
+                 "'slide-to-slip' above it [default: 0.3 and 1.5]."),
+]  # fmt: skip
+ShearAngleOption = Annotated[
+    float | None,
+    typer.Option("--shear-angle-deg", min=-360.0, max=360.0,
+                 help="'shear' and 'slide-to-slip': the tangential force's direction from "
+                 "the x axis (the rows) [deg], -360 to 360 [default: 0]."),
+]  # fmt: skip
+FrictionOption = Annotated[
+    float | None,
+    typer.Option("--friction", min=0.05, max=5.0,
+                 help="'shear' and 'slide-to-slip': the coefficient of friction mu between "
+                 "sphere and skin [-], 0.05-5 [default: 1]."),
+]  # fmt: skip
+RampOption = Annotated[
+    float | None,
+    typer.Option("--ramp-s", min=1e-3, max=3600.0,
+                 help="'shear' and 'slide-to-slip': how long the tangential force takes to "
+                 "ramp up (and, 'shear', down) [s], 0.001-3600, at least one scan period "
+                 "[default: 0.5 and 1]."),
+]  # fmt: skip
+SHEAR_OPTIONS = ("shear_ratio", "shear_angle_deg", "friction", "ramp_s")
+"""The options of the shear scenarios, passed to the builders under these names
+(``shear_angle_deg`` as ``angle_deg``)."""
+# ---- /shear and slip options (r8-triphys) ----
+
 DEFAULTS = {
     "row": None,
     "col": None,
@@ -222,6 +259,17 @@ USES = {
     ScenarioKind.repeated: ("row", "col", "force_g", "dwell_s", "lift_s", "repeats"),
     ScenarioKind.calibration: ("force_g", "increment"),
     ScenarioKind.knife: ("row", "col", "increment"),
+    # ---- r8-triphys ----
+    ScenarioKind.shear: ("x_mm", "y_mm", "force_g", "size_mm", "dwell_s", *SHEAR_OPTIONS),
+    ScenarioKind.slide_to_slip: (
+        "x_mm",
+        "y_mm",
+        "force_g",
+        "size_mm",
+        "speed_mm_s",
+        "dwell_s",
+        *SHEAR_OPTIONS,
+    ),
 }
 """The options each scenario reads (where a kind's differ: ``Kind.scenario_options``, e.g.
 'knife-edge' and 'calibration' on a pad or a point set); any other scenario option given
@@ -327,8 +375,11 @@ def build_scenario(
     speed_mm_s: float | None = None,
     angle_deg: float | None = None,
     forces_g: str | None = None,
+    shear: dict | None = None,
 ):
     """The :class:`~tactsense.simulate.Scenario` the command-line options describe.
+
+    ``shear``: the shear scenarios' options (:data:`SHEAR_OPTIONS` -> value or None).
 
     Options left as None take :data:`DEFAULTS` (a pad's scenarios: the builders' own
     defaults, :mod:`tactsense.flat_scenarios`); an option given to a scenario that does
@@ -342,9 +393,13 @@ def build_scenario(
             separation_mm=separation_mm, indenter=indenter, size_mm=size_mm,
             speed_mm_s=speed_mm_s, angle_deg=angle_deg, forces_g=forces_g,
         )  # fmt: skip
+        given.update({name: (shear or {}).get(name) for name in SHEAR_OPTIONS})  # r8-triphys
         check_scenario_options(scenario, given, spec.kind)
         check_timing(spec, dwell_s, lift_s)
+        _check_ramp(spec, given["ramp_s"])  # r8-triphys
         return _flat_scenario(spec, scenario, given)
+    if any(value is not None for value in (shear or {}).values()):  # r8-triphys
+        check_scenario_options(scenario, {k: v for k, v in shear.items() if v is not None})
     from tactsense.simulate import calibration_sweep, knife_edge_sweep, probe_sweep, repeated_load
 
     dwell = dwell_s
@@ -393,6 +448,18 @@ def build_scenario(
         dwell_s=dwell_s,
         lift_s=lift_s,
     )
+
+
+def _check_ramp(spec, ramp_s: float | None) -> None:
+    """Refuse a ``--ramp-s`` shorter than one scan period (r8-triphys): the ramp would
+    fall between two readings of the array."""
+    period = spec.scan_period_s
+    if ramp_s is not None and ramp_s < period:
+        raise TactsenseInputError(
+            f"--ramp-s {ramp_s:g} s is shorter than one scan period of sensor {spec.name!r} "
+            f"({period:.4g} s at {spec.electronics.scan_rate_hz:g} Hz): the ramp would fall "
+            f"between two readings; give at least {_round_up(period):g} s"
+        )
 
 
 def parse_forces_g(text: str) -> list[float]:
@@ -461,6 +528,10 @@ def _flat_scenario(spec, scenario: ScenarioKind, given: dict):
     if given["size_mm"] is not None:
         key = {"knife-edge": "length_mm", "punch": "radius_mm"}.get(scenario.value, "size_mm")
         options[key] = given["size_mm"]
+    # ---- r8-triphys ----
+    for name in SHEAR_OPTIONS:
+        if given.get(name) is not None:
+            options["angle_deg" if name == "shear_angle_deg" else name] = given[name]
     if scenario is ScenarioKind.hold and "dwell_s" in options:
         options["hold_s"] = options.pop("dwell_s")
     no_grid = kind_of(spec).surface_grid(spec) is None

@@ -11,6 +11,7 @@ from rich.table import Table
 
 from tactsense._validation import TactsenseInputError
 from tactsense.cli import _robot_sensor  # r7-skin
+from tactsense.cli import _scenario as scenario_options  # r8-triphys: the shear options
 from tactsense.cli._common import (
     SensorOption,
     atomic_output,
@@ -76,6 +77,10 @@ def simulate(
     speed_mm_s: SpeedOption = None,
     angle_deg: AngleOption = None,
     forces_g: ForcesGOption = None,
+    shear_ratio: scenario_options.ShearRatioOption = None,  # r8-triphys
+    shear_angle_deg: scenario_options.ShearAngleOption = None,  # r8-triphys
+    friction: scenario_options.FrictionOption = None,  # r8-triphys
+    ramp_s: scenario_options.RampOption = None,  # r8-triphys
     flaws: FlawsOption = "all",
     seed: SeedOption = 0,
     forward: Annotated[
@@ -143,24 +148,13 @@ def simulate(
                 f"--scenario {scenario.value} (view a pad's recording with 'tactsense view')"
             )
         scene = build_scenario(
-            spec,
-            scenario,
-            row=row,
-            col=col,
-            force_g=force_g,
-            increment=increment,
-            dwell_s=dwell_s,
-            lift_s=lift_s,
-            repeats=repeats,
-            x_mm=x_mm,
-            y_mm=y_mm,
-            separation_mm=separation_mm,
-            indenter=indenter,
-            size_mm=size_mm,
-            speed_mm_s=speed_mm_s,
-            angle_deg=angle_deg,
-            forces_g=forces_g,
-        )
+            spec, scenario, row=row, col=col, force_g=force_g, increment=increment,
+            dwell_s=dwell_s, lift_s=lift_s, repeats=repeats, x_mm=x_mm, y_mm=y_mm,
+            separation_mm=separation_mm, indenter=indenter, size_mm=size_mm,
+            speed_mm_s=speed_mm_s, angle_deg=angle_deg, forces_g=forces_g,
+            shear=dict(shear_ratio=shear_ratio, shear_angle_deg=shear_angle_deg,
+                       friction=friction, ramp_s=ramp_s),  # r8-triphys
+        )  # fmt: skip
         if out.suffix.lower() not in (".h5", ".hdf5"):
             fail(
                 f"--out {out}: a recording is an HDF5 file; use the extension .h5 (or "
@@ -382,7 +376,7 @@ def sensor_check(
     layer = kind.design_model == "layer"  # blind spots are mapped with the layer model
     if not layer and probe_g is not None:
         fail(f"--probe-g maps the blind spots of a pad; {spec.name!r} is a {kind.label}")
-    if kind.multi_contact:  # locate's contact threshold
+    if kind.multi_contact and kind.contact_estimation:  # locate's threshold (r8-triphys)
         from tactsense.estimate.contacts import default_threshold, threshold_counts
 
         noise = float(spec.flaws.read_noise_counts)

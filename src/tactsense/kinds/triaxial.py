@@ -14,44 +14,79 @@ from typing import Any
 import numpy as np
 
 from tactsense.kinds.base import Kind
-from tactsense.sensor.pad import Grid
 from tactsense.sensor.common import Electronics, Flaws, Layer
+from tactsense.sensor.pad import Grid
 from tactsense.sensor.triaxial import MagneticTransduction, TriaxialSpec
+
+MAGNET = {"remanence_t": 1.32, "diameter_mm": 1.0, "height_mm": 1.0}
+"""Each taxel's magnet (an assumption): an N42 NdFeB cylinder (remanence 1.29-1.32 T in
+makers' grade tables) of 1 mm x 1 mm; its moment is ``Br V / mu0``."""
+
+SOURCES = (
+    "pitch 4.7 mm: uSkin's flat version (Tomo et al., IEEE RA-L 3(3), 2018, 2584-2591); "
+    "Hall sensors: Melexis MLX90393, 16 bits, 0.751 / 1.210 uT per count on x, y / z "
+    "(GAIN_SEL 0, RES 0, HALLCONF 0xC: its data sheet's sensitivity table, as the "
+    "Adafruit_MLX90393 library tabulates it), the zero field at 32768 counts; "
+    "assumptions: 1 x 1 mm N42 magnets 1.5 mm deep in a 3-mm silicone layer "
+    "(E 250 kPa, nu 0.5), the Hall elements 1 mm under it, read noise 3 counts, "
+    "a 5 % gain and 20 uT offset spread, the Earth's field 48 uT"
+)
+"""Where the presets' numbers come from, and which are assumptions (docs/triaxial.md)."""
+
+BRIEF = (
+    "4.7 mm pitch (uSkin, Tomo et al., IEEE RA-L 2018), MLX90393 Hall sensors at "
+    "0.751 / 1.210 uT per count (its data sheet); magnets, layer and noise assumed "
+    "(docs/triaxial.md)"
+)
+""":data:`SOURCES` in a line, for a preset's description."""
+
+
+def _magnetic_skin(name: str, rows: int, cols: int, description: str) -> TriaxialSpec:
+    from tactsense.physics.triaxial import magnet_moment_a_m2
+
+    return TriaxialSpec(
+        name=name,
+        description=description,
+        grid=Grid(rows=rows, cols=cols, row_pitch_mm=4.7, col_pitch_mm=4.7,
+                  electrode_x_mm=MAGNET["diameter_mm"], electrode_y_mm=MAGNET["diameter_mm"]),
+        layer=Layer(thickness_mm=3.0, youngs_modulus_pa=2.5e5, poisson_ratio=0.5,
+                    sensing_depth_mm=1.5),
+        transduction=MagneticTransduction(
+            moment_a_m2=round(magnet_moment_a_m2(**MAGNET), 7),
+            hall_depth_mm=4.0,
+            lsb_xy_ut=0.751,
+            lsb_z_ut=1.210,
+            earth_field_x_ut=20.0,
+            earth_field_y_ut=0.0,
+            earth_field_z_ut=-44.0,
+            offset_sd_ut=20.0,
+        ),
+        electronics=Electronics(adc_bits=16, nominal_counts=32768.0, scan_rate_hz=100.0),
+        flaws=Flaws(gain_spread_sd=0.05, gain_min=0.8, gain_max=1.25, read_noise_counts=3.0,
+                    force_jitter_n=0.0, position_jitter_mm=0.0, nonlinear_saturation=0.712,
+                    delayed_fraction=0.1, delayed_time_constant_s=0.05,
+                    creep_fraction=0.05, creep_time_constant_s=10.0),
+    )  # fmt: skip
 
 
 def mag4x4() -> TriaxialSpec:
-    """A 4 x 4 magnetic three-axis pad at 4.7 mm pitch (the class of uSkin/Xela patches).
-
-    Provisional numbers (r8-skel): replaced with sourced ones by the physics work.
-    """
-    return TriaxialSpec(
-        name="mag4x4",
-        description="4 x 4 magnetic three-axis pad (provisional parameters)",
-        grid=Grid(rows=4, cols=4, row_pitch_mm=4.7, col_pitch_mm=4.7,
-                  electrode_x_mm=1.0, electrode_y_mm=1.0),
-        layer=Layer(thickness_mm=3.0, youngs_modulus_pa=2.5e5, poisson_ratio=0.5,
-                    sensing_depth_mm=1.5),
-        transduction=MagneticTransduction(moment_a_m2=1.5e-3, hall_depth_mm=4.0),
-        electronics=Electronics(adc_bits=16, nominal_counts=32768.0, scan_rate_hz=100.0),
-        flaws=Flaws(gain_spread_sd=0.05, gain_min=0.8, gain_max=1.25, read_noise_counts=3.0,
-                    force_jitter_n=0.0, position_jitter_mm=0.0),
-    )
+    """A 4 x 4 magnetic three-axis pad at 4.7 mm pitch (the class of uSkin/Xela's flat
+    patches): :data:`SOURCES` says where each number comes from."""
+    return _magnetic_skin(
+        "mag4x4", 4, 4,
+        "4 x 4 magnetic three-axis pad, the class of uSkin's flat patches: " + BRIEF,
+    )  # fmt: skip
 
 
 def magtip() -> TriaxialSpec:
-    """A 6 x 4 magnetic three-axis fingertip pad (the class of uSkin's fingertips),
-    laid flat. Provisional numbers (r8-skel)."""
-    spec = mag4x4()
-    return TriaxialSpec(
-        name="magtip",
-        description="6 x 4 magnetic three-axis fingertip, flat (provisional parameters)",
-        grid=Grid(rows=6, cols=4, row_pitch_mm=4.7, col_pitch_mm=4.7,
-                  electrode_x_mm=1.0, electrode_y_mm=1.0),
-        layer=spec.layer,
-        transduction=spec.transduction,
-        electronics=spec.electronics,
-        flaws=spec.flaws,
-    )
+    """A 6 x 4 magnetic three-axis fingertip laid flat (the class of uSkin's fingertips,
+    Tomo et al., IEEE RA-L 3(1), 2018, 124-131: 6 N normal range, 10 % hysteresis); its
+    24 taxels' layout is an assumption, the rest as :func:`mag4x4`."""
+    return _magnetic_skin(
+        "magtip", 6, 4,
+        "6 x 4 magnetic three-axis fingertip laid flat, the class of uSkin's fingertips "
+        "(Tomo et al., IEEE RA-L 3(1), 2018; layout assumed): " + BRIEF,
+    )  # fmt: skip
 
 
 class TriaxialKind(Kind):
@@ -64,7 +99,7 @@ class TriaxialKind(Kind):
     view_drawing = "grid"
     design_model = None
     senses_shear = True
-    scenarios = ("press", "hold", "two-probes", "slide", "loads")
+    scenarios = ("press", "shear", "slide-to-slip", "hold", "two-probes", "slide", "loads")
     forwards = ("twin",)
     frame_axes = "time, row, col, component (x, y, z)"
 
@@ -74,8 +109,10 @@ class TriaxialKind(Kind):
 
     def size_text(self, spec):
         g = spec.grid
-        return (f"{g.rows} x {g.cols} taxels x 3 axes",
-                f"{g.row_pitch_mm:g} x {g.col_pitch_mm:g} mm")
+        return (
+            f"{g.rows} x {g.cols} taxels x 3 axes",
+            f"{g.row_pitch_mm:g} x {g.col_pitch_mm:g} mm",
+        )
 
     def layer_strain(self, spec, indenters):
         raise self.unsupported(spec, "a scalar strain per taxel (it reads three components)")
@@ -94,50 +131,34 @@ class TriaxialKind(Kind):
     def reads_capacitive(self, spec):
         return False
 
-    def frame_blocks(self, spec: Any, run: Any, chunk_frames: int):
-        """The three-axis chain (``simulate``): the elastic displacement of each step,
-        sampled at each taxel's instant of the scan, the dipole field, gains (each
-        sensor's sensitivity, all three axes), noise, quantization and the converter's
-        range. Yields ``(first, last, counts)`` with counts of shape (k, rows, cols, 3)."""
-        from tactsense.physics.triaxial import dipole_field_t, field_counts
+    def contact_state(self, spec, contacts):
+        """One frame's contacts as indenters that carry their tangential force
+        (``tangential_force_n`` (x, y) [N]), for ``frames_from_contacts``: a sphere (Hertz
+        pressure, Cattaneo-Mindlin traction) or a disc at (x, y) [mm]. The forces given
+        are the forces applied, so the friction is taken as ``max(1, Q / P)``: a
+        tangential force above the normal one is passed whole (gross slip)."""
+        from tactsense.physics.indenters import DiscProbe, SphereProbe
 
-        rows, cols = spec.shape
-        period = spec.scan_period_s
-        per_frame = rows * cols
-        n_steps = len(run.applied)
-        active = run.active
-        full_scale = 2**spec.electronics.adc_bits - 1
-        dead = np.zeros(spec.shape, dtype=bool)
-        if "dead" in active:
-            for r, c in spec.flaws.dead_tactels:
-                dead[r, c] = True
-        cache: dict[int, np.ndarray] = {}
-        taxel = np.arange(per_frame)
-        for first in range(0, run.n_frames, chunk_frames):
-            last = min(run.n_frames, first + chunk_frames)
-            times = np.arange(first, last)[:, None] * period + run.offsets.ravel()[None, :]
-            step = np.clip(np.searchsorted(run.boundaries, times, side="right") - 1, 0,
-                           n_steps - 1)
-            needed = [int(s) for s in np.unique(step) if int(s) not in cache]
-            if needed:
-                if len(cache) > 4096:
-                    cache.clear()
-                    needed = [int(s) for s in np.unique(step)]
-                values = self.elastic_batch(spec, [run.applied[s] for s in needed])
-                cache.update(zip(needed, values, strict=True))
-            disp = np.stack([np.stack([cache[int(s)].reshape(per_frame, 3)[taxel_i]
-                                       for taxel_i, s in zip(taxel, row, strict=True)])
-                             for row in step])
-            field = dipole_field_t(spec, disp.reshape(last - first, rows, cols, 3))
-            gains = np.asarray(run.gains, dtype=float)
-            gains = gains[..., None] if gains.shape == spec.shape else gains
-            counts = field_counts(spec, field * gains)
-            if "noise" in active:
-                counts = counts + run.rng.normal(0.0, spec.flaws.read_noise_counts, counts.shape)
-            counts = np.clip(np.rint(counts) if "quantization" in active else counts, 0,
-                             full_scale)
-            counts[:, dead] = 0.0
-            yield first, last, counts
+        made = []
+        for c in contacts:
+            cls = SphereProbe if c["shape"] == "sphere" else DiscProbe
+            x, y = c["position_mm"]
+            qx, qy = c.get("tangential_force_n", (0.0, 0.0))
+            force = c["normal_force_n"]
+            friction = max(1.0, float(np.hypot(qx, qy)) / force) if force > 0 else 1.0
+            made.append(cls(x, y, force, radius_mm=c["radius_mm"], shear_x_n=qx,
+                            shear_y_n=qy, friction=friction))  # fmt: skip
+        return tuple(made)
+
+    def frame_blocks(self, spec: Any, run: Any, chunk_frames: int):
+        """The three-axis chain (``simulate``): :func:`tactsense.physics.triaxial_chain.
+        triaxial_frame_blocks` (displacement sampled at each taxel's tick, the layer's
+        memory, dipole and background field, gains, offsets, noise, quantization, the
+        converter's range, dead sensors). Yields ``(first, last, counts)`` with counts of
+        shape (k, rows, cols, 3)."""
+        from tactsense.physics.triaxial_chain import triaxial_frame_blocks
+
+        return triaxial_frame_blocks(self, spec, run, chunk_frames)
 
     # ---- three-axis estimation (r8-triest) -----------------------------------------
     contact_estimation = True

@@ -13,11 +13,11 @@ Coordinates are the pad's: x along rows, y along columns, z outward (``sensor.pa
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 
 import numpy as np
 
-from tactsense.physics.indenters import pressure_map
 from tactsense.physics.pad_response import _pad_grid, modulus_star_pa, oversample
 from tactsense.sensor.triaxial import TriaxialSpec
 
@@ -44,22 +44,118 @@ def _response(spec: TriaxialSpec, shape: tuple[int, int], hx: float, hy: float):
     )
 
 
-def traction_maps(spec: TriaxialSpec, indenters, x_mm, y_mm):
+STICK, PARTIAL_SLIP, GROSS_SLIP = 0, 1, 2
+"""A contact's slip state: all of it sticks, slip spreads in from its edge (Cattaneo-
+Mindlin's annulus ``c < r < a``), or the whole contact slides."""
+
+
+def slip_state(indenter) -> tuple[int, float]:
+    """A contact's slip state (:data:`STICK`, :data:`PARTIAL_SLIP`, :data:`GROSS_SLIP`)
+    and its stick ratio ``c / a`` [-] under its tangential force ``Q`` (``shear_n``).
+
+    A sphere (Hertz pressure; Cattaneo 1938, Mindlin 1949; Johnson 1985, ch. 7): the central
+    stick zone's radius ``c / a = (1 - Q / (mu P))^(1/3)``, partial slip for
+    ``0 < Q < mu P``, gross slip at ``Q >= mu P`` (``c = 0``). Any other indenter: no
+    partial-slip model (stick, ``c / a = 1``, below ``mu P``; gross slip, ``0``, at it).
+    No tangential force: stick, ``c / a = 1``; a tangential force without a normal
+    one: gross slip. (``c / a`` depends on ``Q / (mu P)`` alone: the same sphere and
+    modulus set ``a`` and ``c``.)
+    """
+    q, p, mu = indenter.shear_n, indenter.force_n, indenter.friction
+    if q == 0.0 or p <= 0.0:
+        return (STICK, 1.0) if q == 0.0 else (GROSS_SLIP, 0.0)
+    ratio = q / (mu * p)
+    if ratio >= 1.0:
+        return GROSS_SLIP, 0.0
+    if getattr(indenter, "kind", "") != "sphere":
+        return STICK, 1.0
+    return PARTIAL_SLIP, float((1.0 - ratio) ** (1.0 / 3.0))
+
+
+def transmitted_shear_n(indenter) -> tuple[float, float]:
+    """The tangential force (x, y) [N] a contact passes to the skin: its own, limited in
+    size to ``mu P`` (beyond it the contact slides and friction passes ``mu P``)."""
+    q = indenter.shear_n
+    if q == 0.0:
+        return 0.0, 0.0
+    scale = min(1.0, indenter.friction * indenter.force_n / q)
+    return indenter.shear_x_n * scale, indenter.shear_y_n * scale
+
+
+def tangential_traction_pa(indenter, x_mm, y_mm, *, modulus_star_pa: float) -> np.ndarray:
+    """Magnitude of an indenter's tangential traction on the grid (x_mm, y_mm) [Pa],
+    directed along its tangential force; shape (M, N), cell-averaged like the pressure.
+
+    A sphere (Cattaneo-Mindlin; Johnson 1985, ch. 7): with Hertz's
+    ``p0 = 3 P / (2 pi a^2)``, ``q = mu p0 sqrt(1 - r^2/a^2)`` over the contact minus
+    ``mu p0 (c/a) sqrt(1 - r^2/c^2)`` inside the stick zone ``r < c``. The second term is
+    the Hertz pressure of the same sphere under the load ``P (c/a)^3`` (whose contact
+    radius is ``c``), so ``q = mu (p_P - p_{P (c/a)^3})``, each cell-averaged and summing
+    to its load exactly: the traction sums to ``mu P (1 - (c/a)^3) = Q``. Gross slip
+    (``Q >= mu P``): ``q = mu p``, summing to ``mu P`` (the contact slides; the
+    tangential force it passes is limited to that).
+
+    The traction depends on the present ``Q`` alone: a force ramped down retraces the
+    loading solution (Mindlin-Deresiewicz's reverse slip on unloading is not modelled).
+    With ``nu = 0.5`` the normal and tangential problems uncouple (Dundurs' beta = 0),
+    as Cattaneo-Mindlin assume.
+
+    Any other indenter: the traction is the pressure times ``min(Q, mu P) / P`` (the
+    tangential traction of a rigid flat punch that sticks has the pressure's shape,
+    Johnson 1985, ch. 7, with the coupling of normal and tangential loads left out;
+    for the others an assumption: their partial slip is not modelled).
+    """
+    p = indenter.pressure_pa(x_mm, y_mm, modulus_star_pa=modulus_star_pa)
+    q, force, mu = indenter.shear_n, indenter.force_n, indenter.friction
+    if q == 0.0 or force <= 0.0:
+        return np.zeros_like(p)
+    state, stick = slip_state(indenter)
+    if state == PARTIAL_SLIP:
+        inner = dataclasses.replace(indenter, force_n=force * stick**3)
+        return mu * (p - inner.pressure_pa(x_mm, y_mm, modulus_star_pa=modulus_star_pa))
+    return p * (min(q, mu * force) / force)
+
+
+def _window(indenter, x_mm, y_mm, modulus: float) -> tuple[slice, slice]:
+    """The cells of the grid (x_mm, y_mm) an indenter's load can reach, and one more on
+    each side (its pressure is zero beyond ``reach_mm``); clipped to the grid."""
+    reach = indenter.reach_mm(modulus)
+    hx = float(x_mm[1] - x_mm[0]) if np.size(x_mm) > 1 else 1.0
+    hy = float(y_mm[1] - y_mm[0]) if np.size(y_mm) > 1 else 1.0
+    span = []
+    for centre, axis, h in ((indenter.x_mm, x_mm, hx), (indenter.y_mm, y_mm, hy)):
+        lo = int(np.searchsorted(axis, centre - reach - 1.5 * h))
+        hi = int(np.searchsorted(axis, centre + reach + 1.5 * h, side="right"))
+        lo, hi = max(0, lo - 1), min(np.size(axis), hi + 1)
+        span.append(slice(lo, hi) if hi - lo >= 2 else slice(0, np.size(axis)))
+    return span[0], span[1]
+
+
+def traction_maps(spec: TriaxialSpec, indenters, x_mm, y_mm, *, window: bool = True):
     """Pressure and tangential tractions (p, q_x, q_y) [Pa] on the grid (x_mm, y_mm).
 
-    Each indenter's tangential traction is its pressure times its tangential force over its
-    normal force (the traction of full slip, limited to ``friction`` times the pressure).
+    Each indenter's tangential traction is :func:`tangential_traction_pa` (Cattaneo-
+    Mindlin on a sphere), directed along its tangential force (``shear_x_n``,
+    ``shear_y_n``). ``window``: each indenter's load is evaluated on the cells it can
+    reach alone (the same cell averages and the same scaling to its force as on the
+    whole grid: ``tests/physics/test_triaxial.py`` checks the two agree to 1e-12); False:
+    on the whole grid (the straightforward way, for the benchmark).
     """
     modulus = modulus_star_pa(spec.layer)
-    p = np.zeros((np.size(x_mm), np.size(y_mm)))
+    x_mm, y_mm = np.asarray(x_mm, dtype=float), np.asarray(y_mm, dtype=float)
+    p = np.zeros((x_mm.size, y_mm.size))
     qx, qy = np.zeros_like(p), np.zeros_like(p)
     for indenter in indenters:
-        own = pressure_map([indenter], x_mm, y_mm, modulus_star_pa=modulus)
-        p += own
-        if indenter.force_n > 0 and (indenter.shear_x_n or indenter.shear_y_n):
-            ratio = min(1.0, indenter.friction * indenter.force_n / max(indenter.shear_n, 1e-300))
-            qx += own * (indenter.shear_x_n * ratio / indenter.force_n)
-            qy += own * (indenter.shear_y_n * ratio / indenter.force_n)
+        if indenter.force_n <= 0:
+            continue
+        cells = _window(indenter, x_mm, y_mm, modulus) if window else (slice(None),) * 2
+        xs, ys = x_mm[cells[0]], y_mm[cells[1]]
+        p[cells] += indenter.pressure_pa(xs, ys, modulus_star_pa=modulus)
+        shear = indenter.shear_n
+        if shear > 0:
+            q = tangential_traction_pa(indenter, xs, ys, modulus_star_pa=modulus)
+            qx[cells] += q * (indenter.shear_x_n / shear)
+            qy[cells] += q * (indenter.shear_y_n / shear)
     return p, qx, qy
 
 
@@ -116,6 +212,29 @@ def field_counts(spec: TriaxialSpec, field_t: np.ndarray) -> np.ndarray:
     return spec.electronics.nominal_counts + np.asarray(field_t) / spec.lsb_t
 
 
+def background_field_t(spec: TriaxialSpec) -> np.ndarray:
+    """The uniform background field (the Earth's) every sensor reads [T], shape (3,)."""
+    t = spec.transduction
+    return 1e-6 * np.array([t.earth_field_x_ut, t.earth_field_y_ut, t.earth_field_z_ut])
+
+
+def sensor_offsets_t(spec: TriaxialSpec, rng=None) -> np.ndarray:
+    """Each sensor's offset per axis [T], shape (rows, cols, 3): normal with standard
+    deviation ``transduction.offset_sd_ut``, drawn from ``flaws.gain_seed`` (the skin's
+    own, the same in every run) unless ``rng`` is given."""
+    rng = np.random.default_rng(spec.flaws.gain_seed + 1 if rng is None else rng)
+    return 1e-6 * spec.transduction.offset_sd_ut * rng.standard_normal((*spec.shape, 3))
+
+
 def rest_field_t(spec: TriaxialSpec) -> np.ndarray:
-    """The field every sensor reads untouched [T], shape (rows, cols, 3)."""
-    return dipole_field_t(spec, np.zeros((*spec.shape, 3)))
+    """The field every sensor reads untouched [T], shape (rows, cols, 3): the magnets'
+    (its own and, with ``neighbours``, the others') and the background field (before
+    gains and offsets)."""
+    return dipole_field_t(spec, np.zeros((*spec.shape, 3))) + background_field_t(spec)
+
+
+def magnet_moment_a_m2(remanence_t: float, diameter_mm: float, height_mm: float) -> float:
+    """Dipole moment of a uniformly magnetised cylinder [A m^2]: ``Br V / mu0`` with its
+    remanence ``Br`` [T] and volume ``pi d^2 h / 4`` (d, h [mm])."""
+    volume_m3 = np.pi * (diameter_mm * 1e-3) ** 2 * (height_mm * 1e-3) / 4.0
+    return float(remanence_t * volume_m3 / (4e-7 * np.pi))

@@ -19,6 +19,7 @@ bonded face).
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass, field
 from typing import ClassVar
 
@@ -53,6 +54,19 @@ class MagneticTransduction:
     neighbours: bool = True
     """Whether a sensor reads every magnet of the pad (True: the physical crosstalk of a
     magnetic skin) or its own alone."""
+    earth_field_x_ut: float = 0.0
+    """A uniform background field every sensor reads, along x [uT]: the Earth's (25-65 uT
+    in magnitude) in the pad's frame as mounted. Always on (it is the world's field, not
+    a flaw); an estimator takes it out with the baseline."""
+    earth_field_y_ut: float = 0.0
+    """The background field along y [uT]."""
+    earth_field_z_ut: float = 0.0
+    """The background field along z, the outward normal [uT]."""
+    offset_sd_ut: float = 0.0
+    """Standard deviation of each sensor's offset per axis [uT]: the Hall element's own
+    offset and the magnet's placement error at assembly. Drawn once per sensor from
+    ``flaws.gain_seed`` (it belongs to the skin, not to a run), switched on with the
+    flaw ``gain_spread`` (the skin's manufacturing spread)."""
 
 
 @dataclass(frozen=True)
@@ -67,15 +81,20 @@ class TriaxialSpec(SpecBase):
 
     name: str = "triaxial"
     description: str = ""
-    grid: Grid = field(default_factory=lambda: Grid(rows=4, cols=4, row_pitch_mm=4.7,
-                                                    col_pitch_mm=4.7, electrode_x_mm=1.0,
-                                                    electrode_y_mm=1.0))
-    layer: Layer = field(default_factory=lambda: Layer(thickness_mm=3.0,
-                                                       sensing_depth_mm=1.5))
+    grid: Grid = field(
+        default_factory=lambda: Grid(
+            rows=4,
+            cols=4,
+            row_pitch_mm=4.7,
+            col_pitch_mm=4.7,
+            electrode_x_mm=1.0,
+            electrode_y_mm=1.0,
+        )
+    )
+    layer: Layer = field(default_factory=lambda: Layer(thickness_mm=3.0, sensing_depth_mm=1.5))
     transduction: MagneticTransduction = field(default_factory=MagneticTransduction)
     electronics: Electronics = field(
-        default_factory=lambda: Electronics(adc_bits=16, nominal_counts=32768.0,
-                                            scan_rate_hz=100.0)
+        default_factory=lambda: Electronics(adc_bits=16, nominal_counts=32768.0, scan_rate_hz=100.0)
     )
     flaws: Flaws = field(default_factory=Flaws)
 
@@ -146,8 +165,16 @@ class TriaxialSpec(SpecBase):
                 f"nu = {layer.poisson_ratio:g}",
             ),
             ("magnets", f"{t.moment_a_m2:g} A m^2 at {layer.sensing_depth_mm:g} mm depth"),
-            ("Hall sensors", f"at {t.hall_depth_mm:g} mm depth, "
-             f"{t.lsb_xy_ut:g} / {t.lsb_z_ut:g} uT per count (x, y / z)"),
+            (
+                "Hall sensors",
+                f"at {t.hall_depth_mm:g} mm depth, "
+                f"{t.lsb_xy_ut:g} / {t.lsb_z_ut:g} uT per count (x, y / z)",
+            ),
+            (
+                "background field (x, y, z)",
+                f"{t.earth_field_x_ut:g}, {t.earth_field_y_ut:g}, "
+                f"{t.earth_field_z_ut:g} uT; offsets {t.offset_sd_ut:g} uT sd per axis",
+            ),
             (
                 "zero field reads",
                 f"{self.electronics.nominal_counts:g} counts of {2**self.electronics.adc_bits - 1}",
@@ -173,6 +200,20 @@ def _validate(spec: TriaxialSpec) -> list[str]:
         problems.append(f'[transduction] kind = {t.kind!r}: only "magnetic" is modelled')
     for name in ("moment_a_m2", "hall_depth_mm", "lsb_xy_ut", "lsb_z_ut"):
         positive(problems, "transduction", name, getattr(t, name))
+    for name in ("earth_field_x_ut", "earth_field_y_ut", "earth_field_z_ut", "offset_sd_ut"):
+        value = getattr(t, name)
+        if not (
+            isinstance(value, int | float)
+            and not isinstance(value, bool)
+            and math.isfinite(value)
+            and abs(value) <= 1e5
+        ):
+            problems.append(
+                f"[transduction] {name} must be a finite number of at most "
+                f"100000 uT in size; got {value!r}"
+            )
+    if isinstance(t.offset_sd_ut, int | float) and t.offset_sd_ut < 0:
+        problems.append(f"[transduction] offset_sd_ut must be >= 0; got {t.offset_sd_ut!r}")
     if not problems and t.hall_depth_mm < layer.thickness_mm:
         problems.append(
             f"[transduction] hall_depth_mm = {t.hall_depth_mm:g} lies inside the layer "

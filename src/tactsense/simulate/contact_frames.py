@@ -93,7 +93,8 @@ class ContactBatch:
     tangential_force_n : (N, k, 2) ndarray or None
         Tangential force along the two surface coordinates [N]. Kinds whose layer model
         takes normal pressure only (pads, point sets) ignore it (:func:`frames_from_contacts`
-        warns once, :class:`ShearIgnoredWarning`); the finger takes its axial part.
+        warns once, :class:`ShearIgnoredWarning`); the finger takes its axial part; a
+        three-axis pad takes both (Cattaneo-Mindlin traction on a sphere).
     radius_mm : (N, k) ndarray or float
         Radius of each indenter [mm] > 0: a sphere's radius (its contact radius follows
         from its force, Hertz) or a disc's.
@@ -274,7 +275,10 @@ def frames_from_contacts(
     -------
     (N, rows * cols) ndarray of float64
         A/D counts of every taxel, frame order (row-major), as :func:`simulate`'s frames
-        (whole numbers when ``quantization`` is on).
+        (whole numbers when ``quantization`` is on). A sensor of several components per
+        taxel (``spec.components``, a three-axis pad): (N, rows * cols, components), the
+        components last; its tangential forces go into the forward model (the reference
+        path; ``fast`` has no effect on it).
 
     Notes
     -----
@@ -327,11 +331,12 @@ def reference_frames(spec, contacts: ContactBatch, active, gains, rng) -> np.nda
         boundaries=np.arange(n + 1) * period,
         offsets=sample_offsets(spec),
     )
-    out = np.empty((n, math.prod(spec.shape)))
+    # several components per taxel (r8-triphys): (N, taxels, components)
+    out = np.empty((n, math.prod(spec.shape), *spec.frame_shape[2:]))
     if n == 0:
         return out
     for first, last, counts in _frame_blocks(spec, run):
-        out[first:last] = counts.reshape(last - first, -1)
+        out[first:last] = counts.reshape(last - first, *out.shape[1:])
     return out
 
 

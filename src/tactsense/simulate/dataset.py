@@ -276,7 +276,7 @@ def episode_labels(spec, plan: DatasetPlan, index: int) -> Episode:
     return Episode(
         index=index,
         task=task,
-        frames=np.zeros((0, *spec.shape)),
+        frames=np.zeros((0, *spec.frame_shape)),
         position_mm=position,
         normal_force_n=normal,
         tangential_force_n=tangential * present[..., None],
@@ -287,7 +287,7 @@ def episode_labels(spec, plan: DatasetPlan, index: int) -> Episode:
 
 
 def episode(spec, plan: DatasetPlan, index: int, *, gains=None) -> Episode:
-    """Episode ``index`` with its frames [counts], ``(frames, rows, cols)``.
+    """Episode ``index`` with its frames [counts], ``(frames, *spec.frame_shape)``.
 
     The frames' random draws (noise) come from the episode's own stream, so the data set
     is the same however its episodes are shared out.
@@ -305,7 +305,7 @@ def episode(spec, plan: DatasetPlan, index: int, *, gains=None) -> Episode:
     )
     rng = np.random.default_rng(np.random.SeedSequence([plan.seed, index, 1]))
     frames = frames_from_contacts(spec, contacts, flaws=plan.flaws, rng=rng, gains=gains)
-    labelled.frames = np.asarray(frames).reshape(plan.frames, *spec.shape)
+    labelled.frames = np.asarray(frames).reshape(plan.frames, *spec.frame_shape)
     return labelled
 
 

@@ -341,7 +341,7 @@ def _truth(spec: SensorSpec, applied: list[tuple], frame_step: np.ndarray) -> di
         if contacts:
             first[k] = getattr(contacts[0], names[0])
             second[k] = getattr(contacts[0], names[1])
-    return {
+    truth = {
         "frame_step": frame_step.astype(np.int64),
         f"step_{names[0]}": first,
         f"step_{names[1]}": second,
@@ -349,3 +349,34 @@ def _truth(spec: SensorSpec, applied: list[tuple], frame_step: np.ndarray) -> di
         "step_n_contacts": count,
         "step_contacts_json": json.dumps([[c.to_dict() for c in s] for s in applied]),
     }
+    # ---- shear and slip truth (r8-triphys) ----
+    pressed = [c for contacts in applied for c in contacts]
+    if kind_of(spec).senses_shear and pressed and all(hasattr(c, "shear_x_n") for c in pressed):
+        truth.update(_shear_truth(applied))
+    return truth
+
+
+def _shear_truth(applied: list[tuple]) -> dict:
+    """Per step: the tangential force the contacts pass to the skin (x, y) [N] (each
+    limited to mu times its normal force), and the first contact's slip state
+    (``step_slip``: 0 stick, 1 partial slip, 2 gross slip; 0 without contact) and stick
+    ratio ``c/a`` (``step_stick_ratio`` [-], NaN without contact), Cattaneo-Mindlin's
+    (:func:`tactsense.physics.triaxial.slip_state`)."""
+    from tactsense.physics.triaxial import slip_state, transmitted_shear_n
+
+    n = len(applied)
+    shear = np.zeros((n, 2))
+    slip = np.zeros(n, dtype=np.int64)
+    stick = np.full(n, np.nan)
+    for k, contacts in enumerate(applied):
+        for c in contacts:
+            shear[k] += transmitted_shear_n(c)
+        if contacts:
+            slip[k], stick[k] = slip_state(contacts[0])
+    return {
+        "step_shear_x_n": shear[:, 0],
+        "step_shear_y_n": shear[:, 1],
+        "step_slip": slip,
+        "step_stick_ratio": stick,
+    }
+    # ---- /shear and slip truth (r8-triphys) ----

@@ -114,6 +114,8 @@ def simulate_to_file(
                 "step_x_mm": "mm",
                 "step_y_mm": "mm",
                 "step_force_n": "N",
+                "step_shear_x_n": "N",  # r8-triphys
+                "step_shear_y_n": "N",  # r8-triphys
             }
             for key, value in _truth(spec, run.applied, np.zeros(0, np.int64)).items():
                 if key == "frame_step":
