@@ -55,7 +55,9 @@ def sweep(spec, ratio: float, angle_deg: float, seed: int):
     for r in range(spec.shape[0]):
         for c in range(spec.shape[1]):
             x, y = r * spec.grid.row_pitch_mm, c * spec.grid.col_pitch_mm
-            probe = SphereProbe(x, y, FORCE_N, shear_x_n=qx, shear_y_n=qy, friction=2.0)
+            probe = SphereProbe(
+                x, y, FORCE_N, shear_x_n=qx, shear_y_n=qy, friction=max(ratio, 0.05)
+            )
             steps += [Step((probe,), 8 * period, "pressed"), Step((), 4 * period, "lifted")]
     recording = simulate(spec, Scenario(tuple(steps), "sweep"), rng=seed)
     import json

@@ -104,7 +104,9 @@ def _sweep(spec, ratio, angle_deg, seed):
     steps = [Step((), 10 * period, "untouched")]
     for r in range(spec.shape[0]):
         for c in range(spec.shape[1]):
-            probe = SphereProbe(r * 4.7, c * 4.7, 0.49, shear_x_n=qx, shear_y_n=qy, friction=2.0)
+            probe = SphereProbe(
+                r * 4.7, c * 4.7, 0.49, shear_x_n=qx, shear_y_n=qy, friction=max(ratio, 0.05)
+            )
             steps += [Step((probe,), 6 * period, "pressed"), Step((), 3 * period, "lifted")]
     recording = simulate(spec, Scenario(tuple(steps), "sweep"), rng=seed)
     truth = recording.truth
@@ -136,7 +138,7 @@ def test_calibration_takes_out_each_sensors_gain(spec):
         for r in range(spec.shape[0]):
             for c in range(spec.shape[1]):
                 probe = SphereProbe(r * 4.7, c * 4.7, 0.49, shear_x_n=qx, shear_y_n=qy,
-                                    friction=2.0)  # fmt: skip
+                                    friction=max(ratio, 0.05))  # fmt: skip
                 steps += [Step((probe,), 6 * period, "pressed"), Step((), 3 * period, "lifted")]
         recording = simulate(spec, Scenario(tuple(steps), "sweep"), rng=0,
                              flaws=["gain_spread"], gains=gains)  # fmt: skip
