@@ -335,3 +335,21 @@ def test_two_contacts_a_pitch_apart_are_two_with_their_own_shear(spec):
         assert abs(table.force_n[k] - 0.49) < 0.05 * 0.49
         qx, qy = table.extra["shear_x_n"][k], table.extra["shear_y_n"][k]
         assert _angle_error(qx, qy, want.shear_x_n, want.shear_y_n) < 5.0
+
+
+def test_pieces_give_the_whole(spec, calibration):
+    """The tracks and slip carry from piece to piece: a recording estimated 7 frames at
+    a time gives exactly what it gives whole."""
+    recording = simulate(spec, shear_ramp(spec, x_mm=8.0, y_mm=6.5, angle_deg=-150.0,
+                                          ratio_max=0.7, friction=0.5), rng=12)  # fmt: skip
+    whole, _ = ShearPipeline(spec, calibration.baseline, calibration=calibration)(recording.frames)
+    pipeline = ShearPipeline(spec, calibration.baseline, calibration=calibration)
+    pieces = [pipeline(recording.frames[i : i + 7], first_frame=i)[0]
+              for i in range(0, len(recording.frames), 7)]  # fmt: skip
+    for name in ("shear_x_n", "slip_state", "slip_onset_s"):
+        got = np.concatenate([p.extra[name] for p in pieces])
+        if got.dtype == object:
+            assert list(got) == list(whole.extra[name])
+        else:
+            np.testing.assert_array_equal(got, whole.extra[name])
+    assert "gross" in set(whole.extra["slip_state"])
