@@ -9,12 +9,13 @@ the whole contact slides (gross slip), the tangential force staying at ``mu P``.
 What the taxels show of it is the ratio ``Q / P`` a contact carries. With the friction
 coefficient known (``friction``), the state follows from the ratio: ``stick`` below
 :data:`STICK_RATIO` (no tangential load worth the name), ``partial`` up to ``mu`` less a
-margin, ``gross`` beyond; the stick ratio ``c/a`` is Cattaneo-Mindlin's. Without it, a
+margin, ``gross`` beyond it for :data:`CONFIRM` frames running (the onset dated to the
+first); the stick ratio ``c/a`` is Cattaneo-Mindlin's. Without it, a
 contact's gross slip is found where its ratio stops rising while it carries a tangential
-load and the contact starts to move along its tangential force: the ratio rose by more
-than :data:`RISE` a frame over the frames before and has risen by less than a quarter of
-that since (the plateau at ``mu``), and the contact has moved more than
-:data:`SLIDE_MM` along the tangential force since the plateau began (a hold below ``mu``
+load and the contact starts to move along its tangential force: the ratio has stayed
+within :data:`FLAT` since a frame (the plateau at ``mu``) before which it rose by more than
+:data:`RISE` a frame, and the contact has moved more than :data:`SLIDE_MM` along the
+tangential force since the plateau began (a hold below ``mu``
 is a plateau too, but nothing slides). The onset is dated back to the plateau's first
 frame, and from then on the contact's ``mu`` is the ratio there. The detection itself
 comes at least :data:`PLATEAU_FRAMES` frames after the onset it dates (the
@@ -38,14 +39,31 @@ noise of the ratio on the twin is about 0.01)."""
 MARGIN = 0.04
 """A ratio within this share of ``mu`` of it counts as gross slip [-]."""
 
-RISE = 0.002
-"""Least rise of the ratio per frame [-/frame] for the frames before a plateau."""
+RISE = 0.004
+"""Least rise of the ratio per frame [-/frame] over the :data:`RISE_FRAMES` frames
+before a plateau."""
+
+RISE_FRAMES = 6
+"""Frames over which the rise before a plateau is measured [frames]."""
+
+FLAT = 0.04
+"""Largest spread of the ratio over a plateau [-] (about four times its noise on the
+twin)."""
 
 PLATEAU_FRAMES = 3
-"""Frames of a plateau that declare gross slip (the detection's delay) [frames]."""
+"""Least frames of a plateau that declare gross slip (the detection's delay) [frames]."""
 
-SLIDE_MM = 0.1
+SLIDE_MM = 0.06
 """Movement along the tangential force that tells a slide from a hold [mm]."""
+
+CONFIRM = 2
+"""Consecutive frames at ``mu`` that declare gross slip when ``mu`` is known (one frame
+alone is a glitch: a lift's last frame under the layer's memory fits as any load)
+[frames]."""
+
+MIN_FORCE_N = 0.02
+"""Normal force below which a contact's ratio means nothing (a lift's last frames, where
+noise over a vanishing force reads as any ratio): it counts as unloaded [N]."""
 
 HISTORY = 24
 """Frames of each contact's ratio kept [frames]."""
@@ -78,10 +96,11 @@ class SlipMonitor:
             self._tracks[ident] = track
         return track
 
-    def update(self, frame, ids, ratio, x_mm, y_mm, angle_deg) -> dict[str, np.ndarray]:
+    def update(self, frame, ids, ratio, x_mm, y_mm, angle_deg, force_n) -> dict[str, np.ndarray]:
         """The slip columns of a tracked table's rows (in frame order): each row's
-        frame, id, tangential/normal ratio [-], position [mm] and tangential force's
-        direction [deg].
+        frame, id, tangential/normal ratio [-], position [mm], tangential force's
+        direction [deg] and normal force [N] (below :data:`MIN_FORCE_N` the contact
+        counts as unloaded).
 
         Returns ``slip_state`` (one of :data:`SLIP_STATES`), ``stick_ratio`` (c/a [-],
         NaN where ``mu`` is not known yet), ``friction`` (the ``mu`` used [-], NaN if
@@ -94,7 +113,8 @@ class SlipMonitor:
         onset, detected = np.full(n, np.nan), np.full(n, np.nan)
         for k in range(n):
             track = self._track(int(ids[k]))
-            rho = float(ratio[k]) if np.isfinite(ratio[k]) else 0.0
+            loaded = np.isfinite(ratio[k]) and force_n[k] >= MIN_FORCE_N
+            rho = float(ratio[k]) if loaded else 0.0
             f = int(frame[k])
             if track["frames"] and f != track["frames"][-1] + 1:  # a gap: start over
                 track["ratio"].clear()
@@ -113,9 +133,11 @@ class SlipMonitor:
                     track["onset"] = track["frames"][start] * self.period
                     track["detected"] = f * self.period
             else:
-                gross = rho >= mu * (1.0 - MARGIN)
-                if gross and not track["gross"]:
-                    track["onset"] = track["detected"] = f * self.period
+                at_mu = [r >= mu * (1.0 - MARGIN) for r in list(track["ratio"])[-CONFIRM:]]
+                gross = len(at_mu) == CONFIRM and all(at_mu)
+                if gross and not track["gross"]:  # dated to the first frame at mu
+                    track["onset"] = track["frames"][-CONFIRM] * self.period
+                    track["detected"] = f * self.period
                 if not gross and track["gross"] and rho >= mu * (1.0 - 3 * MARGIN):
                     gross = True  # hysteresis: noise about mu does not end a slide
                 track["gross"] = gross
@@ -134,27 +156,25 @@ class SlipMonitor:
 
     @staticmethod
     def _plateau(ratios, xy, angle_deg: float) -> int | None:
-        """Index in ``ratios`` where a plateau after a rise begins, along which the
-        contact slid, or None."""
+        """Index in ``ratios`` where a plateau after a rise begins (the knee), along
+        which the contact slid, or None."""
         r = np.asarray(ratios, dtype=float)
-        p = PLATEAU_FRAMES
-        if len(r) < 2 * p + 1 or r[-1] < 2 * STICK_RATIO:
+        if len(r) < RISE_FRAMES + PLATEAU_FRAMES + 1 or r[-1] < 2 * STICK_RATIO:
             return None
+        knee = None
+        for start in range(len(r) - 1 - PLATEAU_FRAMES, RISE_FRAMES - 1, -1):
+            if np.ptp(r[start:]) > FLAT:
+                break
+            knee = start  # flat from here on: move the knee back while it stays flat
+        if knee is None:
+            return None
+        if (r[knee] - r[knee - RISE_FRAMES]) / RISE_FRAMES <= RISE:
+            return None  # no rise before it: a hold, not a slip
         along = np.array([math.cos(math.radians(angle_deg)), math.sin(math.radians(angle_deg))])
         moved = np.asarray(xy, dtype=float) @ along
-        for start in range(len(r) - p - 1, p - 1, -1):  # the latest plateau first
-            before = (r[start] - r[start - p]) / p
-            if before <= RISE:
-                continue
-            since = r[start:] - r[start]
-            if np.abs(since).max() < 0.25 * before * max(len(since) - 1, 1) and (
-                moved[-1] - moved[start] > SLIDE_MM
-            ):
-                while start > 1 and r[start] - r[start - 1] < 0.5 * before:
-                    start -= 1  # back to the knee: the last frame that still rose
-                return start
+        if moved[-1] - moved[knee] <= SLIDE_MM:
             return None
-        return None
+        return knee
 
     def forget(self, alive_ids) -> None:
         """Drop the tracks of contacts no longer alive."""
