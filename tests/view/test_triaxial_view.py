@@ -382,18 +382,17 @@ def test_browser_a_three_axis_device_live(page, tmp_path):  # noqa: F811
     server.start()
     try:
         page.goto(server.url)
-        page.wait_for_function(
-            "() => { const s = window.tactsenseView; return s.latest && s.latest.tangential"
+        # read the marks in the same call that finds them drawn: the emulator repeats its
+        # recording, so a later frame (untouched, at the start of a repeat) has none
+        said = page.wait_for_function(
+            "() => { const s = window.tactsenseView; if (!(s.latest && s.latest.tangential"
             " && s.latest.estimate && s.latest.estimate.n_contacts > 0"
-            " && s.drawnIndex === s.lastIndex && s.shearMarks.length > 0; }",
-            timeout=30000,
-        )
-        said = page.evaluate(
-            "() => { const s = window.tactsenseView;"
+            " && s.drawnIndex === s.lastIndex && s.shearMarks.length > 0)) return null;"
             " return {arrows: s.arrowMarks.length, shear: s.shearMarks,"
             " shape: [s.latest.counts.length, s.latest.counts[0].length,"
-            " s.latest.counts[0][0].length]}; }"
-        )
+            " s.latest.counts[0][0].length]}; }",
+            timeout=30000,
+        ).json_value()
     finally:
         server.stop()
         emulator.stop()
