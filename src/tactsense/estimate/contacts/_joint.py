@@ -15,6 +15,7 @@ import warnings
 import numpy as np
 from scipy.optimize import least_squares
 
+from tactsense.estimate.contacts._joint_lm import levenberg_marquardt, tables_of
 from tactsense.estimate.reading import signal_noise_variance
 
 SEED_RADIUS_MM = 1.0
@@ -35,9 +36,57 @@ PRIOR_WIDTH = 0.7
 """Width of the prior on ln a [-] (spheres 1-10 mm at 10-500 g span ln a by 2.1)."""
 
 
+def _bounds(model, frame, k):
+    """Lower and upper bounds (5 k) of the fit's parameters."""
+    px, py = model.pitch_mm
+    rows, cols = frame.shape
+    lo = np.tile([-2.0 * px, -2.0 * py, 0.0, 0.0, 0.0], k)
+    hi = np.tile([(rows + 1) * px, (cols + 1) * py, np.inf, model.a_top_mm, 1.0], k)
+    return lo, hi
+
+
+def _start(model, x0, y0, f0, a0, w0, lo, hi):
+    k = len(x0)
+    w0 = np.full(k, 0.5) if w0 is None else w0
+    p0 = np.column_stack(
+        [x0, y0, np.maximum(f0, 1e-6), np.clip(a0, 0.0, model.a_top_mm), np.clip(w0, 0, 1)]
+    )
+    return np.clip(p0.ravel(), lo + 1e-9, hi - 1e-9)
+
+
+MAX_ITERATIONS = 200
+"""Most Levenberg-Marquardt steps per fit (a fit converges in 5-40)."""
+
+
 def _fit_frame(model, frame, x0, y0, f0, a0, w0=None, sigma=None):
     """Least-squares (x, y [mm], force [N], a [mm], flat share w [-]) of k contacts on
     one frame (k, 5), and the residual sum of squares [-^2]. With ``sigma`` [-] (the
+    noise's standard deviation) each ln a is drawn toward the prior's
+    (:data:`PRIOR_RADIUS_MM`, :data:`PRIOR_WIDTH`): a maximum a posteriori fit, the
+    prior weighing one noise's worth per width. Compiled Levenberg-Marquardt with the
+    Jacobian in closed form (:mod:`._joint_lm`); :func:`_fit_frame_reference` is the
+    same fit by SciPy with finite differences."""
+    k = len(x0)
+    lo, hi = _bounds(model, frame, k)
+    p0 = _start(model, x0, y0, f0, a0, w0, lo, hi)
+    prior = np.array(
+        [0.0 if sigma is None else float(sigma), PRIOR_WIDTH, PRIOR_RADIUS_MM,
+         model.modulus_star_pa]
+    )  # fmt: skip
+    with np.errstate(all="ignore"):
+        p, rss, _ = levenberg_marquardt(
+            p0, lo, np.minimum(hi, 1e300), np.ascontiguousarray(frame, float).ravel(),
+            model.x_taxel, model.y_taxel, tables_of(model), not model.capacitive,
+            float(model.scale), prior, MAX_ITERATIONS,
+        )  # fmt: skip
+    return p.reshape(k, NP), rss
+
+
+def _fit_frame_reference(model, frame, x0, y0, f0, a0, w0=None, sigma=None):
+    """Least-squares (x, y [mm], force [N], a [mm], flat share w [-]) of k contacts on
+    one frame (k, 5), and the residual sum of squares [-^2]: :func:`_fit_frame` by SciPy's
+    trust-region least squares with finite-difference Jacobians (the reference its
+    compiled fit is checked and timed against). With ``sigma`` [-] (the
     noise's standard deviation) each ln a is drawn toward the prior's
     (:data:`PRIOR_RADIUS_MM`, :data:`PRIOR_WIDTH`): a maximum a posteriori fit, the
     prior weighing one noise's worth per width."""
