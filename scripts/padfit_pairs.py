@@ -93,8 +93,9 @@ def bound(spec, truth, noise_counts):
     reading = np.abs(r[:n]) > 0.5 / per  # a taxel reading at least half an A/D step
     j = jac[:n][:, [0, 1, 2, 5, 6, 7]]
     fisher = j.T @ j / variance
-    s = np.linalg.svd(fisher, compute_uv=False)
-    rank = int(np.sum(s > 1e-9 * s[0])) if s[0] > 0 else 0
+    unit = j / np.maximum(np.linalg.norm(j, axis=0), 1e-300)  # the rank in any units
+    s = np.linalg.svd(unit, compute_uv=False)
+    rank = int(np.sum(s > 1e-6 * s[0])) if s[0] > 0 else 0
     if rank < 6:
         return rank, np.inf, int(reading.sum())
     c = np.diag(np.linalg.inv(fisher))
