@@ -286,10 +286,14 @@ def joint_fit(signal, seg, row, col, force, sensor, model, noise_var=None, max_c
         f = int(frames[good[0]])
         frame = np.asarray(signal[f], float)
         sigma = math.sqrt(signal_noise_variance(sensor))
-        q, rss = _fit_frame(
-            model, frame, row[good] * px, col[good] * py,
-            force[good], np.full(len(good), SEED_RADIUS_MM), sigma=sigma,
-        )  # fmt: skip
+        q, rss = None, np.inf
+        for a0 in _seed_radii(model, seg, good):  # the best of a few starting sizes
+            q2, rss2 = _fit_frame(
+                model, frame, row[good] * px, col[good] * py,
+                force[good], a0, sigma=sigma,
+            )  # fmt: skip
+            if rss2 < rss:
+                q, rss = q2, rss2
         parents = np.arange(len(good))
         if noise_var is not None and max_contacts > len(good):
             sigma = sigma + MODEL_ERROR * float(np.abs(frame).max())
@@ -307,6 +311,18 @@ def joint_fit(signal, seg, row, col, force, sensor, model, noise_var=None, max_c
         for p in set(range(len(good))) - seen:  # an original pruned away: its row goes
             dropped.append(good[p])
     return row, col, force, radius, flat, added, dropped
+
+
+def _seed_radii(model, seg, good):
+    """Starting contact radii [mm] of a frame's first fit: :data:`SEED_RADIUS_MM`, each
+    region's extent (the root of its largest second moment, in mm), and half the table's
+    top. A resistive taxel in tension reads rest, so a fit started too narrow sees no
+    slope toward a wider contact whose readings it misses: it must start near it."""
+    px = max(model.pitch_mm)
+    extent = np.sqrt(np.maximum(np.maximum(seg["rr"][good], seg["cc"][good]), 0.0)) * px
+    top = np.full(len(good), 0.5 * model.a_top_mm)
+    one = np.full(len(good), SEED_RADIUS_MM)
+    return [one, np.clip(extent, 0.1, model.a_top_mm), top]
 
 
 def information(rss, noise_var, n_taxels, n_params):

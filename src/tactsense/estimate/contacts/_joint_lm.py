@@ -195,14 +195,25 @@ def levenberg_marquardt(p0, lo, hi, target, x_taxel, y_taxel, tabs, clip, scale,
         floor = 1e-12 * max(diag.max(), 1e-300)
         for q in range(diag.size):
             diag[q] = max(diag[q], floor)
+        # a parameter on its bound that the gradient pushes outward stays there (active
+        # set): the others move, so a fit is not stalled by one bound
+        held = np.zeros(diag.size, dtype=np.bool_)
+        for q in range(diag.size):
+            held[q] = (p[q] <= lo[q] and g[q] > 0.0) or (p[q] >= hi[q] and g[q] < 0.0)
         accepted = False
         trial = p
         new_cost = cost
         while lam < 1e16:
             system = a.copy()
+            rhs = -g
             for q in range(diag.size):
                 system[q, q] += lam * diag[q]
-            delta = np.linalg.solve(system, -g)
+                if held[q]:
+                    system[q, :] = 0.0
+                    system[:, q] = 0.0
+                    system[q, q] = 1.0
+                    rhs[q] = 0.0
+            delta = np.linalg.solve(system, rhs)
             trial = np.minimum(np.maximum(p + delta, lo), hi)
             residual_jacobian(trial, target, x_taxel, y_taxel, tabs, clip, scale, prior, r2, j2)
             evaluations += 1
