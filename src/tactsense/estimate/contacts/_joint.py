@@ -198,8 +198,9 @@ def _split_seeds(q, c, moments, pitch):
 
 
 def _order(model, frame, q, rss, moments, noise_var, max_contacts):
-    """More contacts where a likelihood criterion asks for them: the contact whose
-    region's residual is largest split in two and the frame refitted jointly; kept when
+    """More contacts where a likelihood criterion asks for them: one more at the largest
+    residual (:func:`_residual_seed`) or a contact split in two (:func:`_split_seeds`),
+    the frame refitted jointly from each seed and the best kept when
     the Bayesian information criterion falls (:data:`NP` more parameters: ``rss /
     sigma^2`` must fall by more than ``NP ln n``). Returns the fitted contacts (k', NP),
     the index among the originals each came from, and the RSS."""
