@@ -20,6 +20,10 @@ How the numbers are made (seeded, so a run repeats them):
 * **Centroid**: ``tactsense locate ex.h5 --method fit`` (uncalibrated): the located
   contacts' force-weighted centroid against MuJoCo's (the truth's ``step_x_mm``,
   ``step_y_mm``).
+* **The size-aware joint fit** (issue 38 item 2, issue 34 item 1): ``tactsense locate
+  ex.h5 --method joint`` (uncalibrated: the force is the layer model's, each contact's
+  size fitted with its position and force, contacts added or removed by the information
+  criterion): each frame's summed force against MuJoCo's, and its centroid as above.
 * **Slip**: MuJoCo's onset (the first frame with a contact at the friction cone's limit
   after the ball press) against the first frame of the slide that ``locate`` flags
   ``slip`` (a contact moving under a steady force).
@@ -134,6 +138,25 @@ def _figure(spec, frames, touch, grid, contacts) -> None:
     save_figure(fig, FIGURE)
 
 
+def _centroid(table):
+    """Each frame's force-weighted contact centroid [mm] from a ``locate`` table."""
+    weighted = table.assign(wx=table.x_mm * table.force_n, wy=table.y_mm * table.force_n)
+    sums = weighted.groupby("frame")[["wx", "wy", "force_n"]].sum()
+    return pd.DataFrame(np.c_[sums.wx / sums.force_n, sums.wy / sums.force_n], index=sums.index)
+
+
+def _force_error(total, force, frames) -> str:
+    """Median and largest error [%] of the summed force against MuJoCo's."""
+    error = 100 * (total.reindex(frames).fillna(0).to_numpy() / force[frames] - 1)
+    return f"{np.median(error):+.2f}, {error[np.argmax(np.abs(error))]:+.2f}"
+
+
+def _centroid_error(located, centre, frames) -> str:
+    """Median and largest centroid error [mm] (and the largest in pitches)."""
+    gap = np.hypot(*(located.reindex(frames).to_numpy() - centre[frames]).T)
+    return f"{np.nanmedian(gap):.3f}, {np.nanmax(gap):.3f} ({np.nanmax(gap) / PITCH_MM:.2f})"
+
+
 def _numbers(folder: Path, spec, touch, grid) -> str:
     ex = folder / "ex.h5"
     _tactsense("mujoco", "--out", str(ex), "--seed", "2", "-q")
@@ -160,26 +183,27 @@ def _numbers(folder: Path, spec, touch, grid) -> str:
     _tactsense("calibrate", str(weights), "--force-log", str(log), "--out", str(cal))
     _tactsense("locate", str(ex), "--calibration", str(cal), "--out", str(folder / "cal.csv"))
     _tactsense("locate", str(ex), "--method", "fit", "--out", str(folder / "fit.csv"))
+    _tactsense("locate", str(ex), "--method", "joint", "--out", str(folder / "joint.csv"))
     calibrated = pd.read_csv(folder / "cal.csv")
     fitted = pd.read_csv(folder / "fit.csv")
+    joint = pd.read_csv(folder / "joint.csv")
     total = calibrated.groupby("frame").force_n.sum()
-    weighted = fitted.assign(wx=fitted.x_mm * fitted.force_n, wy=fitted.y_mm * fitted.force_n)
-    sums = weighted.groupby("frame")[["wx", "wy", "force_n"]].sum()
-    located = np.c_[sums.wx / sums.force_n, sums.wy / sums.force_n]
-    located = pd.DataFrame(located, index=sums.index)
+    joint_total = joint.groupby("frame").force_n.sum()
+    located, joint_located = _centroid(fitted), _centroid(joint)
     out = [
         "| phase | MuJoCo force [N] | force error, calibrated: median, largest [%] | "
-        "centroid error (fit): median, largest [mm] (pitch) |",
-        "|---|---|---|---|",
+        "centroid error (fit): median, largest [mm] (pitch) | force error, joint fit "
+        "(no calibration): median, largest [%] | centroid error (joint): median, largest "
+        "[mm] (pitch) |",
+        "|---|---|---|---|---|---|",
     ]
     for label, frames in PHASES.items():
         frames = list(frames)
-        error = 100 * (total.reindex(frames).fillna(0).to_numpy() / force[frames] - 1)
-        gap = np.hypot(*(located.reindex(frames).to_numpy() - centre[frames]).T)
         out.append(
-            f"| {label} | {force[frames].mean():.3f} | {np.median(error):+.2f}, "
-            f"{error[np.argmax(np.abs(error))]:+.2f} | {np.nanmedian(gap):.3f}, "
-            f"{np.nanmax(gap):.3f} ({np.nanmax(gap) / PITCH_MM:.2f}) |"
+            f"| {label} | {force[frames].mean():.3f} | {_force_error(total, force, frames)} | "
+            f"{_centroid_error(located, centre, frames)} | "
+            f"{_force_error(joint_total, force, frames)} | "
+            f"{_centroid_error(joint_located, centre, frames)} |"
         )
     onset = 180 + int(np.argmax(truth["mujoco_slip"][180:]))
     flagged = fitted[(fitted.frame >= 180) & (fitted.frame < 420) & fitted.slip]

@@ -16,3 +16,13 @@ def improved():
 @pytest.fixture(params=["initial", "improved"], scope="session")
 def any_preset(request):
     return ts.preset(request.param)
+
+
+# ---- the joint fit's tables kept in a folder of the session's own (r8-padjoint) ----
+@pytest.fixture(autouse=True, scope="session")
+def _table_cache_folder(tmp_path_factory):
+    """The pad fit's tables (``physics._pad_model.cached_table``) go to a temporary
+    folder, not the user's cache."""
+    import os
+
+    os.environ.setdefault("TACTSENSE_CACHE_DIR", str(tmp_path_factory.mktemp("table_cache")))

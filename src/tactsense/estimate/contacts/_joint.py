@@ -15,6 +15,7 @@ import warnings
 import numpy as np
 from scipy.optimize import least_squares
 
+from tactsense.estimate.contacts._joint_lm import levenberg_marquardt, tables_of
 from tactsense.estimate.reading import signal_noise_variance
 
 SEED_RADIUS_MM = 1.0
@@ -35,9 +36,57 @@ PRIOR_WIDTH = 0.7
 """Width of the prior on ln a [-] (spheres 1-10 mm at 10-500 g span ln a by 2.1)."""
 
 
+def _bounds(model, frame, k):
+    """Lower and upper bounds (5 k) of the fit's parameters."""
+    px, py = model.pitch_mm
+    rows, cols = frame.shape
+    lo = np.tile([-2.0 * px, -2.0 * py, 0.0, 0.0, 0.0], k)
+    hi = np.tile([(rows + 1) * px, (cols + 1) * py, np.inf, model.a_top_mm, 1.0], k)
+    return lo, hi
+
+
+def _start(model, x0, y0, f0, a0, w0, lo, hi):
+    k = len(x0)
+    w0 = np.full(k, 0.5) if w0 is None else w0
+    p0 = np.column_stack(
+        [x0, y0, np.maximum(f0, 1e-6), np.clip(a0, 0.0, model.a_top_mm), np.clip(w0, 0, 1)]
+    )
+    return np.clip(p0.ravel(), lo + 1e-9, hi - 1e-9)
+
+
+MAX_ITERATIONS = 200
+"""Most Levenberg-Marquardt steps per fit (a fit converges in 5-40)."""
+
+
 def _fit_frame(model, frame, x0, y0, f0, a0, w0=None, sigma=None):
     """Least-squares (x, y [mm], force [N], a [mm], flat share w [-]) of k contacts on
     one frame (k, 5), and the residual sum of squares [-^2]. With ``sigma`` [-] (the
+    noise's standard deviation) each ln a is drawn toward the prior's
+    (:data:`PRIOR_RADIUS_MM`, :data:`PRIOR_WIDTH`): a maximum a posteriori fit, the
+    prior weighing one noise's worth per width. Compiled Levenberg-Marquardt with the
+    Jacobian in closed form (:mod:`._joint_lm`); :func:`_fit_frame_reference` is the
+    same fit by SciPy with finite differences."""
+    k = len(x0)
+    lo, hi = _bounds(model, frame, k)
+    p0 = _start(model, x0, y0, f0, a0, w0, lo, hi)
+    prior = np.array(
+        [0.0 if sigma is None else float(sigma), PRIOR_WIDTH, PRIOR_RADIUS_MM,
+         model.modulus_star_pa]
+    )  # fmt: skip
+    with np.errstate(all="ignore"):
+        p, rss, _ = levenberg_marquardt(
+            p0, lo, np.minimum(hi, 1e300), np.ascontiguousarray(frame, float).ravel(),
+            model.x_taxel, model.y_taxel, tables_of(model), not model.capacitive,
+            float(model.scale), prior, MAX_ITERATIONS,
+        )  # fmt: skip
+    return p.reshape(k, NP), rss
+
+
+def _fit_frame_reference(model, frame, x0, y0, f0, a0, w0=None, sigma=None):
+    """Least-squares (x, y [mm], force [N], a [mm], flat share w [-]) of k contacts on
+    one frame (k, 5), and the residual sum of squares [-^2]: :func:`_fit_frame` by SciPy's
+    trust-region least squares with finite-difference Jacobians (the reference its
+    compiled fit is checked and timed against). With ``sigma`` [-] (the
     noise's standard deviation) each ln a is drawn toward the prior's
     (:data:`PRIOR_RADIUS_MM`, :data:`PRIOR_WIDTH`): a maximum a posteriori fit, the
     prior weighing one noise's worth per width."""
@@ -94,15 +143,19 @@ SPLIT_MIN_SHARE = 0.1
 """Each of two contacts found by a split carries at least this share of their force."""
 
 
-def _split_seed(q, c, moments, pitch):
+def _split_seed(q, c, moments, pitch, turn=0.0, half=None):
     """Seeds (k + 1, 4) with contact ``c`` replaced by two along its major axis: a pair
     d apart widens a contact's signal by (d/2)^2 along it, so the half separation is
-    the square root of the major minus the minor second moment (at least 0.4 taxel)."""
+    the square root of the major minus the minor second moment (at least 0.4 taxel).
+    ``turn`` [rad] turns the axis, ``half`` [taxel] sets the half separation."""
     rr, cc, rc = moments
     lam = np.linalg.eigh(np.array([[rr, rc], [rc, cc]]))
     (minor, major), vectors = lam
     u = vectors[:, 1]
-    h = max(0.4, math.sqrt(max(major - minor, 0.0)))  # [taxel]
+    if turn:
+        cos, sin = math.cos(turn), math.sin(turn)
+        u = np.array([cos * u[0] - sin * u[1], sin * u[0] + cos * u[1]])
+    h = max(0.4, math.sqrt(max(major - minor, 0.0))) if half is None else half  # [taxel]
     step = np.array([u[0] * h * pitch[0], u[1] * h * pitch[1]])
     one, two = q[c].copy(), q[c].copy()
     one[:2] += step
@@ -113,9 +166,41 @@ def _split_seed(q, c, moments, pitch):
     return np.vstack([np.delete(q, c, axis=0), one, two])
 
 
+SPLIT_TURNS_DEG = (0.0, 45.0, 90.0, -45.0)
+"""Directions a split is tried in, from the contact's major axis [deg]: where the
+moments do not show the pair's axis (a pair on the diagonal of a coarse grid reads
+round), the fit starts from each (issue 34 item 2: every orientation)."""
+
+SPLIT_HALVES = (None, 0.6, 0.9)
+"""Half separations a split is tried at [taxel]; None: from the second moments."""
+
+
+def _residual_seed(model, frame, q):
+    """(c, seed): the contacts kept and one more at the taxel where the frame most
+    exceeds the fit (its force: that excess over the response's peak per newton), ``c``
+    the contact nearest to it (the seed lists it last but one, as a split does)."""
+    fitted = model.signal(q[:, :2], q[:, 2], q[:, 3], q[:, 4])
+    excess = np.asarray(frame, float) - fitted
+    i, j = np.unravel_index(int(np.argmax(excess)), excess.shape)
+    where = np.array([model.x_taxel[i], model.y_taxel[j]])
+    radius = float(_prior_radius(model, np.array([max(float(q[:, 2].mean()), 1e-3)]))[0])
+    peak = float(model.signal([where], [1.0], [radius]).max())
+    new = np.array([*where, max(excess[i, j], 0.0) / max(peak, 1e-30), radius, 0.0])
+    c = int(np.argmin(np.hypot(q[:, 0] - where[0], q[:, 1] - where[1])))
+    return c, np.vstack([np.delete(q, c, axis=0), q[c], new])
+
+
+def _split_seeds(q, c, moments, pitch):
+    """Every seed :func:`_order` tries for a split of contact ``c``."""
+    for turn in SPLIT_TURNS_DEG:
+        for half in SPLIT_HALVES:
+            yield _split_seed(q, c, moments, pitch, math.radians(turn), half)
+
+
 def _order(model, frame, q, rss, moments, noise_var, max_contacts):
-    """More contacts where a likelihood criterion asks for them: the contact whose
-    region's residual is largest split in two and the frame refitted jointly; kept when
+    """More contacts where a likelihood criterion asks for them: one more at the largest
+    residual (:func:`_residual_seed`) or a contact split in two (:func:`_split_seeds`),
+    the frame refitted jointly from each seed and the best kept when
     the Bayesian information criterion falls (:data:`NP` more parameters: ``rss /
     sigma^2`` must fall by more than ``NP ln n``). Returns the fitted contacts (k', NP),
     the index among the originals each came from, and the RSS."""
@@ -125,8 +210,13 @@ def _order(model, frame, q, rss, moments, noise_var, max_contacts):
         if rss / noise_var < n + 3.0 * math.sqrt(2.0 * n):  # consistent with noise alone
             break
         best = None
-        for c in range(len(q)):  # try each contact's split, keep the best
-            seed = _split_seed(q, c, moments[parents[c]], model.pitch_mm)
+        tries = [_residual_seed(model, frame, q)]
+        tries += [
+            (c, seed)
+            for c in range(len(q))
+            for seed in _split_seeds(q, c, moments[parents[c]], model.pitch_mm)
+        ]
+        for c, seed in tries:  # try each contact's splits, keep the best
             q2, rss2 = _fit_frame(model, frame, *seed.T, sigma=math.sqrt(noise_var))
             pair = q2[-2:]
             apart = np.hypot(*((pair[0, :2] - pair[1, :2]) / model.pitch_mm))
@@ -140,7 +230,31 @@ def _order(model, frame, q, rss, moments, noise_var, max_contacts):
         if best is None:
             break
         q, rss, parents = best
+    if len(q) > len(moments):
+        q, rss, parents = _prune(model, frame, q, rss, parents, noise_var)
     return q, np.asarray(parents), rss
+
+
+def _prune(model, frame, q, rss, parents, noise_var):
+    """Backward elimination after splits: while a fit without one of the contacts (the
+    others its seed, refitted jointly) explains the frame as well by the Bayesian
+    information criterion (``rss / sigma^2`` grows by at most :data:`NP` ``ln n``),
+    that contact goes (a split that only repaired a poor local minimum of the fewer
+    contacts' fit)."""
+    n = frame.size
+    sigma = math.sqrt(noise_var)
+    while len(q) > 1:
+        best = None
+        for c in range(len(q)):
+            q2, rss2 = _fit_frame(model, frame, *np.delete(q, c, axis=0).T, sigma=sigma)
+            if best is None or rss2 < best[1]:
+                best = (q2, rss2, c)
+        q2, rss2, c = best
+        if (rss2 - rss) / noise_var > NP * math.log(n):
+            break
+        q, rss = q2, rss2
+        parents = [p for i, p in enumerate(parents) if i != c]
+    return q, rss, parents
 
 
 def joint_fit(signal, seg, row, col, force, sensor, model, noise_var=None, max_contacts=0):
@@ -153,14 +267,15 @@ def joint_fit(signal, seg, row, col, force, sensor, model, noise_var=None, max_c
     With ``noise_var`` [-^2] and ``max_contacts`` > 0, a frame may hold more contacts
     than the watershed found (:func:`_order`): returns also ``added``, a list of
     ``(parent index, row, col, force, radius)`` for each contact added (it shares its
-    parent's region)."""
+    parent's region), and ``dropped``, the indices of the originals whose contacts the
+    pruning removed all of (:func:`_prune`)."""
     n = len(seg["frame"])
     row, col, force = (np.array(v, float, copy=True) for v in (row, col, force))
     radius = np.full(n, np.nan)
     flat = np.full(n, np.nan)
-    added = []
+    added, dropped = [], []
     if n == 0:
-        return row, col, force, radius, flat, added
+        return row, col, force, radius, flat, added, dropped
     px, py = model.pitch_mm
     frames = np.asarray(seg["frame"])
     order = np.argsort(frames, kind="stable")
@@ -172,10 +287,14 @@ def joint_fit(signal, seg, row, col, force, sensor, model, noise_var=None, max_c
         f = int(frames[good[0]])
         frame = np.asarray(signal[f], float)
         sigma = math.sqrt(signal_noise_variance(sensor))
-        q, rss = _fit_frame(
-            model, frame, row[good] * px, col[good] * py,
-            force[good], np.full(len(good), SEED_RADIUS_MM), sigma=sigma,
-        )  # fmt: skip
+        q, rss = None, np.inf
+        for a0 in _seed_radii(model, seg, good):  # the best of a few starting sizes
+            q2, rss2 = _fit_frame(
+                model, frame, row[good] * px, col[good] * py,
+                force[good], a0, sigma=sigma,
+            )  # fmt: skip
+            if rss2 < rss:
+                q, rss = q2, rss2
         parents = np.arange(len(good))
         if noise_var is not None and max_contacts > len(good):
             sigma = sigma + MODEL_ERROR * float(np.abs(frame).max())
@@ -190,10 +309,21 @@ def joint_fit(signal, seg, row, col, force, sensor, model, noise_var=None, max_c
                 continue
             seen.add(p)
             row[i], col[i], force[i], radius[i], flat[i] = values
-        missing = set(range(len(good))) - seen
-        for p in missing:  # an original replaced by none (cannot happen: splits only add)
-            force[good[p]] = np.nan
-    return row, col, force, radius, flat, added
+        for p in set(range(len(good))) - seen:  # an original pruned away: its row goes
+            dropped.append(good[p])
+    return row, col, force, radius, flat, added, dropped
+
+
+def _seed_radii(model, seg, good):
+    """Starting contact radii [mm] of a frame's first fit: :data:`SEED_RADIUS_MM`, each
+    region's extent (the root of its largest second moment, in mm), and half the table's
+    top. A resistive taxel in tension reads rest, so a fit started too narrow sees no
+    slope toward a wider contact whose readings it misses: it must start near it."""
+    px = max(model.pitch_mm)
+    extent = np.sqrt(np.maximum(np.maximum(seg["rr"][good], seg["cc"][good]), 0.0)) * px
+    top = np.full(len(good), 0.5 * model.a_top_mm)
+    one = np.full(len(good), SEED_RADIUS_MM)
+    return [one, np.clip(extent, 0.1, model.a_top_mm), top]
 
 
 def information(rss, noise_var, n_taxels, n_params):
@@ -208,21 +338,29 @@ def fit_sizes(signal, seg, row, col, force, sensor, model, max_contacts):
     after the frame's others), sorted by frame and contact, and each row's row, column
     [taxel], force [N], contact radius [mm] and flat share [-]."""
     noise_var = signal_noise_variance(sensor)
-    row, col, force, radius, flat, added = joint_fit(
+    row, col, force, radius, flat, added, dropped = joint_fit(
         signal, seg, row, col, force, sensor, model, noise_var, max_contacts
     )
-    if not added:
+    if not added and not dropped:
         return seg, row, col, force, radius, flat
     parent = np.array([a[0] for a in added], np.int64)
     seg = {key: np.concatenate([value, value[parent]]) for key, value in seg.items()}
+    seg["contact"] = seg["contact"].copy()
     n_old = len(row)
     for j, p in enumerate(parent):  # numbered after the frame's others
         same = seg["frame"] == seg["frame"][p]
         seg["contact"][n_old + j] = seg["contact"][same].max() + 1
-    extra = np.array([a[1:] for a in added], float)
+    extra = np.array([a[1:] for a in added], float).reshape(len(added), 5)
     row, col = np.concatenate([row, extra[:, 0]]), np.concatenate([col, extra[:, 1]])
     force, radius = np.concatenate([force, extra[:, 2]]), np.concatenate([radius, extra[:, 3]])
     flat = np.concatenate([flat, extra[:, 4]])
-    order = np.lexsort((seg["contact"], seg["frame"]))
+    keep = np.ones(len(row), bool)
+    keep[np.asarray(dropped, np.int64)] = False
+    order = np.flatnonzero(keep)[np.lexsort((seg["contact"][keep], seg["frame"][keep]))]
     seg = {key: value[order] for key, value in seg.items()}
+    if dropped:  # numbered 0, 1, ... in each frame again
+        frames = seg["frame"]
+        first = np.r_[0, np.flatnonzero(np.diff(frames)) + 1]
+        starts = np.repeat(first, np.diff(np.r_[first, len(frames)]))
+        seg["contact"] = np.arange(len(frames)) - starts
     return seg, row[order], col[order], force[order], radius[order], flat[order]

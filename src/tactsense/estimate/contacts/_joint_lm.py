@@ -1,0 +1,253 @@
+"""The joint fit's compiled Levenberg-Marquardt (issue 34 item 1: the fit made fast).
+
+The same problem as :func:`tactsense.estimate.contacts._joint._fit_frame`'s reference
+(SciPy's ``least_squares`` with finite-difference Jacobians, one frame evaluation per
+parameter per step): the frame's signal under k round contacts, each
+``F s ((1 - w) G_sphere(a; x_i - x, y_j - y) + w G_disc(a; ...))`` from the pad's
+separable tables (:mod:`tactsense.physics._hertz_table`, interpolated as
+:func:`tactsense.physics._contact_kernel.superpose` does: linear in a, cubic in dx, dy),
+with its Jacobian in closed form (the derivative of the interpolants), and the prior on
+ln a as k extra residuals. Everything runs compiled (Numba): one call per frame.
+
+The step is Marquardt's (``(J^T J + lambda diag(J^T J)) delta = -J^T r``) projected on the
+bounds (each parameter clipped into its box after the step); lambda falls by 3 on a step
+that lowers the cost and rises by 4 on one that does not.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import numpy as np
+
+from tactsense._jit import jit
+
+NP = 5
+"""Parameters per contact: x, y [mm], force [N], contact radius a [mm], flat share [-]."""
+
+
+@jit(inline="always")
+def _weights(w):
+    """Cubic Lagrange weights at -1, 0, 1, 2 for w in [0, 1), and their derivatives."""
+    return (
+        -w * (w - 1.0) * (w - 2.0) / 6.0,
+        (w + 1.0) * (w - 1.0) * (w - 2.0) / 2.0,
+        -(w + 1.0) * w * (w - 2.0) / 2.0,
+        (w + 1.0) * w * (w - 1.0) / 6.0,
+        -(3.0 * w * w - 6.0 * w + 2.0) / 6.0,
+        (3.0 * w * w - 4.0 * w - 1.0) / 2.0,
+        -(3.0 * w * w - 2.0 * w - 2.0) / 2.0,
+        (3.0 * w * w - 1.0) / 6.0,
+    )
+
+
+@jit()
+def unit_response(x_taxel, y_taxel, xc, yc, a, xf, yf, step, a_step, g, gx, gy, ga):
+    """One contact's response per newton ``g`` (rows, cols) [1/N] at (xc, yc) [mm] with
+    pressure radius ``a`` [mm], and its derivatives along xc, yc [1/(N mm)] and a
+    [1/(N mm)], written into ``g``, ``gx``, ``gy``, ``ga``; ``xf``, ``yf`` the table's
+    padded factors (``SeparableResponse.padded_x``/``padded_y``)."""
+    n_a, n_x, terms = xf.shape
+    n_y = yf.shape[0]
+    rows, cols = x_taxel.size, y_taxel.size
+    u = np.zeros((rows, terms))
+    ux = np.zeros((rows, terms))
+    ua = np.zeros((rows, terms))
+    v = np.zeros((terms, cols))
+    vy = np.zeros((terms, cols))
+    t = a / a_step
+    ia = min(int(t), n_a - 2)
+    wa = t - ia
+    slope = 1.0 / a_step
+    if wa > 1.0:
+        wa = 1.0
+        slope = 0.0
+    below, above = xf[ia], xf[ia + 1]
+    for i in range(rows):
+        s = x_taxel[i] - xc
+        d = abs(s) / step
+        ix = int(d)
+        if ix >= n_x - 3:
+            continue
+        w0, w1, w2, w3, d0, d1, d2, d3 = _weights(d - ix)
+        sign = -1.0 if s > 0.0 else 1.0  # d(d)/d(xc) times step
+        for r in range(terms):
+            lo = w0 * below[ix, r] + w1 * below[ix + 1, r] + w2 * below[ix + 2, r]
+            lo += w3 * below[ix + 3, r]
+            hi = w0 * above[ix, r] + w1 * above[ix + 1, r] + w2 * above[ix + 2, r]
+            hi += w3 * above[ix + 3, r]
+            dlo = d0 * below[ix, r] + d1 * below[ix + 1, r] + d2 * below[ix + 2, r]
+            dlo += d3 * below[ix + 3, r]
+            dhi = d0 * above[ix, r] + d1 * above[ix + 1, r] + d2 * above[ix + 2, r]
+            dhi += d3 * above[ix + 3, r]
+            u[i, r] = (1.0 - wa) * lo + wa * hi
+            ua[i, r] = (hi - lo) * slope
+            ux[i, r] = ((1.0 - wa) * dlo + wa * dhi) * sign / step
+    for j in range(cols):
+        s = y_taxel[j] - yc
+        d = abs(s) / step
+        iy = int(d)
+        if iy >= n_y - 3:
+            continue
+        w0, w1, w2, w3, d0, d1, d2, d3 = _weights(d - iy)
+        sign = -1.0 if s > 0.0 else 1.0
+        for r in range(terms):
+            v[r, j] = w0 * yf[iy, r] + w1 * yf[iy + 1, r] + w2 * yf[iy + 2, r] + w3 * yf[iy + 3, r]
+            dv = d0 * yf[iy, r] + d1 * yf[iy + 1, r] + d2 * yf[iy + 2, r] + d3 * yf[iy + 3, r]
+            vy[r, j] = dv * sign / step
+    for i in range(rows):
+        for j in range(cols):
+            s0 = 0.0
+            sx = 0.0
+            sy = 0.0
+            sa = 0.0
+            for r in range(terms):
+                s0 += u[i, r] * v[r, j]
+                sx += ux[i, r] * v[r, j]
+                sy += u[i, r] * vy[r, j]
+                sa += ua[i, r] * v[r, j]
+            g[i, j] = s0
+            gx[i, j] = sx
+            gy[i, j] = sy
+            ga[i, j] = sa
+
+
+@jit()
+def residual_jacobian(p, target, x_taxel, y_taxel, tabs, clip, scale, prior, out_r, out_j):
+    """Residual (n + k) [-] and Jacobian (n + k, 5 k) of k contacts' parameters ``p``
+    (5 k: x, y [mm], F [N], a [mm], w [-] per contact) against ``target`` (rows * cols)
+    [-]; the prior's k residuals last when ``prior[0]`` (sigma [-]) > 0.
+
+    ``tabs``: (sphere x factors, y factors, step, disc x factors, y factors, step,
+    a step); ``clip``: a resistive taxel reads no tension (its residual and Jacobian row
+    where the model is below zero: zero signal, zero slope); ``scale`` the force's
+    factor (a capacitive pad's strain gain); ``prior``: (sigma, width, sphere radius
+    [mm], plane-strain modulus [Pa])."""
+    xs, ys, step_s, xd, yd, step_d, a_step = tabs
+    rows, cols = x_taxel.size, y_taxel.size
+    n = rows * cols
+    k = p.size // 5
+    out_r[:] = 0.0
+    out_j[:, :] = 0.0
+    gs = np.empty((4, rows, cols))
+    gd = np.empty((4, rows, cols))
+    model = np.zeros(n)
+    for c in range(k):
+        x, y, f, a, w = p[5 * c], p[5 * c + 1], p[5 * c + 2], p[5 * c + 3], p[5 * c + 4]
+        unit_response(x_taxel, y_taxel, x, y, a, xs, ys, step_s, a_step, gs[0], gs[1], gs[2], gs[3])
+        unit_response(x_taxel, y_taxel, x, y, a, xd, yd, step_d, a_step, gd[0], gd[1], gd[2], gd[3])
+        fs = f * scale
+        for i in range(rows):
+            for j in range(cols):
+                m = i * cols + j
+                s0 = (1.0 - w) * gs[0, i, j] + w * gd[0, i, j]
+                model[m] += fs * s0
+                out_j[m, 5 * c] = fs * ((1.0 - w) * gs[1, i, j] + w * gd[1, i, j])
+                out_j[m, 5 * c + 1] = fs * ((1.0 - w) * gs[2, i, j] + w * gd[2, i, j])
+                out_j[m, 5 * c + 2] = scale * s0
+                out_j[m, 5 * c + 3] = fs * ((1.0 - w) * gs[3, i, j] + w * gd[3, i, j])
+                out_j[m, 5 * c + 4] = fs * (gd[0, i, j] - gs[0, i, j])
+    for m in range(n):
+        if clip and model[m] <= 0.0:
+            out_r[m] = -target[m]
+            out_j[m, :] = 0.0
+        else:
+            out_r[m] = model[m] - target[m]
+    sigma, width, radius, e_star = prior
+    if sigma > 0.0:
+        for c in range(k):
+            f, a = p[5 * c + 2], p[5 * c + 3]
+            ff = max(f, 1e-4)
+            hertz = (3.0 * ff * 1e-3 * radius / (4.0 * e_star)) ** (1.0 / 3.0) * 1e3
+            capped = hertz >= radius
+            ref = radius if capped else hertz
+            aa = max(a, 1e-3)
+            out_r[n + c] = sigma * math.log(aa / ref) / width
+            if a > 1e-3:
+                out_j[n + c, 5 * c + 3] = sigma / (width * a)
+            if f > 1e-4 and not capped:
+                out_j[n + c, 5 * c + 2] = -sigma / (3.0 * width * f)
+
+
+@jit()
+def levenberg_marquardt(p0, lo, hi, target, x_taxel, y_taxel, tabs, clip, scale, prior, max_iter):
+    """Least squares of :func:`residual_jacobian` from ``p0`` within [lo, hi]: returns
+    the parameters, the data's residual sum of squares [-^2] (without the prior) and the
+    number of Jacobians evaluated."""
+    n = target.size
+    k = p0.size // 5
+    m = n + (k if prior[0] > 0.0 else 0)
+    r = np.empty(n + k)
+    jac = np.empty((n + k, 5 * k))
+    r2 = np.empty(n + k)
+    j2 = np.empty((n + k, 5 * k))
+    p = np.minimum(np.maximum(p0.copy(), lo), hi)
+    residual_jacobian(p, target, x_taxel, y_taxel, tabs, clip, scale, prior, r, jac)
+    cost = np.sum(r[:m] ** 2)
+    lam = 1e-3
+    evaluations = 1
+    for _ in range(max_iter):
+        jm = jac[:m]
+        a = jm.T @ jm
+        g = jm.T @ r[:m]
+        diag = np.diag(a).copy()
+        floor = 1e-12 * max(diag.max(), 1e-300)
+        for q in range(diag.size):
+            diag[q] = max(diag[q], floor)
+        # a parameter on its bound that the gradient pushes outward stays there (active
+        # set): the others move, so a fit is not stalled by one bound
+        held = np.zeros(diag.size, dtype=np.bool_)
+        for q in range(diag.size):
+            held[q] = (p[q] <= lo[q] and g[q] > 0.0) or (p[q] >= hi[q] and g[q] < 0.0)
+        accepted = False
+        trial = p
+        new_cost = cost
+        while lam < 1e16:
+            system = a.copy()
+            rhs = -g
+            for q in range(diag.size):
+                system[q, q] += lam * diag[q]
+                if held[q]:
+                    system[q, :] = 0.0
+                    system[:, q] = 0.0
+                    system[q, q] = 1.0
+                    rhs[q] = 0.0
+            delta = np.linalg.solve(system, rhs)
+            trial = np.minimum(np.maximum(p + delta, lo), hi)
+            residual_jacobian(trial, target, x_taxel, y_taxel, tabs, clip, scale, prior, r2, j2)
+            evaluations += 1
+            new_cost = np.sum(r2[:m] ** 2)
+            if new_cost < cost:
+                accepted = True
+                lam = max(lam / 3.0, 1e-12)
+                break
+            lam *= 4.0
+        if not accepted:
+            break
+        moved = np.max(np.abs(trial - p) / (np.abs(p) + 1e-3))
+        drop = cost - new_cost
+        p = trial
+        cost = new_cost
+        r[:] = r2
+        jac[:, :] = j2
+        if drop <= 1e-12 * cost or moved < 1e-10:
+            break
+    return p, float(np.sum(r[:n] ** 2)), evaluations
+
+
+@functools.lru_cache(maxsize=8)
+def tables_of(model):
+    """The argument ``tabs`` of :func:`residual_jacobian` for a
+    :class:`~tactsense.physics._pad_model.PadContactModel` (once per model)."""
+    s, d = model.tables["sphere"], model.tables["disc"]
+    assert s.a_step_mm == d.a_step_mm  # one grid of a for both shapes (PadContactModel)
+    return (
+        np.ascontiguousarray(s.padded_x, dtype=np.float64),
+        np.ascontiguousarray(s.padded_y, dtype=np.float64),
+        float(s.step_mm),
+        np.ascontiguousarray(d.padded_x, dtype=np.float64),
+        np.ascontiguousarray(d.padded_y, dtype=np.float64),
+        float(d.step_mm),
+        float(s.a_step_mm),
+    )
