@@ -33,26 +33,33 @@ def shear_ramp(
     settle_frames: int = 10,
     press_frames: int = 10,
     size_mm: float = 1.6,
+    slide_mm_s: float = 10.0,
 ) -> Scenario:
     """Untouched, a press of ``force_n`` [N] at (x, y) [mm], then the tangential force
     ramped linearly in ``ramp_frames`` frames to ``ratio_max`` times the normal force
-    along ``angle_deg`` (from +x toward +y) [deg], held, released, lifted. One step a
-    frame while it ramps."""
+    along ``angle_deg`` (from +x toward +y) [deg], held ``hold_frames``, released,
+    lifted. One step a frame while it ramps and holds. Where the tangential force
+    reaches ``friction`` times the normal force the contact slides along it at
+    ``slide_mm_s`` [mm/s] (gross slip: it moves, its tangential force stays at mu P)."""
     period = spec.scan_period_s
     steps = [Step((), settle_frames * period, "untouched")]
+    along = (math.cos(math.radians(angle_deg)), math.sin(math.radians(angle_deg)))
+    slid = [0.0]
 
     def probe(ratio: float) -> SphereProbe:
         q = ratio * force_n
         return SphereProbe(
-            x_mm, y_mm, force_n, radius_mm=size_mm, friction=friction,
-            shear_x_n=q * math.cos(math.radians(angle_deg)),
-            shear_y_n=q * math.sin(math.radians(angle_deg)),
+            x_mm + slid[0] * along[0], y_mm + slid[0] * along[1], force_n,
+            radius_mm=size_mm, friction=friction,
+            shear_x_n=q * along[0], shear_y_n=q * along[1],
         )  # fmt: skip
 
     steps.append(Step((probe(0.0),), press_frames * period, "pressed"))
-    for k in range(1, ramp_frames + 1):
-        steps.append(Step((probe(ratio_max * k / ramp_frames),), period, "ramp"))
-    steps.append(Step((probe(ratio_max),), hold_frames * period, "held"))
+    ratios = [ratio_max * k / ramp_frames for k in range(1, ramp_frames + 1)]
+    for ratio in ratios + [ratio_max] * hold_frames:
+        if ratio >= friction:
+            slid[0] += slide_mm_s * period
+        steps.append(Step((probe(ratio),), period, "ramp" if ratio < ratio_max else "held"))
     steps.append(Step((probe(0.0),), press_frames * period, "released"))
     steps.append(Step((), settle_frames * period, "lifted"))
     return Scenario(

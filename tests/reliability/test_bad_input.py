@@ -1082,6 +1082,64 @@ def test_triinterop_bad_three_axis_files(workspace, line, names):
 # ---- /three-axis frames in other tools' files (r8-triinterop) ----
 
 
+# ---- three-axis locate and calibrate (r8-triest) ----
+TRIEST_BAD = [
+    ("locate MAG --friction 0 -o OUT", "--friction must be a coefficient in 0.05-5"),
+    ("locate MAG --friction nan -o OUT", "--friction must be a coefficient in 0.05-5"),
+    ("locate MAG --friction 9 -o OUT", "--friction must be a coefficient in 0.05-5"),
+    ("locate REC --friction 0.5 -o OUT", "--friction applies to three-axis sensors"),
+    ("locate MAG --method fit -o OUT", "--method fit is for pads"),
+    ("locate MAG --calibration PADCAL -o OUT", "is not a three-axis calibration"),
+    ("calibrate MAG --shear-sweep MISSING -o OUT", "triest_missing.h5 does not exist"),
+    ("calibrate MAG --press -o OUT", "--press is not for three-axis sensors"),
+    ("calibrate MAGNOTRUTH -o OUT", "has no known loads"),
+    ("calibrate REC --shear-sweep MAG -o OUT", "--shear-sweep is for three-axis sensors"),
+]
+
+
+@pytest.fixture(scope="module")
+def triest_workspace(tmp_path_factory):
+    import json
+
+    import h5py
+
+    from tactsense.flat_scenarios import SCENARIOS
+
+    folder = tmp_path_factory.mktemp("triest_matrix")
+    spec = ts.preset("mag4x4")
+    recording = ts.simulate(spec, SCENARIOS["press"](spec), rng=0)
+    ts.write_recording(folder / "triest_mag.h5", recording)
+    ts.write_recording(folder / "triest_mag_no_truth.h5", recording)
+    with h5py.File(folder / "triest_mag_no_truth.h5", "a") as f:
+        for group in ("truth",):
+            if group in f:
+                del f[group]
+    pad = ts.fearing1990_initial()
+    ts.write_recording(folder / "triest_rec.h5", ts.simulate(pad, ts.probe_sweep(pad), rng=0))
+    (folder / "triest_pad_cal.json").write_text(json.dumps({"format": "something-else"}))
+    return folder
+
+
+@pytest.mark.parametrize("line, names", TRIEST_BAD, ids=[line for line, _ in TRIEST_BAD])
+def test_triest_bad_input(triest_workspace, line, names):
+    folder = triest_workspace
+    out = folder / "never_written_triest.csv"
+    args = (
+        line.replace("MAGNOTRUTH", str(folder / "triest_mag_no_truth.h5"))
+        .replace("MAG", str(folder / "triest_mag.h5"))
+        .replace("REC", str(folder / "triest_rec.h5"))
+        .replace("PADCAL", str(folder / "triest_pad_cal.json"))
+        .replace("MISSING", str(folder / "triest_missing.h5"))
+        .replace("OUT", str(out))
+        .split()
+    )
+    _check(runner.invoke(app, args), names)
+    assert not out.exists()
+
+
+# ---- /r8-triest ----
+
+
 # ---- (r8-triphys) ----
 TRIPHYS_BAD = [  # the shear scenarios' options (issue 35 item 5)
     ("simulate --sensor mag4x4 --scenario shear --shear-ratio 1.2 -o OUT", "friction"),

@@ -23,6 +23,12 @@ def threshold_counts(sensor, noise_gain: float = 1.0) -> float:
     readings) set it, times ``noise_gain`` where the signal is read through a filter that
     amplifies the noise (the creep compensation,
     :func:`~tactsense.estimate.creep.compensation_noise_gain`)."""
+    # ---- three-axis taxels (r8-triest): the length of a taxel's change ----
+    if int(getattr(sensor, "components", 1)) > 1:
+        from tactsense.estimate.triaxial.fit import default_threshold_counts
+
+        return default_threshold_counts(sensor) * noise_gain
+    # ---- /r8-triest ----
     bits = int(sensor.electronics.adc_bits)
     counts = 10.0 if bits >= 12 else max(3.0, 10.0 * 2.0 ** (bits - 12))
     return max(counts, 5.0 * float(sensor.flaws.read_noise_counts) * noise_gain)
@@ -51,6 +57,10 @@ def default_threshold(sensor, creep=None, frame_period_s: float | None = None) -
 
         gain = compensation_noise_gain(creep, frame_period_s or sensor.scan_period_s)
     n = threshold_counts(sensor, gain)
+    # ---- three-axis taxels (r8-triest): a share of the converter's full scale ----
+    if int(getattr(sensor, "components", 1)) > 1:
+        return n / (2 ** int(sensor.electronics.adc_bits) - 1)
+    # ---- /r8-triest ----
     transduction = getattr(sensor, "transduction", None)
     if transduction is not None and transduction.kind != "capacitive":
         return n / transduction.counts_per_strain

@@ -7,8 +7,8 @@ with the ring of taxels around it (less other groups' taxels), is fitted with th
 kind's response (:mod:`.response`): for a position ``p`` the change is
 ``N R_n(p) + Q_x R_x(p) + Q_y R_y(p)``, linear in the loads, so the loads are a linear
 least-squares solution at each node of the response grid and the position is the node
-of least residual, refined by a parabola through its neighbours along each axis
-(variable projection). The tangential force's magnitude and direction follow.
+of least residual, refined by a simplex search over the response's cubic spline
+between nodes (variable projection). The tangential force's magnitude and direction follow.
 
 The normal force cannot come from a sum over the taxels: an incompressible layer
 (nu = 0.5) bonded to a rigid base moves as much material up beside a contact as down
@@ -21,7 +21,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy import ndimage
+from scipy import ndimage, optimize
 
 from tactsense._validation import TactsenseInputError
 from tactsense.estimate.results import ContactTable, Flag
@@ -136,9 +136,9 @@ def find_shear_contacts(
             own = labels == label
             window = ndimage.binary_dilation(own, structure=_EIGHT) & ~ignored
             window &= (labels == 0) | own
-            fit = _fit_group(change, window, own, table, sensor)
-            if fit is not None:
-                found.append((fit, own, railed))
+            fits = _fit_group(change, window, own, table, sensor, max_contacts > 1)
+            for fit, mine in fits:
+                found.append((fit, mine, railed))
         found.sort(key=lambda item: -item[0]["force_n"])
         for rank, (fit, own, railed_) in enumerate(found[:max_contacts]):
             _append(out, first_frame + f, rank, fit, own, size, railed_, flags, sensor)
@@ -158,8 +158,9 @@ def _solve(a: np.ndarray, m: np.ndarray):
     return loads, residual
 
 
-def _fit_group(change, window, own, table, sensor):
-    """The position, loads and residual of the contact on ``own`` (a dict), or None."""
+def _fit_group(change, window, own, table, sensor, pairs: bool = True) -> list:
+    """The contacts on the group ``own``: one, or two where a pair explains its taxels
+    much better (:data:`PAIR_GAIN`), each as (fit dict, its taxels)."""
     pick = np.repeat(window.ravel(), 3)
     m = change.reshape(-1)[pick]
     rows_, cols_ = np.nonzero(own)
@@ -171,36 +172,107 @@ def _fit_group(change, window, own, table, sensor):
     j0 = max(0, int((cols_.min() - 0.5) * n_sub_y))
     j1 = min(len(table.y_mm), math.ceil((cols_.max() + 1.5) * n_sub_y) + 1)
     a = table.values[i0:i1, j0:j1][..., pick]
+    nodes = (table.x_mm[i0:i1], table.y_mm[j0:j1])
+    one = _fit_one(m, a, nodes, table, pick)
+    if one is None:
+        return []
+    noise = max(float(getattr(sensor.flaws, "read_noise_counts", 0.0) or 0.0), 1.0)
+    fits = [one]
+    if pairs and own.sum() >= 3 and _rms(one[1], m) > PAIR_MIN * noise:
+        pair = _fit_pair(m, a, nodes, table, pick, one, sensor)
+        if pair is not None and pair[1] < one[1] / PAIR_GAIN:
+            fits = [(pair[0][0], pair[1]), (pair[0][1], pair[1])]
+    out = []
+    positions = np.array([f[0][:2] for f in fits])
+    r, c = np.nonzero(own)
+    xy = np.column_stack([r * sensor.grid.row_pitch_mm, c * sensor.grid.col_pitch_mm])
+    nearest = np.argmin(((xy[:, None] - positions[None]) ** 2).sum(-1), axis=1)
+    for k, ((x, y, load), res) in enumerate(fits):
+        mine = np.zeros_like(own)
+        mine[r[nearest == k], c[nearest == k]] = True
+        if not mine.any():
+            continue
+        fit = {"x_mm": float(x), "y_mm": float(y), "force_n": float(load[0]),
+               "shear_x_n": float(load[1]), "shear_y_n": float(load[2]),
+               "residual": _rms(res, m) / noise}  # fmt: skip
+        out.append((fit, mine))
+    return out
+
+
+PAIR_MIN = 4.0
+"""A group whose one-contact fit leaves more than this many read noises (rms) is tried
+as a pair of contacts [-]."""
+
+PAIR_GAIN = 4.0
+"""A pair replaces the one contact where it divides the residual (sum of squares) by
+more than this [-]."""
+
+
+PAIR_SEPARATION = 0.9
+"""Two contacts closer than this many pitches are one (a single contact's misfit, the
+field's curvature under a magnet, is not taken for a second) [-]."""
+
+
+def _rms(res: float, m: np.ndarray) -> float:
+    return math.sqrt(max(float(res), 0.0) / max(len(m), 1))
+
+
+def _fit_one(m, a, nodes, table, pick):
+    """((x, y, loads), residual) of one contact, or None."""
     shape = a.shape[:2]
     loads, residual = _solve(a.reshape(-1, 3, a.shape[-1]), m)
     residual = np.where(loads[:, 0] > 0, residual, np.inf).reshape(shape)
     if not np.isfinite(residual).any():
         return None
     bi, bj = np.unravel_index(int(np.argmin(residual)), shape)
+    x0, y0 = nodes[0][bi], nodes[1][bj]
     hx, hy = table.step_mm
-    x = table.x_mm[i0 + bi] + hx * _vertex(residual[max(bi - 1, 0) : bi + 2, bj], bi)
-    y = table.y_mm[j0 + bj] + hy * _vertex(residual[bi, max(bj - 1, 0) : bj + 2], bj)
-    response = table.at(x, y)[:, pick]
-    (load,), (res,) = _solve(response[None], m)
-    if load[0] <= 0:
-        load, res = loads.reshape(*shape, 3)[bi, bj], residual[bi, bj]
-        x, y = table.x_mm[i0 + bi], table.y_mm[j0 + bj]
-    noise = max(float(getattr(sensor.flaws, "read_noise_counts", 0.0) or 0.0), 1.0)
-    return {"x_mm": float(x), "y_mm": float(y), "force_n": float(load[0]),
-            "shear_x_n": float(load[1]), "shear_y_n": float(load[2]),
-            "residual": math.sqrt(max(float(res), 0.0) / max(len(m), 1)) / noise}  # fmt: skip
+
+    def solved(p):
+        loads_, res_ = _solve(table.at(p[0], p[1], pick)[None], m)
+        return loads_[0], float(res_[0])
+
+    best = optimize.minimize(
+        lambda p: solved(p)[1], np.array([x0, y0]), method="Nelder-Mead",
+        options={"initial_simplex": [[x0, y0], [x0 + 0.5 * hx, y0], [x0, y0 + 0.5 * hy]],
+                 "xatol": 1e-3, "fatol": 1e-6 * max(float(m @ m), 1e-12), "maxiter": 200},
+    )  # fmt: skip
+    load, res = solved(best.x)
+    if load[0] <= 0 or res > residual[bi, bj]:
+        return (x0, y0, loads.reshape(*shape, 3)[bi, bj]), float(residual[bi, bj])
+    return (float(best.x[0]), float(best.x[1]), load), res
 
 
-def _vertex(values: np.ndarray, centre: int) -> float:
-    """Offset [nodes] of a parabola's vertex through three residuals about the least,
-    in [-0.5, 0.5]; 0 at the grid's edge or where the residuals are not convex."""
-    if len(values) != 3 or centre == 0 or not np.isfinite(values).all():
-        return 0.0
-    left, mid, right = values
-    curvature = left - 2.0 * mid + right
-    if curvature <= 0:
-        return 0.0
-    return float(np.clip(0.5 * (left - right) / curvature, -0.5, 0.5))
+def _fit_pair(m, a, nodes, table, pick, one, sensor):
+    """(((x, y, loads), (x, y, loads)), residual) of two contacts, or None: the second
+    placed where it best explains what the first leaves, then both moved together."""
+    (x1, y1, load1), _ = one
+    rest = m - load1 @ table.at(x1, y1, pick)
+    second = _fit_one(rest, a, nodes, table, pick)
+    if second is None:
+        return None
+    (x2, y2, _), _ = second
+
+    def solved(p):
+        both = np.concatenate([table.at(p[0], p[1], pick), table.at(p[2], p[3], pick)])
+        gram = both @ both.T + 1e-9 * np.eye(6)
+        rhs = both @ m
+        loads = np.linalg.solve(gram, rhs)
+        return loads, float(m @ m - loads @ rhs)
+
+    start = np.array([x1, y1, x2, y2])
+    best = optimize.minimize(lambda p: solved(p)[1], start, method="Nelder-Mead",
+                             options={"xatol": 1e-3, "maxiter": 600})  # fmt: skip
+    loads, res = solved(best.x)
+    separation = math.hypot(best.x[0] - best.x[2], best.x[1] - best.x[3])
+    if (
+        loads[0] <= 0
+        or loads[3] <= 0
+        or separation < PAIR_SEPARATION * min(sensor.grid.row_pitch_mm, sensor.grid.col_pitch_mm)
+    ):
+        return None  # fmt: skip
+    x = best.x
+    return ((x[0], x[1], loads[:3]), (x[2], x[3], loads[3:])), res
 
 
 def _append(out, frame, rank, fit, own, size, railed, flags, sensor) -> None:

@@ -71,7 +71,7 @@ class ShearPipeline:
         tracked, events = self.tracker.update(table, first_frame=first_frame)
         columns = self.slip.update(
             tracked.frame, tracked.id, tracked.extra["shear_ratio"], tracked.x_mm,
-            tracked.y_mm, tracked.extra["shear_angle_deg"],
+            tracked.y_mm, tracked.extra["shear_angle_deg"], tracked.force_n,
         )  # fmt: skip
         tracked.extra.update(columns)
         tracked.slip = np.asarray(columns["slip_state"] == "gross", dtype=bool)

@@ -9,7 +9,8 @@ the whole contact slides (gross slip), the tangential force staying at ``mu P``.
 What the taxels show of it is the ratio ``Q / P`` a contact carries. With the friction
 coefficient known (``friction``), the state follows from the ratio: ``stick`` below
 :data:`STICK_RATIO` (no tangential load worth the name), ``partial`` up to ``mu`` less a
-margin, ``gross`` beyond; the stick ratio ``c/a`` is Cattaneo-Mindlin's. Without it, a
+margin, ``gross`` beyond it for :data:`CONFIRM` frames running (the onset dated to the
+first); the stick ratio ``c/a`` is Cattaneo-Mindlin's. Without it, a
 contact's gross slip is found where its ratio stops rising while it carries a tangential
 load and the contact starts to move along its tangential force: the ratio rose by more
 than :data:`RISE` a frame over the frames before and has risen by less than a quarter of
@@ -47,6 +48,15 @@ PLATEAU_FRAMES = 3
 SLIDE_MM = 0.1
 """Movement along the tangential force that tells a slide from a hold [mm]."""
 
+CONFIRM = 2
+"""Consecutive frames at ``mu`` that declare gross slip when ``mu`` is known (one frame
+alone is a glitch: a lift's last frame under the layer's memory fits as any load)
+[frames]."""
+
+MIN_FORCE_N = 0.02
+"""Normal force below which a contact's ratio means nothing (a lift's last frames, where
+noise over a vanishing force reads as any ratio): it counts as unloaded [N]."""
+
 HISTORY = 24
 """Frames of each contact's ratio kept [frames]."""
 
@@ -78,10 +88,11 @@ class SlipMonitor:
             self._tracks[ident] = track
         return track
 
-    def update(self, frame, ids, ratio, x_mm, y_mm, angle_deg) -> dict[str, np.ndarray]:
+    def update(self, frame, ids, ratio, x_mm, y_mm, angle_deg, force_n) -> dict[str, np.ndarray]:
         """The slip columns of a tracked table's rows (in frame order): each row's
-        frame, id, tangential/normal ratio [-], position [mm] and tangential force's
-        direction [deg].
+        frame, id, tangential/normal ratio [-], position [mm], tangential force's
+        direction [deg] and normal force [N] (below :data:`MIN_FORCE_N` the contact
+        counts as unloaded).
 
         Returns ``slip_state`` (one of :data:`SLIP_STATES`), ``stick_ratio`` (c/a [-],
         NaN where ``mu`` is not known yet), ``friction`` (the ``mu`` used [-], NaN if
@@ -94,7 +105,8 @@ class SlipMonitor:
         onset, detected = np.full(n, np.nan), np.full(n, np.nan)
         for k in range(n):
             track = self._track(int(ids[k]))
-            rho = float(ratio[k]) if np.isfinite(ratio[k]) else 0.0
+            loaded = np.isfinite(ratio[k]) and force_n[k] >= MIN_FORCE_N
+            rho = float(ratio[k]) if loaded else 0.0
             f = int(frame[k])
             if track["frames"] and f != track["frames"][-1] + 1:  # a gap: start over
                 track["ratio"].clear()
@@ -113,9 +125,11 @@ class SlipMonitor:
                     track["onset"] = track["frames"][start] * self.period
                     track["detected"] = f * self.period
             else:
-                gross = rho >= mu * (1.0 - MARGIN)
-                if gross and not track["gross"]:
-                    track["onset"] = track["detected"] = f * self.period
+                at_mu = [r >= mu * (1.0 - MARGIN) for r in list(track["ratio"])[-CONFIRM:]]
+                gross = len(at_mu) == CONFIRM and all(at_mu)
+                if gross and not track["gross"]:  # dated to the first frame at mu
+                    track["onset"] = track["frames"][-CONFIRM] * self.period
+                    track["detected"] = f * self.period
                 if not gross and track["gross"] and rho >= mu * (1.0 - 3 * MARGIN):
                     gross = True  # hysteresis: noise about mu does not end a slide
                 track["gross"] = gross
