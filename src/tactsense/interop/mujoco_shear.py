@@ -54,7 +54,9 @@ def slip_controls_path() -> Path:
     return Path(str(resources.files("tactsense.interop") / "data" / "mujoco_slip.csv"))
 
 
-def _sweep(spec, radius_mm: float, force_n: float, ratio: float, angle_deg: float, seed):
+def _sweep(
+    spec, radius_mm: float, force_n: float, ratio: float, angle_deg: float, seed, step: int = 1
+):
     """A simulated bench sweep: the ball pressed on every taxel with ``force_n`` [N] and
     a tangential force ``ratio`` times it along ``angle_deg`` [deg]; (frames, frame_step,
     step contacts) as ``calibrate_triaxial`` takes them."""
@@ -68,10 +70,10 @@ def _sweep(spec, radius_mm: float, force_n: float, ratio: float, angle_deg: floa
     qy = ratio * force_n * math.sin(math.radians(angle_deg))
     period = spec.scan_period_s
     steps = [Step((), 10 * period, "untouched")]
-    for r in range(rows):
-        for c in range(cols):
+    for r in range(step * (rows - 1) + 1):
+        for c in range(step * (cols - 1) + 1):
             probe = SphereProbe(
-                r * x_pitch, c * y_pitch, force_n, radius_mm=radius_mm,
+                r * x_pitch / step, c * y_pitch / step, force_n, radius_mm=radius_mm,
                 shear_x_n=qx, shear_y_n=qy, friction=2.0,
             )  # fmt: skip
             steps += [Step((probe,), 6 * period, "pressed"), Step((), 3 * period, "lifted")]
@@ -81,16 +83,16 @@ def _sweep(spec, radius_mm: float, force_n: float, ratio: float, angle_deg: floa
 
 
 def ball_calibration(spec, *, radius_mm: float = EXAMPLE_BALL_RADIUS_MM, force_n: float = 0.5,
-                     ratio: float = 0.3, seed: int = 0):  # fmt: skip
+                     ratio: float = 0.3, seed: int = 0, step: int = 1):  # fmt: skip
     """The sensor's three-axis calibration made with the example's ball: a normal sweep
     and two tangential sweeps (``ratio`` of ``force_n`` [N] along x, then y), simulated
     with the sensor's flaws; see :func:`calibrate_triaxial`."""
     from tactsense.estimate.triaxial import calibrate_triaxial
 
     sweeps = [
-        _sweep(spec, radius_mm, force_n, 0.0, 0.0, seed),
-        _sweep(spec, radius_mm, force_n, ratio, 0.0, seed + 1),
-        _sweep(spec, radius_mm, force_n, ratio, 90.0, seed + 2),
+        _sweep(spec, radius_mm, force_n, 0.0, 0.0, seed, step),
+        _sweep(spec, radius_mm, force_n, ratio, 0.0, seed + 1, step),
+        _sweep(spec, radius_mm, force_n, ratio, 90.0, seed + 2, step),
     ]
     return calibrate_triaxial(sweeps, spec)
 

@@ -1,0 +1,84 @@
+"""MuJoCo in, three-axis frames out: the slip example (issue 38 item 2) against MuJoCo.
+
+The example ``mujoco_slip.xml`` presses a ``mag4x4`` pad on a ball and drags it until
+friction gives way; the three-axis estimator on its frames is set against MuJoCo's own
+contacts (``tactsense.interop.mujoco_shear.compare``). Bounds are the measured figures
+of docs/mujoco.md's slip block with a margin, noise-free frames (flaws 'none') so that
+they test the chain (contacts -> frames -> estimate), not one noise draw."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+pytest.importorskip("mujoco")
+
+from tactsense.estimate.triaxial.locate import ShearPipeline  # noqa: E402
+from tactsense.interop.mujoco import (  # noqa: E402
+    MujocoSensor,
+    load_model,
+    read_controls,
+    record_mujoco,
+)
+from tactsense.interop.mujoco_shear import (  # noqa: E402
+    EXAMPLE_FRICTION,
+    compare,
+    slip_controls_path,
+    slip_model_path,
+)
+from tactsense.io.recording import read_recording  # noqa: E402
+from tactsense.sensor import preset  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory):
+    spec = preset("mag4x4")
+    model = load_model(slip_model_path())
+    controls = read_controls(slip_controls_path(), model)
+    path = tmp_path_factory.mktemp("mjslip") / "mjslip_example.h5"
+    record_mujoco(path, MujocoSensor(model, spec, geom="pad"), seconds=4.0, controls=controls,
+                  flaws="none", rng=0)  # fmt: skip
+    recording = read_recording(path)
+    baseline = np.median(recording.frames[:5].astype(float), axis=0)
+    table, _ = ShearPipeline(spec, baseline, friction=EXAMPLE_FRICTION)(recording.frames)
+    return spec, recording, compare(recording.truth, table, spec.scan_period_s)
+
+
+def test_the_example_presses_drags_and_slips_in_mujoco(run):
+    """The example does what its docs say: three-axis frames, one press, MuJoCo's friction
+    reaching mu times the normal force (the cone's limit) partway through the drag."""
+    spec, recording, result = run
+    assert recording.frames.shape[1:] == spec.frame_shape == (4, 4, 3)
+    truth = recording.truth
+    (press,) = result.presses
+    onset = press["mujoco_onset"]
+    assert onset is not None and press["first"] + 30 < onset < press["last"] - 30
+    ratio = np.hypot(*truth["mujoco_tangential_force_n"].T) / np.maximum(
+        truth["step_force_n"], 1e-9
+    )
+    assert ratio[onset + 5] == pytest.approx(EXAMPLE_FRICTION, rel=0.01)
+    assert ratio[onset - 20] < 0.8 * EXAMPLE_FRICTION  # stick before: the ratio still rising
+    assert np.all(truth["mujoco_slip"][press["first"] : onset] == 0)
+
+
+def test_the_frames_give_the_slip_onset_near_mujocos(run):
+    """Onset from the frames (mu given) against MuJoCo's transition. Measured: 2 frames
+    early (the estimator calls gross slip at mu less 4 %); the issue's goal is one frame:
+    not met, and this bound says so."""
+    (press,) = run[2].presses
+    assert press["delay"] is not None
+    assert -3 <= press["delay"] <= 0
+
+
+def test_the_frames_give_mujocos_normal_force_and_contact_point(run):
+    """Normal force within 2 % of MuJoCo's sum while the contact sticks (measured -0.3 %
+    noise-free, the kind's response alone), 5 % while sliding; the contact within a
+    quarter pitch of MuJoCo's contact point in every pressed frame."""
+    spec, _, result = run
+    assert np.isfinite(result.force_error).all()
+    stick = result.force_error[~result.sliding & (result.mujoco_force_n > 0.25)]
+    slide = result.force_error[result.sliding & (result.mujoco_force_n > 0.25)]
+    assert len(stick) > 30 and len(slide) > 30
+    assert abs(np.median(stick)) < 0.02
+    assert np.max(np.abs(slide)) < 0.05
+    assert np.max(result.centroid_error_mm) < 0.25 * spec.grid.row_pitch_mm
