@@ -54,7 +54,7 @@ def step_alone(model, controls, seconds: float) -> float:
     """MuJoCo's stepping alone over the example's motion [s of wall time]."""
     mujoco = _mujoco()
     data = mujoco.MjData(model)
-    n = int(round(seconds / model.opt.timestep))
+    n = round(seconds / model.opt.timestep)
     start = time.perf_counter()
     for _ in range(n):
         data.ctrl[:] = controls.at(data.time)
@@ -131,7 +131,7 @@ def main() -> None:
         f"* MuJoCo's onsets (friction at the cone's limit): frames {onsets}; pressed frames "
         f"without an estimated contact: {missing} of {len(c0.frames)}.",
         f"* Throughput (one core): recording {n} frames with MuJoCo stepping "
-        f"({int(round(SECONDS / model.opt.timestep))} steps of 1 ms) took {record_s:.2f} s "
+        f"({round(SECONDS / model.opt.timestep)} steps of 1 ms) took {record_s:.2f} s "
         f"({n / record_s:.0f} frames/s); MuJoCo's stepping alone {stepping_s:.2f} s "
         f"({stepping_s / record_s:.0%} of it); the estimator (ball calibration, mu given) "
         f"{total_locate:.2f} s ({n / total_locate:.0f} frames/s); the bench calibration "

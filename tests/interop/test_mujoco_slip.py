@@ -13,21 +13,21 @@ import pytest
 
 pytest.importorskip("mujoco")
 
-from tactsense.estimate.triaxial.locate import ShearPipeline  # noqa: E402
-from tactsense.interop.mujoco import (  # noqa: E402
+from tactsense.estimate.triaxial.locate import ShearPipeline
+from tactsense.interop.mujoco import (
     MujocoSensor,
     load_model,
     read_controls,
     record_mujoco,
 )
-from tactsense.interop.mujoco_shear import (  # noqa: E402
+from tactsense.interop.mujoco_shear import (
     EXAMPLE_FRICTION,
     compare,
     slip_controls_path,
     slip_model_path,
 )
-from tactsense.io.recording import read_recording  # noqa: E402
-from tactsense.sensor import preset  # noqa: E402
+from tactsense.io.recording import read_recording
+from tactsense.sensor import preset
 
 
 @pytest.fixture(scope="module")

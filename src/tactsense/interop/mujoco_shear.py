@@ -157,7 +157,7 @@ def compare(truth: dict, table, period_s: float, *, min_force_n: float = 0.05) -
             press["mujoco_onset"] = int(first + mujoco[0])
         if inside.any():
             k = np.flatnonzero(inside)[0]
-            press["onset"] = int(round(onset_s[k] / period_s))
+            press["onset"] = round(onset_s[k] / period_s)
             press["detected"] = int(frame[k])
         if press["onset"] is not None and press["mujoco_onset"] is not None:
             press["delay"] = press["onset"] - press["mujoco_onset"]
