@@ -38,6 +38,7 @@ from tactsense.interop.mujoco_shear import (  # noqa: E402
     EXAMPLE_FRICTION,
     ball_calibration,
     compare,
+    force_curve,
     slip_controls_path,
     slip_model_path,
 )
@@ -81,61 +82,101 @@ def main() -> None:
     bench = ball_calibration(spec)
     calibration_s = time.perf_counter() - start
     calibration = TriaxialCalibration(spec.name, baseline, bench.matrices)
-    results = {}
-    locate_s = {}
-    for label, cal in (("the kind's response alone", None), ("ball calibration", calibration)):
+    curve, bench_residual = force_curve(spec)
+    configs = {
+        "the kind's response alone": (None, None),
+        "3x3 bench calibration (ball)": (calibration, None),
+        "response + force curve (ball)": (None, curve),
+    }
+    results, locate_s = {}, {}
+    for label, (cal, use_curve) in configs.items():
         for mu_label, mu in (("given", EXAMPLE_FRICTION), ("found", None)):
             pipeline = ShearPipeline(spec, baseline, calibration=cal, friction=mu)
             start = time.perf_counter()
             table, _ = pipeline(frames)
             locate_s[(label, mu_label)] = time.perf_counter() - start
-            results[(label, mu_label)] = compare(truth, table, period)
+            results[(label, mu_label)] = (
+                compare(truth, table, period, curve=use_curve),
+                compare(truth, table, period, curve=use_curve, ramp=True),
+            )
     lines = [
         f"`mag4x4` on `mujoco_slip.xml`, {n} frames at {1 / period:g} Hz with every per-frame "
         f"flaw (noise seed {SEED}); MuJoCo {_mujoco().__version__}. Two presses of about "
         f"{np.median(truth['step_force_n'][truth['step_force_n'] > 0.4]):.3f} N, each "
         "dragged until friction (mu 0.5) gives way: along the pad's +x, then -y. "
-        "Force and centroid over the frames with MuJoCo's normal force >= 0.05 N "
-        "(`python scripts/mujoco_slip_numbers.py`).",
+        "Onset delay: the frames' onset minus MuJoCo's (the first frame with the friction "
+        "force at the cone's limit), press 1 / press 2; 'estimator': `locate`'s "
+        "`slip_onset_s`; 'ramp': the ramp of Q/P fitted and crossed with its sliding "
+        "plateau (`ramp_onsets`, offline). Force and centroid over the frames with "
+        "MuJoCo's normal force >= 0.05 N (`python scripts/mujoco_slip_numbers.py`).",
         "",
-        "| estimate | mu | onset delay, press 1 / press 2 [frames] | detected after MuJoCo's "
-        "onset [frames] | force error, stick: median / largest [%] | force error, sliding: "
-        "median / largest [%] | centroid error: median / largest [mm] (pitch) |",
-        "|---|---|---|---|---|---|---|",
+        "| normal force from | mu | onset delay, estimator [frames] | onset delay, ramp "
+        "[frames] | flagged after MuJoCo's onset [frames] | force error, stick: median / "
+        "largest [%] | force error, sliding: median / largest [%] | centroid error: median "
+        "/ largest [mm] (pitch) |",
+        "|---|---|---|---|---|---|---|---|",
     ]
-    for (label, mu_label), c in results.items():
-        delays = [p["delay"] for p in c.presses if p["mujoco_onset"] is not None]
+
+    def pair(v):
+        v = v[np.isfinite(v)]
+        return f"{np.median(v):+.2f} / {v[np.argmax(np.abs(v))]:+.2f}" if len(v) else "-"
+
+    def delays(c):
+        out = [p["delay"] for p in c.presses if p["mujoco_onset"] is not None]
+        return " / ".join("missed" if d is None else f"{d:+d}" for d in out)
+
+    for (label, mu_label), (c, r) in results.items():
         detected = [p["detected"] - p["mujoco_onset"] for p in c.presses
                     if p["detected"] is not None and p["mujoco_onset"] is not None]  # fmt: skip
         stick = 100 * c.force_error[~c.sliding]
         slide = 100 * c.force_error[c.sliding]
-
-        def pair(v):
-            v = v[np.isfinite(v)]
-            return f"{np.median(v):+.2f} / {v[np.argmax(np.abs(v))]:+.2f}" if len(v) else "-"
-
         cen = c.centroid_error_mm[np.isfinite(c.centroid_error_mm)]
         lines.append(
-            f"| {label} | {mu_label} | "
-            + " / ".join("missed" if d is None else f"{d:+d}" for d in delays)
-            + f" | {', '.join(f'{d:+d}' for d in detected) or '-'} | {pair(stick)} | "
+            f"| {label} | {mu_label} | {delays(c)} | {delays(r)} | "
+            f"{', '.join(f'{d:+d}' for d in detected) or '-'} | {pair(stick)} | "
             f"{pair(slide)} | {np.median(cen):.3f} / {cen.max():.3f} "
             f"({np.median(cen) / pitch:.2f} / {cen.max() / pitch:.2f}) |"
         )
-    c0 = results[("ball calibration", "given")]
+    seeds = []
+    for seed in range(SEED + 1, SEED + 6):
+        with tempfile.TemporaryDirectory() as folder:
+            path = Path(folder) / "slip.h5"
+            record_mujoco(path, MujocoSensor(model, spec, geom="pad"), seconds=SECONDS,
+                          controls=controls, rng=seed)  # fmt: skip
+            again = read_recording(path)
+        rest = np.median(again.frames[:5].astype(float), axis=0)
+        table, _ = ShearPipeline(spec, rest)(again.frames)
+        c = compare(again.truth, table, period, ramp=True, curve=curve)
+        seeds += [p["delay"] for p in c.presses]
+        seeds_force = 100 * np.nanmedian(c.force_error[~c.sliding])
+        seeds.append(f"{seeds_force:+.2f} %")
+    c0 = results[("the kind's response alone", "given")][0]
     onsets = [p["mujoco_onset"] for p in c0.presses]
     missing = np.isnan(c0.force_error).sum()
-    total_locate = locate_s[("ball calibration", "given")]
+    total_locate = locate_s[("the kind's response alone", "given")]
+    lo, hi = np.percentile(100 * bench_residual, [5, 95])
     lines += [
         "",
         f"* MuJoCo's onsets (friction at the cone's limit): frames {onsets}; pressed frames "
         f"without an estimated contact: {missing} of {len(c0.frames)}.",
+        f"* The force curve (`force_curve`: the ball pressed with 0.2, 0.5, 0.8 N on a grid "
+        f"a half pitch apart): true = {curve[0]:.4f} e {curve[1]:+.4f} e^2 [N]; the bench's "
+        f"own presses scatter {lo:+.1f} % to {hi:+.1f} % (5-95 %) about it, with the place "
+        "of the press.",
+        "* Other noise seeds (response + force curve, mu found, ramp onset): "
+        + "; ".join(
+            f"seed {SEED + 1 + k}: delays {seeds[3 * k]:+d} / {seeds[3 * k + 1]:+d}, "
+            f"stick force {seeds[3 * k + 2]}"
+            for k in range(5)
+        )
+        + ".",
         f"* Throughput (one core): recording {n} frames with MuJoCo stepping "
         f"({round(SECONDS / model.opt.timestep)} steps of 1 ms) took {record_s:.2f} s "
         f"({n / record_s:.0f} frames/s); MuJoCo's stepping alone {stepping_s:.2f} s "
-        f"({stepping_s / record_s:.0%} of it); the estimator (ball calibration, mu given) "
-        f"{total_locate:.2f} s ({n / total_locate:.0f} frames/s); the bench calibration "
-        f"(three simulated sweeps) {calibration_s:.1f} s, once.",
+        f"({stepping_s / record_s:.0%} of it); the estimator (response alone, mu given) "
+        f"{total_locate:.2f} s ({n / total_locate:.0f} frames/s, its response table "
+        f"included); the bench calibration (three simulated sweeps) {calibration_s:.1f} s, "
+        "once.",
     ]
     text = "\n".join([BEGIN, *lines, END])
     print(text)

@@ -31,6 +31,8 @@ __all__ = [
     "SlipComparison",
     "ball_calibration",
     "compare",
+    "force_curve",
+    "ramp_onsets",
     "slip_controls_path",
     "slip_model_path",
 ]
@@ -97,6 +99,43 @@ def ball_calibration(spec, *, radius_mm: float = EXAMPLE_BALL_RADIUS_MM, force_n
     return calibrate_triaxial(sweeps, spec)
 
 
+def force_curve(spec, *, radius_mm: float = EXAMPLE_BALL_RADIUS_MM,
+                forces_n=(0.2, 0.5, 0.8), calibration=None, seed: int = 11):  # fmt: skip
+    """A normal-force curve, as a lab makes one on the bench: the ball pressed with each
+    of ``forces_n`` [N] at every point of a grid a half pitch apart over the pad's
+    interior (simulated with the sensor's flaws), the estimator's normal force against
+    the known one; returns ``(a, b)`` of ``true = a e + b e^2`` (``e`` the estimate
+    [N]), least squares over the settled frames, and the bench's relative residuals
+    (true over the curve's value, minus 1) [-]."""
+    from tactsense.estimate.triaxial.locate import ShearPipeline
+    from tactsense.kinds import kind_of
+    from tactsense.physics.indenters import SphereProbe
+    from tactsense.simulate.run import simulate
+    from tactsense.simulate.scenario import Scenario, Step
+
+    (x_pitch, rows), (y_pitch, cols) = kind_of(spec).surface_grid(spec)
+    period = spec.scan_period_s
+    steps = [Step((), 10 * period, "untouched")]
+    for x in np.arange(1, 2 * rows - 2) * x_pitch / 2:
+        for y in np.arange(1, 2 * cols - 2) * y_pitch / 2:
+            for force in forces_n:
+                probe = SphereProbe(float(x), float(y), float(force), radius_mm=radius_mm)
+                steps += [Step((probe,), 6 * period, "pressed"), Step((), 3 * period, "lifted")]
+    recording = simulate(spec, Scenario(tuple(steps), "force curve"), rng=seed)
+    step = np.asarray(recording.truth["frame_step"])
+    true = np.asarray(recording.truth["step_force_n"], float)[step]
+    baseline = np.median(recording.frames[:5].astype(float), axis=0)
+    if calibration is not None:
+        baseline = calibration.baseline
+    table, _ = ShearPipeline(spec, baseline, calibration=calibration)(recording.frames)
+    estimate = np.zeros(len(step))
+    np.add.at(estimate, np.asarray(table.frame), np.asarray(table.force_n))
+    settled = (true > 0) & (np.r_[-1, -1, step[:-2]] == step) & (estimate > 0)
+    e, t = estimate[settled], true[settled]
+    (a, b), *_ = np.linalg.lstsq(np.column_stack([e, e * e]), t, rcond=None)
+    return (float(a), float(b)), t / (a * e + b * e * e) - 1.0
+
+
 @dataclass(frozen=True)
 class SlipComparison:
     """The estimator's contacts against MuJoCo's, per press and per frame.
@@ -135,18 +174,64 @@ def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
     return list(zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1), strict=True))
 
 
-def compare(truth: dict, table, period_s: float, *, min_force_n: float = 0.05) -> SlipComparison:
+RAMP_BAND = (0.3, 0.85)
+"""The share of the sliding plateau's ratio between which :func:`ramp_onsets` fits the
+ramp's line [-]: above the press's own ratio, below the rounding into the plateau."""
+
+
+def ramp_onsets(table, *, min_points: int = 4) -> dict[int, float]:
+    """Each gross-slipping contact's onset [frames, fractional] from the whole record,
+    where the tangential-to-normal ratio's ramp reaches the plateau it slides at.
+
+    For a contact (a track id of ``table``) the estimator called in gross slip: the
+    plateau is the median of its ``shear_ratio`` from that call on (frames loaded with
+    at least 0.8 times its median normal force: not the lift); the ramp is the frames
+    before the call whose ratio is within :data:`RAMP_BAND` of the plateau; a straight
+    line fitted to the ramp (least squares) crosses the plateau at the onset. Offline:
+    it needs frames after the onset (a recording's analysis; ``live`` has the
+    estimator's own onset). A contact with fewer than ``min_points`` ramp frames (a
+    jerk into slip) gets the estimator's onset frame.
+    """
+    ratio = np.asarray(table.extra["shear_ratio"], float)
+    gross = np.asarray(table.extra["slip_state"]) == "gross"
+    frame, ids, force = np.asarray(table.frame), np.asarray(table.id), np.asarray(table.force_n)
+    onsets = {}
+    for i in np.unique(ids[gross]):
+        mine = np.flatnonzero(ids == i)
+        f, q, g = frame[mine], ratio[mine], gross[mine]
+        loaded = force[mine] >= 0.8 * np.median(force[mine])
+        called = np.argmax(g)
+        after = (np.arange(len(q)) >= called) & loaded & np.isfinite(q)
+        plateau = float(np.median(q[after])) if after.any() else np.nan
+        low, high = RAMP_BAND
+        ramp = (np.arange(len(q)) < called) & loaded & (q > low * plateau) & (q < high * plateau)
+        if np.isfinite(plateau) and ramp.sum() >= min_points:
+            slope, intercept = np.polyfit(f[ramp], q[ramp], 1)
+            if slope > 0:
+                onsets[int(i)] = float((plateau - intercept) / slope)
+                continue
+        onsets[int(i)] = float(f[called])
+    return onsets
+
+
+def compare(truth: dict, table, period_s: float, *, min_force_n: float = 0.05,
+            ramp: bool = False, curve=None) -> SlipComparison:  # fmt: skip
     """Set the estimator's ``table`` (a ``ContactTable`` with the three-axis columns)
     against ``truth`` (the recording's: ``step_force_n``, ``step_x_mm``, ``step_y_mm``,
     ``mujoco_slip``; one entry per frame). Frames with MuJoCo's normal force below
     ``min_force_n`` [N] (touching down, lifting) are left out of the force and centroid
-    errors; ``period_s`` [s] turns the estimator's onset times into frames."""
+    errors; ``period_s`` [s] turns the estimator's onset times into frames. ``ramp``:
+    the onsets of :func:`ramp_onsets` (the first frame at or after the ramp's crossing)
+    instead of the estimator's ``slip_onset_s``. ``curve``: ``(a, b)`` of
+    :func:`force_curve`, applied to the estimated normal force."""
     force = np.asarray(truth["step_force_n"], float)
     x, y = np.asarray(truth["step_x_mm"], float), np.asarray(truth["step_y_mm"], float)
     slip = np.asarray(truth["mujoco_slip"], bool)
     frame = np.asarray(table.frame)
     onset_s = np.asarray(table.extra["slip_onset_s"], float)
     gross = np.asarray(table.extra["slip_state"]) == "gross"
+    refined = ramp_onsets(table) if ramp else {}
+    ids = np.asarray(table.id)
     presses = []
     for first, last in _runs(force > 0):
         mujoco = np.flatnonzero(slip[first:last])
@@ -157,7 +242,10 @@ def compare(truth: dict, table, period_s: float, *, min_force_n: float = 0.05) -
             press["mujoco_onset"] = int(first + mujoco[0])
         if inside.any():
             k = np.flatnonzero(inside)[0]
-            press["onset"] = round(onset_s[k] / period_s)
+            if ramp:
+                press["onset"] = math.ceil(refined[int(ids[k])] - 1e-9)
+            else:
+                press["onset"] = round(onset_s[k] / period_s)
             press["detected"] = int(frame[k])
         if press["onset"] is not None and press["mujoco_onset"] is not None:
             press["delay"] = press["onset"] - press["mujoco_onset"]
@@ -169,7 +257,10 @@ def compare(truth: dict, table, period_s: float, *, min_force_n: float = 0.05) -
         rows = np.flatnonzero(frame == j)
         if len(rows) == 0:
             continue
-        f_err[i] = table.force_n[rows].sum() / force[j] - 1.0
+        estimate = float(np.sum(table.force_n[rows]))
+        if curve is not None:
+            estimate = curve[0] * estimate + curve[1] * estimate**2
+        f_err[i] = estimate / force[j] - 1.0
         k = rows[np.argmax(table.force_n[rows])]
         c_err[i] = math.hypot(table.x_mm[k] - x[j], table.y_mm[k] - y[j])
     return SlipComparison(presses, f_err, c_err, slip[pressed], force[pressed], pressed)
