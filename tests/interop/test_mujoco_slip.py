@@ -23,6 +23,7 @@ from tactsense.interop.mujoco import (
 from tactsense.interop.mujoco_shear import (
     EXAMPLE_FRICTION,
     compare,
+    ramp_onsets,
     slip_controls_path,
     slip_model_path,
 )
@@ -30,24 +31,29 @@ from tactsense.io.recording import read_recording
 from tactsense.sensor import preset
 
 
-@pytest.fixture(scope="module")
-def run(tmp_path_factory):
+def _run(folder, flaws, friction):
     spec = preset("mag4x4")
     model = load_model(slip_model_path())
     controls = read_controls(slip_controls_path(), model)
-    path = tmp_path_factory.mktemp("mjslip") / "mjslip_example.h5"
+    path = folder / f"mjslip_example_{flaws}.h5"
     record_mujoco(path, MujocoSensor(model, spec, geom="pad"), seconds=4.0, controls=controls,
-                  flaws="none", rng=0)  # fmt: skip
+                  flaws=flaws, rng=0)  # fmt: skip
     recording = read_recording(path)
     baseline = np.median(recording.frames[:5].astype(float), axis=0)
-    table, _ = ShearPipeline(spec, baseline, friction=EXAMPLE_FRICTION)(recording.frames)
-    return spec, recording, compare(recording.truth, table, spec.scan_period_s)
+    table, _ = ShearPipeline(spec, baseline, friction=friction)(recording.frames)
+    return spec, recording, table
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory):
+    spec, recording, table = _run(tmp_path_factory.mktemp("mjslip"), "none", EXAMPLE_FRICTION)
+    return spec, recording, compare(recording.truth, table, spec.scan_period_s), table
 
 
 def test_the_example_presses_drags_and_slips_in_mujoco(run):
     """The example does what its docs say: three-axis frames, one press, MuJoCo's friction
     reaching mu times the normal force (the cone's limit) partway through the drag."""
-    spec, recording, result = run
+    spec, recording, result, _ = run
     assert recording.frames.shape[1:] == spec.frame_shape == (4, 4, 3)
     truth = recording.truth
     (press,) = result.presses
@@ -74,7 +80,7 @@ def test_the_frames_give_mujocos_normal_force_and_contact_point(run):
     """Normal force within 2 % of MuJoCo's sum while the contact sticks (measured -0.3 %
     noise-free, the kind's response alone), 5 % while sliding; the contact within a
     quarter pitch of MuJoCo's contact point in every pressed frame."""
-    spec, _, result = run
+    spec, _, result, _ = run
     assert np.isfinite(result.force_error).all()
     stick = result.force_error[~result.sliding & (result.mujoco_force_n > 0.25)]
     slide = result.force_error[result.sliding & (result.mujoco_force_n > 0.25)]
@@ -82,3 +88,25 @@ def test_the_frames_give_mujocos_normal_force_and_contact_point(run):
     assert abs(np.median(stick)) < 0.02
     assert np.max(np.abs(slide)) < 0.05
     assert np.max(result.centroid_error_mm) < 0.25 * spec.grid.row_pitch_mm
+
+
+def test_the_ramp_onset_is_within_a_frame_of_mujocos(run):
+    """The ramp of Q/P crossed with its sliding plateau (``ramp_onsets``): within one
+    frame of MuJoCo's transition (measured 0 noise-free), and a fractional frame between
+    the estimator's flag and its early call."""
+    spec, recording, _, table = run
+    (press,) = compare(recording.truth, table, spec.scan_period_s, ramp=True).presses
+    assert abs(press["delay"]) <= 1
+    (onset,) = ramp_onsets(table).values()
+    assert press["mujoco_onset"] - 2 < onset < press["mujoco_onset"] + 1
+
+
+def test_with_the_pads_flaws_and_mu_unknown_the_ramp_onset_holds(tmp_path):
+    """Noise, gain spread, quantization and the rest of the per-frame flaws, ``mu`` not
+    given (the estimator finds it at the plateau, flagging late): the ramp onset still
+    within one frame of MuJoCo's; the flag itself comes after MuJoCo's onset."""
+    spec, recording, table = _run(tmp_path, "all", None)
+    (ramp,) = compare(recording.truth, table, spec.scan_period_s, ramp=True).presses
+    (flag,) = compare(recording.truth, table, spec.scan_period_s).presses
+    assert abs(ramp["delay"]) <= 1
+    assert flag["detected"] > flag["mujoco_onset"]
