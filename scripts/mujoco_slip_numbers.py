@@ -150,6 +150,15 @@ def main() -> None:
         seeds += [p["delay"] for p in c.presses]
         seeds_force = 100 * np.nanmedian(c.force_error[~c.sliding])
         seeds.append(f"{seeds_force:+.2f} %")
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "slip.h5"
+        record_mujoco(path, MujocoSensor(model, spec, geom="pad"), seconds=SECONDS,
+                      controls=controls, rng=SEED, flaws="none")  # fmt: skip
+        clean = read_recording(path)
+    rest = np.median(clean.frames[:5].astype(float), axis=0)
+    table, _ = ShearPipeline(spec, rest, friction=EXAMPLE_FRICTION)(clean.frames)
+    clean_c = compare(clean.truth, table, period)
+    clean_r = compare(clean.truth, table, period, ramp=True)
     c0 = results[("the kind's response alone", "given")][0]
     onsets = [p["mujoco_onset"] for p in c0.presses]
     missing = np.isnan(c0.force_error).sum()
@@ -163,6 +172,10 @@ def main() -> None:
         f"a half pitch apart): true = {curve[0]:.4f} e {curve[1]:+.4f} e^2 [N]; the bench's "
         f"own presses scatter {lo:+.1f} % to {hi:+.1f} % (5-95 %) about it, with the place "
         "of the press.",
+        "* Noise-free frames (flaws 'none'), the kind's response alone, mu given: onset "
+        f"delay, estimator {delays(clean_c)}, ramp {delays(clean_r)} [frames]; force "
+        f"error, stick {pair(100 * clean_c.force_error[~clean_c.sliding])} %, sliding "
+        f"{pair(100 * clean_c.force_error[clean_c.sliding])} % (median / largest).",
         "* Other noise seeds (response + force curve, mu found, ramp onset): "
         + "; ".join(
             f"seed {SEED + 1 + k}: delays {seeds[3 * k]:+d} / {seeds[3 * k + 1]:+d}, "

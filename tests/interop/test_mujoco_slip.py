@@ -77,16 +77,17 @@ def test_the_frames_give_the_slip_onset_near_mujocos(run):
 
 
 def test_the_frames_give_mujocos_normal_force_and_contact_point(run):
-    """Normal force within 2 % of MuJoCo's sum while the contact sticks (measured -0.3 %
-    noise-free, the kind's response alone), 5 % while sliding; the contact within a
-    quarter pitch of MuJoCo's contact point in every pressed frame."""
+    """Noise-free, the kind's response alone: normal force within 2 % of MuJoCo's sum in
+    every frame pressed with more than 0.25 N, sticking or sliding (measured: median
+    -0.3 %, largest 1.7 %); the contact within a quarter pitch of MuJoCo's contact point
+    in every pressed frame."""
     spec, _, result, _ = run
     assert np.isfinite(result.force_error).all()
     stick = result.force_error[~result.sliding & (result.mujoco_force_n > 0.25)]
     slide = result.force_error[result.sliding & (result.mujoco_force_n > 0.25)]
     assert len(stick) > 30 and len(slide) > 30
-    assert abs(np.median(stick)) < 0.02
-    assert np.max(np.abs(slide)) < 0.05
+    assert np.max(np.abs(stick)) < 0.02
+    assert np.max(np.abs(slide)) < 0.02
     assert np.max(result.centroid_error_mm) < 0.25 * spec.grid.row_pitch_mm
 
 
