@@ -104,7 +104,9 @@ def _sweep(spec, ratio, angle_deg, seed):
     steps = [Step((), 10 * period, "untouched")]
     for r in range(spec.shape[0]):
         for c in range(spec.shape[1]):
-            probe = SphereProbe(r * 4.7, c * 4.7, 0.49, shear_x_n=qx, shear_y_n=qy, friction=2.0)
+            probe = SphereProbe(
+                r * 4.7, c * 4.7, 0.49, shear_x_n=qx, shear_y_n=qy, friction=max(ratio, 0.05)
+            )
             steps += [Step((probe,), 6 * period, "pressed"), Step((), 3 * period, "lifted")]
     recording = simulate(spec, Scenario(tuple(steps), "sweep"), rng=seed)
     truth = recording.truth
@@ -136,7 +138,7 @@ def test_calibration_takes_out_each_sensors_gain(spec):
         for r in range(spec.shape[0]):
             for c in range(spec.shape[1]):
                 probe = SphereProbe(r * 4.7, c * 4.7, 0.49, shear_x_n=qx, shear_y_n=qy,
-                                    friction=2.0)  # fmt: skip
+                                    friction=max(ratio, 0.05))  # fmt: skip
                 steps += [Step((probe,), 6 * period, "pressed"), Step((), 3 * period, "lifted")]
         recording = simulate(spec, Scenario(tuple(steps), "sweep"), rng=0,
                              flaws=["gain_spread"], gains=gains)  # fmt: skip
@@ -333,3 +335,21 @@ def test_two_contacts_a_pitch_apart_are_two_with_their_own_shear(spec):
         assert abs(table.force_n[k] - 0.49) < 0.05 * 0.49
         qx, qy = table.extra["shear_x_n"][k], table.extra["shear_y_n"][k]
         assert _angle_error(qx, qy, want.shear_x_n, want.shear_y_n) < 5.0
+
+
+def test_pieces_give_the_whole(spec, calibration):
+    """The tracks and slip carry from piece to piece: a recording estimated 7 frames at
+    a time gives exactly what it gives whole."""
+    recording = simulate(spec, shear_ramp(spec, x_mm=8.0, y_mm=6.5, angle_deg=-150.0,
+                                          ratio_max=0.7, friction=0.5), rng=12)  # fmt: skip
+    whole, _ = ShearPipeline(spec, calibration.baseline, calibration=calibration)(recording.frames)
+    pipeline = ShearPipeline(spec, calibration.baseline, calibration=calibration)
+    pieces = [pipeline(recording.frames[i : i + 7], first_frame=i)[0]
+              for i in range(0, len(recording.frames), 7)]  # fmt: skip
+    for name in ("shear_x_n", "slip_state", "slip_onset_s"):
+        got = np.concatenate([p.extra[name] for p in pieces])
+        if got.dtype == object:
+            assert list(got) == list(whole.extra[name])
+        else:
+            np.testing.assert_array_equal(got, whole.extra[name])
+    assert "gross" in set(whole.extra["slip_state"])

@@ -25,9 +25,7 @@ def threshold_counts(sensor, noise_gain: float = 1.0) -> float:
     :func:`~tactsense.estimate.creep.compensation_noise_gain`)."""
     # ---- three-axis taxels (r8-triest): the length of a taxel's change ----
     if int(getattr(sensor, "components", 1)) > 1:
-        from tactsense.estimate.triaxial.fit import default_threshold_counts
-
-        return default_threshold_counts(sensor) * noise_gain
+        return vector_threshold_counts(sensor) * noise_gain
     # ---- /r8-triest ----
     bits = int(sensor.electronics.adc_bits)
     counts = 10.0 if bits >= 12 else max(3.0, 10.0 * 2.0 ** (bits - 12))
@@ -161,3 +159,17 @@ def signal_noise_variance(sensor) -> float:
     if transduction is not None and transduction.kind != "capacitive":
         return counts / transduction.counts_per_strain**2
     return counts / sensor.electronics.nominal_counts**2
+
+
+# ---- three-axis taxels (r8-triest) ----
+def vector_threshold_counts(sensor) -> float:
+    """Smallest change of a three-axis taxel's field (the length of its components'
+    change) that counts as contact [counts]: 8 times the read noise of one component
+    times sqrt(3), at least 10 counts."""
+    import math
+
+    noise = float(getattr(sensor.flaws, "read_noise_counts", 0.0) or 0.0)
+    return max(10.0, 8.0 * math.sqrt(3.0) * noise)
+
+
+# ---- /r8-triest ----

@@ -178,6 +178,7 @@ class TriaxialKind(Kind):
         force_n: float = 0.49,
         shear_ratio: float = 0.25,
         size_mm: float = 1.6,
+        friction: float | None = None,
     ) -> np.ndarray:
         """The change of every taxel's reading [counts/N] per newton of normal force and
         per newton of tangential force along x and along y, for a sphere of ``size_mm``
@@ -188,19 +189,23 @@ class TriaxialKind(Kind):
         Differences of the kind's forward model (magnet displacement, then the dipole
         fields, no gains, no noise) about a press of ``force_n`` [N]: the normal response
         from rest to the press, the tangential ones from the press to the press with a
-        tangential force of ``shear_ratio`` times it (friction high enough that nothing
-        slips), so that the field's curvature about the loaded state is taken in."""
+        tangential force of ``shear_ratio`` times it, so that the field's curvature about
+        the loaded state is taken in. ``friction`` None: ``shear_ratio`` (the traction of
+        gross slip, the pressure's shape times Q/P; of the shapes Cattaneo-Mindlin
+        passes through, from the stick's edge-heavy one to this, the one whose fit of
+        the scenarios' ramps erred least, noise-free: ``docs/triaxial.md``)."""
         from tactsense.physics.indenters import SphereProbe
         from tactsense.physics.triaxial import dipole_field_t, magnet_displacement
 
         positions = np.asarray(positions_mm, dtype=float).reshape(-1, 2)
         shear = shear_ratio * force_n
+        friction = shear_ratio if friction is None else friction
         rest = dipole_field_t(spec, np.zeros((*spec.shape, 3)))
         out = np.empty((len(positions), 3, *spec.shape, 3))
         for k, (x, y) in enumerate(positions):
             loads = ({}, {"shear_x_n": shear}, {"shear_y_n": shear})
             probes = [
-                SphereProbe(x, y, force_n, radius_mm=size_mm, friction=100.0, **load)
+                SphereProbe(x, y, force_n, radius_mm=size_mm, friction=friction, **load)
                 for load in loads
             ]
             disp = np.stack([magnet_displacement(spec, [probe]) for probe in probes])

@@ -24,6 +24,7 @@ import numpy as np
 from scipy import ndimage, optimize
 
 from tactsense._validation import TactsenseInputError
+from tactsense.estimate.reading import vector_threshold_counts
 from tactsense.estimate.results import ContactTable, Flag
 from tactsense.estimate.triaxial.response import response_table
 
@@ -37,11 +38,9 @@ def vector_taxels(sensor) -> bool:
 
 
 def default_threshold_counts(sensor) -> float:
-    """Smallest change of a taxel's field (the length of its three components' change)
-    that counts as contact [counts]: 8 times the read noise of one component times
-    sqrt(3), at least 10 counts."""
-    noise = float(getattr(sensor.flaws, "read_noise_counts", 0.0) or 0.0)
-    return max(10.0, 8.0 * math.sqrt(3.0) * noise)
+    """Smallest change of a taxel's field that counts as contact [counts]
+    (:func:`~tactsense.estimate.reading.vector_threshold_counts`)."""
+    return vector_threshold_counts(sensor)
 
 
 def check_vector_frames(frames, sensor) -> np.ndarray:

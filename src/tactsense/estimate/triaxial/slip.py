@@ -12,10 +12,10 @@ coefficient known (``friction``), the state follows from the ratio: ``stick`` be
 margin, ``gross`` beyond it for :data:`CONFIRM` frames running (the onset dated to the
 first); the stick ratio ``c/a`` is Cattaneo-Mindlin's. Without it, a
 contact's gross slip is found where its ratio stops rising while it carries a tangential
-load and the contact starts to move along its tangential force: the ratio rose by more
-than :data:`RISE` a frame over the frames before and has risen by less than a quarter of
-that since (the plateau at ``mu``), and the contact has moved more than
-:data:`SLIDE_MM` along the tangential force since the plateau began (a hold below ``mu``
+load and the contact starts to move along its tangential force: the ratio has stayed
+within :data:`FLAT` since a frame (the plateau at ``mu``) before which it rose by more than
+:data:`RISE` a frame, and the contact has moved more than :data:`SLIDE_MM` along the
+tangential force since the plateau began (a hold below ``mu``
 is a plateau too, but nothing slides). The onset is dated back to the plateau's first
 frame, and from then on the contact's ``mu`` is the ratio there. The detection itself
 comes at least :data:`PLATEAU_FRAMES` frames after the onset it dates (the
@@ -39,13 +39,21 @@ noise of the ratio on the twin is about 0.01)."""
 MARGIN = 0.04
 """A ratio within this share of ``mu`` of it counts as gross slip [-]."""
 
-RISE = 0.002
-"""Least rise of the ratio per frame [-/frame] for the frames before a plateau."""
+RISE = 0.004
+"""Least rise of the ratio per frame [-/frame] over the :data:`RISE_FRAMES` frames
+before a plateau."""
+
+RISE_FRAMES = 6
+"""Frames over which the rise before a plateau is measured [frames]."""
+
+FLAT = 0.04
+"""Largest spread of the ratio over a plateau [-] (about four times its noise on the
+twin)."""
 
 PLATEAU_FRAMES = 3
-"""Frames of a plateau that declare gross slip (the detection's delay) [frames]."""
+"""Least frames of a plateau that declare gross slip (the detection's delay) [frames]."""
 
-SLIDE_MM = 0.1
+SLIDE_MM = 0.06
 """Movement along the tangential force that tells a slide from a hold [mm]."""
 
 CONFIRM = 2
@@ -148,27 +156,25 @@ class SlipMonitor:
 
     @staticmethod
     def _plateau(ratios, xy, angle_deg: float) -> int | None:
-        """Index in ``ratios`` where a plateau after a rise begins, along which the
-        contact slid, or None."""
+        """Index in ``ratios`` where a plateau after a rise begins (the knee), along
+        which the contact slid, or None."""
         r = np.asarray(ratios, dtype=float)
-        p = PLATEAU_FRAMES
-        if len(r) < 2 * p + 1 or r[-1] < 2 * STICK_RATIO:
+        if len(r) < RISE_FRAMES + PLATEAU_FRAMES + 1 or r[-1] < 2 * STICK_RATIO:
             return None
+        knee = None
+        for start in range(len(r) - 1 - PLATEAU_FRAMES, RISE_FRAMES - 1, -1):
+            if np.ptp(r[start:]) > FLAT:
+                break
+            knee = start  # flat from here on: move the knee back while it stays flat
+        if knee is None:
+            return None
+        if (r[knee] - r[knee - RISE_FRAMES]) / RISE_FRAMES <= RISE:
+            return None  # no rise before it: a hold, not a slip
         along = np.array([math.cos(math.radians(angle_deg)), math.sin(math.radians(angle_deg))])
         moved = np.asarray(xy, dtype=float) @ along
-        for start in range(len(r) - p - 1, p - 1, -1):  # the latest plateau first
-            before = (r[start] - r[start - p]) / p
-            if before <= RISE:
-                continue
-            since = r[start:] - r[start]
-            if np.abs(since).max() < 0.25 * before * max(len(since) - 1, 1) and (
-                moved[-1] - moved[start] > SLIDE_MM
-            ):
-                while start > 1 and r[start] - r[start - 1] < 0.5 * before:
-                    start -= 1  # back to the knee: the last frame that still rose
-                return start
+        if moved[-1] - moved[knee] <= SLIDE_MM:
             return None
-        return None
+        return knee
 
     def forget(self, alive_ids) -> None:
         """Drop the tracks of contacts no longer alive."""
