@@ -60,8 +60,9 @@ def _sweep(
     spec, radius_mm: float, force_n: float, ratio: float, angle_deg: float, seed, step: int = 1
 ):
     """A simulated bench sweep: the ball pressed on every taxel with ``force_n`` [N] and
-    a tangential force ``ratio`` times it along ``angle_deg`` [deg]; (frames, frame_step,
-    step contacts) as ``calibrate_triaxial`` takes them."""
+    dragged with a tangential force ``ratio`` times it along ``angle_deg`` [deg] (gross
+    slip: friction ``ratio``, so that the tangential force is known, as triest's sweeps);
+    (frames, frame_step, step contacts) as ``calibrate_triaxial`` takes them."""
     from tactsense.kinds import kind_of
     from tactsense.physics.indenters import SphereProbe
     from tactsense.simulate.run import simulate
@@ -76,7 +77,7 @@ def _sweep(
         for c in range(step * (cols - 1) + 1):
             probe = SphereProbe(
                 r * x_pitch / step, c * y_pitch / step, force_n, radius_mm=radius_mm,
-                shear_x_n=qx, shear_y_n=qy, friction=2.0,
+                shear_x_n=qx, shear_y_n=qy, friction=max(ratio, 0.05),
             )  # fmt: skip
             steps += [Step((probe,), 6 * period, "pressed"), Step((), 3 * period, "lifted")]
     recording = simulate(spec, Scenario(tuple(steps), "bench sweep"), rng=seed)
