@@ -73,7 +73,11 @@ def test_csv_has_a_column_per_taxel_and_component(tmp_path, pressed):
     assert table.column_names == ["time", *_expected_names(4, 4)]
     for name, (r, c, k) in (("r0c0x", (0, 0, 0)), ("r2c3y", (2, 3, 1)), ("r3c1z", (3, 1, 2))):
         np.testing.assert_array_equal(table.column(name).to_numpy(), rec.frames[:, r, c, k])
-    back = _import(out, tmp_path / "back.h5", "--sensor", "mag4x4")
+    result = runner.invoke(app, ["import", str(out), "--sensor", "mag4x4", "-o",
+                                 str(tmp_path / "back.h5")])  # fmt: skip
+    assert result.exit_code == 0, result.output
+    assert f"{len(rec)} frames of mag4x4 (4 x 4 x 3 components)" in result.output
+    back = ts.read_recording(tmp_path / "back.h5")
     np.testing.assert_array_equal(back.frames, rec.frames)
     assert back.frames.dtype == np.uint16
 
@@ -634,3 +638,132 @@ def test_lsl_contact_slots_carry_the_shear(pressed):
         assert np.isnan(got[0][11:]).all()
     finally:
         outlets.close()
+
+
+def test_record_from_a_three_axis_lsl_outlet(tmp_path, pressed):
+    """``record lsl:NAME``: the sensor from the outlet's own description, the frames
+    (T, 4, 4, 3) as pushed."""
+    import dataclasses
+    import threading
+
+    from tactsense.interop.lsl import LslOutlets
+
+    _, rec = pressed
+    sensor = dataclasses.replace(rec.sensor, name=f"lslrec{uuid.uuid4().hex[:8]}")
+    outlets = LslOutlets(sensor, {"serial": uuid.uuid4().hex[:6]}, 100.0)
+    stop = threading.Event()
+
+    def push():
+        time.sleep(1.0)  # the recorder resolves and opens the inlet first
+        for frame in _stream_frames(rec):
+            if stop.is_set():
+                return
+            outlets.push(frame, None)
+            time.sleep(1 / 200)
+
+    pusher = threading.Thread(target=push, daemon=True)
+    pusher.start()
+    out = tmp_path / "from_lsl.h5"
+    try:
+        result = runner.invoke(
+            app, ["record", f"lsl:{sensor.name}-frames", "--frames", str(len(rec)), "--out",
+                  str(out), "--duration", "30"],
+        )  # fmt: skip
+    finally:
+        stop.set()
+        pusher.join(5)
+        outlets.close()
+    assert result.exit_code == 0, result.output
+    got = ts.read_recording(out)
+    assert got.sensor == sensor
+    np.testing.assert_array_equal(got.frames, rec.frames)
+
+
+@pytest.mark.parametrize("form", ["mcap", "lerobot", "rrd"])
+def test_frames_alone_refuse_the_options_of_contacts(tmp_path, pressed, monkeypatch, form):
+    """Without a contact estimator (none installed: monkeypatched away where it is) the
+    export writes the frames alone and refuses --threshold rather than ignore it."""
+    from tactsense._validation import TactsenseInputError
+    from tactsense.interop import components
+    from tactsense.interop.lerobot import export_lerobot
+    from tactsense.interop.mcap import export_mcap
+    from tactsense.interop.rerun import export_rerun
+
+    monkeypatch.setattr(components, "component_contacts", lambda *a, **k: None)
+    path, _ = pressed
+    run = {"mcap": export_mcap, "lerobot": export_lerobot, "rrd": export_rerun}[form]
+    with pytest.raises(TactsenseInputError, match="apply to contacts; no contact estimator"):
+        run(path, tmp_path / f"out.{form}", threshold=0.01)
+    assert not (tmp_path / f"out.{form}").is_dir()
+    summary = run(path, tmp_path / f"frames.{form}")
+    assert summary["contacts"] is None
+
+
+def test_ros2_live_contacts_carry_the_live_shear(loopback_dds, sheared):
+    """The live three-axis estimate's contacts, published: each TactileContact's wrench
+    force is (shear_x_n, shear_y_n, -force_n) of the estimate (rosbags decodes it)."""
+    from tactsense.interop.ros2 import Ros2Publisher
+
+    from .ros2_subscriber import typestore
+
+    _, rec = sheared
+    store = typestore()
+    estimator = pytest.importorskip("tactsense.estimate.triaxial")
+    live = estimator.LiveShearContacts(rec.sensor, baseline_frames=5)
+    publisher = Ros2Publisher(rec.sensor, node_name="trishear", frame_id="pad")
+    compared = 0
+    try:
+        for frame in _stream_frames(rec):
+            estimate = live(frame)
+            if estimate is None:
+                continue
+            raw = publisher.encode(frame, estimate)["contact_states"]
+            message = store.deserialize_cdr(raw, "tactile_msgs/msg/TactileContacts")
+            kept = [
+                c
+                for c in estimate["contacts"]
+                if all(np.isfinite(c[k]) for k in ("x_mm", "y_mm", "z_mm", "force_n"))
+            ]
+            assert len(message.contacts) == len(kept)
+            for got, want in zip(message.contacts, kept, strict=True):
+                f = got.wrench.force
+                assert [f.x, f.y, f.z] == [want["shear_x_n"], want["shear_y_n"],
+                                           -want["force_n"]]  # fmt: skip
+                compared += 1
+    finally:
+        publisher.close()
+    assert compared > 10
+
+
+def test_rerun_contacts_and_their_shear(tmp_path, sheared):
+    """With the three-axis estimator: each frame's contacts in the Rerun file are
+    'locate''s (positions [mm], ids), each with an arrow of its tangential force at
+    SHEAR_MM_PER_N (rerun.chunk.RrdReader)."""
+    import pyarrow.parquet as pq
+
+    from tactsense.interop.rerun_components import SHEAR_MM_PER_N
+
+    path, rec = sheared
+    out, located = tmp_path / "sheared.rrd", tmp_path / "located.parquet"
+    result = runner.invoke(app, ["export", str(path), "-o", str(out), "--quiet"])
+    assert result.exit_code == 0, result.output
+    assert runner.invoke(app, ["locate", str(path), "-o", str(located)]).exit_code == 0
+    rows = [r for r in pq.read_table(located).to_pylist() if np.isfinite(r["x_mm"])]
+    columns = _rerun_columns(out)
+    points = columns[("/triaxial/contacts", "Points3D:positions")]
+    arrows = columns[("/triaxial/contact_shear", "Arrows3D:vectors")]
+    time_of = {round(t, 9): k for k, t in enumerate(rec.time_s)}
+    by_frame = {}
+    for r in rows:
+        by_frame.setdefault(r["frame"], []).append(r)
+    got = [(time_of[round(t, 9)], v) for t, v in points if v]
+    assert len(got) == len(by_frame) > 10
+    for (k, positions), (_, vectors) in zip(got, [a for a in arrows if a[1]], strict=True):
+        want = sorted(by_frame[k], key=lambda r: r["contact"])
+        np.testing.assert_allclose(
+            positions, [[r["x_mm"], r["y_mm"], r["z_mm"]] for r in want], rtol=1e-6, atol=1e-5
+        )
+        np.testing.assert_allclose(
+            vectors, [[r["shear_x_n"] * SHEAR_MM_PER_N, r["shear_y_n"] * SHEAR_MM_PER_N, 0]
+                      for r in want], rtol=1e-5, atol=1e-5,
+        )  # fmt: skip

@@ -1050,12 +1050,6 @@ def _triinterop_files(folder):
     (folder / "triinterop_scalar.csv").write_text("\n".join(scalar) + "\n")
     short = [*good[:2], good[2].rsplit(",", 1)[0]]
     (folder / "triinterop_short_row.csv").write_text("\n".join(short) + "\n")
-    if not (folder / "triinterop_press.h5").exists():  # a three-axis recording
-        from tactsense import flat_scenarios as fs
-
-        spec = ts.preset("mag4x4")
-        ts.write_recording(folder / "triinterop_press.h5",
-                           ts.simulate(spec, fs.press(spec), rng=0))  # fmt: skip
 
 
 TRIINTEROP_BAD = [
@@ -1065,8 +1059,6 @@ TRIINTEROP_BAD = [
      "16 value columns; sensor 'mag4x4' has 4 x 4 = 16 taxels x 3 components (x, y, z) = 48 "
      "values"),
     ("import DIR/triinterop_short_row.csv --sensor mag4x4 -o OUT", "line 3: 48 fields"),
-    ("export DIR/triinterop_press.h5 -o OUT.rrd --threshold 0.01",
-     "--calibration and --threshold apply to contacts; the Rerun file of 'mag4x4'"),
 ]  # fmt: skip
 
 
@@ -1076,68 +1068,10 @@ def test_triinterop_bad_three_axis_files(workspace, line, names):
     out = workspace / "never_written_triinterop.h5"
     args = line.replace("DIR", str(workspace)).replace("OUT", str(out)).split()
     _check(runner.invoke(app, args), names)
-    assert not out.exists() and not out.with_suffix(".h5.rrd").exists()
-
-
-# ---- /three-axis frames in other tools' files (r8-triinterop) ----
-
-
-# ---- three-axis locate and calibrate (r8-triest) ----
-TRIEST_BAD = [
-    ("locate MAG --friction 0 -o OUT", "--friction must be a coefficient in 0.05-5"),
-    ("locate MAG --friction nan -o OUT", "--friction must be a coefficient in 0.05-5"),
-    ("locate MAG --friction 9 -o OUT", "--friction must be a coefficient in 0.05-5"),
-    ("locate REC --friction 0.5 -o OUT", "--friction applies to three-axis sensors"),
-    ("locate MAG --method fit -o OUT", "--method fit is for pads"),
-    ("locate MAG --calibration PADCAL -o OUT", "is not a three-axis calibration"),
-    ("calibrate MAG --shear-sweep MISSING -o OUT", "triest_missing.h5 does not exist"),
-    ("calibrate MAG --press -o OUT", "--press is not for three-axis sensors"),
-    ("calibrate MAGNOTRUTH -o OUT", "has no known loads"),
-    ("calibrate REC --shear-sweep MAG -o OUT", "--shear-sweep is for three-axis sensors"),
-]
-
-
-@pytest.fixture(scope="module")
-def triest_workspace(tmp_path_factory):
-    import json
-
-    import h5py
-
-    from tactsense.flat_scenarios import SCENARIOS
-
-    folder = tmp_path_factory.mktemp("triest_matrix")
-    spec = ts.preset("mag4x4")
-    recording = ts.simulate(spec, SCENARIOS["press"](spec), rng=0)
-    ts.write_recording(folder / "triest_mag.h5", recording)
-    ts.write_recording(folder / "triest_mag_no_truth.h5", recording)
-    with h5py.File(folder / "triest_mag_no_truth.h5", "a") as f:
-        for group in ("truth",):
-            if group in f:
-                del f[group]
-    pad = ts.fearing1990_initial()
-    ts.write_recording(folder / "triest_rec.h5", ts.simulate(pad, ts.probe_sweep(pad), rng=0))
-    (folder / "triest_pad_cal.json").write_text(json.dumps({"format": "something-else"}))
-    return folder
-
-
-@pytest.mark.parametrize("line, names", TRIEST_BAD, ids=[line for line, _ in TRIEST_BAD])
-def test_triest_bad_input(triest_workspace, line, names):
-    folder = triest_workspace
-    out = folder / "never_written_triest.csv"
-    args = (
-        line.replace("MAGNOTRUTH", str(folder / "triest_mag_no_truth.h5"))
-        .replace("MAG", str(folder / "triest_mag.h5"))
-        .replace("REC", str(folder / "triest_rec.h5"))
-        .replace("PADCAL", str(folder / "triest_pad_cal.json"))
-        .replace("MISSING", str(folder / "triest_missing.h5"))
-        .replace("OUT", str(out))
-        .split()
-    )
-    _check(runner.invoke(app, args), names)
     assert not out.exists()
 
 
-# ---- /r8-triest ----
+# ---- /three-axis frames in other tools' files (r8-triinterop) ----
 
 
 # ---- (r8-triphys) ----
@@ -1224,6 +1158,64 @@ def test_triview_bad_options(tmp_path, line, names):
 
 
 # ---- /three-axis pads in view (r8-triview) ----
+
+
+# ---- three-axis locate and calibrate (r8-triest) ----
+TRIEST_BAD = [
+    ("locate MAG --friction 0 -o OUT", "--friction must be a coefficient in 0.05-5"),
+    ("locate MAG --friction nan -o OUT", "--friction must be a coefficient in 0.05-5"),
+    ("locate MAG --friction 9 -o OUT", "--friction must be a coefficient in 0.05-5"),
+    ("locate REC --friction 0.5 -o OUT", "--friction applies to three-axis sensors"),
+    ("locate MAG --method fit -o OUT", "--method fit is for pads"),
+    ("locate MAG --calibration PADCAL -o OUT", "is not a three-axis calibration"),
+    ("calibrate MAG --shear-sweep MISSING -o OUT", "triest_missing.h5 does not exist"),
+    ("calibrate MAG --press -o OUT", "--press is not for three-axis sensors"),
+    ("calibrate MAGNOTRUTH -o OUT", "has no known loads"),
+    ("calibrate REC --shear-sweep MAG -o OUT", "--shear-sweep is for three-axis sensors"),
+]
+
+
+@pytest.fixture(scope="module")
+def triest_workspace(tmp_path_factory):
+    import json
+
+    import h5py
+
+    from tactsense.flat_scenarios import SCENARIOS
+
+    folder = tmp_path_factory.mktemp("triest_matrix")
+    spec = ts.preset("mag4x4")
+    recording = ts.simulate(spec, SCENARIOS["press"](spec), rng=0)
+    ts.write_recording(folder / "triest_mag.h5", recording)
+    ts.write_recording(folder / "triest_mag_no_truth.h5", recording)
+    with h5py.File(folder / "triest_mag_no_truth.h5", "a") as f:
+        for group in ("truth",):
+            if group in f:
+                del f[group]
+    pad = ts.fearing1990_initial()
+    ts.write_recording(folder / "triest_rec.h5", ts.simulate(pad, ts.probe_sweep(pad), rng=0))
+    (folder / "triest_pad_cal.json").write_text(json.dumps({"format": "something-else"}))
+    return folder
+
+
+@pytest.mark.parametrize("line, names", TRIEST_BAD, ids=[line for line, _ in TRIEST_BAD])
+def test_triest_bad_input(triest_workspace, line, names):
+    folder = triest_workspace
+    out = folder / "never_written_triest.csv"
+    args = (
+        line.replace("MAGNOTRUTH", str(folder / "triest_mag_no_truth.h5"))
+        .replace("MAG", str(folder / "triest_mag.h5"))
+        .replace("REC", str(folder / "triest_rec.h5"))
+        .replace("PADCAL", str(folder / "triest_pad_cal.json"))
+        .replace("MISSING", str(folder / "triest_missing.h5"))
+        .replace("OUT", str(out))
+        .split()
+    )
+    _check(runner.invoke(app, args), names)
+    assert not out.exists()
+
+
+# ---- /r8-triest ----
 
 
 # ---- the three-axis MuJoCo slip example (r8-mjslip) ----

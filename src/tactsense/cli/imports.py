@@ -131,9 +131,12 @@ def import_(
     )  # fmt: skip
     with atomic_output(out) as temporary:
         write_recording(temporary, recording)
+    parts = recording.sensor.components  # r8-triinterop: components a taxel, when several
     console.print(
         f"wrote {out}: {len(recording)} frames of {recording.sensor.name} "
-        f"({recording.sensor.shape[0]} x {recording.sensor.shape[1]})"
+        f"({recording.sensor.shape[0]} x {recording.sensor.shape[1]}"
+        + (f" x {parts} components" if parts > 1 else "")
+        + ")"
     )
     times = np.asarray(recording.time_s, dtype=float)
     no_times = "the file carries no times" in recording.scenario.get("description", "")

@@ -71,9 +71,14 @@ class ComponentStateBytes:
         return b"".join((self.head, _STAMP.pack(sec, nanosec), self.after_stamp(values)))
 
 
-def frames_only(reader, writer, stamps, progress, host: bool) -> dict:
+def frames_only(reader, writer, stamps, progress, host: bool, calibration=None,
+                threshold=None) -> dict:  # fmt: skip
     """The MCAP export of a kind that estimates no contacts (yet): its frames alone, as
-    ``TactileState`` messages (``contacts`` None: none were estimated)."""
+    ``TactileState`` messages (``contacts`` None: none were estimated); the options of
+    contacts refused."""
+    from tactsense.interop.components import refuse_contact_options
+
+    refuse_contact_options(reader.sensor, calibration, threshold)
     for start, frames, time_s in reader.chunks():
         n = len(time_s)
         writer.frames_of(frames, stamps(start, np.asarray(time_s)), np.arange(start, start + n))

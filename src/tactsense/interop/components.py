@@ -197,3 +197,15 @@ def shear_vectors(table, keep) -> np.ndarray | None:
         return None
     sx, sy = np.asarray(sx, dtype=float)[keep], np.asarray(sy, dtype=float)[keep]
     return np.nan_to_num(np.column_stack([sx, sy, np.zeros_like(sx)]))
+
+
+def refuse_contact_options(sensor, calibration, threshold) -> None:
+    """An export of the frames alone (no contact estimator for ``sensor``) refuses the
+    options that apply to contacts, rather than ignoring them."""
+    if calibration is not None or threshold is not None:
+        from tactsense._validation import TactsenseInputError
+
+        raise TactsenseInputError(
+            f"--calibration and --threshold apply to contacts; no contact estimator is "
+            f"installed for {sensor.name!r}, so its frames alone are exported"
+        )

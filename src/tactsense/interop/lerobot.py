@@ -356,6 +356,9 @@ def export_lerobot(
         sensor = reader.sensor
         losses = reader.losses
         if not kind_of(sensor).contact_estimation:  # ---- r8-triinterop: frames alone ----
+            from tactsense.interop.components import refuse_contact_options
+
+            refuse_contact_options(sensor, calibration, threshold)
             state_names = ()
             pieces = (
                 (start, len(time_s), time_s, np.zeros((len(time_s), 0)))
@@ -365,6 +368,7 @@ def export_lerobot(
             from tactsense.batch import iter_contacts
             from tactsense.interop.components import (
                 component_contacts,
+                refuse_contact_options,
                 shear_state,
                 shear_state_names,
             )
@@ -383,6 +387,7 @@ def export_lerobot(
                 )
             )  # fmt: skip
             if found is None:  # the three-axis estimator is not installed: frames alone
+                refuse_contact_options(sensor, calibration, threshold)
                 state_names = ()
                 found = ((start, len(t), t, None, None) for start, _, t in reader.chunks())
             pieces = (

@@ -464,7 +464,7 @@ def export_mcap(
         if not kind_of(reader.sensor).contact_estimation:  # ---- r8-triinterop ----
             from tactsense.interop._state_bytes import frames_only
 
-            return frames_only(reader, writer, stamps, progress, host)
+            return frames_only(reader, writer, stamps, progress, host, calibration, threshold)
         if kind_of(reader.sensor).multi_contact:  # every contact, tracked: one message each
             from tactsense.batch import iter_contacts
             from tactsense.interop.components import component_contacts, shear_vectors
@@ -480,7 +480,8 @@ def export_mcap(
                 if pieces is None:  # not installed: the frames alone
                     from tactsense.interop._state_bytes import frames_only
 
-                    return frames_only(reader, writer, stamps, progress, host)
+                    return frames_only(reader, writer, stamps, progress, host, calibration,
+                                       threshold)  # fmt: skip
             else:
                 pieces = iter_contacts(reader, baseline_frames=baseline_frames,
                                        calibration=calibration, threshold=threshold,

@@ -112,6 +112,7 @@ def export_rerun(
             return export_components_rerun(
                 rr, reader, recording, out, baseline_frames=baseline_frames,
                 value_range=deflection_range, recording_id=recording_id, progress=progress,
+                calibration=calibration, threshold=threshold,
             )  # fmt: skip
         if kind_of(sensor).multi_contact:  # every contact, tracked
             return _export_array(
