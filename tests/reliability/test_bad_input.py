@@ -1216,3 +1216,23 @@ def test_triest_bad_input(triest_workspace, line, names):
 
 
 # ---- /r8-triest ----
+
+
+# ---- the three-axis MuJoCo slip example (r8-mjslip) ----
+MJSLIP_BAD = [
+    ("mujoco --example slips --out OUT", "expected one of gripper, fingertip, slip"),
+    ("mujoco --example slip --geom nothere --out OUT", "--geom nothere: the model has no geom"),
+    ("mujoco --example slip --flaws viscoelastic --out OUT", "need the frame sequence"),
+    ("mujoco --example slip --seconds 0.001 --out OUT", "shorter than one scan of 'mag4x4'"),
+]
+
+
+@pytest.mark.parametrize("line, names", MJSLIP_BAD, ids=[line for line, _ in MJSLIP_BAD])
+def test_mjslip_bad_input(tmp_path, line, names):
+    pytest.importorskip("mujoco")
+    out = tmp_path / "never_written_mjslip.h5"
+    _check(runner.invoke(app, line.replace("OUT", str(out)).split()), names)
+    assert not out.exists()
+
+
+# ---- /the three-axis MuJoCo slip example (r8-mjslip) ----

@@ -34,11 +34,13 @@ def mujoco_command(
         str,
         typer.Option(
             "--example",
-            metavar="[gripper|fingertip]",
+            metavar="[gripper|fingertip|slip]",
             help="Without MODEL, which example: 'gripper' (a gripper finger with a "
-            "40 x 40 mm pad16 pressing on and sliding across a ball and a rod) or "
+            "40 x 40 mm pad16 pressing on and sliding across a ball and a rod), "
             "'fingertip' (the paper's "
-            "finger, the 'initial' preset, slid along its axis over a ball).",
+            "finger, the 'initial' preset, slid along its axis over a ball) or 'slip' "
+            "(a finger with the three-axis mag4x4 pad pressed on a 2 mm ball and dragged "
+            "until it slips, twice; 8 s).",
         ),
     ] = "gripper",
     out: Annotated[Path, typer.Option("--out", "-o", help="HDF5 recording to write (.h5).")] = (
@@ -134,6 +136,11 @@ def mujoco_command(
         "gripper": (adapter.example_model_path(), "pad", "pad16"),
         "fingertip": (adapter.fingertip_model_path(), "finger", "initial"),
     }
+    # ---- the three-axis slip example (r8-mjslip) ----
+    from tactsense.interop.mujoco_shear import slip_model_path
+
+    examples["slip"] = (slip_model_path(), "pad", "mag4x4")
+    # ---- /r8-mjslip ----
     if example not in examples:
         fail(f"--example {example}: expected one of {', '.join(examples)}")
     if model is None:

@@ -168,8 +168,9 @@ def frame_blocks(
     ------
     first, last : int
         The frames of the block (``last`` exclusive).
-    counts : ndarray, shape (last - first, rows, cols)
-        A/D counts [counts], as ``frames_from_contacts`` makes them.
+    counts : ndarray, shape (last - first, *spec.frame_shape)
+        A/D counts [counts], as ``frames_from_contacts`` makes them (a three-axis
+        kind's component axis last).
     labels : dict of ndarray
         :func:`contact_labels` of those frames (MuJoCo's contacts).
     """
@@ -180,7 +181,6 @@ def frame_blocks(
     active = active_flaws(flaws)
     rng = np.random.default_rng(rng)
     period, dt, t0 = spec.scan_period_s, model.opt.timestep, float(data.time)
-    rows, cols = spec.shape
     shear = kind_of(spec).senses_shear  # a kind without shear is not given it
     fast = n_frames >= AUTO_FAST_FRAMES if fast is None else fast
     for first in range(0, n_frames, chunk_frames):
@@ -200,7 +200,7 @@ def frame_blocks(
         yield (
             first,
             last,
-            np.asarray(counts).reshape(last - first, rows, cols),
+            np.asarray(counts).reshape(last - first, *spec.frame_shape),
             (contact_labels(readings)),
         )
 
@@ -292,8 +292,8 @@ def record_mujoco(
             )
             options = {"compression": "gzip", "fletcher32": True}
             frames = h5.create_dataset(
-                "frames", (n, *spec.shape), dtype, chunks=(chunk, *spec.shape),
-                maxshape=(None, *spec.shape), **options,
+                "frames", (n, *spec.frame_shape), dtype, chunks=(chunk, *spec.frame_shape),
+                maxshape=(None, *spec.frame_shape), **options,
             )  # fmt: skip
             frames.attrs["units"] = "counts"
             frames.attrs["axes"] = kind_of(spec).frame_axes

@@ -1,0 +1,113 @@
+"""MuJoCo in, three-axis frames out: the slip example (issue 38 item 2) against MuJoCo.
+
+The example ``mujoco_slip.xml`` presses a ``mag4x4`` pad on a ball and drags it until
+friction gives way; the three-axis estimator on its frames is set against MuJoCo's own
+contacts (``tactsense.interop.mujoco_shear.compare``). Bounds are the measured figures
+of docs/mujoco.md's slip block with a margin, noise-free frames (flaws 'none') so that
+they test the chain (contacts -> frames -> estimate), not one noise draw."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+pytest.importorskip("mujoco")
+
+from tactsense.estimate.triaxial.locate import ShearPipeline
+from tactsense.interop.mujoco import (
+    MujocoSensor,
+    load_model,
+    read_controls,
+    record_mujoco,
+)
+from tactsense.interop.mujoco_shear import (
+    EXAMPLE_FRICTION,
+    compare,
+    ramp_onsets,
+    slip_controls_path,
+    slip_model_path,
+)
+from tactsense.io.recording import read_recording
+from tactsense.sensor import preset
+
+
+def _run(folder, flaws, friction):
+    spec = preset("mag4x4")
+    model = load_model(slip_model_path())
+    controls = read_controls(slip_controls_path(), model)
+    path = folder / f"mjslip_example_{flaws}.h5"
+    record_mujoco(path, MujocoSensor(model, spec, geom="pad"), seconds=4.0, controls=controls,
+                  flaws=flaws, rng=0)  # fmt: skip
+    recording = read_recording(path)
+    baseline = np.median(recording.frames[:5].astype(float), axis=0)
+    table, _ = ShearPipeline(spec, baseline, friction=friction)(recording.frames)
+    return spec, recording, table
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory):
+    spec, recording, table = _run(tmp_path_factory.mktemp("mjslip"), "none", EXAMPLE_FRICTION)
+    return spec, recording, compare(recording.truth, table, spec.scan_period_s), table
+
+
+def test_the_example_presses_drags_and_slips_in_mujoco(run):
+    """The example does what its docs say: three-axis frames, one press, MuJoCo's friction
+    reaching mu times the normal force (the cone's limit) partway through the drag."""
+    spec, recording, result, _ = run
+    assert recording.frames.shape[1:] == spec.frame_shape == (4, 4, 3)
+    truth = recording.truth
+    (press,) = result.presses
+    onset = press["mujoco_onset"]
+    assert onset is not None and press["first"] + 30 < onset < press["last"] - 30
+    ratio = np.hypot(*truth["mujoco_tangential_force_n"].T) / np.maximum(
+        truth["step_force_n"], 1e-9
+    )
+    assert ratio[onset + 5] == pytest.approx(EXAMPLE_FRICTION, rel=0.01)
+    assert ratio[onset - 20] < 0.8 * EXAMPLE_FRICTION  # stick before: the ratio still rising
+    assert np.all(truth["mujoco_slip"][press["first"] : onset] == 0)
+
+
+def test_the_frames_give_the_slip_onset_near_mujocos(run):
+    """Onset from the frames (mu given) against MuJoCo's transition. Measured: 2 frames
+    early (the estimator calls gross slip at mu less 4 %); the issue's goal is one frame:
+    not met, and this bound says so."""
+    (press,) = run[2].presses
+    assert press["delay"] is not None
+    assert -3 <= press["delay"] <= 0
+
+
+def test_the_frames_give_mujocos_normal_force_and_contact_point(run):
+    """Noise-free, the kind's response alone: normal force within 2 % of MuJoCo's sum in
+    every frame pressed with more than 0.25 N, sticking or sliding (measured: median
+    -0.3 %, largest 1.7 %); the contact within a quarter pitch of MuJoCo's contact point
+    in every pressed frame."""
+    spec, _, result, _ = run
+    assert np.isfinite(result.force_error).all()
+    stick = result.force_error[~result.sliding & (result.mujoco_force_n > 0.25)]
+    slide = result.force_error[result.sliding & (result.mujoco_force_n > 0.25)]
+    assert len(stick) > 30 and len(slide) > 30
+    assert np.max(np.abs(stick)) < 0.02
+    assert np.max(np.abs(slide)) < 0.02
+    assert np.max(result.centroid_error_mm) < 0.25 * spec.grid.row_pitch_mm
+
+
+def test_the_ramp_onset_is_within_a_frame_of_mujocos(run):
+    """The ramp of Q/P crossed with its sliding plateau (``ramp_onsets``): within one
+    frame of MuJoCo's transition (measured 0 noise-free), and a fractional frame between
+    the estimator's flag and its early call."""
+    spec, recording, _, table = run
+    (press,) = compare(recording.truth, table, spec.scan_period_s, ramp=True).presses
+    assert abs(press["delay"]) <= 1
+    (onset,) = ramp_onsets(table).values()
+    assert press["mujoco_onset"] - 2 < onset < press["mujoco_onset"] + 1
+
+
+def test_with_the_pads_flaws_and_mu_unknown_the_ramp_onset_holds(tmp_path):
+    """Noise, gain spread, quantization and the rest of the per-frame flaws, ``mu`` not
+    given (the estimator finds it at the plateau, flagging late): the ramp onset still
+    within one frame of MuJoCo's; the flag itself comes after MuJoCo's onset."""
+    spec, recording, table = _run(tmp_path, "all", None)
+    (ramp,) = compare(recording.truth, table, spec.scan_period_s, ramp=True).presses
+    (flag,) = compare(recording.truth, table, spec.scan_period_s).presses
+    assert abs(ramp["delay"]) <= 1
+    assert flag["detected"] > flag["mujoco_onset"]
