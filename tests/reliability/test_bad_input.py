@@ -1236,3 +1236,23 @@ def test_mjslip_bad_input(tmp_path, line, names):
 
 
 # ---- /the three-axis MuJoCo slip example (r8-mjslip) ----
+
+
+# ---- trial8 fixes (r8-fixc8) ----
+FIXC8_BAD = [
+    ("emulate --sensor mag4x4 --scenario shear --shear-angle-deg nan", "--shear-angle-deg"),
+    ("emulate --sensor mag4x4 --scenario shear --shear-ratio 0", "--shear-ratio"),
+    ("emulate --sensor mag4x4 --scenario shear --friction 9", "--friction"),
+    ("emulate --sensor mag4x4 --scenario slide-to-slip --shear-ratio 0.5", "does not exceed"),
+    ("emulate --sensor pad4 --scenario press --ramp-s 1", "--ramp-s does not apply"),
+    ("emulate --recording REC --shear-ratio 0.5", "--recording excludes --shear-ratio"),
+]
+
+
+@pytest.mark.parametrize("line, names", FIXC8_BAD, ids=[line for line, _ in FIXC8_BAD])
+def test_fixc8_bad_input(workspace, line, names):
+    args = line.replace("REC", str(workspace / "rec.h5")).split()
+    _check(runner.invoke(app, [*args, "--port", "0"]), names)
+
+
+# ---- /trial8 fixes (r8-fixc8) ----

@@ -17,6 +17,7 @@ from rich.progress import Progress, TextColumn
 from tactsense._signals import stopped_by
 from tactsense._validation import TactsenseInputError
 from tactsense.cli import _robot_live as robot  # r7-capture
+from tactsense.cli import _scenario as shear_options  # r8-fixc8: simulate's
 from tactsense.cli._common import (
     BaselineFramesOption,
     CalibrationOption,
@@ -95,7 +96,8 @@ RATE = dict(min=0.0, max=1.0)
 SCENARIO_PARAMETERS = (
     "sensor", "scenario", "row", "col", "force_g", "increment", "dwell_s", "lift_s",
     "repeats", "x_mm", "y_mm", "separation_mm", "indenter", "size_mm", "speed_mm_s",
-    "angle_deg", "forces_g", "flaws", "seed",
+    "angle_deg", "forces_g", "shear_ratio", "shear_angle_deg", "friction", "ramp_s",
+    "flaws", "seed",
 )  # fmt: skip
 """emulate's options that build a scenario: a --recording brings its own frames."""
 
@@ -120,6 +122,10 @@ def emulate(
     speed_mm_s: SpeedOption = None,
     angle_deg: AngleOption = None,
     forces_g: ForcesGOption = None,
+    shear_ratio: shear_options.ShearRatioOption = None,  # r8-fixc8: simulate's shear options
+    shear_angle_deg: shear_options.ShearAngleOption = None,
+    friction: shear_options.FrictionOption = None,
+    ramp_s: shear_options.RampOption = None,
     flaws: FlawsOption = "all",
     seed: SeedOption = 0,
     recording: Annotated[
@@ -197,10 +203,8 @@ def emulate(
         return robot.emulate_skin(ctx, locals())
     wire_format = format_with_components(wire_format, components)  # r8-triwire
     if not 0 < speed <= 1e6:
-        fail(
-            f"--speed must be more than 0 and at most 1e6 (a multiple of the scan rate); "
-            f"got {speed:g}; 1e6 sends as fast as the line takes them"
-        )
+        fail(f"--speed must be more than 0 and at most 1e6 (a multiple of the scan rate); "
+             f"got {speed:g}; 1e6 sends as fast as the line takes them")  # fmt: skip
     if recording is not None and robot.is_robot_folder(recording):  # r7-fixc
         fail(f"--recording {recording} is a robot recording (a folder): add --skin SKIN")
     if recording is not None:
@@ -210,10 +214,8 @@ def emulate(
             if getattr(ctx.get_parameter_source(name), "name", "") == "COMMANDLINE"
         ]
         if given:
-            fail(
-                f"--recording excludes {', '.join(given)}: the recording brings its own "
-                "sensor and frames"
-            )
+            fail(f"--recording excludes {', '.join(given)}: the recording brings its own "
+                 "sensor and frames")  # fmt: skip
     try:
         faults = FaultRates(garbage, bitflip, drop, truncate, stall, stall_s)
         fmt = None if wire_format is None else parse_format(wire_format)
@@ -227,6 +229,8 @@ def emulate(
                 dwell_s=dwell_s, lift_s=lift_s, repeats=repeats, x_mm=x_mm, y_mm=y_mm,
                 separation_mm=separation_mm, indenter=indenter, size_mm=size_mm,
                 speed_mm_s=speed_mm_s, angle_deg=angle_deg, forces_g=forces_g,
+                shear=dict(shear_ratio=shear_ratio, shear_angle_deg=shear_angle_deg,
+                           friction=friction, ramp_s=ramp_s),  # r8-fixc8
             )  # fmt: skip
             source = run_scenario(spec, scene, flaws=flaws, seed=seed)
         emulator = Emulator.from_recording(
@@ -264,12 +268,9 @@ def emulate(
     except OSError as error:
         fail(f"cannot serve: {error.strerror or error}")
     log = emulator.log
-    console.print(
-        f"sent {log.frames} frames ({log.delivered_intact} intact); injected: "
-        + ", ".join(
-            f"{k} {getattr(log, k)}" for k in ("garbage", "bitflip", "drop", "truncate", "stall")
-        )
-    )
+    injected = ("garbage", "bitflip", "drop", "truncate", "stall")
+    console.print(f"sent {log.frames} frames ({log.delivered_intact} intact); injected: "
+                  + ", ".join(f"{k} {getattr(log, k)}" for k in injected))  # fmt: skip
 
 
 @app.command()
