@@ -291,29 +291,54 @@ def raster(
     size_mm: float = 1.6,
     dwell_s: float = 0.1,
     settle_s: float = 0.2,
+    shear_ratio: float | None = None,
+    angle_deg: float = 0.0,
+    friction: float = 1.0,
 ) -> Scenario:
     """A sphere pressed on the centre of every taxel in turn, lifted between presses: the
     probe sweep a pad's or a point set's gains are calibrated from (``tactsense
-    calibrate``; the finger's 'calibration' sweep on an array)."""
+    calibrate``; the finger's 'calibration' sweep on an array).
+
+    ``shear_ratio`` (a kind that senses shear; r8-fixc8): each press also pushes along
+    ``angle_deg`` (from x [deg]) with that many times the normal force, below
+    ``friction`` (the contact sticks): the tangential sweeps of a three-axis calibration
+    (docs/triaxial.md)."""
     check_positive(dwell_s, "dwell_s")
+    load = {}
+    if shear_ratio is not None:  # ---- r8-fixc8 ----
+        _shear_checks(spec, shear_ratio, friction, 1.0, angle_deg)
+        if shear_ratio >= friction:
+            raise TactsenseInputError(
+                f"shear_ratio {shear_ratio:g} is at or above the friction {friction:g}: the "
+                "probe would slide; a calibration sweep holds below it"
+            )
+        q = shear_ratio * force_n
+        ux, uy = math.cos(math.radians(angle_deg)), math.sin(math.radians(angle_deg))
+        load = {"shear_x_n": q * ux, "shear_y_n": q * uy, "friction": friction}
     steps = _settle(settle_s)
     grid = kind_of(spec).surface_grid(spec)
+    if grid is None and load:
+        raise TactsenseInputError(f"{spec.name!r} has no grid: its calibration sweep "
+                                  "takes no tangential push")  # fmt: skip
     if grid is not None:
         (row_pitch, rows), (col_pitch, cols) = grid
         for r in range(rows):
             for c in range(cols):
                 x, y = r * row_pitch, c * col_pitch
-                probe = SphereProbe(x, y, force_n, radius_mm=size_mm)
+                probe = SphereProbe(x, y, force_n, radius_mm=size_mm, **load)
                 steps += [Step((probe,), dwell_s, f"taxel ({r}, {c})"), Step((), dwell_s, "lifted")]
     else:
         for k in range(spec.n_taxels):
             probe = make_indenter("sphere", 0.0, 0.0, force_n, size_mm, at_taxel=k)
             steps += [Step((probe,), dwell_s, f"taxel {k}"), Step((), dwell_s, "lifted")]
+    pushed = "" if not load else f", pushed at Q/P = {shear_ratio:g} along {angle_deg:g} deg"
+    extra = {} if not load else {"shear_ratio": shear_ratio, "angle_deg": angle_deg,
+                                 "friction": friction}  # fmt: skip
     return Scenario(
         tuple(steps),
         "calibration",
-        f"{size_mm:g}-mm sphere of {force_n:g} N pressed on every taxel in turn",
-        {"force_n": force_n, "size_mm": size_mm},
+        f"{size_mm:g}-mm sphere of {force_n:g} N pressed on every taxel in turn{pushed}",
+        {"force_n": force_n, "size_mm": size_mm, **extra},
     )
 
 

@@ -1246,13 +1246,20 @@ FIXC8_BAD = [
     ("emulate --sensor mag4x4 --scenario slide-to-slip --shear-ratio 0.5", "does not exceed"),
     ("emulate --sensor pad4 --scenario press --ramp-s 1", "--ramp-s does not apply"),
     ("emulate --recording REC --shear-ratio 0.5", "--recording excludes --shear-ratio"),
+    ("simulate --sensor mag4x4 --scenario calibration --shear-ratio 1.2", "above the friction"),
+    ("simulate --sensor mag4x4 --scenario calibration --ramp-s 1", "--ramp-s does not apply"),
+    ("simulate --sensor pad4 --scenario calibration --shear-ratio 0.3", "does not apply"),
+    ("simulate --scenario calibration --shear-angle-deg 90", "does not apply"),
 ]
 
 
 @pytest.mark.parametrize("line, names", FIXC8_BAD, ids=[line for line, _ in FIXC8_BAD])
 def test_fixc8_bad_input(workspace, line, names):
+    out = workspace / "fixc8_never_written.h5"
     args = line.replace("REC", str(workspace / "rec.h5")).split()
-    _check(runner.invoke(app, [*args, "--port", "0"]), names)
+    tail = ["--port", "0"] if args[0] == "emulate" else ["-o", str(out)]
+    _check(runner.invoke(app, [*args, *tail]), names)
+    assert not out.exists()
 
 
 # ---- /trial8 fixes (r8-fixc8) ----

@@ -49,8 +49,10 @@ ScenarioOption = Annotated[
         "'slide' slides a sphere across at --speed-mm-s, 'sweep' presses a sphere every "
         "--increment mm along y (Fig. 7 on a pad), 'knife-edge' presses a knife edge "
         "across the middle, 'punch' a flat punch (a uniform press), 'calibration' a "
-        "sphere on every taxel in turn (for 'calibrate'), 'loads' presses a sphere with "
-        "each of --forces-g in turn, lifted between (a box of weights, or a load cell: "
+        "sphere on every taxel in turn (for 'calibrate'; on a three-axis pad with "
+        "--shear-ratio also pushed along --shear-angle-deg: the tangential sweeps), "
+        "'loads' presses a sphere with each of --forces-g in turn, lifted between (a box "
+        "of weights, or a load cell: "
         "for 'calibrate --force-log', with the log --force-log writes or a CSV of the "
         "masses in order). A three-axis pad also: 'shear' presses a sphere and ramps a "
         "tangential force to --shear-ratio, holds and releases it, 'slide-to-slip' ramps "
@@ -181,19 +183,21 @@ ShearRatioOption = Annotated[
     typer.Option("--shear-ratio", min=1e-3, max=10.0,
                  help="'shear' and 'slide-to-slip': the tangential force ramped to, over the "
                  "normal force (Q/P) [-], 0.001-10; 'shear' below --friction, "
-                 "'slide-to-slip' above it [default: 0.3 and 1.5]."),
+                 "'slide-to-slip' above it [default: 0.3 and 1.5]; 'calibration' on a "
+                 "three-axis pad: each press also pushes so [default: no push]."),
 ]  # fmt: skip
 ShearAngleOption = Annotated[
     float | None,
     typer.Option("--shear-angle-deg", min=-360.0, max=360.0,
-                 help="'shear' and 'slide-to-slip': the tangential force's direction from "
-                 "the x axis (the rows) [deg], -360 to 360 [default: 0]."),
+                 help="'shear', 'slide-to-slip' and a pushing 'calibration': the tangential "
+                 "force's direction from the x axis (the rows) [deg], -360 to 360 "
+                 "[default: 0]."),
 ]  # fmt: skip
 FrictionOption = Annotated[
     float | None,
     typer.Option("--friction", min=0.05, max=5.0,
-                 help="'shear' and 'slide-to-slip': the coefficient of friction mu between "
-                 "sphere and skin [-], 0.05-5 [default: 1]."),
+                 help="'shear', 'slide-to-slip' and a pushing 'calibration': the coefficient "
+                 "of friction mu between sphere and skin [-], 0.05-5 [default: 1]."),
 ]  # fmt: skip
 RampOption = Annotated[
     float | None,
@@ -283,7 +287,11 @@ def _flag(name: str) -> str:
 def _uses(scenario: ScenarioKind, kind: str) -> tuple[str, ...]:
     """The options ``scenario`` reads on a sensor of ``kind`` (its name): the kind's own
     where it has them (``Kind.scenario_options``), else :data:`USES`."""
-    return kind_of(kind).scenario_options.get(scenario.value, USES[scenario])
+    uses = kind_of(kind).scenario_options.get(scenario.value, USES[scenario])
+    # r8-fixc8: a kind that takes 'shear' pushes in its calibration (the tangential sweeps)
+    if scenario is ScenarioKind.calibration and "shear" in kind_of(kind).scenarios:
+        uses = (*uses, "shear_ratio", "shear_angle_deg", "friction")
+    return uses
 
 
 def check_scenario_options(scenario: ScenarioKind, given: dict, kind: str = "finger") -> dict:
