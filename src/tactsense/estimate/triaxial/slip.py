@@ -8,8 +8,8 @@ the whole contact slides (gross slip), the tangential force staying at ``mu P``.
 
 What the taxels show of it is the ratio ``Q / P`` a contact carries. With the friction
 coefficient known (``friction``), the state follows from the ratio: ``stick`` below
-:data:`STICK_RATIO` (no tangential load worth the name; once in partial slip, below
-:data:`STICK_EXIT`: a dead band), ``partial`` up to ``mu`` less a
+:data:`PARTIAL_RATIO` (no tangential load worth the name; once in partial slip, below
+:data:`STICK_RATIO`: a dead band), ``partial`` up to ``mu`` less a
 margin, ``gross`` beyond it for :data:`CONFIRM` frames running (the onset dated to the
 first); the stick ratio ``c/a`` is Cattaneo-Mindlin's. Without it, a
 contact's gross slip is found where its ratio stops rising while it carries a tangential
@@ -38,12 +38,13 @@ STICK_RATIO = 0.03
 noise of the ratio on the twin is about 0.01)."""
 
 # ---- a dead band between stick and partial; a stick row's c/a (r8-fixb8) ----
-STICK_EXIT = 0.015
-"""Ratio below which a contact in partial slip counts as sticking again [-]: with
-:data:`STICK_RATIO` a dead band (hysteresis), so the noise of the ratio about the stick
-ratio (0.015-0.03 on the twin under a press alone) does not flip a contact between
-``stick`` and ``partial`` frame after frame. A ``stick`` row's stick ratio c/a is 1 (no
-tangential load: no slip annulus), whether ``mu`` is known or not."""
+PARTIAL_RATIO = 0.05
+"""Ratio from which a sticking contact counts as in partial slip [-]; once there, it
+counts as sticking again only below :data:`STICK_RATIO`: a dead band (hysteresis), so the
+ratio's noise under a press alone (up to 0.035 on the uncalibrated twin, straddling
+:data:`STICK_RATIO`) does not flip a contact between ``stick`` and ``partial``. A
+``stick`` row's stick ratio c/a is 1 (no tangential load: no slip annulus), whether
+``mu`` is known or not."""
 # ---- /r8-fixb8 ----
 
 MARGIN = 0.04
@@ -156,8 +157,8 @@ class SlipMonitor:
                 if not gross and track["gross"] and rho >= mu * (1.0 - 3 * MARGIN):
                     gross = True  # hysteresis: noise about mu does not end a slide
                 track["gross"] = gross
-            # r8-fixb8: partial from STICK_RATIO up, stick again only below STICK_EXIT
-            track["partial"] = rho >= (STICK_EXIT if track["partial"] else STICK_RATIO)
+            # r8-fixb8: partial from PARTIAL_RATIO up, stick again only below STICK_RATIO
+            track["partial"] = rho >= (STICK_RATIO if track["partial"] else PARTIAL_RATIO)
             if track["gross"]:
                 state[k] = "gross"
             elif track["partial"]:
