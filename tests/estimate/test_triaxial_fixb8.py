@@ -91,3 +91,14 @@ def test_live_takes_locates_threshold_on_a_three_axis_pad(tmp_path):
     assert locator._options["threshold_counts"] == pytest.approx(0.01 * 65535)
     assert threshold_counts_of(spec, 0.01) == pytest.approx(0.01 * 65535)
     assert threshold_counts_of(spec, None) is None
+
+
+def test_live_method_message_has_no_doubled_quote(tmp_path):
+    # the trial saw `'mag4x4''s` in `live --method cop`'s refusal
+    from tactsense._validation import TactsenseInputError
+    from tactsense.cli._live_sources import _locator_for
+
+    spec, _ = _recording(tmp_path)
+    with pytest.raises(TactsenseInputError) as error:
+        _locator_for(spec, None, 5, None, keep_deflection=False, contact_options={"method": "cop"})
+    assert "''" not in str(error.value) and "the contacts of 'mag4x4'" in str(error.value)

@@ -179,8 +179,8 @@ def _locator_for(
         options = contact_options or {}
         if options.get("method", "interpolate") != "interpolate":
             raise TactsenseInputError(
-                f"--method {options['method']!r} applies to scalar pads; {spec.name!r}'s "
-                "contacts are fitted with their shear (leave --method out)"
+                f"--method {options['method']!r} applies to scalar pads; the contacts of "
+                f"{spec.name!r} are fitted with their shear (leave --method out)"
             )
         from tactsense.view.vectors import warmed
 
