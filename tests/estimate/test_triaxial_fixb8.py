@@ -102,3 +102,12 @@ def test_live_method_message_has_no_doubled_quote(tmp_path):
     with pytest.raises(TactsenseInputError) as error:
         _locator_for(spec, None, 5, None, keep_deflection=False, contact_options={"method": "cop"})
     assert "''" not in str(error.value) and "the contacts of 'mag4x4'" in str(error.value)
+
+
+def test_locate_help_states_the_three_axis_threshold_rule():
+    from tactsense.cli import app
+
+    result = CliRunner().invoke(app, ["locate", "--help"], terminal_width=200)
+    text = " ".join(result.output.replace("│", " ").split())
+    assert "Three-axis taxels (the same rule in locate, export, live and view)" in text
+    assert "read_noise_counts times sqrt(3), at least 10 counts" in text
