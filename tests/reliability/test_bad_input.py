@@ -1142,8 +1142,9 @@ def test_triwire_components_bad_input(workspace, line, names):
 
 # ---- three-axis pads in view (r8-triview) ----
 TRIVIEW_BAD = [
-    # a scalar pad's fractional threshold does not apply to a three-axis pad's contacts
-    ("view TRIVIEW_REC --threshold 0.01", "leave --threshold out"),
+    # --threshold on a three-axis pad: a fraction of full scale, as locate's (r8-fixb8);
+    # beyond (0, 1] refused as everywhere
+    ("view TRIVIEW_REC --threshold 2", "must be a number in (0, 1]"),
 ]
 
 
@@ -1263,3 +1264,27 @@ def test_fixc8_bad_input(workspace, line, names):
 
 
 # ---- /trial8 fixes (r8-fixc8) ----
+# ---- trial8 fixes (r8-fixb8) ----
+FIXB8_CSV = [("big", "70000", "is beyond 65535"), ("neg", "-7", "is negative"),
+             ("frac", "32768.4", "is not whole counts"),
+             ("empty", "", "column r0c0z")]  # fmt: skip
+
+
+@pytest.mark.parametrize("name, cell, names", FIXB8_CSV, ids=[c[0] for c in FIXB8_CSV])
+def test_fixb8_csv_counts_the_converter_cannot_give(tmp_path, name, cell, names):
+    # a three-axis CSV with one bad cell: refused with its line and column, not imported
+    # as float frames reading as a phantom contact
+    spec = ts.preset("mag4x4")
+    columns = [f"r{r}c{c}{a}" for r in range(4) for c in range(4) for a in "xyz"]
+    rows = [["0.01", *(["32768"] * len(columns))], ["0.02", *(["32768"] * len(columns))]]
+    rows[1][3] = cell
+    source = tmp_path / f"fixb8_{name}.csv"
+    source.write_text("\n".join(",".join(r) for r in [["time", *columns], *rows]) + "\n")
+    out = tmp_path / "fixb8_never.h5"
+    result = runner.invoke(app, ["import", str(source), "--sensor", spec.name, "-o", str(out)])
+    for words in ("line 3, column r0c0z", names):
+        _check(result, words)
+    assert not out.exists()
+
+
+# ---- /trial8 fixes (r8-fixb8) ----

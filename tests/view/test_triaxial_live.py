@@ -94,8 +94,8 @@ def test_live_csv_has_the_shear_columns(pushed):
 
 @pytest.mark.parametrize(
     "threshold, options, said",
-    [(0.01, {}, "--threshold is a fraction"),
-     (None, {"method": "joint"}, "--method 'joint' applies to scalar pads")],
+    # (--threshold is taken, as locate takes it: tests/estimate/test_triaxial_fixb8.py)
+    [(None, {"method": "joint"}, "--method 'joint' applies to scalar pads")],
 )  # fmt: skip
 def test_live_refuses_a_scalar_pads_options_on_a_three_axis_pad(threshold, options, said):
     from tactsense._validation import TactsenseInputError

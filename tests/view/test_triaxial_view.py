@@ -358,11 +358,12 @@ def test_browser_draws_the_estimated_shear_of_the_kinds_estimator(page, tmp_path
     assert m["slip"] == contact["slip_state"] and m["slip"] in ("stick", "partial", "gross")
 
 
-def test_view_refuses_a_scalar_threshold_on_a_three_axis_pad():
-    from tactsense._validation import TactsenseInputError
-
-    with pytest.raises(TactsenseInputError, match="leave --threshold out"):
-        view_locator(preset("mag4x4"), threshold=0.01)
+def test_view_takes_locates_threshold_on_a_three_axis_pad():
+    # r8-fixb8: one rule for --threshold on a three-axis pad (locate, export, live, view):
+    # a fraction of the converter's full scale
+    spec = preset("mag4x4")
+    reading = view_locator(spec, threshold=0.01)
+    assert reading.inner._options["threshold_counts"] == pytest.approx(0.01 * 65535)
 
 
 def test_browser_a_three_axis_device_live(page, tmp_path):  # noqa: F811

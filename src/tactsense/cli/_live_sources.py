@@ -174,18 +174,13 @@ def _locator_for(
     # ---- taxels of several components (r8-triview): contacts with shear and slip ----
     if int(getattr(spec, "components", 1)) > 1:
         from tactsense.estimate.triaxial import LiveShearContacts
+        from tactsense.estimate.triaxial.locate import threshold_counts_of  # r8-fixb8
 
         options = contact_options or {}
-        if threshold is not None:
-            raise TactsenseInputError(
-                f"--threshold is a fraction of a scalar taxel's reading; {spec.name!r} has "
-                f"{spec.components} components a taxel and its contacts' own threshold: "
-                "leave --threshold out"
-            )
         if options.get("method", "interpolate") != "interpolate":
             raise TactsenseInputError(
-                f"--method {options['method']!r} applies to scalar pads; {spec.name!r}'s "
-                "contacts are fitted with their shear (leave --method out)"
+                f"--method {options['method']!r} applies to scalar pads; the contacts of "
+                f"{spec.name!r} are fitted with their shear (leave --method out)"
             )
         from tactsense.view.vectors import warmed
 
@@ -194,6 +189,7 @@ def _locator_for(
             spec,
             baseline_frames=baseline_frames,
             calibration=calibration,
+            threshold_counts=threshold_counts_of(spec, threshold),  # locate's rule (r8-fixb8)
             max_contacts=options.get("max_contacts", 8),
             keep_deflection=keep_deflection,
         )

@@ -45,9 +45,9 @@ def locate_shear(recording: Path, out: Path, force: bool, quiet: bool, *, sensor
             f"the calibration is not a three-axis one; {sensor.name!r} reads three "
             "components a taxel: calibrate it with 'tactsense calibrate' on its own sweeps"
         )
-    threshold_counts = None
-    if threshold is not None:
-        threshold_counts = threshold * (2**sensor.electronics.adc_bits - 1)
+    from tactsense.estimate.triaxial.locate import threshold_counts_of  # r8-fixb8
+
+    threshold_counts = threshold_counts_of(sensor, threshold)
     sidecar = events_sidecar(out) if output_format(out) == "csv" else None
     if sidecar is not None:
         check_output(sidecar, force, inputs=[recording])
@@ -63,6 +63,18 @@ def locate_shear(recording: Path, out: Path, force: bool, quiet: bool, *, sensor
             progress=lambda done, total: bar.update(task, completed=done, total=total),
         )  # fmt: skip
     also = f" (events in {sidecar})" if sidecar is not None else ""
+    # ---- no "nan N" when nothing was touched (r8-fixb8) ----
+    if summary["rows"] == 0:
+        from tactsense.estimate.triaxial.fit import default_threshold_counts
+
+        counts = default_threshold_counts(sensor) if threshold is None else threshold_counts
+        given = "default" if threshold is None else f"{threshold:g} of full scale"
+        console.print(
+            f"wrote {out}{also}: {summary['frames']} frames, no contact found (threshold "
+            f"{given} = {counts:.0f} counts of field change)"
+        )
+        return
+    # ---- /r8-fixb8 ----
     console.print(
         f"wrote {out}{also}: {summary['frames']} frames, {summary['rows']} contact rows in "
         f"{summary['frames_with_contact']} frames (at most {summary['most']} at once), "

@@ -31,6 +31,21 @@ from tactsense.kinds import kind_of
 
 app = new_group("Estimate contacts and calibrations from recordings.")
 
+# ---- locate's --threshold states the three-axis rule too (r8-fixb8) ----
+_THRESHOLD = ContactThresholdOption.__metadata__[0]
+LocateThresholdOption = Annotated[
+    float | None,
+    typer.Option(
+        "--threshold",
+        callback=_THRESHOLD.callback,
+        help=_THRESHOLD.help + " Three-axis taxels (the same rule in locate, export, live "
+        "and view): a fraction of the converter's full scale (2**adc_bits - 1 counts) that "
+        "the length of a taxel's field change (x, y, z) must exceed [default: 8 times the "
+        "description's read_noise_counts times sqrt(3), at least 10 counts].",
+    ),
+]
+# ---- /r8-fixb8 ----
+
 
 def _locate_contacts(recording, out, force, quiet, **options) -> None:
     """``locate`` writing the long table of tracked contacts (pads, point sets,
@@ -105,7 +120,7 @@ def locate(
         ),
     ] = Path("estimates.csv"),
     baseline_frames: BaselineFramesOption = 5,
-    threshold: ContactThresholdOption = None,
+    threshold: LocateThresholdOption = None,  # r8-fixb8
     calibration: CalibrationOption = None,
     contacts: Annotated[
         bool,

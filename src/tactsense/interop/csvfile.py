@@ -6,9 +6,11 @@ clock [s]), ``host_time`` when the recording holds the host's arrival times (Uni
 ``r<row>c<col>`` (a point set: ``r0c<k>``, its taxels in the sensor's order); a taxel of
 several components (a three-axis taxel) has a column per component, ``r<row>c<col>x``,
 ``...y``, ``...z``, together and in that order (:mod:`tactsense.interop.components`). Counts
-are written as integers; a recording of fractional counts with 17 significant digits
-(a float64 reads back equal), a lost reading as ``nan``. Times with 17 significant
-digits. The file holds frames only: the sensor is given again on import (``--sensor``).
+are written as integers; a recording of fractional counts with 17 significant digits,
+a lost reading as ``nan``. ``import`` takes whole counts the converter can give
+(0..2**adc_bits - 1) or ``nan``, and refuses any other value with its line and
+column. Times with 17 significant digits. The file holds frames only: the sensor is
+given again on import (``--sensor``).
 """
 
 from __future__ import annotations

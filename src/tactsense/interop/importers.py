@@ -395,6 +395,8 @@ def read_csv(source: Path, *, sensor=None, time_column: str = "time"):
                 )
             _check_value_names([n for k, n in enumerate(header) if k not in (t, h)], spec,
                                source)  # fmt: skip
+            names = [n for k, n in enumerate(header) if k not in (t, h)]  # r8-fixb8
+            full = 2**spec.electronics.adc_bits - 1
             previous = None
             for line, row in enumerate(reader, start=2):
                 if not row:
@@ -406,7 +408,8 @@ def read_csv(source: Path, *, sensor=None, time_column: str = "time"):
                 try:
                     numbers = [float(x) for x in row]
                 except ValueError as error:
-                    raise ImportError_(f"{source} line {line}: {error}") from None
+                    raise ImportError_(f"{source} line {line}{_bad_cell(row, header)}: "
+                                       f"{error}") from None  # fmt: skip
                 if not all(math.isfinite(x) or math.isnan(x) for x in numbers):
                     raise ImportError_(f"{source} line {line}: a value is infinite")
                 stamp = numbers[t]
@@ -427,7 +430,9 @@ def read_csv(source: Path, *, sensor=None, time_column: str = "time"):
                 stamps.append(stamp)
                 if h is not None:
                     hosts.append(host)
-                frames.append([x for k, x in enumerate(numbers) if k != t and k != h])
+                values = [x for k, x in enumerate(numbers) if k != t and k != h]
+                _check_counts(values, line, names, full, source)  # r8-fixb8
+                frames.append(values)
     except UnicodeDecodeError:
         raise ImportError_(f"{source} is not a text (UTF-8) CSV file") from None
     except csv.Error as error:
@@ -438,6 +443,37 @@ def read_csv(source: Path, *, sensor=None, time_column: str = "time"):
     if hosts:  # the host's arrival times, as the recording that was exported had them
         recording = dataclasses.replace(recording, host_time_s=np.asarray(hosts, float))
     return recording
+
+
+# ---- counts the converter cannot give are refused (r8-fixb8) ----
+def _check_counts(values: list[float], line: int, names: list[str], full: int,
+                  source: Path) -> None:  # fmt: skip
+    """A row's values must be counts the sensor's converter can give: whole numbers in
+    0..2**adc_bits - 1 (``nan``: a lost reading). Anything else (a negative, a fraction,
+    a value beyond the range: a typo or another unit) is refused with its line and column,
+    as the text and JustFloat readers count such values as garbage; imported, it would
+    read as a phantom contact."""
+    for name, x in zip(names, values, strict=True):
+        if math.isnan(x) or (0.0 <= x <= full and x == int(x)):
+            continue
+        why = "negative" if x < 0 else f"beyond {full}" if x > full else "not whole counts"
+        raise ImportError_(
+            f"{source} line {line}, column {name}: {x!r} is {why}; the sensor's converter "
+            f"gives whole counts 0..{full} (nan for a lost reading)"
+        )
+
+
+def _bad_cell(row: list[str], header: list[str]) -> str:
+    """``, column NAME`` of a row's first cell that is not a number (or "")."""
+    for name, cell in zip(header, row, strict=True):
+        try:
+            float(cell)
+        except ValueError:
+            return f", column {name}"
+    return ""
+
+
+# ---- /r8-fixb8 ----
 
 
 _TACTSENSE_NAME = re.compile(r"r\d+c\d+[a-z]?")

@@ -140,12 +140,6 @@ def view_locator(
     wrapped in :class:`~tactsense.view.vectors.VectorReading`: the map and the arrows."""
     # ---- taxels of several components (r8-triview) ----
     if is_vector(sensor):
-        if threshold is not None:
-            raise TactsenseInputError(
-                f"--threshold is a fraction of a scalar taxel's reading; {sensor.name!r} has "
-                f"{sensor.components} components a taxel and its contacts' own threshold: "
-                "leave --threshold out"
-            )
         inner = None
         if estimates(sensor) or calibration is not None:
             inner = _estimator(sensor, calibration, baseline_frames, threshold,
@@ -158,14 +152,16 @@ def view_locator(
 def _estimator(sensor, calibration, baseline_frames, threshold, frame_period_s, baseline):
     locator = live_estimator(sensor)
     if locator is not None and _vector_kind(kind_of(sensor)):  # r8-triview
-        # (--threshold is a pad's fraction of the reading: the shear estimator's own
-        # threshold in counts applies)
+        # --threshold: a fraction of the converter's full scale, locate's rule (r8-fixb8)
+        from tactsense.estimate.triaxial.locate import threshold_counts_of
+
         warmed(locator, sensor)
         return locator(
             sensor,
             baseline_frames=baseline_frames,
             baseline=baseline,
             calibration=calibration,
+            threshold_counts=threshold_counts_of(sensor, threshold),
         )
     if locator is LiveContacts:
         return LiveContacts(

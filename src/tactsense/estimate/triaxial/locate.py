@@ -26,6 +26,18 @@ def check_friction(friction: float | None) -> float | None:
     return float(friction)
 
 
+def threshold_counts_of(sensor, threshold: float | None) -> float | None:
+    """``--threshold`` on a three-axis sensor, in counts: the ONE rule of ``locate``,
+    ``export``, ``live`` and ``view`` (r8-fixb8). ``threshold`` is a fraction of the
+    converter's full scale (``2**adc_bits - 1`` counts) that the length of a taxel's field
+    change (its three components') must exceed; None: the default,
+    :func:`~tactsense.estimate.reading.vector_threshold_counts` (8 read noises times
+    sqrt(3), at least 10 counts)."""
+    if threshold is None:
+        return None
+    return float(threshold) * (2**sensor.electronics.adc_bits - 1)
+
+
 class ShearPipeline:
     """Frames in, tracked contacts with their shear and slip out; state (tracks, slip)
     carried from call to call.

@@ -8,7 +8,8 @@ the whole contact slides (gross slip), the tangential force staying at ``mu P``.
 
 What the taxels show of it is the ratio ``Q / P`` a contact carries. With the friction
 coefficient known (``friction``), the state follows from the ratio: ``stick`` below
-:data:`STICK_RATIO` (no tangential load worth the name), ``partial`` up to ``mu`` less a
+:data:`PARTIAL_RATIO` (no tangential load worth the name; once in partial slip, below
+:data:`STICK_RATIO`: a dead band), ``partial`` up to ``mu`` less a
 margin, ``gross`` beyond it for :data:`CONFIRM` frames running (the onset dated to the
 first); the stick ratio ``c/a`` is Cattaneo-Mindlin's. Without it, a
 contact's gross slip is found where its ratio stops rising while it carries a tangential
@@ -35,6 +36,16 @@ SLIP_STATES = ("stick", "partial", "gross")
 STICK_RATIO = 0.03
 """Tangential/normal force ratio below which a contact counts as sticking [-] (the
 noise of the ratio on the twin is about 0.01)."""
+
+# ---- a dead band between stick and partial; a stick row's c/a (r8-fixb8) ----
+PARTIAL_RATIO = 0.05
+"""Ratio from which a sticking contact counts as in partial slip [-]; once there, it
+counts as sticking again only below :data:`STICK_RATIO`: a dead band (hysteresis), so the
+ratio's noise under a press alone (up to 0.035 on the uncalibrated twin, straddling
+:data:`STICK_RATIO`) does not flip a contact between ``stick`` and ``partial``. A
+``stick`` row's stick ratio c/a is 1 (no tangential load: no slip annulus), whether
+``mu`` is known or not."""
+# ---- /r8-fixb8 ----
 
 MARGIN = 0.04
 """A ratio within this share of ``mu`` of it counts as gross slip [-]."""
@@ -91,7 +102,8 @@ class SlipMonitor:
         if track is None:
             track = {"ratio": deque(maxlen=HISTORY), "frames": deque(maxlen=HISTORY),
                      "xy": deque(maxlen=HISTORY),
-                     "mu": self.friction, "gross": False, "onset": math.nan,
+                     "mu": self.friction, "gross": False, "partial": False,
+                     "onset": math.nan,
                      "detected": math.nan}  # fmt: skip
             self._tracks[ident] = track
         return track
@@ -102,10 +114,14 @@ class SlipMonitor:
         direction [deg] and normal force [N] (below :data:`MIN_FORCE_N` the contact
         counts as unloaded).
 
-        Returns ``slip_state`` (one of :data:`SLIP_STATES`), ``stick_ratio`` (c/a [-],
-        NaN where ``mu`` is not known yet), ``friction`` (the ``mu`` used [-], NaN if
-        unknown), ``slip_onset_s`` (time of the contact's latest gross-slip onset [s],
-        NaN before any), ``slip_detected_s`` (when that onset was detected [s]).
+        Returns ``slip_state`` (one of :data:`SLIP_STATES`), ``stick_ratio`` (c/a [-]:
+        1 in stick, 0 in gross slip, NaN in partial slip where ``mu`` is not known yet),
+        ``friction`` (the ``mu`` used [-], NaN if unknown), ``slip_onset_s`` (time of the
+        contact's latest gross-slip onset [s], dated back to its first frame at ``mu``,
+        NaN before any), ``slip_detected_s`` (when that onset was detected [s]: the time
+        of the first ``gross`` row). The state is causal (what was known at that frame,
+        as ``live`` gives it): the rows from the onset up to its detection stay
+        ``partial``.
         """
         n = len(ids)
         state = np.empty(n, dtype=object)
@@ -141,15 +157,19 @@ class SlipMonitor:
                 if not gross and track["gross"] and rho >= mu * (1.0 - 3 * MARGIN):
                     gross = True  # hysteresis: noise about mu does not end a slide
                 track["gross"] = gross
+            # r8-fixb8: partial from PARTIAL_RATIO up, stick again only below STICK_RATIO
+            track["partial"] = rho >= (STICK_RATIO if track["partial"] else PARTIAL_RATIO)
             if track["gross"]:
                 state[k] = "gross"
-            elif rho >= STICK_RATIO:
+            elif track["partial"]:
                 state[k] = "partial"
             else:
                 state[k] = "stick"
+                stick[k] = 1.0  # no tangential load: c = a (r8-fixb8)
             if mu is not None:
                 mu_out[k] = mu
-                stick[k] = 0.0 if track["gross"] else (1.0 - min(rho / mu, 1.0)) ** (1 / 3)
+                if state[k] != "stick":
+                    stick[k] = 0.0 if track["gross"] else (1.0 - min(rho / mu, 1.0)) ** (1 / 3)
             onset[k], detected[k] = track["onset"], track["detected"]
         return {"slip_state": state, "stick_ratio": stick, "friction": mu_out,
                 "slip_onset_s": onset, "slip_detected_s": detected}  # fmt: skip
