@@ -1266,7 +1266,7 @@ def test_fixc8_bad_input(workspace, line, names):
 # ---- /trial8 fixes (r8-fixc8) ----
 # ---- trial8 fixes (r8-fixb8) ----
 FIXB8_CSV = [("big", "70000", "is beyond 65535"), ("neg", "-7", "is negative"),
-             ("frac", "32768.4", "is not whole counts"),
+             ("big-fraction", "65535.5", "is beyond 65535"),
              ("empty", "", "column r0c0z")]  # fmt: skip
 
 

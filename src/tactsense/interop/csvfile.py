@@ -7,9 +7,9 @@ clock [s]), ``host_time`` when the recording holds the host's arrival times (Uni
 several components (a three-axis taxel) has a column per component, ``r<row>c<col>x``,
 ``...y``, ``...z``, together and in that order (:mod:`tactsense.interop.components`). Counts
 are written as integers; a recording of fractional counts with 17 significant digits,
-a lost reading as ``nan``. ``import`` takes whole counts the converter can give
-(0..2**adc_bits - 1) or ``nan``, and refuses any other value with its line and
-column. Times with 17 significant digits. The file holds frames only: the sensor is
+a lost reading as ``nan``. ``import`` takes counts the converter's range holds
+(0..2**adc_bits - 1; fractions too, as an unquantized simulation writes them) or
+``nan``, and refuses any other value with its line and column. Times with 17 significant digits. The file holds frames only: the sensor is
 given again on import (``--sensor``).
 """
 

@@ -448,18 +448,19 @@ def read_csv(source: Path, *, sensor=None, time_column: str = "time"):
 # ---- counts the converter cannot give are refused (r8-fixb8) ----
 def _check_counts(values: list[float], line: int, names: list[str], full: int,
                   source: Path) -> None:  # fmt: skip
-    """A row's values must be counts the sensor's converter can give: whole numbers in
-    0..2**adc_bits - 1 (``nan``: a lost reading). Anything else (a negative, a fraction,
-    a value beyond the range: a typo or another unit) is refused with its line and column,
-    as the text and JustFloat readers count such values as garbage; imported, it would
-    read as a phantom contact."""
+    """A row's values must be counts the sensor's converter can give: 0..2**adc_bits - 1
+    (``nan``: a lost reading; fractions are kept: an unquantized simulation exports them,
+    and ``export`` then ``import`` gives them back). A negative value or one beyond the
+    range (a typo or another unit) is refused with its line and column, as the text and
+    JustFloat readers count such values as garbage; imported, it would read as a phantom
+    contact."""
     for name, x in zip(names, values, strict=True):
-        if math.isnan(x) or (0.0 <= x <= full and x == int(x)):
+        if math.isnan(x) or 0.0 <= x <= full:
             continue
-        why = "negative" if x < 0 else f"beyond {full}" if x > full else "not whole counts"
+        why = "negative" if x < 0 else f"beyond {full}"
         raise ImportError_(
             f"{source} line {line}, column {name}: {x!r} is {why}; the sensor's converter "
-            f"gives whole counts 0..{full} (nan for a lost reading)"
+            f"gives counts 0..{full} (nan for a lost reading)"
         )
 
 
