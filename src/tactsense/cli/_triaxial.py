@@ -30,9 +30,10 @@ def locate_shear(recording: Path, out: Path, force: bool, quiet: bool, *, sensor
                  calibration, threshold, baseline_frames: int, max_contacts: int,
                  chunk_frames, friction, method: str) -> None:  # fmt: skip
     """``locate`` on a three-axis recording: the long table with shear and slip."""
+    from tactsense.batch import shear_contacts_file
     from tactsense.estimate.output import events_sidecar, output_format
     from tactsense.estimate.triaxial.calibration import TriaxialCalibration
-    from tactsense.estimate.triaxial.locate import check_friction, shear_contacts_file
+    from tactsense.estimate.triaxial.locate import check_friction
 
     check_friction(friction)
     if method != "interpolate":

@@ -9,7 +9,8 @@ loads (:mod:`.response`, asked of the kind, never of the simulator) to each cont
 taxels (:mod:`.fit`): a contact's position [mm], normal force [N] and tangential force
 (x, y) [N]. :mod:`.slip` follows each tracked contact's tangential/normal ratio through
 time for incipient slip (Cattaneo-Mindlin) and gross slip with its onset.
-:mod:`.locate` runs a recording piece by piece; :mod:`.live` frame by frame.
+:mod:`.locate` runs a recording piece by piece (a file:
+:func:`tactsense.batch.shear_contacts_file`); :mod:`.live` frame by frame.
 """
 
 from tactsense.estimate.triaxial.calibration import (
@@ -19,7 +20,6 @@ from tactsense.estimate.triaxial.calibration import (
 )
 from tactsense.estimate.triaxial.fit import find_shear_contacts, vector_taxels
 from tactsense.estimate.triaxial.live import LiveShearContacts
-from tactsense.estimate.triaxial.locate import shear_contacts_file
 from tactsense.estimate.triaxial.response import ResponseTable, response_table
 from tactsense.estimate.triaxial.slip import SLIP_STATES, SlipMonitor
 
@@ -33,6 +33,5 @@ __all__ = [
     "find_shear_contacts",
     "is_triaxial_calibration",
     "response_table",
-    "shear_contacts_file",
     "vector_taxels",
 ]

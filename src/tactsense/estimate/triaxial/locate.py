@@ -4,13 +4,12 @@ written as the long table (``tactsense locate``)."""
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterator
-from pathlib import Path
+from collections.abc import Iterator
 
 import numpy as np
 
 from tactsense._validation import TactsenseInputError
-from tactsense.estimate.results import ContactTable, Flag
+from tactsense.estimate.results import ContactTable
 
 SLIP_COLUMNS = ("slip_state", "stick_ratio", "friction", "slip_onset_s", "slip_detected_s")
 """The columns :class:`~tactsense.estimate.triaxial.slip.SlipMonitor` adds."""
@@ -121,66 +120,3 @@ def empty_table(sensor) -> ContactTable:
     pipeline = ShearPipeline(sensor, np.zeros(sensor.frame_shape))
     table, _ = pipeline(np.zeros((0, *sensor.frame_shape)))
     return table
-
-
-def shear_contacts_file(
-    recording: str | Path,
-    out: str | Path,
-    *,
-    baseline_frames: int = 5,
-    calibration=None,
-    threshold_counts: float | None = None,
-    friction: float | None = None,
-    max_contacts: int = 8,
-    chunk_frames: int | None = None,
-    events_path: str | Path | None = None,
-    progress: Callable[[int, int], None] | None = None,
-) -> dict:
-    """Every contact of a three-axis recording, tracked, with shear and slip, written
-    as the long table (CSV, Parquet or HDF5 by extension; bounded memory).
-
-    Returns a summary: ``frames``, ``rows``, ``frames_with_contact``, ``ids``, ``most``,
-    ``saturated``, ``force_max_n`` and ``shear_max_n`` [N], ``gross_slips`` (contacts
-    that slipped) and ``births``/``deaths``/``merges``/``splits``.
-    """
-    from tactsense.estimate.output import ContactsWriter, output_format
-    from tactsense.io.recording import RecordingReader
-
-    output_format(out)
-    check_friction(friction)
-    counts = {"births": 0, "deaths": 0, "merges": 0, "splits": 0}
-    frames_with = most = saturated = 0
-    force_max = shear_max = float("nan")
-    slipped: set[int] = set()
-    with RecordingReader(recording) as reader:
-        sensor = reader.sensor
-        total = reader.n_frames
-        pieces = iter_shear_contacts(
-            reader, baseline_frames=baseline_frames, calibration=calibration,
-            threshold_counts=threshold_counts, friction=friction,
-            max_contacts=max_contacts, chunk_frames=chunk_frames,
-        )  # fmt: skip
-        with ContactsWriter(out, events_path=events_path) as writer:
-            if progress is not None:
-                progress(0, total)
-            ids = 0
-            for start, n, time_s, tracked, events in pieces:
-                writer.write_contacts(np.asarray(time_s)[tracked.frame - start], tracked, events)
-                per_frame = np.bincount(tracked.frame - start, minlength=n)
-                frames_with += int(np.count_nonzero(per_frame))
-                most = max(most, int(per_frame.max(initial=0)))
-                saturated += int(np.count_nonzero(tracked.flags & int(Flag.SATURATED)))
-                if len(tracked):
-                    force_max = float(np.fmax(force_max, np.nanmax(tracked.force_n)))
-                    shear_max = float(np.fmax(shear_max, np.nanmax(tracked.extra["shear_n"])))
-                    slipped.update(int(i) for i in tracked.id[tracked.slip])
-                    ids = max(ids, int(tracked.id.max()) + 1)
-                for e in events:
-                    counts[e.kind + "s"] += 1
-                if progress is not None:
-                    progress(start + n, total)
-            if writer.rows == 0:
-                writer.write_contacts(np.zeros(0), empty_table(sensor))
-    return {"frames": total, "rows": writer.rows, "frames_with_contact": frames_with,
-            "ids": ids, "most": most, "saturated": saturated, "force_max_n": force_max,
-            "shear_max_n": shear_max, "gross_slips": len(slipped), **counts}  # fmt: skip
