@@ -352,3 +352,22 @@ def test_windowed_tractions_are_the_whole_grids():
     both = tri.traction_maps(spec, cases[:2], x, y)
     np.testing.assert_allclose(both[0], sum(tri.traction_maps(spec, [c], x, y)[0]
                                             for c in cases[:2]), rtol=1e-12)  # fmt: skip
+
+
+# ---- trial8 fixes (r8-fixa8) ----
+@pytest.mark.parametrize("angle_deg", [-149.0, -138.0, -63.0, 40.0, 46.0, 137.0])
+@pytest.mark.parametrize("friction", [0.5, 1.0, 0.3])
+def test_gross_slip_at_mu_p_whatever_the_angle(angle_deg, friction):
+    """Q = mu P set at an angle (its x and y parts) is gross slip, though hypot(Qx, Qy)
+    comes back a few ulp short of mu P at some angles (trial 8: the slide-to-slip truth
+    stayed "partial", c/a < 0.01, while sliding); just below the tolerance it is partial."""
+    force = 2.0
+    angle = math.radians(angle_deg)
+
+    def probe(q):
+        return SphereProbe(0, 0, force, radius_mm=R, shear_x_n=q * math.cos(angle),
+                           shear_y_n=q * math.sin(angle), friction=friction)  # fmt: skip
+
+    assert tri.slip_state(probe(friction * force)) == (tri.GROSS_SLIP, 0.0)
+    state, stick = tri.slip_state(probe(friction * force * (1 - 1e-6)))
+    assert state == tri.PARTIAL_SLIP and stick == pytest.approx(1e-2, rel=1e-3)

@@ -49,6 +49,12 @@ STICK, PARTIAL_SLIP, GROSS_SLIP = 0, 1, 2
 Mindlin's annulus ``c < r < a``), or the whole contact slides."""
 
 
+SLIP_TOLERANCE = 1e-9
+"""Relative rounding allowed in ``Q / (mu P)`` at gross slip [-]: ``Q`` is the length of
+its x and y parts, so ``Q = mu P`` set at an angle comes back a few ulp short (at -138 deg,
+1 - 1e-16: "partial", ``c/a`` 5e-6, while sliding)."""
+
+
 def slip_state(indenter) -> tuple[int, float]:
     """A contact's slip state (:data:`STICK`, :data:`PARTIAL_SLIP`, :data:`GROSS_SLIP`)
     and its stick ratio ``c / a`` [-] under its tangential force ``Q`` (``shear_n``).
@@ -65,7 +71,7 @@ def slip_state(indenter) -> tuple[int, float]:
     if q == 0.0 or p <= 0.0:
         return (STICK, 1.0) if q == 0.0 else (GROSS_SLIP, 0.0)
     ratio = q / (mu * p)
-    if ratio >= 1.0:
+    if ratio >= 1.0 - SLIP_TOLERANCE:  # Q = mu P rebuilt from its x, y parts: rounding
         return GROSS_SLIP, 0.0
     if getattr(indenter, "kind", "") != "sphere":
         return STICK, 1.0
