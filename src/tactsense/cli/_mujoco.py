@@ -13,6 +13,7 @@ from tactsense.cli._common import (
     check_output,
     console,
     fail,
+    frame_text,
     new_group,
     progress_bar,
     sensor_file,
@@ -193,9 +194,8 @@ def mujoco_command(
                 progress=lambda done, total: bar.update(task, completed=done),
                 fast=paths[frames_path],
             )
-    rows, cols = spec.shape
     console.print(
-        f"wrote {out}: {written} frames of {rows}x{cols} counts at "
+        f"wrote {out}: {written} frames of {frame_text(spec)} counts at "
         f"{spec.electronics.scan_rate_hz:g} Hz ({spec.name} on "
         f"{'geom' if geom else 'site'} {geom or site} of {Path(model_path).name}, "
         f"{round(seconds / mj_model.opt.timestep)} MuJoCo steps)"
