@@ -73,7 +73,7 @@ def sensor_help() -> str:
         names = list(PRESETS)
         labels = {name: kind.label for kind in kinds().values()
                   for name in (getattr(kind, "presets", None) or {})}  # fmt: skip
-    except TactsenseInputError:
+    except Exception:  # a plug-in that fails to load must not stop the CLI (it says so later)
         names, labels = list(_PRESET_TEXTS), {}
     texts = [_PRESET_TEXTS.get(n) or f"'{n}' ({labels.get(n, 'a registered kind')})"
              for n in names]  # fmt: skip
