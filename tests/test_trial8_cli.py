@@ -74,3 +74,19 @@ def test_sensor_help_lists_every_registered_preset(command):
     text = _text(runner.invoke(app, [command, "--help"], terminal_width=400))
     for name in PRESETS:
         assert f"'{name}'" in text, name
+
+
+def test_mujoco_on_a_three_axis_pad_writes_its_components(tmp_path):
+    """Trial 8: ``mujoco --sensor mag4x4`` raised a reshape traceback; now it writes
+    (T, 4, 4, 3) frames and says so, and warns of a rest field on the rail."""
+    pytest.importorskip("mujoco")
+    from tactsense.io.recording import read_recording
+
+    out = tmp_path / "fixa8_mj.h5"
+    args = ["mujoco", "--sensor", "mag4x4", "--seconds", "0.2", "--out", str(out), "--quiet"]
+    result = runner.invoke(app, args)
+    text = _text(result)
+    assert result.exit_code == 0, text
+    assert "frames of 4x4x3 (x, y, z) counts" in text and "warning" not in text
+    frames = read_recording(out).frames
+    assert frames.shape[1:] == (4, 4, 3)

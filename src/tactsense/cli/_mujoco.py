@@ -16,6 +16,7 @@ from tactsense.cli._common import (
     frame_text,
     new_group,
     progress_bar,
+    rest_warnings,
     sensor_file,
 )
 
@@ -176,6 +177,8 @@ def mujoco_command(
     note = mount.size_note()
     if note is not None:
         console.print(f"[yellow]note:[/] {note}", soft_wrap=True, markup=True, emoji=False)
+    for warning in rest_warnings(spec):  # trial8 (r8-fixa8): a rest reading on the rail
+        console.print(f"warning: {warning}", soft_wrap=True, markup=False, highlight=False)
     if seconds is None:
         seconds = float(table.time_s[-1]) if table is not None and table.time_s[-1] > 0 else 1.0
     n = adapter.frame_count(spec, seconds)
