@@ -68,7 +68,7 @@ def test_a_rest_field_on_the_rail_is_warned_of(tmp_path, change, axis, rail):
     assert "frames of 4x4x3 (x, y, z) counts" in _text(result)
 
 
-@pytest.mark.parametrize("command", ["simulate", "emulate"])
+@pytest.mark.parametrize("command", ["simulate", "emulate", "mujoco"])
 def test_sensor_help_lists_every_registered_preset(command):
     """The list comes from the registry: the three-axis kind's presets (a plug-in's) too."""
     text = _text(runner.invoke(app, [command, "--help"], terminal_width=400))

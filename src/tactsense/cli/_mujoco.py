@@ -18,6 +18,7 @@ from tactsense.cli._common import (
     progress_bar,
     rest_warnings,
     sensor_file,
+    sensor_help,
 )
 
 app = new_group("MuJoCo in, taxel frames out.")
@@ -69,9 +70,8 @@ def mujoco_command(
         str | None,
         typer.Option(
             "--sensor",
-            help="The tactile sensor: a preset (pad16, pad12x32, fsr16, dome12, initial, "
-            "...; 'tactsense sensor list') or a sensor TOML file. Default: pad16 (the "
-            "fingertip example: initial).",
+            help="The tactile sensor. " + sensor_help() + " Default: pad16 (the fingertip "
+            "example: initial; the slip example: mag4x4).",
         ),
     ] = None,
     seconds: Annotated[
