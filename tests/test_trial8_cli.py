@@ -90,3 +90,15 @@ def test_mujoco_on_a_three_axis_pad_writes_its_components(tmp_path):
     assert "frames of 4x4x3 (x, y, z) counts" in text and "warning" not in text
     frames = read_recording(out).frames
     assert frames.shape[1:] == (4, 4, 3)
+
+
+def test_lerobot_export_of_one_recording_says_one_episode(tmp_path):
+    """Trial 8: "1 episodes"."""
+    pytest.importorskip("pyarrow")
+    rec = tmp_path / "fixa8_press.h5"
+    args = ["simulate", "--sensor", "pad4", "--scenario", "press", "-o", str(rec)]
+    assert runner.invoke(app, args).exit_code == 0
+    out = tmp_path / "fixa8_lerobot"
+    result = runner.invoke(app, ["export", str(rec), "--format", "lerobot", "-o", str(out)])
+    assert result.exit_code == 0, _text(result)
+    assert " in 1 episode at " in _text(result)
