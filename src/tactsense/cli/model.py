@@ -525,7 +525,7 @@ def sensor_import(
         else:
             with atomic_output(out) as temporary:
                 spec.to_toml(temporary)
-            console.print(f"wrote {out}: {spec.name}, {spec.kind}, frames of {spec.shape}")
+            console.print(f"wrote {out}: {spec.name}, {spec.kind}, frames of {spec.frame_shape}")
     except (TactsenseInputError, FileExistsError) as error:
         fail(str(error))
 
