@@ -1288,3 +1288,33 @@ def test_fixb8_csv_counts_the_converter_cannot_give(tmp_path, name, cell, names)
 
 
 # ---- /trial8 fixes (r8-fixb8) ----
+# ---- trial8 fixes (r8-fixa8) ----
+FIXA8_BAD = [
+    ("sensor check fixa8_nosuch", "cannot read sensor file fixa8_nosuch"),
+    ("sensor check mag4x4 --probe-g 50", "--probe-g maps the blind spots of a pad"),
+]
+
+
+@pytest.mark.parametrize("line, names", FIXA8_BAD, ids=[line for line, _ in FIXA8_BAD])
+def test_fixa8_bad_input(tmp_path, monkeypatch, line, names):
+    monkeypatch.chdir(tmp_path)  # 'fixa8_nosuch' is looked for here, and is not a preset
+    _check(runner.invoke(app, line.split()), names)
+
+
+def test_fixa8_rest_field_on_the_rail_is_a_warning_not_silence(tmp_path):
+    """A description whose magnets saturate the converter at rest: 'sensor check' and
+    'simulate' name the axis and the count (a warning: the description is valid)."""
+    import re
+
+    text = ts.preset("mag4x4").to_toml_string()
+    path = tmp_path / "fixa8_bigm.toml"
+    path.write_text(re.sub(r"^moment_a_m2 = .*$", "moment_a_m2 = 0.01", text, flags=re.M))
+    out = str(tmp_path / "fixa8_bigm.h5")
+    for args in (["sensor", "check", str(path)], ["simulate", "--sensor", str(path), "-o", out]):
+        message = " ".join(runner.invoke(app, args).output.split())
+        assert "Traceback" not in message
+        assert "warning: 'mag4x4': the rest field saturates the converter on the z axis" in message
+        assert "129160 counts untouched; the range is 0 .. 65535" in message
+
+
+# ---- /trial8 fixes (r8-fixa8) ----

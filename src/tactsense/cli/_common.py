@@ -48,19 +48,88 @@ def print_table(table) -> None:
     out.print(table)
 
 
-SensorOption = Annotated[
-    str,
-    typer.Option(
-        "--sensor",
-        help="A preset: the paper's fingers 'initial' (3.8 mm x 45 deg) and 'improved' "
-        "(3.3 mm x 18 deg), the pads 'pad4' (4x4, 5 mm), 'pad16' (16x16, 2.5 mm), "
-        "'pad12x32' (12x32, 2 mm), "
-        "the piezoresistive pads 'fsr16' (16x16 FSR, 4 mm) and 'dsa9205' (6x14, 3.4 mm), "
-        "the point sets 'dome12' (docs/sensors.md) and "
-        "'icub_fingertip' (the iCub's, 8 bits, falling; docs/contacts.md); "
-        "or the path of a sensor TOML file.",
-    ),
-]
+_PRESET_TEXTS = {
+    "initial": "the paper's fingers 'initial' (3.8 mm x 45 deg)",
+    "improved": "'improved' (3.3 mm x 18 deg)",
+    "pad4": "the pads 'pad4' (4x4, 5 mm)",
+    "pad16": "'pad16' (16x16, 2.5 mm)",
+    "pad12x32": "'pad12x32' (12x32, 2 mm)",
+    "fsr16": "the piezoresistive pads 'fsr16' (16x16 FSR, 4 mm)",
+    "dsa9205": "'dsa9205' (6x14, 3.4 mm)",
+    "dome12": "the point sets 'dome12' (docs/sensors.md)",
+    "icub_fingertip": "'icub_fingertip' (the iCub's, 8 bits, falling; docs/contacts.md)",
+}
+"""How ``--sensor``'s help describes a built-in preset (the names come from the registry)."""
+
+
+def sensor_help() -> str:
+    """``--sensor``'s help: every preset the registry holds (``tactsense.sensor.PRESETS``,
+    the registered kinds' included, each of those named with its kind's label), never a
+    typed list; a plug-in that fails to load leaves the built-ins listed."""
+    from tactsense.kinds import kinds
+    from tactsense.sensor import PRESETS
+
+    try:
+        names = list(PRESETS)
+        labels = {name: kind.label for kind in kinds().values()
+                  for name in (getattr(kind, "presets", None) or {})}  # fmt: skip
+    except Exception:  # a plug-in that fails to load must not stop the CLI (it says so later)
+        names, labels = list(_PRESET_TEXTS), {}
+    texts = [_PRESET_TEXTS.get(n) or f"'{n}' ({labels.get(n, 'a registered kind')})"
+             for n in names]  # fmt: skip
+    return f"A preset: {', '.join(texts)}; or the path of a sensor TOML file."
+
+
+SensorOption = Annotated[str, typer.Option("--sensor", help=sensor_help())]
+
+
+# ---- trial8 fixes (r8-fixa8): sensor check and simulate ----
+def checked_sensor(path: Path):
+    """The sensor ``sensor check PATH`` validates: a preset by name (as ``sensor show``;
+    a file of that name comes first), a TOML file, or a finger's file."""
+    from tactsense.sensor import PRESETS, SensorSpec, load_sensor
+
+    if not path.exists() and str(path).removeprefix("fearing1990_") in PRESETS:
+        return load_sensor(str(path))
+    return load_sensor(path) if path.suffix.lower() == ".toml" else SensorSpec.from_toml(path)
+
+
+def threshold_rule(spec) -> str:
+    """The rule that gives locate's default contact threshold of ``spec``
+    (:func:`tactsense.estimate.reading.threshold_counts`), in words with its numbers."""
+    noise = float(spec.flaws.read_noise_counts)
+    if spec.components > 1:  # the length of a taxel's change (vector_threshold_counts)
+        return (
+            f"the length of a taxel's change over its {spec.components} components, the "
+            f"larger of 10 counts and 8 x the read noise of {noise:.3g} counts x "
+            f"sqrt({spec.components})"
+        )
+    return (
+        f"the larger of 10 counts, the same share of a range of fewer than 12 bits but at "
+        f"least 3, and 5 x the read noise of {noise:.3g} counts; raised where creep is "
+        "taken out"
+    )
+
+
+def rest_warnings(spec) -> list[str]:
+    """What is wrong with ``spec`` untouched, one line each (its kind's ``rest_warnings``,
+    e.g. a three-axis skin whose rest field saturates the converter); none by default."""
+    from tactsense.kinds import kind_of
+
+    check = getattr(kind_of(spec), "rest_warnings", None)
+    return list(check(spec)) if check is not None else []
+
+
+def frame_text(spec) -> str:
+    """A frame's shape for "wrote X: N frames of ... counts": ``4x4`` for scalar taxels,
+    ``4x4x3 (x, y, z)`` for taxels of several components."""
+    text = "x".join(str(n) for n in spec.frame_shape)
+    if spec.components > 1:
+        text += f" ({', '.join(spec.component_names)})"
+    return text
+
+
+# ---- /trial8 fixes (r8-fixa8) ----
 
 
 CalibrationOption = Annotated[

@@ -232,6 +232,7 @@ def dataset(
         fail(f"cannot write the data set or reach the scheduler: {error}")
     drawn = ", ".join(f"{n:,} {task}" for task, n in summary["episodes_per_task"].items())
     console.print(
-        f"wrote {out}: {summary['frames']:,} frames in {summary['episodes']:,} episodes "
+        f"wrote {out}: {summary['frames']:,} frames in {summary['episodes']:,} "
+        f"{'episode' if summary['episodes'] == 1 else 'episodes'} "
         f"({drawn}) at {summary['fps']} fps ({spec.name}, {format.value})"
     )

@@ -13,9 +13,12 @@ from tactsense.cli._common import (
     check_output,
     console,
     fail,
+    frame_text,
     new_group,
     progress_bar,
+    rest_warnings,
     sensor_file,
+    sensor_help,
 )
 
 app = new_group("MuJoCo in, taxel frames out.")
@@ -67,9 +70,8 @@ def mujoco_command(
         str | None,
         typer.Option(
             "--sensor",
-            help="The tactile sensor: a preset (pad16, pad12x32, fsr16, dome12, initial, "
-            "...; 'tactsense sensor list') or a sensor TOML file. Default: pad16 (the "
-            "fingertip example: initial).",
+            help="The tactile sensor. " + sensor_help() + " Default: pad16 (the fingertip "
+            "example: initial; the slip example: mag4x4).",
         ),
     ] = None,
     seconds: Annotated[
@@ -175,6 +177,8 @@ def mujoco_command(
     note = mount.size_note()
     if note is not None:
         console.print(f"[yellow]note:[/] {note}", soft_wrap=True, markup=True, emoji=False)
+    for warning in rest_warnings(spec):  # trial8 (r8-fixa8): a rest reading on the rail
+        console.print(f"warning: {warning}", soft_wrap=True, markup=False, highlight=False)
     if seconds is None:
         seconds = float(table.time_s[-1]) if table is not None and table.time_s[-1] > 0 else 1.0
     n = adapter.frame_count(spec, seconds)
@@ -193,9 +197,8 @@ def mujoco_command(
                 progress=lambda done, total: bar.update(task, completed=done),
                 fast=paths[frames_path],
             )
-    rows, cols = spec.shape
     console.print(
-        f"wrote {out}: {written} frames of {rows}x{cols} counts at "
+        f"wrote {out}: {written} frames of {frame_text(spec)} counts at "
         f"{spec.electronics.scan_rate_hz:g} Hz ({spec.name} on "
         f"{'geom' if geom else 'site'} {geom or site} of {Path(model_path).name}, "
         f"{round(seconds / mj_model.opt.timestep)} MuJoCo steps)"

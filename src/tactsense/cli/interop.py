@@ -273,6 +273,7 @@ def _export_lerobot(recording, out, calibration, baseline_frames, threshold, epi
     if counts.get("contacts", 0) is None:  # ---- frames only (r8-triinterop) ----
         contacts = f"no contacts (sensor kind {counts['kind']!r} has no contact estimator)"
     console.print(
-        f"wrote {out}: {counts['frames']} frames in {counts['episodes']} episodes at "
+        f"wrote {out}: {counts['frames']} frames in {counts['episodes']} "
+        f"{'episode' if counts['episodes'] == 1 else 'episodes'} at "  # trial8 (r8-fixa8)
         f"{counts['fps']} fps, {contacts} (lerobot)"
     )

@@ -16,12 +16,16 @@ from tactsense.cli._common import (
     SensorOption,
     atomic_output,
     check_output,
+    checked_sensor,
     console,
     fail,
+    frame_text,
     new_group,
     print_table,
+    rest_warnings,
     same_file,
     sensor_file,
+    threshold_rule,
 )
 from tactsense.cli._scenario import (
     AngleOption,
@@ -49,7 +53,7 @@ from tactsense.cli._scenario import (
 )
 from tactsense.io.recording import read_recording
 from tactsense.kinds import kind_of
-from tactsense.sensor import SensorSpec, load_sensor
+from tactsense.sensor import load_sensor
 
 app = new_group("Simulate the finger and describe recordings.")
 sensor_app = new_group("Show, export and check sensor descriptions.")
@@ -160,6 +164,8 @@ def simulate(
                 f"--out {out}: a recording is an HDF5 file; use the extension .h5 (or "
                 ".hdf5). Other formats come from 'tactsense export' or 'locate'"
             )
+        for warning in rest_warnings(spec):  # trial8 (r8-fixa8): a rest reading on the rail
+            console.print(f"warning: {warning}", soft_wrap=True, markup=False, highlight=False)
         # frames go to the file as they are made: memory stays flat however long
         with atomic_output(out) as temporary:
             written = run_scenario(spec, scene, flaws=flaws, seed=seed, path=temporary,
@@ -169,8 +175,8 @@ def simulate(
             "finger3d-foam": ", the 3-D skin on the foam dielectric",
         }.get(forward, "")
         console.print(
-            f"wrote {out}: {written} frames of {spec.shape[0]}x{spec.shape[1]} "
-            f"counts at {spec.electronics.scan_rate_hz:g} Hz ({spec.name}{model})"
+            f"wrote {out}: {written} frames of {frame_text(spec)} counts at "
+            f"{spec.electronics.scan_rate_hz:g} Hz ({spec.name}{model})"
         )
         if force_log is not None:
             with atomic_output(force_log) as temporary:
@@ -367,7 +373,7 @@ def sensor_check(
         return _robot_sensor.check_skin(path)
     # ---- /r7-skin ----
     try:
-        spec = load_sensor(path) if path.suffix.lower() == ".toml" else SensorSpec.from_toml(path)
+        spec = checked_sensor(path)  # a preset's name too, as 'sensor show' (trial 8)
     except TactsenseInputError as error:
         fail(str(error))
     table = Table(title=f"{spec.name}: valid", show_header=False)
@@ -381,17 +387,15 @@ def sensor_check(
     if kind.multi_contact and kind.contact_estimation:  # locate's threshold (r8-triphys)
         from tactsense.estimate.contacts import default_threshold, threshold_counts
 
-        noise = float(spec.flaws.read_noise_counts)
         table.add_row(
             "contact threshold",
             f"{threshold_counts(spec):.3g} counts from the rest, signal "
-            f"{default_threshold(spec):.3g} (locate's default: the larger of 10 counts, the "
-            f"same share of a range of fewer than 12 bits but at least 3, and 5 x the read "
-            f"noise of {noise:.3g} counts; raised where creep is taken out)",
+            f"{default_threshold(spec):.3g} (locate's default: {threshold_rule(spec)})",
         )
     if layer:
         label, value, warnings = _blind_spot_report(spec, 50.0 if probe_g is None else probe_g)
         table.add_row(label, value)
+    warnings += rest_warnings(spec)  # trial8 (r8-fixa8): a rest reading on the rail
     print_table(table)
     for warning in warnings:
         console.print(
@@ -521,7 +525,7 @@ def sensor_import(
         else:
             with atomic_output(out) as temporary:
                 spec.to_toml(temporary)
-            console.print(f"wrote {out}: {spec.name}, {spec.kind}, frames of {spec.shape}")
+            console.print(f"wrote {out}: {spec.name}, {spec.kind}, frames of {spec.frame_shape}")
     except (TactsenseInputError, FileExistsError) as error:
         fail(str(error))
 

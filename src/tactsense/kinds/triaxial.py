@@ -160,6 +160,25 @@ class TriaxialKind(Kind):
 
         return triaxial_frame_blocks(self, spec, run, chunk_frames)
 
+    def rest_warnings(self, spec) -> list[str]:
+        """Problems of the untouched skin, one line each (``sensor check`` and
+        ``simulate`` print them): an axis whose rest field already reads the
+        converter's rail (:func:`tactsense.physics.triaxial.rest_saturation`)."""
+        from tactsense.physics.triaxial import rest_saturation
+
+        lines = []
+        for s in rest_saturation(spec):
+            side = "full scale" if s["rail"] else "zero"
+            lines.append(
+                f"{spec.name!r}: the rest field saturates the converter on the {s['axis']} "
+                f"axis of {s['taxels']} of {s['of']} taxels (it would read "
+                f"{s['counts']:.0f} counts untouched; the range is 0 .. "
+                f"{2 ** int(spec.electronics.adc_bits) - 1}): they read {s['rail']} "
+                f"({side}) whatever the load. Lower [transduction] moment_a_m2 or the "
+                "background field, or put the Hall sensors further (hall_depth_mm)"
+            )
+        return lines
+
     # ---- three-axis estimation (r8-triest) -----------------------------------------
     contact_estimation = True
     """Contacts are estimated (:mod:`tactsense.estimate.triaxial`: position, normal and

@@ -49,6 +49,12 @@ STICK, PARTIAL_SLIP, GROSS_SLIP = 0, 1, 2
 Mindlin's annulus ``c < r < a``), or the whole contact slides."""
 
 
+SLIP_TOLERANCE = 1e-9
+"""Relative rounding allowed in ``Q / (mu P)`` at gross slip [-]: ``Q`` is the length of
+its x and y parts, so ``Q = mu P`` set at an angle comes back a few ulp short (at -138 deg,
+1 - 1e-16: "partial", ``c/a`` 5e-6, while sliding)."""
+
+
 def slip_state(indenter) -> tuple[int, float]:
     """A contact's slip state (:data:`STICK`, :data:`PARTIAL_SLIP`, :data:`GROSS_SLIP`)
     and its stick ratio ``c / a`` [-] under its tangential force ``Q`` (``shear_n``).
@@ -65,7 +71,7 @@ def slip_state(indenter) -> tuple[int, float]:
     if q == 0.0 or p <= 0.0:
         return (STICK, 1.0) if q == 0.0 else (GROSS_SLIP, 0.0)
     ratio = q / (mu * p)
-    if ratio >= 1.0:
+    if ratio >= 1.0 - SLIP_TOLERANCE:  # Q = mu P rebuilt from its x, y parts: rounding
         return GROSS_SLIP, 0.0
     if getattr(indenter, "kind", "") != "sphere":
         return STICK, 1.0
@@ -238,3 +244,23 @@ def magnet_moment_a_m2(remanence_t: float, diameter_mm: float, height_mm: float)
     remanence ``Br`` [T] and volume ``pi d^2 h / 4`` (d, h [mm])."""
     volume_m3 = np.pi * (diameter_mm * 1e-3) ** 2 * (height_mm * 1e-3) / 4.0
     return float(remanence_t * volume_m3 / (4e-7 * np.pi))
+
+
+def rest_saturation(spec: TriaxialSpec) -> list[dict]:
+    """Where the untouched skin's reading is at or beyond the converter's range: one entry
+    per axis and side that any taxel reaches, ``{"axis": "z", "taxels": n, "of": rows x
+    cols, "counts": the most extreme rest count (before clipping), "rail": 0 or full
+    scale}``. The rest field (:func:`rest_field_t`, offsets and gains left out: they
+    move it by tens of uT) through :func:`field_counts`: a taxel there reads its rail
+    and no press or shear can move that axis."""
+    counts = field_counts(spec, rest_field_t(spec))
+    full = 2 ** int(spec.electronics.adc_bits) - 1
+    found = []
+    for axis, name in enumerate(spec.component_names):
+        values = counts[..., axis]
+        for rail, hit in ((0, values <= 0), (full, values >= full)):
+            if hit.any():
+                extreme = values.min() if rail == 0 else values.max()
+                found.append({"axis": name, "taxels": int(hit.sum()), "of": int(hit.size),
+                              "counts": float(extreme), "rail": rail})  # fmt: skip
+    return found
