@@ -81,7 +81,7 @@ def locate_shear(recording: Path, out: Path, force: bool, quiet: bool, *, sensor
         f"{summary['frames_with_contact']} frames (at most {summary['most']} at once), "
         f"{summary['ids']} tracked ids; largest normal force {summary['force_max_n']:.3g} N, "
         f"largest tangential {summary['shear_max_n']:.3g} N; {summary['gross_slips']} "
-        "contacts slipped (gross slip)"
+        f"contact{'' if summary['gross_slips'] == 1 else 's'} slipped (gross slip)"
     )
 
 
