@@ -53,38 +53,13 @@ class Grid:
     """Extent of a taxel's electrode along y (the column direction) [mm]."""
 
 
-@dataclass(frozen=True)
-class PadSpec(SpecBase):
-    """Complete description of a flat taxel pad.
-
-    Construct from a preset (``tactsense.sensor.preset("pad16")``), from TOML with
-    ``kind = "pad"``, or directly; immutable and validated on construction.
-    """
-
-    name: str = "pad"
-    description: str = ""
-    grid: Grid = field(default_factory=Grid)
-    layer: Layer = field(default_factory=Layer)
-    transduction: Transduction = field(default_factory=Transduction)
-    electronics: Electronics = field(default_factory=Electronics)
-    flaws: Flaws = field(default_factory=Flaws)
-
-    kind: ClassVar[str] = "pad"
-    SECTIONS: ClassVar[dict[str, type]] = {
-        "grid": Grid,
-        "layer": Layer,
-        "transduction": Transduction,
-        "electronics": Electronics,
-        "flaws": Flaws,
-    }
-
-    def problems(self) -> list[str]:
-        """Every problem with this description, as readable sentences (none: valid)."""
-        return _validate(self)
+class GridGeometry:
+    """Where the taxels of a flat rectangular grid are (``grid``: a :class:`Grid`): the
+    pad's coordinates, shared by every kind laid out on one (pads, three-axis pads)."""
 
     @property
     def shape(self) -> tuple[int, int]:
-        """Shape ``(rows, cols)`` of a frame [-]."""
+        """Shape ``(rows, cols)`` of the grid of taxels [-] (a frame is ``frame_shape``)."""
         return (self.grid.rows, self.grid.cols)
 
     @property
@@ -113,6 +88,36 @@ class PadSpec(SpecBase):
         normals = np.zeros((self.n_taxels, 3))
         normals[:, 2] = 1.0
         return normals
+
+
+@dataclass(frozen=True)
+class PadSpec(GridGeometry, SpecBase):
+    """Complete description of a flat taxel pad.
+
+    Construct from a preset (``tactsense.sensor.preset("pad16")``), from TOML with
+    ``kind = "pad"``, or directly; immutable and validated on construction.
+    """
+
+    name: str = "pad"
+    description: str = ""
+    grid: Grid = field(default_factory=Grid)
+    layer: Layer = field(default_factory=Layer)
+    transduction: Transduction = field(default_factory=Transduction)
+    electronics: Electronics = field(default_factory=Electronics)
+    flaws: Flaws = field(default_factory=Flaws)
+
+    kind: ClassVar[str] = "pad"
+    SECTIONS: ClassVar[dict[str, type]] = {
+        "grid": Grid,
+        "layer": Layer,
+        "transduction": Transduction,
+        "electronics": Electronics,
+        "flaws": Flaws,
+    }
+
+    def problems(self) -> list[str]:
+        """Every problem with this description, as readable sentences (none: valid)."""
+        return _validate(self)
 
     def summary(self) -> list[tuple[str, str]]:
         """Derived quantities worth printing, as (label, value with unit) rows."""

@@ -27,7 +27,7 @@ import numpy as np
 
 from tactsense.sensor.checks import check_electronics, check_flaws, check_layer, positive
 from tactsense.sensor.common import Electronics, Flaws, Layer, SpecBase
-from tactsense.sensor.pad import Grid
+from tactsense.sensor.pad import Grid, GridGeometry
 
 
 @dataclass(frozen=True)
@@ -70,7 +70,7 @@ class MagneticTransduction:
 
 
 @dataclass(frozen=True)
-class TriaxialSpec(SpecBase):
+class TriaxialSpec(GridGeometry, SpecBase):
     """Complete description of a three-axis (magnetic) taxel pad.
 
     Construct from a preset (``tactsense.sensor.preset("mag4x4")``), from TOML with
@@ -112,38 +112,6 @@ class TriaxialSpec(SpecBase):
     def problems(self) -> list[str]:
         """Every problem with this description, as readable sentences (none: valid)."""
         return _validate(self)
-
-    @property
-    def shape(self) -> tuple[int, int]:
-        """Shape ``(rows, cols)`` of the grid of taxels [-] (a frame is ``frame_shape``)."""
-        return (self.grid.rows, self.grid.cols)
-
-    @property
-    def x_mm(self) -> np.ndarray:
-        """x of each row's centre, shape (rows,) [mm]."""
-        return self.grid.row_pitch_mm * np.arange(self.grid.rows, dtype=float)
-
-    @property
-    def y_mm(self) -> np.ndarray:
-        """y of each column's centre, shape (cols,) [mm]."""
-        return self.grid.col_pitch_mm * np.arange(self.grid.cols, dtype=float)
-
-    @property
-    def extent_mm(self) -> tuple[float, float]:
-        """Size ``(along x, along y)`` of the pad, a half pitch beyond the outer taxels [mm]."""
-        g = self.grid
-        return (g.rows * g.row_pitch_mm, g.cols * g.col_pitch_mm)
-
-    def taxel_positions_mm(self) -> np.ndarray:
-        """Centre of every taxel on the free surface, frame order, shape (rows*cols, 3) [mm]."""
-        x, y = np.meshgrid(self.x_mm, self.y_mm, indexing="ij")
-        return np.column_stack([x.ravel(), y.ravel(), np.zeros(x.size)])
-
-    def taxel_normals(self) -> np.ndarray:
-        """Outward normal of every taxel, shape (rows*cols, 3) [-]."""
-        normals = np.zeros((self.n_taxels, 3))
-        normals[:, 2] = 1.0
-        return normals
 
     @property
     def lsb_t(self) -> np.ndarray:
