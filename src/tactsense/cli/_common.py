@@ -116,8 +116,7 @@ def rest_warnings(spec) -> list[str]:
     e.g. a three-axis skin whose rest field saturates the converter); none by default."""
     from tactsense.kinds import kind_of
 
-    check = getattr(kind_of(spec), "rest_warnings", None)
-    return list(check(spec)) if check is not None else []
+    return list(kind_of(spec).rest_warnings(spec))
 
 
 def frame_text(spec) -> str:

@@ -312,6 +312,20 @@ class Kind:
         largest a it covers), ``pitch_mm`` and ``modulus_star_pa`` [Pa]."""
         return None
 
+    # ---- three-axis taxels and the untouched sensor (r8) -------------------------
+    def shear_response(self, spec: Any, positions_mm: np.ndarray, **load: Any) -> np.ndarray:
+        """The change of every taxel's reading per newton of normal force and of
+        tangential force along x and y for a contact at each of ``positions_mm`` (P, 2)
+        [mm], shape (P, 3, *spec.frame_shape) [counts/N]: what the three-axis estimator
+        fits (``tactsense.estimate.triaxial``). Default: the kind has none."""
+        raise self.unsupported(spec, "three-axis contact estimation (no shear response)")
+
+    def rest_warnings(self, spec: Any) -> list[str]:
+        """What is wrong with ``spec`` untouched, one line each (``sensor check``,
+        ``simulate`` and ``mujoco`` print them), e.g. a rest reading already on the
+        converter's rail. Default: nothing."""
+        return []
+
 
 RESPONSE_PROBE_N = 0.49
 """The load of the probe whose response :meth:`Kind.contact_response` tabulates: the

@@ -74,16 +74,13 @@ def response_table(spec, n_sub: int = N_SUB) -> ResponseTable:
 
 @functools.lru_cache(maxsize=8)
 def _table(spec, n_sub: int) -> ResponseTable:
-    kind = kind_of(spec)
-    respond = getattr(kind, "shear_response", None)
-    if respond is None:
-        raise kind.unsupported(spec, "three-axis contact estimation (no shear response)")
+    respond = functools.partial(kind_of(spec).shear_response, spec)  # unsupported: says so
     rows, cols = spec.shape
     px, py = spec.grid.row_pitch_mm, spec.grid.col_pitch_mm
     x = px * (np.arange(rows * n_sub + 1) / n_sub - 0.5)
     y = py * (np.arange(cols * n_sub + 1) / n_sub - 0.5)
     xx, yy = np.meshgrid(x, y, indexing="ij")
-    values = respond(spec, np.column_stack([xx.ravel(), yy.ravel()]))
+    values = respond(np.column_stack([xx.ravel(), yy.ravel()]))
     values = values.reshape(len(x), len(y), 3, rows * cols * 3)
     coefficients = ndimage.spline_filter1d(values, order=3, axis=0, mode="mirror")
     coefficients = ndimage.spline_filter1d(coefficients, order=3, axis=1, mode="mirror")
