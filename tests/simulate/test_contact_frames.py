@@ -315,9 +315,11 @@ def test_fast_and_reference_agree_on_a_pad_within_the_twins_grid_error():
     assert np.abs(fast - ref).max() <= 0.05 * (ref - rest).max()
 
 
-def test_a_contact_beyond_the_tables_runs_the_reference():
+def test_a_contact_too_wide_even_for_the_spectrum_runs_the_reference():
+    """A disc of metres needs more than WIDE_GRID_TERMS wavenumbers: the reference runs
+    (contacts wider than the tables but within that: test_contact_frames_wide.py)."""
     spec = _pad()
-    batch = ContactBatch(np.array([[[18.0, 18.0]]]), np.array([[0.5]]), radius_mm=6.0, shape="disc")
+    batch = ContactBatch(np.array([[[18.0, 18.0]]]), np.array([[0.5]]), radius_mm=1e4, shape="disc")
     assert kind_of(spec).contact_forward(spec).prepare(batch) is None
     np.testing.assert_array_equal(
         frames_from_contacts(spec, batch, flaws="none"),
@@ -344,14 +346,14 @@ def test_fix38_huge_contacts_cost_bounded_work(monkeypatch, radius_mm, force_n, 
     from tactsense.physics._hertz_table import A_TOP_LIMIT_MM
 
     asked = []
-    real = _contact_kernel.layer_response_table
+    real = _contact_kernel.cached_response_table
 
     def spy(layer, electrode, kind, top):
         asked.append(top)  # checked before the build: a failing case fails fast
         assert top <= A_TOP_LIMIT_MM + _contact_kernel.A_TOP_GRAIN_MM, top
         return real(layer, electrode, kind, top)
 
-    monkeypatch.setattr(_contact_kernel, "layer_response_table", spy)
+    monkeypatch.setattr(_contact_kernel, "cached_response_table", spy)
     batch = ContactBatch(
         position_mm=np.full((1, 1, 2), position_mm),
         normal_force_n=[[force_n]],

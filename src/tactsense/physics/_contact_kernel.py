@@ -19,7 +19,9 @@ from tactsense._jit import jit
 from tactsense.physics._hertz_table import (
     A_TOP_LIMIT_MM,
     SeparableResponse,
-    layer_response_table,
+    cached_response_table,
+    pressure_transform,
+    table_step_mm,
 )
 
 A_TOP_GRAIN_MM = 0.5
@@ -152,11 +154,100 @@ def superpose_array(x_taxel, y_taxel, position, force, radius, table: SeparableR
     return np.einsum("nkir,nkjr->nij", u, v)
 
 
+WIDE_GRID_TERMS = 2048
+"""Most wavenumbers per axis of :class:`WideContacts`' cosine sums [-] (memory and work
+bounded: 2,049^2 terms, 34 MB): a contact whose sum would need more (a pressure radius
+of metres) runs the kind's reference path, with a warning."""
+
+
+class WideContacts:
+    """Contacts wider than the tables (pressure radius above
+    :data:`~tactsense.physics._hertz_table.A_TOP_LIMIT_MM`), one at a time: every taxel's
+    compressive strain per newton as the cosine series of the layer's periodic field,
+    ``G(dx, dy) = -1/(Lx Ly) sum_(m, n) T(k) E(k) P(|k| a) cos(kx dx) cos(ky dy)``
+    (``T`` the bonded layer's strain transfer, ``E`` the electrode's sincs, ``P`` the
+    pressure's exact transform, as the tables use; the field is even in dx and in dy).
+
+    The period ``L`` along each axis is the pad's extent plus twice the response's
+    reach from the contact's edge (``a`` + 18 layer thicknesses + the electrode, as the
+    tables take it), so the periodic images lie beyond every taxel's reach; the
+    wavenumbers stop at ``pi / h``, ``h`` = 2.5 tables' steps (an eighth of the
+    narrowest of the electrode, the layer and the sensing depth, where ``T E`` has died
+    out: tests/simulate/test_contact_frames.py checks the result against the exact
+    Hankel solution). No pressure is sampled and no table is stored: each contact costs
+    two small matrix products, milliseconds.
+    """
+
+    def __init__(self, spec, x_taxel, y_taxel, electrode):
+        self.layer = spec.layer
+        self.x_taxel, self.y_taxel = x_taxel, y_taxel
+        self.electrode = electrode
+        self.step_mm = 2.5 * table_step_mm(self.layer, electrode)
+        self.extent = (float(np.ptp(x_taxel)), float(np.ptp(y_taxel)))
+        self._spectra = {}
+
+    def reach_mm(self, a_mm: float) -> float:
+        """Distance from a contact's centre beyond which it presses no taxel [mm]."""
+        return float(a_mm) + 18.0 * self.layer.thickness_mm + max(self.electrode)
+
+    def terms(self, a_mm: float) -> tuple[int, int]:
+        """Wavenumbers per axis the sum takes for a contact of radius ``a_mm`` [-]."""
+        reach = self.reach_mm(a_mm)
+        return tuple(
+            math.ceil((extent + 2.0 * reach) / (2.0 * self.step_mm)) for extent in self.extent
+        )
+
+    def takes(self, a_mm: np.ndarray) -> np.ndarray:
+        """Whether each contact's sum stays within :data:`WIDE_GRID_TERMS` per axis."""
+        reach = np.asarray(a_mm, float) + self.reach_mm(0.0)
+        widest = max(self.extent) + 2.0 * reach
+        return np.ceil(widest / (2.0 * self.step_mm)) <= WIDE_GRID_TERMS
+
+    def _spectrum(self, terms: tuple[int, int]):
+        """Frequencies [cycles/mm] along x and y, and ``T E`` times the cosine series'
+        weights (1 at 0, 2 beyond) over their product [1/Pa]; kept per period."""
+        if terms not in self._spectra:
+            from tactsense.physics.pad_response import strain_transfer
+
+            periods = [2.0 * self.step_mm * m for m in terms]
+            fx, fy = (np.arange(m + 1) / period for m, period in zip(terms, periods, strict=True))
+            transfer = strain_transfer(
+                fx[:, None], fy[None, :], self.layer.sensing_depth_mm, self.layer
+            )
+            transfer = transfer * np.sinc(fx * self.electrode[0])[:, None]
+            transfer = transfer * np.sinc(fy * self.electrode[1])[None, :]
+            wx = np.where(fx == 0, 1.0, 2.0)[:, None]
+            wy = np.where(fy == 0, 1.0, 2.0)[None, :]
+            scale = 1e6 / (periods[0] * periods[1])  # 1/(Lx Ly) in 1/m^2
+            k = 2.0 * np.pi * np.hypot(fx[:, None], fy[None, :])  # [rad/mm]
+            if len(self._spectra) > 2:  # a few periods at once: memory bounded
+                self._spectra.clear()
+            self._spectra[terms] = (fx, fy, -scale * wx * wy * transfer, k)
+        return self._spectra[terms]
+
+    def add(self, frame, position_mm, force, a_mm, shape) -> None:
+        """Add one contact's strain (force times the field per newton) to ``frame``
+        (rows, cols); a contact beyond every taxel's reach adds nothing."""
+        dx = self.x_taxel - position_mm[0]
+        dy = self.y_taxel - position_mm[1]
+        reach = self.reach_mm(a_mm)
+        if np.abs(dx).min() > reach or np.abs(dy).min() > reach:
+            return
+        fx, fy, weighted, k = self._spectrum(self.terms(a_mm))
+        spectrum = weighted * pressure_transform(shape, k * a_mm)
+        cx = np.cos(2.0 * np.pi * np.outer(dx, fx))
+        cy = np.cos(2.0 * np.pi * np.outer(fy, dy))
+        frame += force * (cx @ spectrum @ cy)
+
+
 class PadContactForward:
     """A pad's fast forward (``Kind.contact_forward``): the tabulated layer response.
 
     The layer is taken as unbounded around the pad (as the twin's own forward takes it
     within its margin), so a contact beside the pad still presses its edge taxels.
+    Contacts of pressure radius up to :data:`~tactsense.physics._hertz_table.A_TOP_LIMIT_MM`
+    are superposed from the tables; wider ones are summed one by one in the layer's
+    spectrum (:class:`WideContacts`), equally exact and slower.
     """
 
     def __init__(self, spec):
@@ -169,27 +260,34 @@ class PadContactForward:
         self.scale = t.strain_gain if t.kind == "capacitive" else 1.0
         layer = spec.layer
         self.modulus_star_pa = layer.youngs_modulus_pa / (1.0 - layer.poisson_ratio**2)
+        self.wide = WideContacts(spec, self.x_taxel, self.y_taxel, self.electrode)
 
     def table(self, shape: str, a_top_mm: float) -> SeparableResponse:
-        """The layer's table for ``shape`` covering pressure radii up to ``a_top_mm``."""
+        """The layer's table for ``shape`` covering pressure radii up to ``a_top_mm``
+        (kept on disk: :func:`~tactsense.physics._hertz_table.cached_response_table`)."""
         top = A_TOP_GRAIN_MM * max(1, math.ceil(a_top_mm / A_TOP_GRAIN_MM - 1e-9))
-        return layer_response_table(self.spec.layer, self.electrode, shape, top)
+        return cached_response_table(self.spec.layer, self.electrode, shape, top)
 
     def prepare(self, contacts):
         """A function ``(first, last) -> (last - first, rows * cols)``: the fractional
         deflection [-] of every taxel (before gains; float32, 1e-7 of the peak) for
-        those frames of ``contacts`` (a
-        ContactBatch), with the tables its largest contacts need (chosen once, so a frame
-        reads the same whatever block it is computed in); None when a contact's pressure
-        radius exceeds :data:`~tactsense.physics._hertz_table.A_TOP_LIMIT_MM` (the
-        caller runs the reference path)."""
+        those frames of ``contacts`` (a ContactBatch), with the tables its contacts up to
+        :data:`~tactsense.physics._hertz_table.A_TOP_LIMIT_MM` need (chosen once, so a
+        frame reads the same whatever block it is computed in) and the wider ones summed
+        in the spectrum; None when a contact is too wide even for that
+        (:data:`WIDE_GRID_TERMS`: the caller runs the reference path)."""
         radius = contacts.pressure_radius_mm(self.modulus_star_pa)
-        if np.any(radius[contacts.normal_force_n > 0] > A_TOP_LIMIT_MM):
+        touching = contacts.normal_force_n > 0
+        wide = touching & (radius > A_TOP_LIMIT_MM)
+        if np.any(wide) and not np.all(self.wide.takes(radius[wide])):
             return None
+        narrow = touching & ~wide
         tables = {}
         for shape, chosen in contacts.shape_masks():
-            top = float(np.max(radius[chosen] if chosen is not True else radius, initial=0.0))
-            table = self.table(shape, top)
+            mine = narrow if chosen is True else narrow & chosen
+            if not np.any(mine):
+                continue
+            table = self.table(shape, float(np.max(radius[mine])))
             tables[shape] = (
                 table,
                 table.padded_x.astype(np.float32),
@@ -200,8 +298,11 @@ class PadContactForward:
         def block(first: int, last: int) -> np.ndarray:
             out = np.zeros((last - first, rows, cols), dtype=np.float32)
             position = np.ascontiguousarray(contacts.position_mm[first:last])
-            force = contacts.normal_force_n[first:last] * self.scale
+            force = np.where(narrow[first:last], contacts.normal_force_n[first:last], 0.0)
+            force = force * self.scale
             for shape, chosen in contacts.shape_masks(first, last):
+                if shape not in tables:
+                    continue
                 table, x_factors, y_factors = tables[shape]
                 superpose(
                     self.x_taxel,
@@ -215,6 +316,21 @@ class PadContactForward:
                     table.a_step_mm,
                     out,
                 )
+            for p, c in zip(*np.nonzero(wide[first:last]), strict=True):
+                frame = np.zeros((rows, cols))
+                shape = (
+                    contacts.shape
+                    if isinstance(contacts.shape, str)
+                    else contacts.shape[first + p, c]
+                )
+                self.wide.add(
+                    frame,
+                    contacts.position_mm[first + p, c],
+                    contacts.normal_force_n[first + p, c] * self.scale,
+                    float(radius[first + p, c]),
+                    str(shape),
+                )
+                out[p] += frame.astype(np.float32)
             return out.reshape(last - first, rows * cols)
 
         return block

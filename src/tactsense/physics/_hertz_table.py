@@ -25,8 +25,16 @@ linearly in a and by cubics in dx, dy.
 from __future__ import annotations
 
 import functools
+import hashlib
+import inspect
 import math
+import os
+import sys
+import tempfile
+import warnings
+import zipfile
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 from scipy import special
@@ -184,3 +192,114 @@ def layer_response_table(
             break
     x_factors = np.ascontiguousarray(x_flat.reshape(n_a, size, rank))
     return SeparableResponse(x_factors, y_factors, step, a_step, peak, error / peak)
+
+
+# ---- the tables kept on disk (r9-fastpath) ----
+class TableCacheWarning(UserWarning):
+    """A table file in the cache could not be read (corrupt or truncated): rebuilt."""
+
+
+TABLE_FIELDS = ("x_factors", "y_factors", "step_mm", "a_step_mm", "peak", "rank_error")
+
+
+def table_cache_folder() -> Path:
+    """Where the tables are kept between runs: ``$TACTSENSE_CACHE_DIR``, else
+    ``$XDG_CACHE_HOME/tactsense``, else ``~/.cache/tactsense`` (as the joint fit's)."""
+    if os.environ.get("TACTSENSE_CACHE_DIR"):
+        return Path(os.environ["TACTSENSE_CACHE_DIR"])
+    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "tactsense"
+
+
+@functools.lru_cache(maxsize=1)
+def _code_digest() -> str | None:
+    """Digest of the code a table comes from (this module, the strain transfer and the
+    layer's transfer functions): a change of it makes new tables; None where the source
+    cannot be read (no disk cache then)."""
+    from tactsense.physics import layer, pad_response
+
+    try:
+        here = sys.modules[__name__]
+        text = "".join(inspect.getsource(m) for m in (here, pad_response, layer))
+    except (OSError, TypeError):
+        return None
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def table_cache_path(
+    layer: Layer, electrode_mm, shape: str, a_top_mm: float, a_step_mm
+) -> Path | None:
+    """The file a table is kept in: named by a digest of everything it depends on (the
+    layer, the electrode [mm], the shape, the radii [mm] and the code); None: no cache."""
+    code = _code_digest()
+    if code is None:
+        return None
+    a_step = A_STEP_MM if a_step_mm is None else float(a_step_mm)
+    key = repr((layer, tuple(float(e) for e in electrode_mm), shape, float(a_top_mm), a_step))
+    digest = hashlib.sha256((key + code).encode()).hexdigest()[:32]
+    return table_cache_folder() / f"frames_table_{digest}.npz"
+
+
+def _read_table(path: Path) -> SeparableResponse | None:
+    """The table stored at ``path``; None if there is none; a corrupt file: None and a
+    :class:`TableCacheWarning` (it is rebuilt and replaced)."""
+    if not path.exists():
+        return None
+    try:
+        with np.load(path) as stored:
+            values = {f: stored[f] if stored[f].ndim else float(stored[f]) for f in TABLE_FIELDS}
+        table = SeparableResponse(**values)
+        if table.x_factors.ndim != 3 or table.y_factors.ndim != 2:
+            raise ValueError("factors of the wrong rank")
+        if table.x_factors.shape[2] != table.y_factors.shape[1]:
+            raise ValueError("factors of different ranks")
+        if not (np.all(np.isfinite(table.x_factors)) and np.all(np.isfinite(table.y_factors))):
+            raise ValueError("factors not finite")
+        return table
+    except (OSError, KeyError, ValueError, EOFError, zipfile.BadZipFile) as error:
+        warnings.warn(
+            f"table cache file {path} unreadable ({type(error).__name__}: {error}); rebuilding it",
+            TableCacheWarning,
+            stacklevel=3,
+        )
+        return None
+
+
+@functools.lru_cache(maxsize=16)
+def cached_response_table(
+    layer: Layer,
+    electrode_mm: tuple[float, float],
+    shape: str,
+    a_top_mm: float,
+    a_step_mm: float | None = None,
+) -> SeparableResponse:
+    """:func:`layer_response_table`, kept on disk (:func:`table_cache_folder`) by a
+    digest of its inputs and code (:func:`table_cache_path`) and in the process: the
+    first run builds it (seconds), later runs read it (milliseconds). The file is written
+    under a temporary name and moved into place (an interrupted write leaves no table); a
+    folder that cannot be written is no error (the table is then built every run); a
+    corrupt file is rebuilt with a :class:`TableCacheWarning`."""
+    path = table_cache_path(layer, electrode_mm, shape, a_top_mm, a_step_mm)
+    table = None if path is None else _read_table(path)
+    if table is not None:
+        return table
+    table = layer_response_table(layer, electrode_mm, shape, a_top_mm, a_step_mm)
+    if path is None:
+        return table
+    partial = None
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile(dir=path.parent, suffix=".part", delete=False) as f:
+            partial = f.name
+            np.savez(f, **{name: getattr(table, name) for name in TABLE_FIELDS})
+        os.replace(partial, path)
+        partial = None
+    except OSError:
+        pass
+    finally:  # an error or a Ctrl-C during the write leaves no partial file
+        if partial is not None:
+            Path(partial).unlink(missing_ok=True)
+    return table
+
+
+# ---- /r9-fastpath ----
