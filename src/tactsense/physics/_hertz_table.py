@@ -175,6 +175,13 @@ def layer_response_table(
     tail = np.maximum.accumulate(beyond[::-1])[::-1]
     size = int(np.argmax(tail < REACH_TOLERANCE * peak)) or trial
     size = min(trial, size + 2)
+    # the table itself on the smallest periodic grid whose images lie beyond the reach
+    # (twice the reach and a margin: the images add under 1e-5 of the peak), a third to a
+    # quarter of the first one's side: the build is that much faster
+    small = next_fast_len(2 * size + 16)
+    if small < n:
+        n = small
+        transfer, k = _spectrum(layer, electrode_mm, step, n)
     grid = np.stack([_quadrant(transfer, k, shape, a, step, n, size) for a in a_values])
     peak = float(np.abs(grid).max())
     grid[:, -1, :] = 0.0  # zero at the reach: the interpolation falls to it
@@ -184,13 +191,19 @@ def layer_response_table(
     # squared; the terms kept are far above the round-off of the squares)
     _, vectors = np.linalg.eigh(matrix.T @ matrix)
     basis = vectors[:, ::-1]
+    # the residual after each term, one rank-one update at a time (the same numbers as
+    # refactoring at every rank, a fraction of the work)
+    residual = matrix.copy()
+    columns = []
     for rank in range(1, size + 1):
-        y_factors = np.ascontiguousarray(basis[:, :rank])
-        x_flat = matrix @ y_factors
-        error = float(np.abs(matrix - x_flat @ y_factors.T).max())
+        column = matrix @ basis[:, rank - 1]
+        columns.append(column)
+        residual -= np.outer(column, basis[:, rank - 1])
+        error = float(np.abs(residual).max())
         if error <= RANK_TOLERANCE * peak:
             break
-    x_factors = np.ascontiguousarray(x_flat.reshape(n_a, size, rank))
+    y_factors = np.ascontiguousarray(basis[:, :rank])
+    x_factors = np.ascontiguousarray(np.stack(columns, axis=1).reshape(n_a, size, rank))
     return SeparableResponse(x_factors, y_factors, step, a_step, peak, error / peak)
 
 
