@@ -13,6 +13,11 @@ flaw (noise included) and without flaws:
   scenario of one step per frame through ``simulate`` (the scan loop, the pad's
   ``layer_strain`` per frame), on a sample of the frames (it is slow).
 
+Two more measurements (r9-fastpath): the one-off table build against reading it back
+from the disk cache and against today's path on the same frames (hand4's 18 x 18 palm
+pad under a 40-mm sphere, round 7's 21-s case; and pad16), and the rate of contacts
+wider than the tables (summed in the layer's spectrum) against today's path.
+
 Times are the process's CPU time (``time.process_time``) over the whole call, best of
 three calls, the one-off table build excluded (the first call, its time printed); the
 best wall time is printed beside it (other jobs share this machine's two cores). Today's
@@ -120,6 +125,93 @@ def measure(n_frames: int = 200_000, n_reference: int = 200) -> list[dict]:
     return rows
 
 
+def palm_pad():
+    """hand4's 18 x 18 palm pad (2-mm pitch, pad16's layer and cells)."""
+    from tactsense.robot.presets import _hand4_pad
+
+    return _hand4_pad(18, 18)
+
+
+def big_sphere_contacts(spec, n: int, seed: int = 0) -> ContactBatch:
+    """N frames of one 40-mm sphere (radius 20 mm) anywhere on the pad, 0.05-2.5 N:
+    Hertz radii 1.3-4.8 mm (tables up to 5 mm)."""
+    rng = np.random.default_rng(seed)
+    g = spec.grid
+    extent = np.array([(g.rows - 1) * g.row_pitch_mm, (g.cols - 1) * g.col_pitch_mm])
+    position = rng.uniform(0.0, 1.0, (n, 1, 2)) * extent
+    return ContactBatch(position, rng.uniform(0.05, 2.5, (n, 1)), radius_mm=20.0)
+
+
+def measure_builds(n_frames: int = 200) -> list[dict]:
+    """Per pad: the first call on a cold cache (the table built), the first call of a
+    new process with the table on disk (read back), a later call (in memory), and
+    today's path on the same frames [s, CPU and wall]."""
+    import os
+    import tempfile
+
+    from tactsense.physics._hertz_table import cached_response_table
+
+    rows = []
+    for name, make in (("hand4 palm_0 (18x18, 2 mm)", palm_pad), ("pad16", pad16)):
+        spec = make()
+        batch = big_sphere_contacts(spec, n_frames)
+        saved = os.environ.get("TACTSENSE_CACHE_DIR")
+        with tempfile.TemporaryDirectory() as folder:
+            os.environ["TACTSENSE_CACHE_DIR"] = folder
+            try:
+                cached_response_table.cache_clear()
+                call = lambda s=spec, b=batch: frames_from_contacts(s, b, flaws="none")  # noqa: E731
+                cold = timed(call)
+                cached_response_table.cache_clear()  # a new process: the table on disk
+                disk = timed(call)
+                memory = timed(call, repeats=3)
+            finally:
+                cached_response_table.cache_clear()
+                if saved is None:
+                    os.environ.pop("TACTSENSE_CACHE_DIR")
+                else:
+                    os.environ["TACTSENSE_CACHE_DIR"] = saved
+        today = timed(lambda s=spec, b=batch: frames_from_contacts(s, b, flaws="none", fast=False))
+        rows.append(
+            {
+                "sensor": name,
+                "frames": n_frames,
+                "cold": cold[:2],
+                "disk": disk[:2],
+                "memory": memory[:2],
+                "today": today[:2],
+            }
+        )
+    return rows
+
+
+def wide_contacts(spec, n: int, seed: int = 0) -> ContactBatch:
+    """N frames of one disc of radius 6-18 mm (wider than the tables) anywhere on the
+    pad, 0.5-5 N."""
+    rng = np.random.default_rng(seed)
+    g = spec.grid
+    extent = np.array([(g.rows - 1) * g.row_pitch_mm, (g.cols - 1) * g.col_pitch_mm])
+    position = rng.uniform(0.0, 1.0, (n, 1, 2)) * extent
+    force = rng.uniform(0.5, 5.0, (n, 1))
+    return ContactBatch(position, force, radius_mm=rng.uniform(6.0, 18.0, (n, 1)), shape="disc")
+
+
+def measure_wide(n_frames: int = 200) -> dict:
+    """pad16 frames of one contact wider than the tables: the spectral sum against
+    today's path on the same frames [frames/s, CPU]."""
+    spec = pad16()
+    batch = wide_contacts(spec, n_frames)
+    fast_cpu, fast_wall, _ = timed(lambda: frames_from_contacts(spec, batch, flaws="all", rng=1), 3)
+    ref_cpu, _, _ = timed(lambda: frames_from_contacts(spec, batch, flaws="all", rng=1, fast=False))
+    return {
+        "frames": n_frames,
+        "frames_per_s": n_frames / fast_cpu,
+        "wall_frames_per_s": n_frames / fast_wall,
+        "reference_frames_per_s": n_frames / ref_cpu,
+        "ratio": ref_cpu / fast_cpu,
+    }
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--frames", type=int, default=200_000, help="frames per run [-]")
@@ -132,6 +224,17 @@ def main() -> None:
             f"{row['reference_frames_per_s']:,.0f} frames/s  ratio {row['ratio']:,.0f}x  "
             f"(first call {row['warm_up_s']:.1f} s)"
         )
+    for row in measure_builds():
+        print(
+            f"{row['sensor']}: {row['frames']} frames, first call (table built) "
+            f"{row['cold'][0]:.2f} s CPU, table read from disk {row['disk'][0]:.3f} s, "
+            f"in memory {row['memory'][0]:.3f} s, today's path {row['today'][0]:.2f} s"
+        )
+    wide = measure_wide()
+    print(
+        f"pad16, one disc of 6-18 mm per frame: {wide['frames_per_s']:,.0f} frames/s, "
+        f"today's path {wide['reference_frames_per_s']:,.0f} frames/s, ratio {wide['ratio']:.1f}x"
+    )
 
 
 if __name__ == "__main__":

@@ -64,7 +64,7 @@ def test_every_size_up_to_the_pads_width_is_the_exact_solution(make, narrow):
     its edge and beside it: within 1e-3 of the exact peak, frame by frame (tables below
     A_TOP_LIMIT_MM, one shape per pad to keep the test cheap, the other shape's tables
     are checked in test_contact_frames.py; the spectral sum above, both shapes;
-    measured: 3e-4 and 5e-8)."""
+    measured by scripts/contact_frames_numbers.py: docs/batch-frames.md)."""
     spec = make()
     g = spec.grid
     width = (g.rows - 1) * g.row_pitch_mm

@@ -168,40 +168,42 @@ class WideContacts:
     (``T`` the bonded layer's strain transfer, ``E`` the electrode's sincs, ``P`` the
     pressure's exact transform, as the tables use; the field is even in dx and in dy).
 
-    The period ``L`` along each axis is the pad's extent plus twice the response's
-    reach from the contact's edge (``a`` + 18 layer thicknesses + the electrode, as the
-    tables take it), so the periodic images lie beyond every taxel's reach; the
-    wavenumbers stop at ``pi / h``, ``h`` = 2.5 tables' steps (an eighth of the
-    narrowest of the electrode, the layer and the sensing depth, where ``T E`` has died
-    out: tests/simulate/test_contact_frames.py checks the result against the exact
-    Hankel solution). No pressure is sampled and no table is stored: each contact costs
-    two small matrix products, milliseconds.
+    The period ``L`` along each axis is the pad's extent plus twice the contact's
+    radius and ten layer thicknesses and the electrode, so the periodic images lie
+    beyond every taxel's reach (the field of a layer bonded to a rigid base dies out
+    about e-fold per 1.2 thicknesses); the wavenumbers stop at ``pi / h``, ``h`` = 5
+    tables' steps (a quarter of the narrowest of the electrode, the layer and the
+    sensing depth), where ``T E`` has died out. Measured against the exact Hankel
+    solution (tests/simulate/test_contact_frames_wide.py): within 1e-6 of the peak on
+    pad4, pad16, pad12x32 and hand4's palm pad, where 8 steps give 1e-4 and 12 steps
+    2e-3. No pressure is sampled and no table is stored: a contact costs a pressure
+    transform on the wavenumber grid and two small matrix products (milliseconds); the
+    grid is the same for every wide contact of a batch (sized for its widest).
     """
 
     def __init__(self, spec, x_taxel, y_taxel, electrode):
         self.layer = spec.layer
         self.x_taxel, self.y_taxel = x_taxel, y_taxel
         self.electrode = electrode
-        self.step_mm = 2.5 * table_step_mm(self.layer, electrode)
+        self.step_mm = 5.0 * table_step_mm(self.layer, electrode)
         self.extent = (float(np.ptp(x_taxel)), float(np.ptp(y_taxel)))
         self._spectra = {}
 
     def reach_mm(self, a_mm: float) -> float:
-        """Distance from a contact's centre beyond which it presses no taxel [mm]."""
+        """Distance from a contact's centre beyond which it presses no taxel (as the
+        tables take it: 18 layer thicknesses and the electrode beyond its edge) [mm]."""
         return float(a_mm) + 18.0 * self.layer.thickness_mm + max(self.electrode)
 
     def terms(self, a_mm: float) -> tuple[int, int]:
-        """Wavenumbers per axis the sum takes for a contact of radius ``a_mm`` [-]."""
-        reach = self.reach_mm(a_mm)
+        """Wavenumbers per axis the sum takes for contacts up to radius ``a_mm`` [-]."""
+        margin = float(a_mm) + 10.0 * self.layer.thickness_mm + max(self.electrode)
         return tuple(
-            math.ceil((extent + 2.0 * reach) / (2.0 * self.step_mm)) for extent in self.extent
+            math.ceil((extent + 2.0 * margin) / (2.0 * self.step_mm)) for extent in self.extent
         )
 
     def takes(self, a_mm: np.ndarray) -> np.ndarray:
         """Whether each contact's sum stays within :data:`WIDE_GRID_TERMS` per axis."""
-        reach = np.asarray(a_mm, float) + self.reach_mm(0.0)
-        widest = max(self.extent) + 2.0 * reach
-        return np.ceil(widest / (2.0 * self.step_mm)) <= WIDE_GRID_TERMS
+        return np.array([max(self.terms(a)) <= WIDE_GRID_TERMS for a in np.ravel(a_mm)])
 
     def _spectrum(self, terms: tuple[int, int]):
         """Frequencies [cycles/mm] along x and y, and ``T E`` times the cosine series'
@@ -225,15 +227,16 @@ class WideContacts:
             self._spectra[terms] = (fx, fy, -scale * wx * wy * transfer, k)
         return self._spectra[terms]
 
-    def add(self, frame, position_mm, force, a_mm, shape) -> None:
+    def add(self, frame, position_mm, force, a_mm, shape, terms) -> None:
         """Add one contact's strain (force times the field per newton) to ``frame``
-        (rows, cols); a contact beyond every taxel's reach adds nothing."""
+        (rows, cols), on the wavenumber grid ``terms`` (:meth:`terms` of a radius at
+        least ``a_mm``); a contact beyond every taxel's reach adds nothing."""
         dx = self.x_taxel - position_mm[0]
         dy = self.y_taxel - position_mm[1]
         reach = self.reach_mm(a_mm)
         if np.abs(dx).min() > reach or np.abs(dy).min() > reach:
             return
-        fx, fy, weighted, k = self._spectrum(self.terms(a_mm))
+        fx, fy, weighted, k = self._spectrum(terms)
         spectrum = weighted * pressure_transform(shape, k * a_mm)
         cx = np.cos(2.0 * np.pi * np.outer(dx, fx))
         cy = np.cos(2.0 * np.pi * np.outer(fy, dy))
@@ -281,6 +284,7 @@ class PadContactForward:
         wide = touching & (radius > A_TOP_LIMIT_MM)
         if np.any(wide) and not np.all(self.wide.takes(radius[wide])):
             return None
+        terms = self.wide.terms(float(np.max(radius[wide], initial=0.0)))
         narrow = touching & ~wide
         tables = {}
         for shape, chosen in contacts.shape_masks():
@@ -329,6 +333,7 @@ class PadContactForward:
                     contacts.normal_force_n[first + p, c] * self.scale,
                     float(radius[first + p, c]),
                     str(shape),
+                    terms,
                 )
                 out[p] += frame.astype(np.float32)
             return out.reshape(last - first, rows * cols)
