@@ -123,21 +123,25 @@ def figure(shown) -> None:
 
 def table_block() -> str:
     """What the one-off table of each built-in pad is: steps, reach, terms, build time."""
+    import os
+    import tempfile
     import time
 
     from bench_contact_frames import pad32
-    from tactsense.physics._hertz_table import layer_response_table
+    from tactsense.physics._hertz_table import cached_response_table
 
     lines = [
         "| sensor | shape | offset step [mm] | radius step [mm] | radii tabulated [mm] | "
         "reach [mm] | terms | factoring error / peak | build [s, CPU] |",
         "|---|---|---|---|---|---|---|---|---|",
     ]
+    folder = tempfile.TemporaryDirectory()  # a cold cache: every table built
+    os.environ["TACTSENSE_CACHE_DIR"] = folder.name
     for make in (pad16, pad32, pad12x32):
         spec = make()
         forward = kind_of(spec).contact_forward(spec)
         for shape in ("sphere", "disc"):
-            layer_response_table.cache_clear()
+            cached_response_table.cache_clear()
             start = time.process_time()
             table = forward.table(shape, 1.6)
             build = time.process_time() - start
@@ -147,6 +151,100 @@ def table_block() -> str:
                 f"0-{table.a_top_mm:g} | {table.step_mm * n_x:.1f} | {terms} | "
                 f"{table.rank_error:.1e} | {build:.1f} |"
             )
+    cached_response_table.cache_clear()
+    del os.environ["TACTSENSE_CACHE_DIR"]
+    folder.cleanup()
+    return "\n".join(lines)
+
+
+# ---- every contact size; the table's build and cache; wide contacts (r9-fastpath) ----
+SIZE_SPHERE_MM = 20.0
+"""The 40-mm sphere of round 7's finding on hand4's palm pad [mm]."""
+
+
+def size_cases(spec):
+    """(pressure radius a [mm], place, shape) for a from 0.3 mm to the pad's width."""
+    g = spec.grid
+    width = (g.rows - 1) * g.row_pitch_mm
+    places = {"centre": (width / 2 + 0.3, width / 2 - 0.7), "edge": (0.0, width / 3)}
+    radii = (0.3, 1.0, 2.5, 4.9, 6.0, 10.0, width / 2, width)
+    return [(a, place, places[place], shape) for a in radii for place in places
+            for shape in ("sphere", "disc")]  # fmt: skip
+
+
+def size_block() -> tuple[str, dict]:
+    """The fast path and today's path against the exact layer, one contact a frame, for
+    pressure radii from 0.3 mm to the pad's width: the largest error over the frame's
+    taxels / the exact peak, per radius (worst of centre/edge and sphere/disc)."""
+    from tactsense.physics._hertz_table import A_TOP_LIMIT_MM
+    from tactsense.robot.presets import _hand4_pad
+
+    lines = [
+        "| sensor | pressure radius a [mm] | fast path's route | fast path: error / exact "
+        "peak | today's path (0.5-mm pressure grid, a margin of 4 mm) |",
+        "|---|---|---|---|---|",
+    ]
+    worst = {"fast": 0.0, "today": 0.0}
+    for spec in (_hand4_pad(18, 18), pad16()):
+        kind = kind_of(spec)
+        forward = kind.contact_forward(spec)
+        layer = spec.layer
+        modulus = layer.youngs_modulus_pa / (1 - layer.poisson_ratio**2)
+        cases = size_cases(spec)
+        rows = {}
+        for a, _place, p, shape in cases:
+            sphere = max(SIZE_SPHERE_MM, 2.0 * a)
+            force = (
+                4.0 * modulus * (a * 1e-3) ** 3 / (3.0 * sphere * 1e-3)
+                if shape == "sphere"
+                else 1.0
+            )
+            radius = sphere if shape == "sphere" else a
+            batch = ContactBatch(
+                np.array([[p]]), np.array([[force]]), radius_mm=radius, shape=shape
+            )
+            g = spec.grid
+            fast = forward.prepare(batch)(0, 1).reshape(g.rows, g.cols)
+            today = kind.elastic_batch(spec, [kind.contact_state(spec, batch.frame(0))])
+            exact = _exact_frame(spec, [(p[0], p[1], force, a)], shape)
+            peak = np.abs(exact).max()
+            e_fast = np.abs(fast - exact).max() / peak
+            e_today = np.abs(today.reshape(g.rows, g.cols) - exact).max() / peak
+            old = rows.get(a, (0.0, 0.0))
+            rows[a] = (max(old[0], e_fast), max(old[1], e_today))
+        for a, (e_fast, e_today) in rows.items():
+            route = "table" if a <= A_TOP_LIMIT_MM else "spectral sum"
+            lines.append(f"| {spec.name} | {a:g} | {route} | {e_fast:.1e} | {e_today:.1e} |")
+            worst["fast"] = max(worst["fast"], e_fast)
+            worst["today"] = max(worst["today"], e_today)
+    return "\n".join(lines), worst
+
+
+def builds_block() -> str:
+    """The table's one-off build, the disk cache, and wide contacts (the benchmark)."""
+    from bench_contact_frames import measure_builds, measure_wide
+
+    lines = [
+        "| sensor, 200 frames of a 40-mm sphere (0.05-2.5 N: a 1.3-4.8 mm) | first call, "
+        "table built [s] | first call of a new process, table on disk [s] | later calls "
+        "[s] | today's path [s] |",
+        "|---|---|---|---|---|",
+    ]
+    for r in measure_builds():
+        lines.append(
+            f"| {r['sensor']} | {r['cold'][0]:.2f} (wall {r['cold'][1]:.2f}) | "
+            f"{r['disk'][0]:.3f} (wall {r['disk'][1]:.3f}) | {r['memory'][0]:.4f} | "
+            f"{r['today'][0]:.2f} (wall {r['today'][1]:.2f}) |"
+        )
+    wide = measure_wide()
+    lines.append("")
+    lines.append(
+        f"Contacts wider than the tables (pad16, {wide['frames']} frames of one disc of "
+        f"radius 6-18 mm, 0.5-5 N, every per-frame flaw): **{wide['frames_per_s']:,.0f}** "
+        f"frames/s (CPU; wall {wide['wall_frames_per_s']:,.0f}) on the spectral sum, "
+        f"today's path {wide['reference_frames_per_s']:,.0f} frames/s in the same run "
+        f"({wide['ratio']:.1f}x)."
+    )
     return "\n".join(lines)
 
 
@@ -206,6 +304,18 @@ def main() -> None:
     tables = table_block()
     accuracy, shown = accuracy_block()
     figure(shown)
+    sizes, worst = size_block()
+    builds = builds_block()
+    for name, text in (("sizes", sizes), ("builds", builds)):
+        replace_block(
+            DOC,
+            f"<!-- begin contact-frames {name} -->",
+            f"<!-- end contact-frames {name} -->",
+            f"<!-- begin contact-frames {name} -->\n{text}\n<!-- end contact-frames {name} -->",
+        )
+    print(sizes)
+    print(f"worst: fast {worst['fast']:.1e}, today {worst['today']:.1e}")
+    print(builds)
     for path in (DOC, PERFORMANCE):
         replace_block(
             path,

@@ -268,8 +268,10 @@ def frames_from_contacts(
         Per-taxel gains [-] instead of the sensor's own (``gain_spread``).
     fast : bool
         Use the kind's fast forward (:meth:`Kind.contact_forward`) where it has one and
-        it takes the batch (a pad's: pressure radii up to 5 mm); False: the kind's
-        ``elastic_batch`` frame by frame (the reference).
+        it takes the batch (a pad's: tables up to a pressure radius of 5 mm, wider
+        contacts summed in the layer's spectrum, up to radii of metres); False: the
+        kind's ``elastic_batch`` frame by frame (the reference, whose pad pressure is
+        sampled on a 0.5-mm grid: docs/batch-frames.md).
 
     Returns
     -------
