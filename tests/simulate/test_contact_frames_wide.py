@@ -223,3 +223,57 @@ def test_an_unwritable_cache_folder_is_no_error(tmp_path, monkeypatch):
     cached_response_table.cache_clear()
     table = cached_response_table(*_small_table_args())
     assert table.x_factors.ndim == 3
+
+
+# ---- the finger's fast forward --------------------------------------------------------
+
+
+def _finger_batch(spec, n=60, seed=5):
+    """n frames of one to three contacts on the skin (spheres and discs, radius 1-4 mm,
+    0.05-3 N, an axial and an around tangential force), a third of the slots empty."""
+    rng = np.random.default_rng(seed)
+    axial = rng.uniform(-3.0, float(spec.row_axial_mm.max()) + 3.0, (n, 3))
+    around = rng.uniform(-np.pi / 2, np.pi / 2, (n, 3)) * spec.radius_mm
+    force = rng.uniform(0.05, 3.0, (n, 3))
+    force[rng.random((n, 3)) < 1 / 3] = 0.0
+    return ContactBatch(
+        np.stack([axial, around], axis=-1),
+        force,
+        tangential_force_n=rng.uniform(-0.5, 0.5, (n, 3, 2)),
+        radius_mm=rng.uniform(1.0, 4.0, (n, 3)),
+        shape=np.where(rng.random((n, 3)) < 0.3, "disc", "sphere"),
+    )
+
+
+@pytest.mark.parametrize("name", ["fearing1990_improved", "fearing1990_initial"])
+def test_the_fingers_fast_forward_is_its_elastic_batch(name):
+    """The compiled patches against the twin's own contacts through ``elastic_batch``
+    (the same model and cells: to round-off, 1e-9 of the peak; measured 1e-15), the tip
+    row of the improved finger included."""
+    from tactsense.sensor import registry
+
+    spec = getattr(registry, name)()
+    batch = _finger_batch(spec)
+    kind = kind_of(spec)
+    fast = kind.contact_forward(spec).prepare(batch)(0, batch.n_frames)
+    states = [kind.contact_state(spec, batch.frame(i)) for i in range(batch.n_frames)]
+    reference = kind.elastic_batch(spec, states).reshape(batch.n_frames, -1)
+    assert np.abs(reference).max() > 0
+    assert np.abs(fast - reference).max() <= 1e-9 * np.abs(reference).max()
+
+
+@pytest.mark.parametrize("flaws", ["none", "gain_spread,quantization,nonlinearity,dead"])
+def test_the_fingers_frames_are_the_scan_loops(flaws):
+    """frames_from_contacts on the finger: the fast chain gives the scan loop's counts
+    (a count apart only where the exact value sits on a rounding edge)."""
+    from tactsense.sensor.registry import fearing1990_improved
+
+    spec = fearing1990_improved()
+    batch = _finger_batch(spec, n=40, seed=9)
+    fast = frames_from_contacts(spec, batch, flaws=flaws, rng=2)
+    reference = frames_from_contacts(spec, batch, flaws=flaws, rng=2, fast=False)
+    if "quantization" in flaws:
+        assert np.abs(fast - reference).max() <= 1.0
+        assert np.mean(fast != reference) < 0.01
+    else:
+        assert np.abs(fast - reference).max() <= 1e-9 * np.abs(reference).max()

@@ -137,5 +137,15 @@ class FingerKind(Kind):
                 )
         return tuple(made)
 
+    # ---- the finger's fast forward (r9-fastpath) ----
+    def contact_forward(self, spec):
+        """The 2-D twin compiled over every contact of a batch, as :meth:`contact_state`
+        makes them (:class:`tactsense.physics._fast.FingerContactForward`)."""
+        from tactsense.physics._fast import FingerContactForward
+
+        return FingerContactForward(spec)
+
+    # ---- /r9-fastpath ----
+
 
 KIND: Any = FingerKind()
