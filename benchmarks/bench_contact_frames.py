@@ -8,7 +8,7 @@ forces 0.05-3 N, Hertz radius from the force on a 1.6-mm sphere), with every per
 flaw (noise included) and without flaws:
 
 * the fast path, ``frames_from_contacts(spec, batch)`` (the kind's
-  ``contact_forward``; the finger has none and runs the reference);
+  ``contact_forward``; the finger's: its 2-D twin compiled over the batch's contacts);
 * today's path in the same run, against which the ratio is given: the same frames as a
   scenario of one step per frame through ``simulate`` (the scan loop, the pad's
   ``layer_strain`` per frame), on a sample of the frames (it is slow).

@@ -306,9 +306,10 @@ def main() -> None:
     figure(shown)
     sizes, worst = size_block()
     builds = builds_block()
-    for name, text in (("sizes", sizes), ("builds", builds)):
+    for path, name, text in ((DOC, "sizes", sizes), (DOC, "builds", builds),
+                             (PERFORMANCE, "builds", builds)):  # fmt: skip
         replace_block(
-            DOC,
+            path,
             f"<!-- begin contact-frames {name} -->",
             f"<!-- end contact-frames {name} -->",
             f"<!-- begin contact-frames {name} -->\n{text}\n<!-- end contact-frames {name} -->",

@@ -140,8 +140,8 @@ class FingerKind(Kind):
     # ---- the finger's fast forward (r9-fastpath) ----
     def contact_forward(self, spec):
         """The 2-D twin compiled over every contact of a batch, as :meth:`contact_state`
-        makes them (:class:`tactsense.physics._fast.FingerContactForward`)."""
-        from tactsense.physics._fast import FingerContactForward
+        makes them (:class:`tactsense.physics._finger_forward.FingerContactForward`)."""
+        from tactsense.physics._finger_forward import FingerContactForward
 
         return FingerContactForward(spec)
 
