@@ -201,9 +201,10 @@ class WideContacts:
             math.ceil((extent + 2.0 * margin) / (2.0 * self.step_mm)) for extent in self.extent
         )
 
-    def takes(self, a_mm: np.ndarray) -> np.ndarray:
-        """Whether each contact's sum stays within :data:`WIDE_GRID_TERMS` per axis."""
-        return np.array([max(self.terms(a)) <= WIDE_GRID_TERMS for a in np.ravel(a_mm)])
+    def takes(self, a_mm: float) -> bool:
+        """Whether contacts up to radius ``a_mm`` [mm] stay within
+        :data:`WIDE_GRID_TERMS` wavenumbers per axis."""
+        return max(self.terms(a_mm)) <= WIDE_GRID_TERMS
 
     def _spectrum(self, terms: tuple[int, int]):
         """Frequencies [cycles/mm] along x and y, and ``T E`` times the cosine series'
@@ -282,9 +283,10 @@ class PadContactForward:
         radius = contacts.pressure_radius_mm(self.modulus_star_pa)
         touching = contacts.normal_force_n > 0
         wide = touching & (radius > A_TOP_LIMIT_MM)
-        if np.any(wide) and not np.all(self.wide.takes(radius[wide])):
+        widest = float(np.max(radius[wide], initial=0.0))
+        if not self.wide.takes(widest):
             return None
-        terms = self.wide.terms(float(np.max(radius[wide], initial=0.0)))
+        terms = self.wide.terms(widest)
         narrow = touching & ~wide
         tables = {}
         for shape, chosen in contacts.shape_masks():
