@@ -149,7 +149,7 @@ def measure_builds(n_frames: int = 200) -> list[dict]:
     import os
     import tempfile
 
-    from tactsense.physics._hertz_table import cached_response_table
+    from tactsense.physics._hertz_table import cached_response_table, layer_response_table
 
     rows = []
     for name, make in (("hand4 palm_0 (18x18, 2 mm)", palm_pad), ("pad16", pad16)):
@@ -160,6 +160,7 @@ def measure_builds(n_frames: int = 200) -> list[dict]:
             os.environ["TACTSENSE_CACHE_DIR"] = folder
             try:
                 cached_response_table.cache_clear()
+                layer_response_table.cache_clear()  # nor in the process: built
                 call = lambda s=spec, b=batch: frames_from_contacts(s, b, flaws="none")  # noqa: E731
                 cold = timed(call)
                 cached_response_table.cache_clear()  # a new process: the table on disk

@@ -128,7 +128,7 @@ def table_block() -> str:
     import time
 
     from bench_contact_frames import pad32
-    from tactsense.physics._hertz_table import cached_response_table
+    from tactsense.physics._hertz_table import cached_response_table, layer_response_table
 
     lines = [
         "| sensor | shape | offset step [mm] | radius step [mm] | radii tabulated [mm] | "
@@ -142,14 +142,18 @@ def table_block() -> str:
         forward = kind_of(spec).contact_forward(spec)
         for shape in ("sphere", "disc"):
             cached_response_table.cache_clear()
+            layer_response_table.cache_clear()
+            on_disk = len(os.listdir(folder.name))
             start = time.process_time()
             table = forward.table(shape, 1.6)
-            build = time.process_time() - start
+            build = f"{time.process_time() - start:.1f}"
+            if len(os.listdir(folder.name)) == on_disk:  # the same layer and electrode
+                build = f"{build} (read: the table above)"
             _, n_x, terms = table.x_factors.shape
             lines.append(
                 f"| {spec.name} | {shape} | {table.step_mm:g} | {table.a_step_mm:g} | "
                 f"0-{table.a_top_mm:g} | {table.step_mm * n_x:.1f} | {terms} | "
-                f"{table.rank_error:.1e} | {build:.1f} |"
+                f"{table.rank_error:.1e} | {build} |"
             )
     cached_response_table.cache_clear()
     del os.environ["TACTSENSE_CACHE_DIR"]
@@ -294,60 +298,67 @@ def throughput_block(rows) -> str:
     return "\n".join(lines)
 
 
+def _write(path, name: str, text: str) -> None:
+    replace_block(
+        path,
+        f"<!-- begin contact-frames {name} -->",
+        f"<!-- end contact-frames {name} -->",
+        f"<!-- begin contact-frames {name} -->\n{text}\n<!-- end contact-frames {name} -->",
+    )
+    print(text)
+
+
+def _throughput(frames: int) -> None:
+    table = throughput_block(measure(frames))
+    _write(DOC, "throughput", table)
+    _write(PERFORMANCE, "throughput", table)
+
+
+def _accuracy() -> None:
+    accuracy, shown = accuracy_block()
+    figure(shown)
+    _write(DOC, "accuracy", accuracy)
+
+
+def _sizes() -> None:
+    sizes, worst = size_block()
+    _write(DOC, "sizes", sizes)
+    print(f"worst: fast {worst['fast']:.1e}, today {worst['today']:.1e}")
+
+
+def _builds() -> None:
+    builds = builds_block()
+    _write(DOC, "builds", builds)
+    _write(PERFORMANCE, "builds", builds)
+
+
+BLOCKS = ("throughput", "components", "tables", "accuracy", "sizes", "builds")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--frames", type=int, default=200_000, help="frames per run [-]")
+    parser.add_argument(
+        "--only",
+        default=",".join(BLOCKS),
+        help=f"comma-separated blocks to regenerate (default all: {', '.join(BLOCKS)})",
+    )
     args = parser.parse_args()
-    rows = measure(args.frames)
-    table = throughput_block(rows)
-    components = components_line()
-    tables = table_block()
-    accuracy, shown = accuracy_block()
-    figure(shown)
-    sizes, worst = size_block()
-    builds = builds_block()
-    for path, name, text in ((DOC, "sizes", sizes), (DOC, "builds", builds),
-                             (PERFORMANCE, "builds", builds)):  # fmt: skip
-        replace_block(
-            path,
-            f"<!-- begin contact-frames {name} -->",
-            f"<!-- end contact-frames {name} -->",
-            f"<!-- begin contact-frames {name} -->\n{text}\n<!-- end contact-frames {name} -->",
-        )
-    print(sizes)
-    print(f"worst: fast {worst['fast']:.1e}, today {worst['today']:.1e}")
-    print(builds)
-    for path in (DOC, PERFORMANCE):
-        replace_block(
-            path,
-            "<!-- begin contact-frames throughput -->",
-            "<!-- end contact-frames throughput -->",
-            f"<!-- begin contact-frames throughput -->\n{table}\n"
-            "<!-- end contact-frames throughput -->",
-        )
-    replace_block(
-        DOC,
-        "<!-- begin contact-frames components -->",
-        "<!-- end contact-frames components -->",
-        f"<!-- begin contact-frames components -->\n{components}\n"
-        "<!-- end contact-frames components -->",
-    )
-    replace_block(
-        DOC,
-        "<!-- begin contact-frames tables -->",
-        "<!-- end contact-frames tables -->",
-        f"<!-- begin contact-frames tables -->\n{tables}\n<!-- end contact-frames tables -->",
-    )
-    replace_block(
-        DOC,
-        "<!-- begin contact-frames accuracy -->",
-        "<!-- end contact-frames accuracy -->",
-        f"<!-- begin contact-frames accuracy -->\n{accuracy}\n<!-- end contact-frames accuracy -->",
-    )
-    print(table)
-    print(components)
-    print(tables)
-    print(accuracy)
+    chosen = [b.strip() for b in args.only.split(",") if b.strip()]
+    unknown = sorted(set(chosen) - set(BLOCKS))
+    if unknown:
+        parser.error(f"unknown block(s) {', '.join(unknown)}; expected {', '.join(BLOCKS)}")
+    run = {
+        "throughput": lambda: _throughput(args.frames),
+        "components": lambda: _write(DOC, "components", components_line()),
+        "tables": lambda: _write(DOC, "tables", table_block()),
+        "accuracy": _accuracy,
+        "sizes": _sizes,
+        "builds": _builds,
+    }
+    for name in BLOCKS:
+        if name in chosen:
+            run[name]()
 
 
 if __name__ == "__main__":
