@@ -85,6 +85,13 @@ class ShearPipeline:
             threshold_counts=self.threshold_counts, max_contacts=self.max_contacts,
             first_frame=first_frame, dead=self.dead, radius_mm=self.radius_mm,
         )  # fmt: skip
+        return self.track(table, first_frame)
+
+    def track(self, table, first_frame: int = 0):
+        """``(table, events)``: the contacts ``table`` of
+        :func:`~tactsense.estimate.triaxial.fit.find_shear_contacts` (frames from
+        ``first_frame``) tracked, with the slip columns (what a call does after the fit:
+        one fit can be followed with ``mu`` given and found)."""
         tracked, events = self.tracker.update(table, first_frame=first_frame)
         columns = self.slip.update(
             tracked.frame, tracked.id, tracked.extra["shear_ratio"], tracked.x_mm,

@@ -18,8 +18,8 @@ load and the contact starts to move along its tangential force: the ratio has st
 within :data:`FLAT` since a frame (the plateau at ``mu``) before which it rose by more than
 :data:`RISE` a frame, and the contact has moved more than :data:`SLIDE_MM` along the
 tangential force since the plateau began (a hold below ``mu``
-is a plateau too, but nothing slides). The onset is dated back to the plateau's first
-frame, and from then on the contact's ``mu`` is the ratio there. The detection itself
+is a plateau too, but nothing slides). The onset is dated back (below), and from then on
+the contact's ``mu`` is the ratio there (the plateau's median). The detection itself
 comes at least :data:`PLATEAU_FRAMES` frames after the onset it dates (the
 ``slip_detected_s`` column says when).
 
@@ -29,10 +29,11 @@ holds at ``mu`` once the contact slides. Called from the first frame within
 over the ramp's slope (2-3 frames on the MuJoCo example: ``docs/mujoco.md``). At the
 detection the straight line through the ramp's last :data:`RAMP_FRAMES` frames below
 the plateau (:func:`ramp_crossing`, frames known then: causal) is crossed with ``mu``
-(given, or the plateau's mean when found) and the onset dated to the first frame at or
-after the crossing, kept between the first frame near ``mu`` and the detection; with
-fewer than :data:`RAMP_MIN_POINTS` ramp frames (a jerk into slip) the first frame near
-``mu``.
+(given, or the plateau's median when found) and the onset dated to the first frame at or
+after the crossing, kept from the first frame near ``mu`` on; with ``mu`` given the call
+waits (up to :data:`RAMP_WAIT` frames) while the line reaches ``mu`` after the present
+frame. With fewer than :data:`RAMP_MIN_POINTS` ramp frames (a jerk into slip) the first
+frame near ``mu``.
 """
 
 from __future__ import annotations
@@ -120,14 +121,23 @@ def ramp_crossing(ratios, frames, level: float) -> float | None:
     return float((level - intercept) / slope)
 
 
-def _dated_onset(ratios, frames, level: float, first: int, last: int) -> int:
+RAMP_WAIT = 3
+"""Frames a call of gross slip (``mu`` given) may wait, after the first frame near ``mu``,
+for the ramp's line to reach ``mu`` [frames]."""
+
+
+def _dated_onset(ratios, frames, level: float, first: int, last: int) -> int | None:
     """The onset frame: the first frame at or after :func:`ramp_crossing` at ``level``,
-    kept within [``first``, ``last``] (the first frame near the plateau, the detection);
-    ``first`` without a ramp."""
+    kept from ``first`` (the first frame near the plateau) on; ``first`` without a ramp.
+    None while the line reaches ``level`` after ``last`` (the present frame) and
+    ``last`` is less than :data:`RAMP_WAIT` frames after ``first``: not yet."""
     crossing = ramp_crossing(ratios, frames, level)
     if crossing is None:
         return first
-    return int(min(max(math.ceil(crossing - 1e-9), first), last))
+    onset = max(math.ceil(crossing - 1e-9), first)
+    if onset > last:
+        return None if last - first < RAMP_WAIT else last
+    return int(onset)
 
 
 class SlipMonitor:
@@ -194,21 +204,29 @@ class SlipMonitor:
                 start = self._plateau(track["ratio"], track["xy"], float(angle_deg[k]))
                 if start is not None:
                     plateau = list(track["ratio"])[start:]
-                    track["mu"] = mu = float(np.mean(plateau))
+                    # the median: the knee's first frames may still be on the ramp
+                    track["mu"] = mu = float(np.median(plateau))
                     track["gross"] = True
                     first = _dated_onset(list(track["ratio"])[:start],
                                          list(track["frames"])[:start], mu,
                                          track["frames"][start], f)  # fmt: skip
-                    track["onset"] = first * self.period
+                    track["onset"] = (f if first is None else first) * self.period
                     track["detected"] = f * self.period
             else:
                 at_mu = [r >= mu * (1.0 - MARGIN) for r in list(track["ratio"])[-CONFIRM:]]
                 gross = len(at_mu) == CONFIRM and all(at_mu)
                 if gross and not track["gross"]:  # dated by the ramp's line at mu
-                    first = _dated_onset(track["ratio"], track["frames"], mu,
-                                         track["frames"][-CONFIRM], f)  # fmt: skip
-                    track["onset"] = first * self.period
-                    track["detected"] = f * self.period
+                    ratios = list(track["ratio"])
+                    j = len(ratios) - CONFIRM
+                    while j > 0 and ratios[j - 1] >= mu * (1.0 - MARGIN):
+                        j -= 1  # the run near mu began before (a call that waited)
+                    near = track["frames"][j]  # the history's frames run without a gap
+                    first = _dated_onset(ratios, track["frames"], mu, near, f)
+                    if first is None:
+                        gross = False  # the ramp reaches mu after this frame: not yet
+                    else:
+                        track["onset"] = first * self.period
+                        track["detected"] = f * self.period
                 if not gross and track["gross"] and rho >= mu * (1.0 - 3 * MARGIN):
                     gross = True  # hysteresis: noise about mu does not end a slide
                 track["gross"] = gross
