@@ -106,6 +106,28 @@ def gains_noise_free(spec) -> dict:
     return out
 
 
+def traction_check(spec, radius: float) -> dict:
+    """Largest normal-force error [%] of the fit of the ball's response to frames of the
+    kind's forward model (no flaws) under a sliding ball (0.528 N, Q/P 0.5 along x) at
+    five places along the first drag, with mu 1 and 0.5: {mu: error}."""
+    from tactsense.physics.indenters import SphereProbe
+    from tactsense.physics.triaxial import dipole_field_t, field_counts, magnet_displacement
+
+    rest = field_counts(spec, dipole_field_t(spec, np.zeros((*spec.shape, 3))))
+    out = {}
+    for mu in (1.0, 0.5):
+        errors = []
+        for x in np.linspace(7.05, 10.3, 5):
+            probe = SphereProbe(float(x), 7.05, 0.528, radius_mm=radius, shear_x_n=0.264,
+                                friction=mu)  # fmt: skip
+            frame = field_counts(spec, dipole_field_t(spec, magnet_displacement(spec, [probe])))
+            table = find_shear_contacts(frame, spec, baseline=rest, radius_mm=radius,
+                                        threshold_counts=10.0)  # fmt: skip
+            errors.append(100 * (table.force_n[0] / 0.528 - 1))
+        out[mu] = errors[int(np.argmax(np.abs(errors)))]
+    return out
+
+
 def first_gross(table, comparison) -> list:
     """The ``friction`` column [-] at each press's first gross-slip row (mu found)."""
     frame = np.asarray(table.frame)
@@ -225,7 +247,7 @@ def main() -> None:
         "[pitch] |",
         "|---|---|---|---|---|---|---|---|",
     ]
-    pooled, all_delays, within_total, linear_total = [], [], 0, 0
+    pooled, all_delays, within_total, linear_total, outside = [], [], 0, 0, []
     for seed in SEEDS:
         _, given, _ = run(recordings[seed], "ball + calibration", EXAMPLE_FRICTION)
         table, found, _ = run(recordings[seed], "ball + calibration", None)
@@ -233,6 +255,12 @@ def main() -> None:
         errors = 100 * given.force_error[linear]
         pooled.append(errors)
         within = int(np.sum(np.abs(errors) <= 2.0))
+        for i in np.flatnonzero(linear)[np.abs(errors) > 2.0]:
+            state = "sliding" if given.sliding[i] else "sticking"
+            outside.append(
+                f"seed {seed} frame {given.frames[i]} ({state}, MuJoCo "
+                f"{given.mujoco_force_n[i]:.3f} N): {100 * given.force_error[i]:+.2f} %"
+            )
         within_total += within
         linear_total += len(errors)
         all_delays += [p["delay"] for p in given.presses + found.presses]
@@ -248,6 +276,11 @@ def main() -> None:
     _, clean_c, clean_r = run(clean, "ball", EXAMPLE_FRICTION)
     clean_linear = clean_c.mujoco_force_n >= LINEAR_MIN_N
     onsets = [p["mujoco_onset"] for p in run(recording, "ball", EXAMPLE_FRICTION)[1].presses]
+    light = []  # noise-free, the first touch-down's frames
+    for i in range(len(clean_c.frames)):
+        if clean_c.frames[i] < onsets[0] and clean_c.mujoco_force_n[i] < 0.46:
+            light.append(f"{clean_c.mujoco_force_n[i]:.2f} N {100 * clean_c.force_error[i]:+.1f} %")
+    traction = traction_check(spec, radius)
     ball_gains, probe_gains = gains.values()
     worst = [d for d in all_delays if d is not None]
     lines += [
@@ -267,6 +300,15 @@ def main() -> None:
         + ", ".join(f"{probe_gains[..., a].mean():.4f}" for a in range(3))
         + f" ({np.abs(probe_gains - 1).max():.2%}).",
         f"* MuJoCo's onsets (friction at the cone's limit): frames {onsets}.",
+        "* Frames pressed with 0.25 N or more outside 2 %: " + ("; ".join(outside) or "none") + ".",
+        "* Noise-free, the response for the ball, the first touch-down's frames (MuJoCo's "
+        "force, error): " + ", ".join(light) + ".",
+        "* The traction a sliding contact's frames are made with (the kind's forward model "
+        "alone, a 2-mm ball with 0.528 N and Q/P 0.5 at five places from the pad's centre "
+        "to over a magnet, fitted with the response for the ball), largest force error: "
+        f"with mu taken as 1 (`contact_state`'s for contacts given as forces: "
+        f"Cattaneo-Mindlin's partial slip) {traction[1.0]:+.2f} %; with mu 0.5 (gross "
+        f"slip, as MuJoCo reports) {traction[0.5]:+.2f} %.",
         "* Noise-free frames (flaws 'none'), the response for the ball alone, mu given: "
         f"onset delay, causal {delays(clean_c)}, ramp {delays(clean_r)} [frames]; force "
         f"error, stick {pair(100 * clean_c.force_error[clean_linear & ~clean_c.sliding])} %, "
