@@ -170,3 +170,17 @@ def test_the_causal_onset_under_noise_is_within_a_frame(friction):
     errors = np.abs(errors)
     assert np.mean(errors <= 1) >= 0.9
     assert errors.max() <= 2
+
+
+def test_the_docs_state_the_onsets_constants():
+    """docs/triaxial.md's **Slip** paragraph names the constants the onset's dating uses."""
+    from pathlib import Path
+
+    from tactsense.estimate.triaxial import slip
+
+    doc = (Path(__file__).resolve().parents[2] / "docs" / "triaxial.md").read_text()
+    block = " ".join(
+        doc[doc.index("<!-- r8-triest -->") : doc.index("<!-- /r8-triest -->")].split()
+    )
+    assert f"its last frames below the plateau (up to {slip.RAMP_FRAMES})" in block
+    assert f"waits up to {slip.RAMP_WAIT} frames for the line to reach `mu`" in block
