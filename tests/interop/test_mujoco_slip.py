@@ -170,3 +170,30 @@ def test_with_the_flaws_the_causal_onset_is_within_a_frame(calibrated, friction)
     if friction is None:
         gross = np.asarray(table.extra["slip_state"]) == "gross"
         assert table.extra["friction"][np.argmax(gross)] == pytest.approx(0.5, rel=0.03)
+
+
+def test_locate_takes_the_indenters_radius(tmp_path):
+    """``tactsense locate --indenter-radius 2 --friction 0.5`` on the example's recording
+    writes the forces and onset of ``ShearPipeline(..., radius_mm=2.0)`` (the same numbers,
+    to the CSV's printing), and they differ from the default probe's (the option acts)."""
+    import csv
+
+    from typer.testing import CliRunner
+
+    from tactsense.cli import app
+
+    spec, recording = _record(tmp_path, "none")
+    baseline = np.median(recording.frames[:5].astype(float), axis=0)
+    want, _ = ShearPipeline(spec, baseline, friction=EXAMPLE_FRICTION,
+                            radius_mm=EXAMPLE_BALL_RADIUS_MM)(recording.frames)  # fmt: skip
+    source = tmp_path / "mjslip_example_none.h5"
+    out = tmp_path / "mjslip2_locate.csv"
+    args = ["locate", str(source), "--friction", "0.5", "--indenter-radius", "2", "-o", str(out)]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 0, result.output
+    with out.open() as handle:
+        rows = list(csv.DictReader(handle))
+    forces = np.array([float(r["force_n"]) for r in rows])
+    np.testing.assert_allclose(forces, want.force_n, rtol=1e-6, atol=1e-9)
+    default, _ = ShearPipeline(spec, baseline, friction=EXAMPLE_FRICTION)(recording.frames)
+    assert np.max(np.abs(default.force_n - want.force_n)) > 1e-3
