@@ -421,9 +421,12 @@ def shear_contacts_file(
     chunk_frames: int | None = None,
     events_path: str | Path | None = None,
     progress: Callable[[int, int], None] | None = None,
+    radius_mm: float | None = None,
 ) -> dict:
     """Every contact of a three-axis recording, tracked, with shear and slip, written
     as the long table (CSV, Parquet or HDF5 by extension; bounded memory).
+    ``radius_mm``: the indenter's sphere [mm] (the response fitted; None: the kind's
+    default probe; r9-mjslip2).
 
     Returns a summary: ``frames``, ``rows``, ``frames_with_contact``, ``ids``, ``most``,
     ``saturated``, ``force_max_n`` and ``shear_max_n`` [N], ``gross_slips`` (contacts
@@ -449,7 +452,7 @@ def shear_contacts_file(
         pieces = iter_shear_contacts(
             reader, baseline_frames=baseline_frames, calibration=calibration,
             threshold_counts=threshold_counts, friction=friction,
-            max_contacts=max_contacts, chunk_frames=chunk_frames,
+            max_contacts=max_contacts, chunk_frames=chunk_frames, radius_mm=radius_mm,
         )  # fmt: skip
         with ContactsWriter(out, events_path=events_path) as writer:
             if progress is not None:

@@ -1318,3 +1318,41 @@ def test_fixa8_rest_field_on_the_rail_is_a_warning_not_silence(tmp_path):
 
 
 # ---- /trial8 fixes (r8-fixa8) ----
+
+
+# ---- the indenter's radius on three-axis taxels (r9-mjslip2) ----
+MJSLIP2_BAD = [
+    ("locate MAG --indenter-radius 0 -o OUT", "--indenter-radius: the indenter's radius must"),
+    ("locate MAG --indenter-radius nan -o OUT", "a number of millimetres in 0.2-50"),
+    ("locate MAG --indenter-radius 100 -o OUT", "a number of millimetres in 0.2-50; got 100"),
+    ("locate REC --indenter-radius 2 -o OUT", "--indenter-radius applies to three-axis sensors"),
+]
+
+
+@pytest.fixture(scope="module")
+def mjslip2_workspace(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("mjslip2_matrix")
+    spec = ts.preset("mag4x4")
+    ts.write_recording(
+        folder / "mjslip2_mag.h5", ts.simulate(spec, ts.Scenario((ts.Step((), 0.1),)), rng=0)
+    )
+    pad = ts.fearing1990_initial()
+    ts.write_recording(folder / "mjslip2_rec.h5", ts.simulate(pad, ts.probe_sweep(pad), rng=0))
+    return folder
+
+
+@pytest.mark.parametrize("line, names", MJSLIP2_BAD, ids=[line for line, _ in MJSLIP2_BAD])
+def test_mjslip2_bad_input(mjslip2_workspace, line, names):
+    folder = mjslip2_workspace
+    out = folder / "mjslip2_never_written.csv"
+    args = (
+        line.replace("MAG", str(folder / "mjslip2_mag.h5"))
+        .replace("REC", str(folder / "mjslip2_rec.h5"))
+        .replace("OUT", str(out))
+        .split()
+    )
+    _check(runner.invoke(app, args), names)
+    assert not out.exists()
+
+
+# ---- /r9-mjslip2 ----

@@ -26,9 +26,19 @@ FRICTION_HELP = (
 )
 
 
+# ---- the indenter's radius (r9-mjslip2) ----
+RADIUS_HELP = (
+    "Three-axis sensors: the radius of the sphere that touches the skin [mm] (0.2-50); "
+    "the estimator fits the kind's response for it (docs/triaxial.md) [default: the "
+    "kind's probe, a 1.6-mm sphere]."
+)
+# ---- /r9-mjslip2 ----
+
+
 def locate_shear(recording: Path, out: Path, force: bool, quiet: bool, *, sensor,
                  calibration, threshold, baseline_frames: int, max_contacts: int,
-                 chunk_frames, friction, method: str) -> None:  # fmt: skip
+                 chunk_frames, friction, method: str,
+                 radius_mm: float | None = None) -> None:  # fmt: skip
     """``locate`` on a three-axis recording: the long table with shear and slip."""
     from tactsense.batch import shear_contacts_file
     from tactsense.estimate.output import events_sidecar, output_format
@@ -36,6 +46,13 @@ def locate_shear(recording: Path, out: Path, force: bool, quiet: bool, *, sensor
     from tactsense.estimate.triaxial.locate import check_friction
 
     check_friction(friction)
+    if radius_mm is not None:  # r9-mjslip2: checked before any work
+        from tactsense.estimate.triaxial.response import check_radius_mm
+
+        try:
+            check_radius_mm(radius_mm)
+        except TactsenseInputError as error:
+            raise TactsenseInputError(f"--indenter-radius: {error}") from None
     if method != "interpolate":
         raise TactsenseInputError(
             f"--method {method} is for pads; a three-axis sensor's contacts are fitted with "
@@ -62,6 +79,7 @@ def locate_shear(recording: Path, out: Path, force: bool, quiet: bool, *, sensor
             threshold_counts=threshold_counts, friction=friction, max_contacts=max_contacts,
             chunk_frames=chunk_frames, events_path=events_temporary,
             progress=lambda done, total: bar.update(task, completed=done, total=total),
+            radius_mm=radius_mm,
         )  # fmt: skip
     also = f" (events in {sidecar})" if sidecar is not None else ""
     # ---- no "nan N" when nothing was touched (r8-fixb8) ----

@@ -203,6 +203,11 @@ def locate(
         float | None, typer.Option("--friction", help=_triaxial.FRICTION_HELP)
     ] = None,
     # ---- /r8-triest ----
+    # ---- the indenter's radius on three-axis taxels (r9-mjslip2) ----
+    indenter_radius_mm: Annotated[
+        float | None, typer.Option("--indenter-radius", help=_triaxial.RADIUS_HELP)
+    ] = None,
+    # ---- /r9-mjslip2 ----
 ) -> None:
     """Locate the contact in every frame: position, force, skew and quality flags.
 
@@ -256,12 +261,17 @@ def locate(
                 recording, out, force, quiet, sensor=sensor, calibration=calibrated,
                 threshold=threshold, baseline_frames=baseline_frames,
                 max_contacts=max_contacts, chunk_frames=chunk_frames, friction=friction,
-                method=method,
+                method=method, radius_mm=indenter_radius_mm,
             )  # fmt: skip
             return
         if friction is not None:
             raise TactsenseInputError(
                 f"--friction applies to three-axis sensors; {sensor.name!r} reads one "
+                "component a taxel"
+            )
+        if indenter_radius_mm is not None:  # r9-mjslip2
+            raise TactsenseInputError(
+                f"--indenter-radius applies to three-axis sensors; {sensor.name!r} reads one "
                 "component a taxel"
             )
         # ---- /r8-triest ----

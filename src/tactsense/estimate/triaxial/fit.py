@@ -67,6 +67,7 @@ def find_shear_contacts(
     max_contacts: int = 8,
     first_frame: int = 0,
     dead=None,
+    radius_mm: float | None = None,
 ) -> ContactTable:
     """Every contact of every frame of a three-axis sensor.
 
@@ -88,6 +89,9 @@ def find_shear_contacts(
         Added to the ``frame`` column.
     dead : array_like of bool, shape (rows, cols), optional
         Taxels to ignore.
+    radius_mm : float, optional
+        Radius of the indenter's sphere [mm]: the response fitted is the kind's for it
+        (:func:`.response.response_table`); None: the kind's default probe.
 
     Returns
     -------
@@ -112,7 +116,7 @@ def find_shear_contacts(
         raise TactsenseInputError(f"threshold must be positive; got {threshold_counts!r}")
     rows, cols = sensor.shape
     full_scale = 2**sensor.electronics.adc_bits - 1
-    table = response_table(sensor)
+    table = response_table(sensor, radius_mm=radius_mm)
     bad = np.zeros((rows, cols), bool) if dead is None else np.asarray(dead, bool).copy()
     out: dict[str, list] = {name: [] for name in _COLUMNS}
     for f, frame in enumerate(frames):

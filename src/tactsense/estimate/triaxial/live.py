@@ -44,18 +44,23 @@ class LiveShearContacts:
     keep_deflection : bool
         Keep the last frame's change in :attr:`last_change` [counts] (rows, cols, 3) and
         :attr:`last_deflection` (the same over the converter's full scale [-]).
+    radius_mm : float, optional
+        Radius of the indenter's sphere [mm] (the response fitted is the kind's for it);
+        None: the kind's default probe.
     """
 
     def __init__(self, sensor, *, baseline_frames: int = 5, threshold_counts=None,
                  baseline=None, calibration=None, friction=None, max_contacts: int = 8,
-                 keep_deflection: bool = False):  # fmt: skip
+                 keep_deflection: bool = False,
+                 radius_mm: float | None = None):  # fmt: skip
         if calibration is not None:
             calibration.check_sensor(sensor)
             baseline = calibration.baseline
         self.sensor = sensor
         self.calibration = calibration
         self._options = {"calibration": calibration, "threshold_counts": threshold_counts,
-                         "friction": friction, "max_contacts": max_contacts}  # fmt: skip
+                         "friction": friction, "max_contacts": max_contacts,
+                         "radius_mm": radius_mm}  # fmt: skip
         self._baseline_frames = max(1, int(baseline_frames))
         self._keep = bool(keep_deflection)
         self._collected: list[np.ndarray] = []

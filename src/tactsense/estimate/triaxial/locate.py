@@ -53,11 +53,16 @@ class ShearPipeline:
         The friction coefficient [-] for the slip states; None: found per contact.
     max_contacts : int
     dead : array_like of bool (rows, cols), optional
+    radius_mm : float, optional
+        Radius of the indenter's sphere [mm] (the response fitted is the kind's for it);
+        None: the kind's default probe.
     """
 
     def __init__(self, sensor, baseline, *, calibration=None, threshold_counts=None,
-                 friction=None, max_contacts: int = 8, dead=None):  # fmt: skip
+                 friction=None, max_contacts: int = 8, dead=None,
+                 radius_mm: float | None = None):  # fmt: skip
         from tactsense.estimate.contacts.track import ContactTracker
+        from tactsense.estimate.triaxial.response import check_radius_mm
         from tactsense.estimate.triaxial.slip import SlipMonitor
 
         self.sensor = sensor
@@ -66,6 +71,7 @@ class ShearPipeline:
         self.threshold_counts = threshold_counts
         self.max_contacts = max_contacts
         self.dead = dead
+        self.radius_mm = None if radius_mm is None else check_radius_mm(radius_mm)
         self.tracker = ContactTracker(sensor.scan_period_s)
         self.slip = SlipMonitor(sensor.scan_period_s, check_friction(friction))
 
@@ -77,8 +83,15 @@ class ShearPipeline:
         table = find_shear_contacts(
             frames, self.sensor, baseline=self.baseline, calibration=self.calibration,
             threshold_counts=self.threshold_counts, max_contacts=self.max_contacts,
-            first_frame=first_frame, dead=self.dead,
+            first_frame=first_frame, dead=self.dead, radius_mm=self.radius_mm,
         )  # fmt: skip
+        return self.track(table, first_frame)
+
+    def track(self, table, first_frame: int = 0):
+        """``(table, events)``: the contacts ``table`` of
+        :func:`~tactsense.estimate.triaxial.fit.find_shear_contacts` (frames from
+        ``first_frame``) tracked, with the slip columns (what a call does after the fit:
+        one fit can be followed with ``mu`` given and found)."""
         tracked, events = self.tracker.update(table, first_frame=first_frame)
         columns = self.slip.update(
             tracked.frame, tracked.id, tracked.extra["shear_ratio"], tracked.x_mm,
@@ -93,8 +106,10 @@ class ShearPipeline:
 
 def iter_shear_contacts(reader, *, baseline_frames: int = 5, calibration=None,
                         threshold_counts=None, friction=None, max_contacts: int = 8,
-                        chunk_frames: int | None = None) -> Iterator:  # fmt: skip
-    """``(start, n, time_s, table, events)`` of an open recording, a piece at a time."""
+                        chunk_frames: int | None = None,
+                        radius_mm: float | None = None) -> Iterator:  # fmt: skip
+    """``(start, n, time_s, table, events)`` of an open recording, a piece at a time
+    (``radius_mm``: the indenter's sphere [mm], as :class:`ShearPipeline`'s)."""
     sensor = reader.sensor
     if calibration is not None:
         calibration.check_sensor(sensor)
@@ -108,7 +123,7 @@ def iter_shear_contacts(reader, *, baseline_frames: int = 5, calibration=None,
         baseline = np.nanmedian(reader.frames(0, baseline_frames).astype(float), axis=0)
     pipeline = ShearPipeline(sensor, baseline, calibration=calibration,
                              threshold_counts=threshold_counts, friction=friction,
-                             max_contacts=max_contacts)  # fmt: skip
+                             max_contacts=max_contacts, radius_mm=radius_mm)  # fmt: skip
     for start, frames, time_s in reader.chunks(chunk_frames):
         table, events = pipeline(frames, first_frame=start)
         yield start, len(frames), time_s, table, events

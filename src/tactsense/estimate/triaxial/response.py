@@ -2,11 +2,13 @@
 
 The kind answers it (``Kind.shear_response``: its own forward model, the estimator never
 runs the simulator): the change of every taxel's three components [counts/N] per newton
-of normal force and of tangential force along x and y, for the scenarios' probe (a
-1.6-mm sphere) at each node of a grid of positions that covers the pad a half pitch
-beyond its outer taxels, ``n_sub`` nodes per pitch. Between nodes the response is a
-cubic B-spline through them, within 2 % of the largest value of the kind's own response
-at random places (``tests/estimate/test_triaxial_estimate.py``).
+of normal force and of tangential force along x and y, for a sphere of a given radius
+(by default the scenarios' probe, a 1.6-mm sphere; :func:`response_table`'s
+``radius_mm``: the indenter in use, the bench's ball for a calibration) at each node of
+a grid of positions that covers the pad a half pitch beyond its outer taxels, ``n_sub``
+nodes per pitch. Between nodes the response is a cubic B-spline through them, within
+2 % of the largest value of the kind's own response at random places
+(``tests/estimate/test_triaxial_estimate.py``).
 """
 
 from __future__ import annotations
@@ -65,16 +67,63 @@ def _bspline_weights(t: float) -> np.ndarray:
                      t**3]) / 6.0  # fmt: skip
 
 
-def response_table(spec, n_sub: int = N_SUB) -> ResponseTable:
+def response_table(spec, n_sub: int = N_SUB, *, radius_mm: float | None = None) -> ResponseTable:
     """The kind's response to the three loads on a grid of positions over ``spec``'s
-    pad (cached per sensor description). A kind without a three-axis response says so
-    (:meth:`~tactsense.kinds.Kind.unsupported`)."""
-    return _table(spec, int(n_sub))
+    pad (cached per sensor description and radius). A kind without a three-axis response
+    says so (:meth:`~tactsense.kinds.Kind.unsupported`).
+
+    ``radius_mm``: the radius of the sphere whose response is tabulated [mm] (the
+    indenter in use: a contact's Hertz radius and so the shape of its load follow from
+    it); None: the kind's default probe. A magnet under a contact reads a change that
+    depends on the contact's size, so a response tabulated for another indenter biases
+    the force fitted to it and, more, a calibration judged against it
+    (``docs/mujoco.md``: a 2-mm ball against the 1.6-mm probe's table gave z gains of
+    1.06 instead of 1)."""
+    if radius_mm is None:
+        return _table(spec, int(n_sub), _default_radius_mm(spec))
+    return _table(spec, int(n_sub), check_radius_mm(radius_mm))
+
+
+def _default_radius_mm(spec) -> float | None:
+    """The radius of the kind's default probe [mm] (its ``shear_response``'s
+    ``size_mm``), so that asking for it by number shares the table; None if unknown."""
+    import inspect
+
+    try:
+        size = inspect.signature(kind_of(spec).shear_response).parameters.get("size_mm")
+    except (TypeError, ValueError):
+        return None
+    if size is None or not isinstance(size.default, int | float):
+        return None
+    return float(size.default)
+
+
+RADIUS_RANGE_MM = (0.2, 50.0)
+"""Radii of an indenter's sphere the response is tabulated for [mm]."""
+
+
+def check_radius_mm(radius_mm) -> float:
+    """``radius_mm`` checked: a finite radius in :data:`RADIUS_RANGE_MM` [mm], else a
+    one-line error."""
+    from tactsense._validation import TactsenseInputError
+
+    lo, hi = RADIUS_RANGE_MM
+    ok = isinstance(radius_mm, int | float | np.floating | np.integer) and not isinstance(
+        radius_mm, bool
+    )
+    if not (ok and np.isfinite(radius_mm) and lo <= float(radius_mm) <= hi):
+        raise TactsenseInputError(
+            f"the indenter's radius must be a number of millimetres in {lo:g}-{hi:g}; "
+            f"got {radius_mm!r}"
+        )
+    return float(radius_mm)
 
 
 @functools.lru_cache(maxsize=8)
-def _table(spec, n_sub: int) -> ResponseTable:
+def _table(spec, n_sub: int, radius_mm: float | None = None) -> ResponseTable:
     respond = functools.partial(kind_of(spec).shear_response, spec)  # unsupported: says so
+    if radius_mm is not None:
+        respond = functools.partial(respond, size_mm=radius_mm)
     rows, cols = spec.shape
     px, py = spec.grid.row_pitch_mm, spec.grid.col_pitch_mm
     x = px * (np.arange(rows * n_sub + 1) / n_sub - 0.5)

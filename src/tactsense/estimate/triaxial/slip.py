@@ -11,16 +11,29 @@ coefficient known (``friction``), the state follows from the ratio: ``stick`` be
 :data:`PARTIAL_RATIO` (no tangential load worth the name; once in partial slip, below
 :data:`STICK_RATIO`: a dead band), ``partial`` up to ``mu`` less a
 margin, ``gross`` beyond it for :data:`CONFIRM` frames running (the onset dated to the
-first); the stick ratio ``c/a`` is Cattaneo-Mindlin's. Without it, a
+first frame of the ramp's line at ``mu``: below); the stick ratio ``c/a`` is
+Cattaneo-Mindlin's. Without it, a
 contact's gross slip is found where its ratio stops rising while it carries a tangential
 load and the contact starts to move along its tangential force: the ratio has stayed
 within :data:`FLAT` since a frame (the plateau at ``mu``) before which it rose by more than
 :data:`RISE` a frame, and the contact has moved more than :data:`SLIDE_MM` along the
 tangential force since the plateau began (a hold below ``mu``
-is a plateau too, but nothing slides). The onset is dated back to the plateau's first
-frame, and from then on the contact's ``mu`` is the ratio there. The detection itself
+is a plateau too, but nothing slides). The onset is dated back (below), and from then on
+the contact's ``mu`` is the ratio there (the plateau's median). The detection itself
 comes at least :data:`PLATEAU_FRAMES` frames after the onset it dates (the
 ``slip_detected_s`` column says when).
+
+The onset's date (r9-mjslip2): the ratio climbs a ramp while the tangential load grows and
+holds at ``mu`` once the contact slides. Called from the first frame within
+:data:`MARGIN` of ``mu`` (or the plateau's knee), the onset comes early by the margin
+over the ramp's slope (2-3 frames on the MuJoCo example: ``docs/mujoco.md``). At the
+detection the straight line through the ramp's last :data:`RAMP_FRAMES` frames below
+the plateau (:func:`ramp_crossing`, frames known then: causal) is crossed with ``mu``
+(given, or the plateau's median when found) and the onset dated to the first frame at or
+after the crossing, kept from the first frame near ``mu`` on; with ``mu`` given the call
+waits (up to :data:`RAMP_WAIT` frames) while the line reaches ``mu`` after the present
+frame. With fewer than :data:`RAMP_MIN_POINTS` ramp frames (a jerk into slip) the first
+frame near ``mu``.
 """
 
 from __future__ import annotations
@@ -78,6 +91,53 @@ noise over a vanishing force reads as any ratio): it counts as unloaded [N]."""
 
 HISTORY = 24
 """Frames of each contact's ratio kept [frames]."""
+
+RAMP_FRAMES = 8
+"""Frames of the ramp (the last ones below the plateau) its line is fitted to [frames]."""
+
+RAMP_BAND = (0.3, 0.97)
+"""Ratios, as shares of ``mu`` (or of the plateau's level), that count as the ramp [-]:
+above a press's own, below the plateau's noise (the ratio's noise at ``mu`` is about
+0.6 % of it on the calibrated twin)."""
+
+RAMP_MIN_POINTS = 3
+"""Least ramp frames that date an onset by the ramp's line [frames]."""
+
+
+def ramp_crossing(ratios, frames, level: float) -> float | None:
+    """Fractional frame where the ramp of ``ratios`` (a contact's tangential/normal
+    ratio [-] at ``frames``) reaches ``level`` [-]: the least-squares line through the
+    last :data:`RAMP_FRAMES` frames whose ratio is within :data:`RAMP_BAND` of
+    ``level``, crossed with it. None where fewer than :data:`RAMP_MIN_POINTS` frames are
+    on the ramp or the line does not rise by :data:`RISE` a frame."""
+    r, f = np.asarray(ratios, dtype=float), np.asarray(frames, dtype=float)
+    low, high = RAMP_BAND
+    ramp = np.flatnonzero((r > low * level) & (r < high * level))[-RAMP_FRAMES:]
+    if len(ramp) < RAMP_MIN_POINTS:
+        return None
+    slope, intercept = np.polyfit(f[ramp], r[ramp], 1)
+    if not slope > RISE:
+        return None
+    return float((level - intercept) / slope)
+
+
+RAMP_WAIT = 3
+"""Frames a call of gross slip (``mu`` given) may wait, after the first frame near ``mu``,
+for the ramp's line to reach ``mu`` [frames]."""
+
+
+def _dated_onset(ratios, frames, level: float, first: int, last: int) -> int | None:
+    """The onset frame: the first frame at or after :func:`ramp_crossing` at ``level``,
+    kept from ``first`` (the first frame near the plateau) on; ``first`` without a ramp.
+    None while the line reaches ``level`` after ``last`` (the present frame) and
+    ``last`` is less than :data:`RAMP_WAIT` frames after ``first``: not yet."""
+    crossing = ramp_crossing(ratios, frames, level)
+    if crossing is None:
+        return first
+    onset = max(math.ceil(crossing - 1e-9), first)
+    if onset > last:
+        return None if last - first < RAMP_WAIT else last
+    return int(onset)
 
 
 class SlipMonitor:
@@ -144,16 +204,29 @@ class SlipMonitor:
                 start = self._plateau(track["ratio"], track["xy"], float(angle_deg[k]))
                 if start is not None:
                     plateau = list(track["ratio"])[start:]
-                    track["mu"] = mu = float(np.mean(plateau))
+                    # the median: the knee's first frames may still be on the ramp
+                    track["mu"] = mu = float(np.median(plateau))
                     track["gross"] = True
-                    track["onset"] = track["frames"][start] * self.period
+                    first = _dated_onset(list(track["ratio"])[:start],
+                                         list(track["frames"])[:start], mu,
+                                         track["frames"][start], f)  # fmt: skip
+                    track["onset"] = (f if first is None else first) * self.period
                     track["detected"] = f * self.period
             else:
                 at_mu = [r >= mu * (1.0 - MARGIN) for r in list(track["ratio"])[-CONFIRM:]]
                 gross = len(at_mu) == CONFIRM and all(at_mu)
-                if gross and not track["gross"]:  # dated to the first frame at mu
-                    track["onset"] = track["frames"][-CONFIRM] * self.period
-                    track["detected"] = f * self.period
+                if gross and not track["gross"]:  # dated by the ramp's line at mu
+                    ratios = list(track["ratio"])
+                    j = len(ratios) - CONFIRM
+                    while j > 0 and ratios[j - 1] >= mu * (1.0 - MARGIN):
+                        j -= 1  # the run near mu began before (a call that waited)
+                    near = track["frames"][j]  # the history's frames run without a gap
+                    first = _dated_onset(ratios, track["frames"], mu, near, f)
+                    if first is None:
+                        gross = False  # the ramp reaches mu after this frame: not yet
+                    else:
+                        track["onset"] = first * self.period
+                        track["detected"] = f * self.period
                 if not gross and track["gross"] and rho >= mu * (1.0 - 3 * MARGIN):
                     gross = True  # hysteresis: noise about mu does not end a slide
                 track["gross"] = gross
