@@ -52,7 +52,10 @@ import pandas as pd
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from docblock import replace_block, save_figure
 
+from tactsense.estimate.contacts.calibration import load_calibration
+from tactsense.estimate.contacts.find import find_contacts
 from tactsense.interop import mujoco as adapter
+from tactsense.interop._mujoco_calibrate import joint_force_calibration
 from tactsense.io.recording import read_recording
 from tactsense.sensor import load_sensor
 
@@ -157,12 +160,8 @@ def _centroid_error(located, centre, frames) -> str:
     return f"{np.nanmedian(gap):.3f}, {np.nanmax(gap):.3f} ({np.nanmax(gap) / PITCH_MM:.2f})"
 
 
-def _numbers(folder: Path, spec, touch, grid) -> str:
-    ex = folder / "ex.h5"
-    _tactsense("mujoco", "--out", str(ex), "--seed", "2", "-q")
-    truth = read_recording(ex).truth
-    force, centre = truth["step_force_n"], np.c_[truth["step_x_mm"], truth["step_y_mm"]]
-    # the calibration: presses on the ball, MuJoCo's plateau forces as the weights
+def _presses(folder: Path, name: str, sensor: str) -> Path:
+    """Twelve presses of the finger on the ball (``PRESS_DEPTHS_M``), recorded (seed 1)."""
     controls = folder / "presses.csv"
     rows, t = [(0.0, 0.0, 0.0, 0.0)], 0.0
     for z in PRESS_DEPTHS_M:
@@ -171,8 +170,19 @@ def _numbers(folder: Path, spec, touch, grid) -> str:
         t += 1.7
     rows.append((t + 0.3, 0.0, 0.0, 0.0))
     controls.write_text("time_s,x,y,z\n" + "".join(",".join(map(str, r)) + "\n" for r in rows))
-    weights = folder / "weights.h5"
-    _tactsense("mujoco", "--controls", str(controls), "--out", str(weights), "--seed", "1", "-q")
+    out = folder / name
+    _tactsense("mujoco", "--controls", str(controls), "--sensor", sensor, "--out", str(out),
+               "--seed", "1", "-q")  # fmt: skip
+    return out
+
+
+def _numbers(folder: Path, spec, touch, grid) -> str:
+    ex = folder / "ex.h5"
+    _tactsense("mujoco", "--out", str(ex), "--seed", "2", "-q")
+    truth = read_recording(ex).truth
+    force, centre = truth["step_force_n"], np.c_[truth["step_x_mm"], truth["step_y_mm"]]
+    # the calibration: presses on the ball, MuJoCo's plateau forces as the weights
+    weights = _presses(folder, "weights.h5", "pad16")
     pressed = read_recording(weights).truth["step_force_n"]
     edges = np.flatnonzero(np.diff((pressed > 0.05).astype(int)))
     loads = [np.median(pressed[s + (e - s) // 2 : e - (e - s) // 10])
@@ -225,6 +235,103 @@ def _numbers(folder: Path, spec, touch, grid) -> str:
     return "\n".join(out)
 
 
+def _joined(folder: Path, sensor: str, ex: Path, frames=None):
+    """The pad's calibration joined with the joint fit (issue 38 item 2): the gains and
+    baseline of a probe sweep (``simulate --scenario calibration``, ``calibrate``), a
+    force curve fitted to the joint fit's own force on the twelve presses (every third
+    frame, MuJoCo's normal force at each as the load cell), then ``method="joint"``
+    with that calibration on the example's frames (``frames``: only those). Returns the
+    located contacts as a table (frame, force_n, x_mm, y_mm) and the calibration."""
+    tag = Path(sensor).stem
+    sweep, gains = folder / f"{tag}_sweep.h5", folder / f"{tag}_gains.json"
+    _tactsense("simulate", "--scenario", "calibration", "--sensor", sensor, "--out", str(sweep),
+               "--seed", "1")  # fmt: skip
+    _tactsense("calibrate", str(sweep), "--out", str(gains))
+    presses = read_recording(_presses(folder, f"{tag}_presses.h5", sensor))
+    calibration = joint_force_calibration(
+        load_calibration(gains), presses.sensor, presses.frames[::3],
+        presses.truth["step_force_n"][::3],
+    )  # fmt: skip
+    recording = read_recording(ex)
+    chosen = np.arange(len(recording.frames)) if frames is None else np.asarray(frames)
+    table = find_contacts(recording.frames[chosen], recording.sensor, calibration=calibration,
+                          method="joint")  # fmt: skip
+    located = pd.DataFrame({"frame": chosen[table.frame], "force_n": table.force_n,
+                            "x_mm": table.x_mm, "y_mm": table.y_mm})  # fmt: skip
+    return located, calibration
+
+
+def _joined_rows(label: str, located, truth) -> list[str]:
+    """Rows of the joined table: per phase, the summed force and its centroid against
+    MuJoCo's (a rod's two end contacts merged into one load: their sum and centroid)."""
+    force, centre = truth["step_force_n"], np.c_[truth["step_x_mm"], truth["step_y_mm"]]
+    total = located.groupby("frame").force_n.sum()
+    counts = located.groupby("frame").size()
+    rows = []
+    for phase, frames in PHASES.items():
+        frames = list(frames)
+        n = counts.reindex(frames).fillna(0)
+        rows.append(
+            f"| {label} | {phase} | {_force_error(total, force, frames)} | "
+            f"{_centroid_error(_centroid(located), centre, frames)} | "
+            f"{n.min():.0f}-{n.max():.0f} |"
+        )
+    return rows
+
+
+ALIAS_OFFSETS = np.array([0.0, 0.125, 0.25, 0.375, 0.5])
+"""Offsets of the ball's centre from a taxel's centre [pitch] (along x, then diagonal)."""
+
+
+def _aliasing(specs, force_n=1.9, radius_mm=8.0) -> list[str]:
+    """Why the preset pad16 misses: the example's ball (8 mm, 1.9 N, Hertz radius) at
+    sub-taxel offsets, noise-free frames (no flaws), for each pad: the sum of its
+    readings above rest, the taxels read, and the joint fit's force error."""
+    from tactsense.simulate import ContactBatch, frames_from_contacts
+
+    p = PITCH_MM
+    places = [(d, 0.0) for d in ALIAS_OFFSETS] + [(d, d) for d in ALIAS_OFFSETS[1:]]
+    centre = 7 * p  # taxel (7, 7), near the pad's middle (surface coordinates from taxel 0)
+    at = np.array(
+        [[(centre, centre)]] + [[(centre + dx * p, centre + dy * p)] for dx, dy in places]
+    )
+    n = len(at)
+    batch = ContactBatch(
+        position_mm=at, normal_force_n=np.r_[0.0, np.full(n - 1, force_n)][:, None],
+        radius_mm=np.full((n, 1), radius_mm), shape="sphere",
+    )  # fmt: skip
+    columns = {}
+    for name, spec in specs:
+        frames = frames_from_contacts(spec, batch, flaws="none", fast=False)
+        frames = frames.reshape(n, *spec.shape)
+        up = frames[1:] - frames[0]
+        table = find_contacts(frames[1:], spec, baseline=frames[0], method="joint")
+        fitted = np.zeros(n - 1)
+        np.add.at(fitted, table.frame, np.nan_to_num(table.force_n))
+        total = up.sum(axis=(1, 2))
+        columns[name] = (100 * (total / total.mean() - 1), (up > 10).sum(axis=(1, 2)),
+                         100 * (fitted / force_n - 1))  # fmt: skip
+    names = [name for name, _ in specs]
+    out = [
+        "| ball's offset from a taxel's centre, x, y [pitch] | "
+        + " | ".join(
+            f"{m}: sum of readings against its mean [%] | {m}: taxels read | "
+            f"{m}: joint fit's force error [%]"
+            for m in names
+        )
+        + " |",
+        "|---" * (1 + 3 * len(names)) + "|",
+    ]
+    for i, (dx, dy) in enumerate(places):
+        cells = [f"{c[0][i]:+.1f} | {c[1][i]:d} | {c[2][i]:+.2f}" for c in columns.values()]
+        out.append(f"| {dx:.3f}, {dy:.3f} | " + " | ".join(cells) + " |")
+    spread = {m: (np.ptp(c[0]), np.min(c[2]), np.max(c[2])) for m, c in columns.items()}
+    out += ["", "* Over these offsets: " + "; ".join(
+        f"{m}: the sum of readings spans {s:.1f} %, the joint fit's force {lo:+.2f} to "
+        f"{hi:+.2f} %" for m, (s, lo, hi) in spread.items()) + "."]  # fmt: skip
+    return out
+
+
 def _fingertip(folder: Path) -> str:
     """The finger's slip onset in MuJoCo against the force angle its frames give."""
     from tactsense.physics.halfplane import line_load_skew_coefficient
@@ -257,10 +364,13 @@ def main() -> None:
     frames, touch, grid, contacts = _side_by_side(spec)
     _figure(spec, frames, touch, grid, contacts)
     with tempfile.TemporaryDirectory() as folder:
-        text = _numbers(Path(folder), spec, touch, grid)
+        text, sampling = _numbers(Path(folder), spec, touch, grid)
     begin, end = "<!-- begin mujoco numbers -->", "<!-- end mujoco numbers -->"
     replace_block(DOC, begin, end, f"{begin}\n{text}\n{end}")
+    begin, end = "<!-- begin mujoco sampling numbers -->", "<!-- end mujoco sampling numbers -->"
+    replace_block(DOC, begin, end, f"{begin}\n{sampling}\n{end}")
     print(text)
+    print(sampling)
 
 
 if __name__ == "__main__":
