@@ -20,10 +20,16 @@ How the numbers are made (seeded, so a run repeats them):
 * **Centroid**: ``tactsense locate ex.h5 --method fit`` (uncalibrated): the located
   contacts' force-weighted centroid against MuJoCo's (the truth's ``step_x_mm``,
   ``step_y_mm``).
-* **The size-aware joint fit** (issue 38 item 2, issue 34 item 1): ``tactsense locate
-  ex.h5 --method joint`` (uncalibrated: the force is the layer model's, each contact's
-  size fitted with its position and force, contacts added or removed by the information
-  criterion): each frame's summed force against MuJoCo's, and its centroid as above.
+* **The calibration joined with the joint fit** (issue 38 item 2), on the example's
+  sampling pad (``mujoco_finger_pad.toml``: pad16's grid under a 6-mm layer, recorded
+  the same way, seed 2) and on the preset pad16 (its phases' frames only): the gains
+  and baseline of a probe sweep (``simulate --scenario calibration --seed 1``,
+  ``calibrate``), a force curve fitted to the joint fit's own force on the twelve
+  presses (``interop._mujoco_calibrate.joint_force_calibration``), then
+  ``find_contacts(..., method="joint")`` with it: each frame's summed force and
+  force-weighted centroid against MuJoCo's (a rod's two end contacts so merged into one
+  load). The aliasing table: the ball at sub-taxel offsets, noise-free frames, each
+  pad's joint fit.
 * **Slip**: MuJoCo's onset (the first frame with a contact at the friction cone's limit
   after the ball press) against the first frame of the slide that ``locate`` flags
   ``slip`` (a contact moving under a steady force).
@@ -193,27 +199,20 @@ def _numbers(folder: Path, spec, touch, grid) -> str:
     _tactsense("calibrate", str(weights), "--force-log", str(log), "--out", str(cal))
     _tactsense("locate", str(ex), "--calibration", str(cal), "--out", str(folder / "cal.csv"))
     _tactsense("locate", str(ex), "--method", "fit", "--out", str(folder / "fit.csv"))
-    _tactsense("locate", str(ex), "--method", "joint", "--out", str(folder / "joint.csv"))
     calibrated = pd.read_csv(folder / "cal.csv")
     fitted = pd.read_csv(folder / "fit.csv")
-    joint = pd.read_csv(folder / "joint.csv")
     total = calibrated.groupby("frame").force_n.sum()
-    joint_total = joint.groupby("frame").force_n.sum()
-    located, joint_located = _centroid(fitted), _centroid(joint)
+    located = _centroid(fitted)
     out = [
         "| phase | MuJoCo force [N] | force error, calibrated: median, largest [%] | "
-        "centroid error (fit): median, largest [mm] (pitch) | force error, joint fit "
-        "(no calibration): median, largest [%] | centroid error (joint): median, largest "
-        "[mm] (pitch) |",
-        "|---|---|---|---|---|---|",
+        "centroid error (fit): median, largest [mm] (pitch) |",
+        "|---|---|---|---|",
     ]
     for label, frames in PHASES.items():
         frames = list(frames)
         out.append(
             f"| {label} | {force[frames].mean():.3f} | {_force_error(total, force, frames)} | "
-            f"{_centroid_error(located, centre, frames)} | "
-            f"{_force_error(joint_total, force, frames)} | "
-            f"{_centroid_error(joint_located, centre, frames)} |"
+            f"{_centroid_error(located, centre, frames)} |"
         )
     onset = 180 + int(np.argmax(truth["mujoco_slip"][180:]))
     flagged = fitted[(fitted.frame >= 180) & (fitted.frame < 420) & fitted.slip]
