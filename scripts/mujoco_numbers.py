@@ -328,6 +328,20 @@ def _aliasing(specs, force_n=1.9, radius_mm=8.0) -> list[str]:
     out += ["", "* Over these offsets: " + "; ".join(
         f"{m}: the sum of readings spans {s:.1f} %, the joint fit's force {lo:+.2f} to "
         f"{hi:+.2f} %" for m, (s, lo, hi) in spread.items()) + "."]  # fmt: skip
+    from tactsense.analysis.aliasing import reconstruction_error
+
+    xi = {}
+    for m, spec in specs:
+        layer = spec.layer
+        xi[m] = float(reconstruction_error(layer.sensing_depth_mm, PITCH_MM, layer.poisson_ratio))
+    out.append(
+        "* The paper's eq. 45 (the share of the strain's energy the grid cannot sample, for a "
+        "half space read at the sensing depth; `reconstruction_error`): "
+        + "; ".join(
+            f"{m}: xi {x:.4f} (RMS amplitude error sqrt(xi) {x**0.5:.3f})" for m, x in xi.items()
+        )
+        + "."
+    )
     return out
 
 
