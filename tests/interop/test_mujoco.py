@@ -383,12 +383,13 @@ def test_the_sampling_pad_reads_force_where_the_preset_aliases():
 
 def test_the_sampling_pad_noise_free_on_the_example(tmp_path):
     # no flaws: the joint fit's summed force within 2 % of MuJoCo's normal force sum and
-    # the centroid within a quarter pitch, ball held, rod held and rod sliding (the rod's
+    # the centroid within a quarter pitch, ball and rod, held and sliding (the rod's
     # two end contacts, as MuJoCo reports them, summed and their centroid taken)
-    rec = _thick_recording(tmp_path, "clean", "--flaws", "none", "--seconds", "8")
+    rec = _thick_recording(tmp_path, "clean", "--flaws", "none", "--seconds", "9.1")
     from tactsense.estimate.contacts.find import find_contacts
 
-    frames = np.r_[list(HOLD_BALL)[::6], list(HOLD_ROD)[::8], list(SLIDE_ROD)[:60:12]]
+    slide_ball = list(range(230, 370, 14))
+    frames = np.r_[list(HOLD_BALL)[::6], slide_ball, list(HOLD_ROD)[::8], list(SLIDE_ROD)[::16]]
     rest = np.median(rec.frames[:5], axis=0)
     table = find_contacts(rec.frames[frames], rec.sensor, baseline=rest, method="joint")
     force, centre = _sum_and_centroid(table, frames)
