@@ -1,7 +1,9 @@
 """The MuJoCo adapter (tactsense.interop.mujoco) on its example model: MuJoCo's contacts
 read in the sensor's frame, frames from them, a recording the other commands read, and
 the issue's checks (force with the sensor's calibration within 2 %, contact centroid
-within a quarter pitch, slip onset)."""
+within a quarter pitch, slip onset), and on the example's sampling pad (pad16's grid
+under a 6-mm layer) the calibration joined with the joint fit, and why the preset pad16
+misses (the aliasing of its readings)."""
 
 from __future__ import annotations
 
@@ -459,3 +461,18 @@ def test_the_sampling_pad_with_its_calibration_within_two_percent(tmp_path):
         force, _ = _sum_and_centroid(table, frames)
         ratio = force / rec.truth["step_force_n"][frames]
         assert abs(np.median(ratio) - 1) < 0.02, ratio
+
+
+def test_the_joint_force_calibration_refuses_bad_input():
+    from tactsense._validation import TactsenseInputError
+    from tactsense.estimate.contacts.calibration import ArrayCalibration
+    from tactsense.interop._mujoco_calibrate import joint_force_calibration
+
+    spec = load_sensor(adapter.example_pad_path())
+    cal = ArrayCalibration(sensor_toml=spec.to_toml_string(), baseline=np.full((16, 16), 100.0),
+                           gains=np.ones((16, 16)), dead=np.zeros((16, 16), bool))  # fmt: skip
+    frames = np.full((4, 16, 16), 100.0)
+    with pytest.raises(TactsenseInputError, match="3 forces for 4 frames"):
+        joint_force_calibration(cal, spec, frames, np.ones(3))
+    with pytest.raises(TactsenseInputError, match="min_force_n"):
+        joint_force_calibration(cal, spec, frames, np.ones(4), min_force_n=0.0)
