@@ -2,9 +2,10 @@
 own touch sensor and touch grid, and the adapter's checks (force with the sensor's
 calibration, contact centroid, slip onset) measured on it.
 
-Run: ``python scripts/mujoco_numbers.py`` (about a minute) rewrites the block between
-``<!-- begin mujoco numbers -->`` and ``<!-- end mujoco numbers -->`` in docs/mujoco.md
-and writes ``docs/images/mujoco_side_by_side.png``.
+Run: ``python scripts/mujoco_numbers.py`` (about seven minutes on a shared core)
+rewrites the blocks ``<!-- begin mujoco numbers -->`` ... ``<!-- end mujoco numbers -->``
+and ``<!-- begin mujoco sampling numbers -->`` ... ``<!-- end mujoco sampling numbers
+-->`` in docs/mujoco.md and writes ``docs/images/mujoco_side_by_side.png``.
 
 How the numbers are made (seeded, so a run repeats them):
 
