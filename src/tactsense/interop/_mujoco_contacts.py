@@ -45,6 +45,14 @@ def example_model_path() -> Path:
     return Path(str(resources.files("tactsense.interop") / "data" / "mujoco_finger.xml"))
 
 
+def example_pad_path() -> Path:
+    """The gripper example's sampling pad (``mujoco_finger_pad.toml``): pad16's grid
+    under a 6-mm layer read 4 mm deep, which spreads a contact over 9-11 taxels so that a
+    frame determines its force and size (docs/mujoco.md); the preset pad16 (2-mm layer)
+    reads 1-6."""
+    return Path(str(resources.files("tactsense.interop") / "data" / "mujoco_finger_pad.toml"))
+
+
 def example_controls_path() -> Path:
     """The example model's motion: ``time_s`` [s] and the three servos' targets [m]."""
     return Path(str(resources.files("tactsense.interop") / "data" / "mujoco_finger.csv"))
