@@ -176,6 +176,9 @@ class SurfaceContacts:
         Whether the friction force is at the friction cone's limit (the contact slides).
     geom : ndarray of int, shape (k,)
         The MuJoCo geom pressing on the sensor.
+    friction : ndarray, shape (k,)
+        The contact's friction coefficient (MuJoCo's first tangential one, mu) [-]; 0
+        where the contact has none.
     """
 
     position_mm: np.ndarray
@@ -184,6 +187,7 @@ class SurfaceContacts:
     radius_mm: np.ndarray
     slipping: np.ndarray
     geom: np.ndarray
+    friction: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.normal_force_n)
@@ -350,9 +354,10 @@ class MujocoSensor:
                     self._radius_mm(other),
                     slipping,
                     other,
+                    mu[0],
                 )
             )
-        table = np.array(rows, float).reshape(-1, 8)
+        table = np.array(rows, float).reshape(-1, 9)
         return SurfaceContacts(
             position_mm=table[:, 0:2],
             normal_force_n=table[:, 2],
@@ -360,6 +365,7 @@ class MujocoSensor:
             radius_mm=table[:, 5],
             slipping=table[:, 6].astype(bool),
             geom=table[:, 7].astype(np.int64),
+            friction=table[:, 8],
         )
 
 
@@ -375,16 +381,21 @@ def contact_batch(readings: list[SurfaceContacts], *, shear: bool = True):
     normal = np.zeros((n, k))
     tangential = np.zeros((n, k, 2))
     radius = np.full((n, k), DEFAULT_FLAT_RADIUS_MM)
+    friction = np.zeros((n, k))
     for j, r in enumerate(readings):
         m = len(r)
         position[j, :m], normal[j, :m] = r.position_mm, r.normal_force_n
         tangential[j, :m], radius[j, :m] = r.tangential_force_n, r.radius_mm
+        if r.friction is not None:  # a sliding contact: at the cone's limit (gross slip)
+            ratio = np.hypot(*r.tangential_force_n.T) / np.maximum(r.normal_force_n, 1e-300)
+            friction[j, :m] = np.where(r.slipping, np.maximum(ratio, 1e-12), r.friction)
     return ContactBatch(
         position_mm=position,
         normal_force_n=normal,
         tangential_force_n=tangential if shear else None,
         radius_mm=radius,
         shape="sphere",
+        friction=friction if shear else None,
     )
 
 

@@ -135,8 +135,9 @@ class TriaxialKind(Kind):
         """One frame's contacts as indenters that carry their tangential force
         (``tangential_force_n`` (x, y) [N]), for ``frames_from_contacts``: a sphere (Hertz
         pressure, Cattaneo-Mindlin traction) or a disc at (x, y) [mm]. The forces given
-        are the forces applied, so the friction is taken as ``max(1, Q / P)``: a
-        tangential force above the normal one is passed whole (gross slip)."""
+        are the forces applied; the friction is the contact's own ``friction`` (mu) where
+        given, else ``max(1, Q / P)`` (a tangential force carried without slip at the
+        rim); a tangential force at or above ``mu P`` is gross slip (``mu = Q / P``)."""
         from tactsense.physics.indenters import DiscProbe, SphereProbe
 
         made = []
@@ -145,7 +146,8 @@ class TriaxialKind(Kind):
             x, y = c["position_mm"]
             qx, qy = c.get("tangential_force_n", (0.0, 0.0))
             force = c["normal_force_n"]
-            friction = max(1.0, float(np.hypot(qx, qy)) / force) if force > 0 else 1.0
+            ratio = float(np.hypot(qx, qy)) / force if force > 0 else 0.0
+            friction = max(float(c.get("friction") or 1.0), ratio)
             made.append(cls(x, y, force, radius_mm=c["radius_mm"], shear_x_n=qx,
                             shear_y_n=qy, friction=friction))  # fmt: skip
         return tuple(made)

@@ -101,6 +101,12 @@ class ContactBatch:
     shape : (N, k) ndarray of str, or str
         ``"sphere"`` or ``"disc"`` (:data:`SHAPES`) for every contact (kept as the
         string) or each.
+    friction : (N, k) ndarray, float or None
+        Friction coefficient mu of each contact [-] >= 0, for a kind that takes
+        tangential forces (a three-axis pad: the Cattaneo-Mindlin stick radius
+        ``c/a = (1 - Q/(mu P))^(1/3)``, gross slip at ``Q = mu P``). 0 or None: not known,
+        and the tangential force is then taken as carried without slip at the rim
+        (``mu = max(1, Q/P)``). A tangential force above ``mu P`` is gross slip.
     """
 
     position_mm: np.ndarray
@@ -108,6 +114,7 @@ class ContactBatch:
     tangential_force_n: np.ndarray | None = None
     radius_mm: np.ndarray | float = 1.6
     shape: np.ndarray | str = "sphere"
+    friction: np.ndarray | float | None = None
 
     def __post_init__(self) -> None:
         force = _array("normal_force_n", self.normal_force_n)
@@ -153,6 +160,17 @@ class ContactBatch:
         object.__setattr__(self, "normal_force_n", force)
         object.__setattr__(self, "tangential_force_n", tangential)
         object.__setattr__(self, "radius_mm", radius)
+        if self.friction is not None:
+            friction = _array("friction", self.friction)
+            try:
+                friction = np.broadcast_to(friction, (n, k))
+            except ValueError:
+                raise ContactBatchError(
+                    f"friction has shape {friction.shape}; expected a number or ({n}, {k})"
+                ) from None
+            if np.any(friction < 0):
+                raise ContactBatchError("friction must be >= 0 [-] (0: not known)")
+            object.__setattr__(self, "friction", friction)
         object.__setattr__(self, "shape", shape)
 
     @property
@@ -168,7 +186,7 @@ class ContactBatch:
     def frame(self, index: int) -> list[dict]:
         """The contacts of one frame that touch (force > 0), each a dict of plain numbers:
         ``position_mm`` (2,), ``normal_force_n``, ``tangential_force_n`` (2,),
-        ``radius_mm``, ``shape``."""
+        ``radius_mm``, ``shape``, and ``friction`` [-] where the batch gives it (> 0)."""
         out = []
         for j in range(self.max_contacts):
             force = float(self.normal_force_n[index, j])
@@ -179,17 +197,16 @@ class ContactBatch:
                 if self.tangential_force_n is None
                 else tuple(float(v) for v in self.tangential_force_n[index, j])
             )
-            out.append(
-                {
-                    "position_mm": tuple(float(v) for v in self.position_mm[index, j]),
-                    "normal_force_n": force,
-                    "tangential_force_n": tangential,
-                    "radius_mm": float(self.radius_mm[index, j]),
-                    "shape": str(
-                        self.shape if isinstance(self.shape, str) else self.shape[index, j]
-                    ),
-                }
-            )
+            contact = {
+                "position_mm": tuple(float(v) for v in self.position_mm[index, j]),
+                "normal_force_n": force,
+                "tangential_force_n": tangential,
+                "radius_mm": float(self.radius_mm[index, j]),
+                "shape": str(self.shape if isinstance(self.shape, str) else self.shape[index, j]),
+            }
+            if self.friction is not None and self.friction[index, j] > 0:
+                contact["friction"] = float(self.friction[index, j])
+            out.append(contact)
         return out
 
     def shape_masks(self, first: int = 0, last: int | None = None):
