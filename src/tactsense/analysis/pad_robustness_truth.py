@@ -141,22 +141,32 @@ def true_layer(spec, case: Case) -> TrueLayer:
     return TrueLayer(lay.thickness_mm * f, lay.sensing_depth_mm * f, lay.youngs_modulus_pa, nu)
 
 
-def true_counts(spec, strain, case: Case, gains, rng) -> np.ndarray:
-    """Readings [counts] of the true pad for compressive strains ``strain`` (N, rows,
-    cols) [-]: gains, the twin's transducer (and crosstalk), read noise, rounding, the
-    converter's range."""
-    full = 2**spec.electronics.adc_bits - 1
-    sd = spec.flaws.read_noise_counts if case.noise_fs is None else case.noise_fs * full
+def transduced_counts(spec, strain, case: Case, gains=1.0) -> np.ndarray:
+    """The true pad's noiseless, unrounded readings [counts] for compressive strains
+    ``strain`` (..., rows, cols) [-]: gains, the twin's transducer (and crosstalk)."""
     sampled = np.asarray(strain, dtype=float) * gains
     if spec.transduction.kind == "capacitive":
         # plates held apart at 0.95 of the gap, as the twin's chain holds them
         deflection = np.minimum(spec.transduction.strain_gain * sampled, 0.95)
-        counts = deflection_to_counts(spec, deflection, quantize=False)
-    else:
-        if case.crosstalk:
-            sampled = scan_conductance(np.maximum(sampled, 0.0), 1.0)
-        counts = resistive_counts(spec, sampled)
-    counts = counts + sd * rng.standard_normal(counts.shape)
+        return deflection_to_counts(spec, deflection, quantize=False)
+    if case.crosstalk:
+        sampled = scan_conductance(np.maximum(sampled, 0.0), 1.0)
+    return resistive_counts(spec, sampled)
+
+
+def read_noise_counts(spec, case: Case) -> float:
+    """The true pad's read noise [counts RMS]: the preset's, or ``case.noise_fs`` of the
+    converter's full scale."""
+    full = 2**spec.electronics.adc_bits - 1
+    return spec.flaws.read_noise_counts if case.noise_fs is None else case.noise_fs * full
+
+
+def true_counts(spec, strain, case: Case, gains, rng) -> np.ndarray:
+    """Readings [counts] of the true pad for compressive strains ``strain`` (N, rows,
+    cols) [-]: :func:`transduced_counts`, read noise, rounding, the converter's range."""
+    full = 2**spec.electronics.adc_bits - 1
+    counts = transduced_counts(spec, strain, case, gains)
+    counts = counts + read_noise_counts(spec, case) * rng.standard_normal(counts.shape)
     return np.clip(np.rint(counts), 0, full)
 
 
