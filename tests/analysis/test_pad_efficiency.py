@@ -215,3 +215,33 @@ def test_the_doc_verdicts_are_the_rows_numbers():
             continue  # printed as 1.20: the verdict was taken on the unrounded figure
         assert verdict == ("met" if ok else "missed"), cells
     assert f"met in **{met} of 24 rows**" in block
+
+
+def test_bhattacharyya_of_censored_readings_matches_direct_integration():
+    # one taxel, rest 100, sigma 40, latent means 80 and 130: rho = sqrt(P0 P1) at the
+    # point mass plus int_rest^inf sqrt(f0 f1) dy, integrated here on a fine grid
+    rest, sigma, mu0, mu1 = 100.0, 40.0, np.array([80.0]), np.array([130.0])
+    y = np.linspace(rest, rest + 600, 600001)
+    f0 = np.exp(-0.5 * ((y - mu0) / sigma) ** 2) / (sigma * math.sqrt(2 * math.pi))
+    f1 = np.exp(-0.5 * ((y - mu1) / sigma) ** 2) / (sigma * math.sqrt(2 * math.pi))
+    mass = math.sqrt(special.ndtr((rest - 80.0) / sigma) * special.ndtr((rest - 130.0) / sigma))
+    direct = mass + float(np.sum(np.sqrt(f0 * f1)) * (y[1] - y[0]))
+    log_rho = pc._log_bhattacharyya(mu0, mu1, rest, sigma, True)
+    assert math.exp(log_rho) == pytest.approx(direct, rel=1e-5)
+    # two-sided: exp(-d^2 / 8)
+    assert pc._log_bhattacharyya(mu0, mu1, rest, sigma, False) == pytest.approx(
+        -((50 / 40) ** 2) / 8
+    )
+
+
+def test_the_doc_ml_threshold_rows_reach_the_bound_only_once_the_mirror_is_far():
+    doc = (ROOT / "docs" / "accuracy.md").read_text(encoding="utf-8")
+    block = doc.split("<!-- pad-mlthreshold (r9-padbounds) -->")[1].split("<!-- /pad-ml")[0]
+    rows = [[_number(c) for c in line.strip("|").split("|")]
+            for line in block.splitlines() if re.match(r"\| \d", line)]  # fmt: skip
+    frames = [r[0] for r in rows]
+    assert frames == [1, 4, 16, 64]
+    distance = [r[6] for r in rows]
+    for k, d in zip(frames, distance, strict=True):  # grows as sqrt(K), to rounding
+        assert d == pytest.approx(distance[-1] * math.sqrt(k / 64), abs=0.1)
+    assert rows[0][4] > 2 and rows[-1][4] < 1.2  # RMS over the bound: K = 1, K = 64

@@ -308,3 +308,24 @@ def efficiency_row(
         classic["position_mm"], classic["force_relative"], sized["position_mm"],
         sized["force_relative"], known["censored"]["position_mm"] / classic["position_mm"],
     )  # fmt: skip
+
+
+def bound_over_positions(
+    spec, positions, force_n: float, *, radius_mm: float = 1.6, noise_counts: float | None = None
+) -> dict:
+    """The bound of the truth's frames (classic) at each of ``positions`` ((n, 2) [mm]),
+    as root mean squares over them: ``position_mm`` [mm] and ``force_relative`` [-],
+    with the size unknown where that is finite at every position (``sized`` True),
+    else with the indenter known (the rule of :attr:`EfficiencyRow.goal_bounds`)."""
+    known, sized = [], []
+    for x, y in np.asarray(positions, dtype=float):
+        a, weights, scales = _truth_whitened(spec, x, y, force_n, radius_mm, noise_counts)
+        weights = {"classic": weights["classic"]}
+        k = _bounds(a, weights, scales, force_n, [0, 1, 2])["classic"]
+        s = _bounds(a, weights, scales, force_n, [0, 1, 2, 3])["classic"]
+        known.append((k["position_mm"], k["force_relative"]))
+        sized.append((s["position_mm"], s["force_relative"]))
+    use_sized = bool(np.all(np.isfinite(sized)))
+    values = np.array(sized if use_sized else known)
+    rms = np.sqrt(np.mean(values**2, axis=0))
+    return {"position_mm": float(rms[0]), "force_relative": float(rms[1]), "sized": use_sized}

@@ -193,6 +193,10 @@ class Score:
     """Median |force error| [%] (a withheld force, NaN, counts as 100 %)."""
     force_worst: float
     """Largest |force error| [%]."""
+    position_rms: float = np.nan
+    """Root mean square position error (x and y together) [pitch]."""
+    force_rms: float = np.nan
+    """Root mean square force error [%] (a withheld force counts as 100 %)."""
 
 
 @dataclass(frozen=True)
@@ -203,6 +207,10 @@ class Row:
     case: Case
     before: dict[str, Score]
     after: dict[str, Score]
+    bound: tuple[float, float] | None = None
+    """The Cramer-Rao bound of the case's frames where one applies (a sphere on the
+    described layer, no gain spread or crosstalk): RMS over the positions of position
+    [pitch] and force [%] (``scripts/pad_robustness_truth_numbers.py`` sets it)."""
 
 
 def _score(table, n, positions, force_n, pitch) -> Score:
@@ -223,6 +231,8 @@ def _score(table, n, positions, force_n, pitch) -> Score:
         float(position.max()),
         float(np.median(force)),
         float(force.max()),
+        float(np.sqrt(np.mean(position**2))),
+        float(np.sqrt(np.mean(force**2))),
     )
 
 
@@ -332,18 +342,51 @@ def _cell(s: Score) -> str:
     )
 
 
+def bound_applies(case: Case) -> bool:
+    """Whether the bound of :mod:`tactsense.analysis.pad_efficiency` describes the
+    case's frames: a sphere on the described layer, without gain spread or crosstalk."""
+    return (
+        case.shape == "sphere"
+        and case.thickness_factor == 1.0
+        and case.poisson_ratio is None
+        and not case.gain_spread
+        and not case.crosstalk
+    )
+
+
+def _efficiency(s: Score, bound) -> str:
+    if bound is None:
+        return "-"
+    if not np.isfinite(s.position_rms) or not np.isfinite(s.force_rms):
+        return "n/a"
+    return f"{s.position_rms / bound[0]:.2g} / {s.force_rms / bound[1]:.2g}"
+
+
 def markdown_table(rows: list[Row]) -> str:
-    """The study as a Markdown table: per case and estimator, before -> after."""
-    lines = [
+    """The study as a Markdown table: per case and estimator, before -> after; with an
+    efficiency column (RMS error over the bound, before and after) when any row has a
+    bound."""
+    with_bound = any(r.bound is not None for r in rows)
+    head = (
         "| pad | true pad and load | estimator | one contact found | position, mean / worst "
         "[pitch] | force, median / worst [%] | after calibration: found | position "
-        "| force |",
-        "|---|---|---|---|---|---|---|---|---|",
-    ]
+        "| force |"
+    )
+    rule = "|---|---|---|---|---|---|---|---|---|"
+    if with_bound:
+        head += " efficiency vs bound: position / force, before; after |"
+        rule += "---|"
+    lines = [head, rule]
     for r in rows:
         for method in r.before:
-            lines.append(
+            line = (
                 f"| {r.pad} | {r.case.name} | {method} | {_cell(r.before[method])} "
                 f"| {_cell(r.after[method])} |"
             )
+            if with_bound:
+                line += (
+                    f" {_efficiency(r.before[method], r.bound)}; "
+                    f"{_efficiency(r.after[method], r.bound)} |"
+                )
+            lines.append(line)
     return "\n".join(lines)
