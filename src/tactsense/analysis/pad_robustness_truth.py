@@ -357,6 +357,8 @@ def bound_applies(case: Case) -> bool:
 def _efficiency(s: Score, bound) -> str:
     if bound is None:
         return "-"
+    if not np.all(np.isfinite(bound)):
+        return "singular"
     if not np.isfinite(s.position_rms) or not np.isfinite(s.force_rms):
         return "n/a"
     return f"{s.position_rms / bound[0]:.2g} / {s.force_rms / bound[1]:.2g}"
