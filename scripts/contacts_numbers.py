@@ -4,7 +4,8 @@ the Cramer-Rao bound, and single-contact accuracy of the three position methods.
 
 Run: ``python scripts/contacts_numbers.py`` prints the Markdown blocks that
 docs/contacts.md and docs/accuracy.md hold (``tests/estimate/test_contacts_doc.py``
-checks that they do) and writes ``docs/images/contacts_resolution.png``.
+checks that they do) and writes ``docs/images/contacts_resolution.png``;
+``python scripts/contacts_numbers.py --accuracy`` writes docs/accuracy.md's block.
 
 How the numbers are made (all seeded, so a run repeats them):
 
@@ -346,6 +347,13 @@ OFFSETS_TAXEL = (0.0, 0.1, 0.2, 0.3, 0.4, 0.5)
 def one_contact_bound(spec, x_mm: float, y_mm: float, force_n: float) -> float:
     """Cramer-Rao bound on the position of one sphere [mm] (the larger axis' standard
     deviation), with x, y and force unknown; inf where the readings do not move with it."""
+    cov = one_contact_covariance(spec, x_mm, y_mm, force_n)
+    return float(np.sqrt(max(cov[0, 0], cov[1, 1], 0.0)))
+
+
+def one_contact_covariance(spec, x_mm: float, y_mm: float, force_n: float) -> np.ndarray:
+    """The Cramer-Rao bound's covariance of (x [mm], y [mm], force [N]) of one sphere,
+    (3, 3); every entry inf where the Fisher matrix is singular (rank test)."""
     h = 0.05
     columns = []
     for dx, dy in ((h, 0.0), (0.0, h)):
@@ -359,9 +367,30 @@ def one_contact_bound(spec, x_mm: float, y_mm: float, force_n: float) -> float:
     fisher = jac.T @ jac
     scales = (_pitch(spec), _pitch(spec), force_n)  # a pitch, the load
     if rank_test(jac, scales)["singular"]:  # tolerance 1e-6 (pad_bound.rank_test)
-        return float("inf")
-    cov = np.linalg.inv(fisher)
-    return float(np.sqrt(max(cov[0, 0], cov[1, 1], 0.0)))
+        return np.full((3, 3), np.inf)
+    return np.linalg.inv(fisher)
+
+
+def efficiency(spec, xs, ys, force_n, errors) -> tuple[float, float, int]:
+    """The model-based fit's RMS error over the bound's RMS, at the same placements:
+    position (|error|, x and y together, against ``sqrt(var_x + var_y)``) and force;
+    and how many placements have a singular bound (left out of both RMS)."""
+    pitch = spec.grid.col_pitch_mm
+    cov = np.array(
+        [one_contact_covariance(spec, x, y, force_n) for x, y in zip(xs, ys, strict=True)]
+    )
+    pos, force = errors["fit"]
+    finite = np.isfinite(cov[:, 0, 0])
+    use = finite & np.isfinite(pos) & np.isfinite(force)
+    if not use.any():
+        return np.nan, np.nan, int(np.sum(~finite))
+    bound_pos = np.sqrt(np.mean(cov[use, 0, 0] + cov[use, 1, 1])) / pitch
+    bound_force = 100.0 * np.sqrt(np.mean(cov[use, 2, 2])) / force_n
+    return (
+        float(np.sqrt(np.mean(pos[use] ** 2)) / bound_pos),
+        float(np.sqrt(np.mean(force[use] ** 2)) / bound_force),
+        int(np.sum(~finite)),
+    )
 
 
 def _errors(spec, xs, ys, force_n, rng):
@@ -406,7 +435,9 @@ def accuracy(rng: int = 0, n: int = 60):
             bound = np.median(
                 [one_contact_bound(spec, x, y, f) for x, y in zip(xs[:12], ys[:12], strict=True)]
             )
-            by_load.append((grams, errors, bound / g.col_pitch_mm))
+            by_load.append(
+                (grams, errors, bound / g.col_pitch_mm, efficiency(spec, xs, ys, f, errors))
+            )
         by_offset = []
         row0, col0 = g.rows // 2, g.cols // 2
         for off in OFFSETS_TAXEL:
@@ -415,7 +446,8 @@ def accuracy(rng: int = 0, n: int = 60):
             y = np.full(12, (col0 + off) * g.col_pitch_mm)
             errors = _errors(spec, x, y, FORCE_N, rng)
             bound = one_contact_bound(spec, row0 * g.row_pitch_mm, y[0], FORCE_N)
-            by_offset.append((off, errors, bound / g.col_pitch_mm))
+            eff = efficiency(spec, x, y, FORCE_N, errors)
+            by_offset.append((off, errors, bound / g.col_pitch_mm, eff))
         results[name] = (by_load, by_offset)
     return results
 
@@ -427,43 +459,77 @@ def accuracy_block(results=None) -> str:
         "",
         "Against load (60 random interior positions; mean / worst |error|; position in "
         "taxels, force in percent; bound: the median Cramer-Rao bound on position over 12 "
-        "of the positions, in taxels):",
+        "of the positions, in taxels; the model-based fit's efficiency: its RMS error over "
+        "the bound's RMS at the same placements, position (x and y together) and force, "
+        "where the bound is finite at every placement (one frame a placement: an "
+        "efficiency from 60 is good to about 10 %; on the resistive pads the bound of "
+        "these frames is singular over much of a taxel, and its finite values near the "
+        "clip's kink mean nothing, as said below):",
         "",
         "| pad | load [g] | interpolate: position / force | centre of pressure | "
-        "model-based fit | bound [taxel] |",
-        "|---|---|---|---|---|---|",
+        "model-based fit | bound [taxel] | fit's efficiency: position / force |",
+        "|---|---|---|---|---|---|---|",
     ]
 
     def bound_text(b):
         return "inf" if not np.isfinite(b) else f"{b:.4f}"
 
+    def eff_text(eff, n):
+        pos, force, singular = eff
+        if singular:
+            return f"- (bound singular at {singular} of {n})"
+        return f"{pos:.2f} / {force:.2f}"
+
     for name, (by_load, _) in results.items():
-        for grams, errors, bound in by_load:
+        for grams, errors, bound, eff in by_load:
             cells = [f"{_cell(errors[m][0])}; {_cell(errors[m][1], '.0f')} %"
                      for m in ("interpolate", "cop", "fit")]  # fmt: skip
+            n = len(errors["fit"][0])
             lines.append(
-                f"| {name} | {grams:g} | " + " | ".join(cells) + f" | {bound_text(bound)} |"
+                f"| {name} | {grams:g} | " + " | ".join(cells) + f" | {bound_text(bound)} "
+                f"| {eff_text(eff, n)} |"
             )
     lines += [
         "",
         "Against the position within a taxel (50 g; the probe's offset from a taxel's "
         "centre along y, 12 placements at random offsets across; mean / worst |position "
-        "error| in taxels; bound at the offset, x on the taxel's row):",
+        "error| in taxels; bound at the offset, x on the taxel's row; efficiency as "
+        "above, over the 12 placements, good to about 20 %):",
         "",
         "| pad | offset [taxel] | interpolate | centre of pressure | model-based fit "
-        "| bound [taxel] |",
-        "|---|---|---|---|---|---|",
+        "| bound [taxel] | fit's efficiency: position / force |",
+        "|---|---|---|---|---|---|---|",
     ]
     for name, (_, by_offset) in results.items():
-        for off, errors, bound in by_offset:
+        for off, errors, bound, eff in by_offset:
             cells = [_cell(errors[m][0]) for m in ("interpolate", "cop", "fit")]
+            n = len(errors["fit"][0])
             lines.append(
-                f"| {name} | {off:.1f} | " + " | ".join(cells) + f" | {bound_text(bound)} |"
+                f"| {name} | {off:.1f} | " + " | ".join(cells) + f" | {bound_text(bound)} "
+                f"| {eff_text(eff, n)} |"
             )
+    lines += ["", ACCURACY_END]
     return "\n".join(lines) + "\n"
 
 
+ACCURACY_BEGIN = "<!-- generated by scripts/contacts_numbers.py: do not edit by hand -->"
+ACCURACY_END = "<!-- end of scripts/contacts_numbers.py (accuracy) -->"
+
+
+def write_accuracy() -> None:
+    """Put the single-contact tables in docs/accuracy.md (``--accuracy``)."""
+    sys.path.insert(0, str(ROOT / "scripts"))
+    from docblock import replace_block
+
+    text = accuracy_block().rstrip("\n")
+    replace_block(ROOT / "docs" / "accuracy.md", ACCURACY_BEGIN, ACCURACY_END, text)
+    sys.stdout.write(text + "\n")
+
+
 def main() -> None:
+    if sys.argv[1:] == ["--accuracy"]:
+        write_accuracy()
+        return
     results = compute()
     sys.stdout.write(block(results))
     sys.stdout.write("\n---- docs/accuracy.md ----\n\n")

@@ -21,14 +21,19 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "scripts"))
 
+import numpy as np  # noqa: E402
 from docblock import replace_block  # noqa: E402
 
+from tactsense.analysis.pad_efficiency import bound_over_positions  # noqa: E402
 from tactsense.analysis.pad_robustness_truth import (  # noqa: E402
     Case,
     Row,
     Score,
+    _interior,
+    bound_applies,
     cases,
     markdown_table,
+    read_noise_counts,
     run_case,
 )
 from tactsense.sensor.registry import load_sensor  # noqa: E402
@@ -40,6 +45,20 @@ POSITIONS = 10
 SEED = 34
 
 
+def with_bound(spec, row: Row) -> Row:
+    """``row`` with the bound of its frames where one applies (the positions
+    ``run_case`` drew): RMS over them of position [pitch] and force [%]."""
+    if not bound_applies(row.case):
+        return row
+    positions = _interior(spec, POSITIONS, np.random.default_rng(SEED + 2))
+    noise = read_noise_counts(spec, row.case)
+    b = bound_over_positions(
+        spec, positions, row.case.force_n, radius_mm=row.case.radius_mm, noise_counts=noise
+    )
+    pitch = spec.grid.row_pitch_mm
+    return dataclasses.replace(row, bound=(b["position_mm"] / pitch, 100 * b["force_relative"]))
+
+
 def _to_json(rows: list[Row]) -> list[dict]:
     return [
         {
@@ -47,6 +66,7 @@ def _to_json(rows: list[Row]) -> list[dict]:
             "case": {k: v for k, v in dataclasses.asdict(r.case).items() if k != "layer"},
             "before": {m: dataclasses.asdict(s) for m, s in r.before.items()},
             "after": {m: dataclasses.asdict(s) for m, s in r.after.items()},
+            "bound": r.bound,
         }
         for r in rows
     ]
@@ -59,6 +79,7 @@ def _from_json(items: list[dict]) -> list[Row]:
             Case(**d["case"]),
             {m: Score(**s) for m, s in d["before"].items()},
             {m: Score(**s) for m, s in d["after"].items()},
+            None if d.get("bound") is None else tuple(d["bound"]),
         )
         for d in items
     ]
@@ -92,7 +113,9 @@ def main() -> None:
             todo = sorted(cases(spec), key=lambda c: ["described", "pad", "load"].index(c.group))
             for case in todo:
                 print(f"{time.perf_counter() - t0:7.0f} s {name}: {case.name}", flush=True)
-                rows.append(run_case(spec, case, n_positions=POSITIONS, seed=SEED))
+                rows.append(
+                    with_bound(spec, run_case(spec, case, n_positions=POSITIONS, seed=SEED))
+                )
                 if args.json:  # after every case: a long run keeps what it has done
                     tmp = args.json.with_suffix(".tmp")
                     tmp.write_text(json.dumps(_to_json(rows), indent=1))

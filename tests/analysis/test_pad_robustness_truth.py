@@ -55,7 +55,7 @@ def test_crosstalk_adds_to_the_fourth_corner():
 def _doc_row(pad, case, method):
     for line in DOC.read_text().splitlines():
         cells = [c.strip() for c in line.strip("|").split("|")]
-        if len(cells) == 9 and cells[:3] == [pad, case, method]:
+        if len(cells) in (9, 10) and cells[:3] == [pad, case, method]:
             return cells
     raise AssertionError(f"no row {pad} / {case} / {method} in docs/accuracy.md")
 
@@ -90,3 +90,21 @@ def test_small_rerun_shows_the_docs_directions():
                                  _numbers(doc_spread[7])[0])  # fmt: skip
     assert s_pos > 3 * d_pos and s_pos_after < 0.5 * s_pos
     assert _numbers(doc_spread[5])[0] > 2 * _numbers(doc_described[5])[0]
+
+
+def test_efficiency_column_is_rms_over_the_bound_where_one_applies():
+    # a made-up row: RMS 0.02 pitch and 3 % against a bound of 0.01 pitch and 2 %:
+    # efficiency 2 and 1.5; no column when no row has a bound
+    from tactsense.analysis.pad_robustness_truth import Case, Row, Score, bound_applies
+
+    score = Score(100.0, 0.015, 0.04, 2.0, 5.0, 0.02, 3.0)
+    described = Case("as described")
+    row = Row("pad4", described, {"joint": score}, {"joint": score}, bound=(0.01, 2.0))
+    table = study.markdown_table([row])
+    assert table.splitlines()[2].endswith("| 2 / 1.5; 2 / 1.5 |")
+    assert "efficiency" not in study.markdown_table([Row("pad4", described, {"joint": score},
+                                                       {"joint": score})])  # fmt: skip
+    assert bound_applies(described) and bound_applies(Case("n", noise_fs=0.01))
+    for other in (Case("d", "disc"), Case("t", thickness_factor=1.15), Case("g", gain_spread=True),
+                  Case("nu", poisson_ratio=0.45), Case("x", crosstalk=True)):  # fmt: skip
+        assert not bound_applies(other)

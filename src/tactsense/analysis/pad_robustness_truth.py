@@ -141,22 +141,32 @@ def true_layer(spec, case: Case) -> TrueLayer:
     return TrueLayer(lay.thickness_mm * f, lay.sensing_depth_mm * f, lay.youngs_modulus_pa, nu)
 
 
-def true_counts(spec, strain, case: Case, gains, rng) -> np.ndarray:
-    """Readings [counts] of the true pad for compressive strains ``strain`` (N, rows,
-    cols) [-]: gains, the twin's transducer (and crosstalk), read noise, rounding, the
-    converter's range."""
-    full = 2**spec.electronics.adc_bits - 1
-    sd = spec.flaws.read_noise_counts if case.noise_fs is None else case.noise_fs * full
+def transduced_counts(spec, strain, case: Case, gains=1.0) -> np.ndarray:
+    """The true pad's noiseless, unrounded readings [counts] for compressive strains
+    ``strain`` (..., rows, cols) [-]: gains, the twin's transducer (and crosstalk)."""
     sampled = np.asarray(strain, dtype=float) * gains
     if spec.transduction.kind == "capacitive":
         # plates held apart at 0.95 of the gap, as the twin's chain holds them
         deflection = np.minimum(spec.transduction.strain_gain * sampled, 0.95)
-        counts = deflection_to_counts(spec, deflection, quantize=False)
-    else:
-        if case.crosstalk:
-            sampled = scan_conductance(np.maximum(sampled, 0.0), 1.0)
-        counts = resistive_counts(spec, sampled)
-    counts = counts + sd * rng.standard_normal(counts.shape)
+        return deflection_to_counts(spec, deflection, quantize=False)
+    if case.crosstalk:
+        sampled = scan_conductance(np.maximum(sampled, 0.0), 1.0)
+    return resistive_counts(spec, sampled)
+
+
+def read_noise_counts(spec, case: Case) -> float:
+    """The true pad's read noise [counts RMS]: the preset's, or ``case.noise_fs`` of the
+    converter's full scale."""
+    full = 2**spec.electronics.adc_bits - 1
+    return spec.flaws.read_noise_counts if case.noise_fs is None else case.noise_fs * full
+
+
+def true_counts(spec, strain, case: Case, gains, rng) -> np.ndarray:
+    """Readings [counts] of the true pad for compressive strains ``strain`` (N, rows,
+    cols) [-]: :func:`transduced_counts`, read noise, rounding, the converter's range."""
+    full = 2**spec.electronics.adc_bits - 1
+    counts = transduced_counts(spec, strain, case, gains)
+    counts = counts + read_noise_counts(spec, case) * rng.standard_normal(counts.shape)
     return np.clip(np.rint(counts), 0, full)
 
 
@@ -183,6 +193,10 @@ class Score:
     """Median |force error| [%] (a withheld force, NaN, counts as 100 %)."""
     force_worst: float
     """Largest |force error| [%]."""
+    position_rms: float = np.nan
+    """Root mean square position error (x and y together) [pitch]."""
+    force_rms: float = np.nan
+    """Root mean square force error [%] (a withheld force counts as 100 %)."""
 
 
 @dataclass(frozen=True)
@@ -193,6 +207,10 @@ class Row:
     case: Case
     before: dict[str, Score]
     after: dict[str, Score]
+    bound: tuple[float, float] | None = None
+    """The Cramer-Rao bound of the case's frames where one applies (a sphere on the
+    described layer, no gain spread or crosstalk): RMS over the positions of position
+    [pitch] and force [%] (``scripts/pad_robustness_truth_numbers.py`` sets it)."""
 
 
 def _score(table, n, positions, force_n, pitch) -> Score:
@@ -213,6 +231,8 @@ def _score(table, n, positions, force_n, pitch) -> Score:
         float(position.max()),
         float(np.median(force)),
         float(force.max()),
+        float(np.sqrt(np.mean(position**2))),
+        float(np.sqrt(np.mean(force**2))),
     )
 
 
@@ -322,18 +342,53 @@ def _cell(s: Score) -> str:
     )
 
 
+def bound_applies(case: Case) -> bool:
+    """Whether the bound of :mod:`tactsense.analysis.pad_efficiency` describes the
+    case's frames: a sphere on the described layer, without gain spread or crosstalk."""
+    return (
+        case.shape == "sphere"
+        and case.thickness_factor == 1.0
+        and case.poisson_ratio is None
+        and not case.gain_spread
+        and not case.crosstalk
+    )
+
+
+def _efficiency(s: Score, bound) -> str:
+    if bound is None:
+        return "-"
+    if not np.all(np.isfinite(bound)):
+        return "singular"
+    if not np.isfinite(s.position_rms) or not np.isfinite(s.force_rms):
+        return "n/a"
+    return f"{s.position_rms / bound[0]:.2g} / {s.force_rms / bound[1]:.2g}"
+
+
 def markdown_table(rows: list[Row]) -> str:
-    """The study as a Markdown table: per case and estimator, before -> after."""
-    lines = [
+    """The study as a Markdown table: per case and estimator, before -> after; with an
+    efficiency column (RMS error over the bound, before and after) when any row has a
+    bound."""
+    with_bound = any(r.bound is not None for r in rows)
+    head = (
         "| pad | true pad and load | estimator | one contact found | position, mean / worst "
         "[pitch] | force, median / worst [%] | after calibration: found | position "
-        "| force |",
-        "|---|---|---|---|---|---|---|---|---|",
-    ]
+        "| force |"
+    )
+    rule = "|---|---|---|---|---|---|---|---|---|"
+    if with_bound:
+        head += " efficiency vs bound: position / force, before; after |"
+        rule += "---|"
+    lines = [head, rule]
     for r in rows:
         for method in r.before:
-            lines.append(
+            line = (
                 f"| {r.pad} | {r.case.name} | {method} | {_cell(r.before[method])} "
                 f"| {_cell(r.after[method])} |"
             )
+            if with_bound:
+                line += (
+                    f" {_efficiency(r.before[method], r.bound)}; "
+                    f"{_efficiency(r.after[method], r.bound)} |"
+                )
+            lines.append(line)
     return "\n".join(lines)
