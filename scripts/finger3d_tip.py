@@ -19,13 +19,18 @@ anywhere on the skin to ``src/tactsense/physics/data/finger3d_tip.npz``:
   cylinder's table does not cover.
 
 ``--study`` also solves every level of ``TIP_LEVELS`` (level 2 takes about 2.5 minutes
-and 5 GB) and stores each level's peaks: the mesh study quoted in docs/model.md. The
-tables are always those of ``--level``.
+and 5 GB) and stores each level's peaks in the table's file. The tables are always those
+of ``--level``. ``--study-only`` solves every level with ``--formulation`` (peaks only,
+no tables: the shipped tables stay as they are) and records them, level by level, in
+``docs/data/finger3d_tip_study.json``: the mesh study docs/model.md quotes
+(``scripts/finger3d_tip_figure.py`` reads it, with the observed order and the
+extrapolated peaks).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import time
 from pathlib import Path
 
@@ -34,7 +39,9 @@ import numpy as np
 from tactsense.physics import finger3d_tip as tip
 from tactsense.physics.finger3d import Dielectric
 
-OUT = Path(__file__).resolve().parents[1] / "src" / "tactsense" / "physics" / "data"
+ROOT = Path(__file__).resolve().parents[1]
+OUT = ROOT / "src" / "tactsense" / "physics" / "data"
+STUDY = ROOT / "docs" / "data" / "finger3d_tip_study.json"
 S_MM = np.round(np.r_[np.arange(tip.APEX_S_M * 1e3, 12.0, 0.25), 12.0], 4)
 S_TIP_MM = S_MM[S_MM <= 0.5]
 ANGLE_DEG = np.round(np.r_[np.arange(0.0, 40.0, 1.0), np.arange(40.0, 180.01, 4.0)], 3)
@@ -103,10 +110,40 @@ def solve_level(level, with_tables, formulation="displacement", layer=None):
     return out
 
 
+def study_only(formulation) -> None:
+    """Solve every level of ``TIP_LEVELS`` (peaks only) and record each as it lands."""
+    rows = []
+    for level, spec in enumerate(tip.TIP_LEVELS):
+        out = solve_level(level, False, formulation)
+        rows.append(
+            {
+                "level": level,
+                "mesh": {"n_t": spec.n_t, "h_mm": spec.h_m * 1e3, "n_theta": spec.n_fine_theta},
+                "dofs": int(out["dofs"]),
+                "seconds": out["seconds"],
+                "tip_peak": float(out["tip_peak"][1]),
+                "tip_peak_s_mm": float(out["tip_peak"][0]),
+                "tip_rim_peak": float(out["tip_rim_peak"][1]),
+                "row1_peak": out["row1_peak"],
+                "row1_at_junction": out["row1_at_junction"],
+            }
+        )
+        STUDY.parent.mkdir(parents=True, exist_ok=True)
+        tmp = STUDY.with_suffix(".tmp")
+        tmp.write_text(json.dumps({"formulation": formulation, "levels": rows}, indent=1))
+        tmp.replace(STUDY)
+
+
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--level", type=int, default=1, help="mesh level of TIP_LEVELS")
     parser.add_argument("--study", action="store_true", help="also solve every other level")
+    parser.add_argument(
+        "--study-only",
+        action="store_true",
+        help="solve every level (peaks only, the tables untouched) into "
+        "docs/data/finger3d_tip_study.json",
+    )
     parser.add_argument(
         "--formulation",
         choices=("mixed", "displacement"),
@@ -123,6 +160,9 @@ def main(argv=None) -> None:
     args = parser.parse_args(argv)
     layer = FOAM if args.foam else None
     formulation = "mixed" if args.foam else args.formulation
+    if args.study_only:
+        study_only(formulation)
+        return
     levels = list(range(len(tip.TIP_LEVELS))) if args.study else [args.level]
     study = [solve_level(k, k == args.level, formulation, layer) for k in levels]
     main_level = study[levels.index(args.level)]
