@@ -30,6 +30,7 @@ extrapolated peaks).
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import time
 from pathlib import Path
@@ -85,9 +86,10 @@ def row_functional(solution, row_m, layer=None):
     return solution.normal_strain_functional([[row_m], [0.0], [rho]], [[0.0], [0.0], [1.0]])
 
 
-def solve_level(level, with_tables, formulation="displacement", layer=None):
+def solve_level(level, with_tables, formulation="displacement", layer=None, spec=None):
     start = time.perf_counter()
-    solution = tip.assemble(tip.TIP_LEVELS[level], formulation=formulation, dielectric=layer)
+    spec = tip.TIP_LEVELS[level] if spec is None else spec
+    solution = tip.assemble(spec, formulation=formulation, dielectric=layer)
     s, angle = np.meshgrid(S_MM, ANGLE_DEG, indexing="ij")
     out = {"dofs": solution.n_dofs}
     for name, inner in (("tip", 0.5), ("tip_rim", 0.75)):
@@ -110,27 +112,51 @@ def solve_level(level, with_tables, formulation="displacement", layer=None):
     return out
 
 
-def study_only(formulation) -> None:
-    """Solve every level of ``TIP_LEVELS`` (peaks only) and record each as it lands."""
-    rows = []
-    for level, spec in enumerate(tip.TIP_LEVELS):
-        out = solve_level(level, False, formulation)
-        rows.append(
-            {
-                "level": level,
-                "mesh": {"n_t": spec.n_t, "h_mm": spec.h_m * 1e3, "n_theta": spec.n_fine_theta},
-                "dofs": int(out["dofs"]),
-                "seconds": out["seconds"],
-                "tip_peak": float(out["tip_peak"][1]),
-                "tip_peak_s_mm": float(out["tip_peak"][0]),
-                "tip_rim_peak": float(out["tip_rim_peak"][1]),
-                "row1_peak": out["row1_peak"],
-                "row1_at_junction": out["row1_at_junction"],
-            }
-        )
+RADIAL_N_T = (3, 4, 5)
+"""The ``radial`` family: elements through the rubber on level 0's surface mesh (level 0
+itself is its first member), the direction where the cylinder's error lies."""
+
+
+def _study_row(level, spec, out) -> dict:
+    return {
+        "level": level,
+        "mesh": {"n_t": spec.n_t, "h_mm": spec.h_m * 1e3, "n_theta": spec.n_fine_theta},
+        "dofs": int(out["dofs"]),
+        "seconds": out["seconds"],
+        "tip_peak": float(out["tip_peak"][1]),
+        "tip_peak_s_mm": float(out["tip_peak"][0]),
+        "tip_rim_peak": float(out["tip_rim_peak"][1]),
+        "row1_peak": out["row1_peak"],
+        "row1_at_junction": out["row1_at_junction"],
+    }
+
+
+def study_only(formulation, family="levels") -> None:
+    """Solve a family of meshes (peaks only) and record each as it lands, keeping what
+    is recorded already: ``levels``, every level of ``TIP_LEVELS``; ``radial``, level 0's
+    surface with ``RADIAL_N_T`` elements through the rubber."""
+    data = json.loads(STUDY.read_text()) if STUDY.exists() else {}
+    if data.get("formulation") != formulation:
+        data = {"formulation": formulation}
+    if family == "levels":
+        specs = [(k, spec) for k, spec in enumerate(tip.TIP_LEVELS)]
+    else:
+        specs = [(0, dataclasses.replace(tip.TIP_LEVELS[0], n_t=n)) for n in RADIAL_N_T]
+    rows = data.setdefault(family, [])
+    done = {(r["level"], r["mesh"]["n_t"]) for r in rows}
+    for level, spec in specs:
+        if (level, spec.n_t) in done:
+            continue
+        if family == "radial" and spec == tip.TIP_LEVELS[0]:
+            known = [r for r in data.get("levels", []) if r["level"] == 0]
+            if known:
+                rows.append(known[0])
+                continue
+        out = solve_level(level, False, formulation, spec=spec)
+        rows.append(_study_row(level, spec, out))
         STUDY.parent.mkdir(parents=True, exist_ok=True)
         tmp = STUDY.with_suffix(".tmp")
-        tmp.write_text(json.dumps({"formulation": formulation, "levels": rows}, indent=1))
+        tmp.write_text(json.dumps(data, indent=1))
         tmp.replace(STUDY)
 
 
@@ -140,9 +166,10 @@ def main(argv=None) -> None:
     parser.add_argument("--study", action="store_true", help="also solve every other level")
     parser.add_argument(
         "--study-only",
-        action="store_true",
-        help="solve every level (peaks only, the tables untouched) into "
-        "docs/data/finger3d_tip_study.json",
+        choices=("levels", "radial"),
+        help="solve a family of meshes (peaks only, the tables untouched) into "
+        "docs/data/finger3d_tip_study.json: every level, or level 0's surface with 3, 4, 5 "
+        "elements through the rubber",
     )
     parser.add_argument(
         "--formulation",
@@ -161,7 +188,7 @@ def main(argv=None) -> None:
     layer = FOAM if args.foam else None
     formulation = "mixed" if args.foam else args.formulation
     if args.study_only:
-        study_only(formulation)
+        study_only(formulation, args.study_only)
         return
     levels = list(range(len(tip.TIP_LEVELS))) if args.study else [args.level]
     study = [solve_level(k, k == args.level, formulation, layer) for k in levels]

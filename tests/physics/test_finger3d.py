@@ -271,26 +271,32 @@ def test_model_md_dielectric_block_is_the_recorded_study():
 
 
 def test_recorded_dielectric_study_converges_through_the_skin_and_the_layer():
-    """The recorded convergence study (section 3c): for the solid skin, the solid 0.7-mm
-    rubber layer and the foam, the probe's peak grows monotonically as the skin is refined
-    (3, 4, 6 elements) at an observed order above 1.5 (quadratic elements on a smooth
-    solution; the locking displacement model gave below 1), the layer's refinement
-    (1, 2, 3 elements) moves it by under 2 %, and the table's mesh is within 2 % of the
-    extrapolated value (the bound docs/model.md states)."""
+    """The recorded convergence study (section 3c). The solid skin's point strain at the
+    ring depth grows monotonically as the skin is refined (3, 4, 6 elements) at an
+    observed order above 1.5 (quadratic elements on a smooth solution; the locking
+    displacement model gave below 1), and the table's mesh is within 3 % of its
+    extrapolated value. What the capacitor reads, the layer's mean strain, a mean through
+    the layer, moves by under 1 % over the skin's refinement and over the layer's (1, 2,
+    3 elements), and the table is within 1 % of the converged value: the bounds
+    docs/model.md states."""
     import json
 
     script = _dielectric_script()
-    study = script.convergence(json.loads(script.DATA.read_text()))
+    data = json.loads(script.DATA.read_text())
+    study = script.convergence(data)
     assert set(study) == set(script.STUDY_CASES)
     for k, fams in study.items():
-        radial = fams["radial"]
-        assert radial["peaks"][0] < radial["peaks"][1] < radial["peaks"][2]
-        assert radial["order"] > 1.5
-        if script.CASES[k] is not None:
+        radial = fams["radial"]["peaks"]
+        table = data["solves"][script._key(k, script.TABLE_MESH)]["probe_50g_deflection_pct"]
+        if script.CASES[k] is None:
+            assert radial[0] < radial[1] < radial[2]
+            assert fams["radial"]["order"] > 1.5
+            assert abs(table / fams["converged"] - 1) < 0.03
+        else:
+            assert max(radial) / min(radial) - 1 < 0.01
             layer = fams["layer"]["peaks"]
-            assert abs(layer[-1] / layer[0] - 1) < 0.02
-        table = json.loads(script.DATA.read_text())["solves"][script._key(k, script.TABLE_MESH)]
-        assert abs(table["probe_50g_deflection_pct"] / fams["converged"] - 1) < 0.02
+            assert max(layer) / min(layer) - 1 < 0.01
+            assert abs(table / fams["converged"] - 1) < 0.01
 
 
 @pytest.mark.slow
