@@ -15,9 +15,10 @@ finger, ``(y, z) = r (sin theta, cos theta)``.
 The mesh is a structured tensor-product hexahedral mesh in ``(r, theta, x)``
 (``MeshHex.init_tensor``) mapped onto the shell, graded toward the load, with
 triquadratic elements (``ElementHex2``). Rubber is nearly incompressible
-(nu = 0.5 in the paper); a pure displacement formulation locks as nu -> 0.5, so
-the model uses nu = 0.49 by default with quadratic elements, which lock only
-mildly; :func:`poisson_study` quantifies the effect of nu = 0.45 / 0.48 / 0.49.
+(nu = 0.5 in the paper); a pure displacement formulation locks as nu -> 0.5, so the
+model solves for displacement and pressure together by default (Taylor-Hood, the forms
+in :mod:`tactsense.physics.finger3d_forms`), with nu = 0.49 (``scripts/
+finger3d_convergence.py`` gives the peak against nu from 0.45 to 0.5).
 
 Strain is the radial (normal) strain ``eps_rr = du_r/dr`` [-] (compressive
 negative), at the ring depth 3.2 mm under the outer surface by default.
