@@ -51,6 +51,10 @@ FORCE_N = 0.05 * 9.80665
 STRIP_WIDTH_M = 5.1e-3
 
 
+PLATE_GAP = Dielectric(tip.PLATE_ABOVE_CORE_M)
+"""The rubber between the core and a tactel's plate as a "layer" for the functionals
+only (never assembled): with it they read the mean normal strain over those 0.65 mm,
+the plate's displacement over the gap, instead of the point strain at the plate."""
 FOAM = Dielectric(0.5e-3, 7.0e4, 0.3)
 """The foam dielectric of section 2.3, as ``scripts/finger3d_table.py --foam`` has it."""
 
@@ -105,6 +109,14 @@ def solve_level(level, with_tables, formulation="displacement", layer=None, spec
     row1 = solution.solve(row_functional(solution, 1.1e-3, layer))
     out["row1_at_junction"] = solution.influence(row1, 0.0, 0.0).item()
     out["row1_peak"] = solution.influence(row1, 1.1, 0.0).item()
+    if layer is None and not with_tables:
+        # the mesh study: the same tactels read as a mean strain between the core and
+        # the plate (a displacement over 0.65 mm) besides the point strain
+        v = solution.solve(tip_functional(solution, 0.5, layer=PLATE_GAP))
+        meridian = solution.influence(v, S_MM, 0 * S_MM)
+        out["tip_mean_peak"] = (S_MM[int(np.argmin(meridian))], float(meridian.min()))
+        row1 = solution.solve(row_functional(solution, 1.1e-3, PLATE_GAP))
+        out["row1_mean_peak"] = solution.influence(row1, 1.1, 0.0).item()
     out["seconds"] = time.perf_counter() - start
     peak_s, peak = out["tip_peak"]
     print(f"level {level}: {out['dofs']} dof, {out['seconds']:.0f} s; tip peak "
@@ -128,18 +140,22 @@ def _study_row(level, spec, out) -> dict:
         "tip_rim_peak": float(out["tip_rim_peak"][1]),
         "row1_peak": out["row1_peak"],
         "row1_at_junction": out["row1_at_junction"],
+        "tip_mean_peak": out["tip_mean_peak"][1],
+        "row1_mean_peak": out["row1_mean_peak"],
     }
 
 
-def study_only(formulation, family="levels") -> None:
+def study_only(formulation, family="levels", max_level=None) -> None:
     """Solve a family of meshes (peaks only) and record each as it lands, keeping what
-    is recorded already: ``levels``, every level of ``TIP_LEVELS``; ``radial``, level 0's
+    is recorded already: ``levels``, the levels of ``TIP_LEVELS`` up to ``max_level``
+    (all if None); ``radial``, level 0's
     surface with ``RADIAL_N_T`` elements through the rubber."""
     data = json.loads(STUDY.read_text()) if STUDY.exists() else {}
     if data.get("formulation") != formulation:
         data = {"formulation": formulation}
     if family == "levels":
-        specs = [(k, spec) for k, spec in enumerate(tip.TIP_LEVELS)]
+        top = len(tip.TIP_LEVELS) - 1 if max_level is None else max_level
+        specs = [(k, spec) for k, spec in enumerate(tip.TIP_LEVELS) if k <= top]
     else:
         specs = [(0, dataclasses.replace(tip.TIP_LEVELS[0], n_t=n)) for n in RADIAL_N_T]
     rows = data.setdefault(family, [])
@@ -168,8 +184,8 @@ def main(argv=None) -> None:
         "--study-only",
         choices=("levels", "radial"),
         help="solve a family of meshes (peaks only, the tables untouched) into "
-        "docs/data/finger3d_tip_study.json: every level, or level 0's surface with 3, 4, 5 "
-        "elements through the rubber",
+        "docs/data/finger3d_tip_study.json: the levels up to --level, or level 0's surface "
+        "with 3, 4, 5 elements through the rubber",
     )
     parser.add_argument(
         "--formulation",
@@ -188,7 +204,7 @@ def main(argv=None) -> None:
     layer = FOAM if args.foam else None
     formulation = "mixed" if args.foam else args.formulation
     if args.study_only:
-        study_only(formulation, args.study_only)
+        study_only(formulation, args.study_only, args.level)
         return
     levels = list(range(len(tip.TIP_LEVELS))) if args.study else [args.level]
     study = [solve_level(k, k == args.level, formulation, layer) for k in levels]

@@ -191,8 +191,10 @@ def test_recorded_tip_study_does_not_converge_through_the_rubber():
     """The finding docs/model.md section 3b states: refined through the rubber (3, 4, 5
     elements on level 0's surface) the tip's peak and row 1's peak change by more than
     5 % at some step and the changes do not shrink, so no order is observable (the
-    Richardson step refuses them). When a better discretisation converges, this test
-    fails and the page's finding must change with it."""
+    Richardson step refuses them), while the same tactels read as a mean strain between
+    core and plate (a displacement over 0.65 mm) stay within 3 % (measured 1.8 % and
+    1.5 %). When a better discretisation converges, this test fails and the page's
+    finding must change with it."""
     import importlib.util
     from pathlib import Path
 
@@ -207,3 +209,6 @@ def test_recorded_tip_study_does_not_converge_through_the_rubber():
         assert np.max(np.abs(np.diff(values) / values[:-1])) > 0.05
         with pytest.raises(ValueError, match="shrink"):
             script.richardson(sizes, values)
+    for name in ("tip_mean_peak", "row1_mean_peak"):
+        values = np.abs([r[name] for r in radial])
+        assert values.max() / values.min() - 1 < 0.03
