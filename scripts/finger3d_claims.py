@@ -30,6 +30,7 @@ from scipy.optimize import least_squares
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "scripts"))
 from docblock import replace_block  # noqa: E402
+from finger3d_dielectric import table_rows  # noqa: E402
 
 import tactsense as ts  # noqa: E402
 from tactsense.estimate.finger import fit_checks  # noqa: E402
@@ -115,24 +116,25 @@ def compute() -> dict:
         for name, spec in presets.items()
     }
     study = json.loads(DIELECTRIC.read_text())
+    rows = table_rows(study)
 
     def case(modulus, nu, thickness_mm):
         return next(
             c
-            for c in study["cases"]
+            for c in rows
             if c["modulus_pa"] == modulus
             and c["poisson_ratio"] == nu
             and abs((c["thickness_mm"] or 0) - thickness_mm) < 1e-9
         )
 
-    solid_pt = next(c for c in study["cases"] if c["modulus_pa"] is None)
+    solid_pt = next(c for c in rows if c["modulus_pa"] is None)
     dielectric: dict = {
         "point_strain_pct": solid_pt["probe_50g_deflection_pct"],
         "rubber_layer_0.5_pct": case(2.5e5, 0.49, 0.5)["probe_50g_deflection_pct"],
         "rubber_layer_0.7_pct": case(2.5e5, 0.49, 0.7)["probe_50g_deflection_pct"],
         "foam_layer_pct": case(7.0e4, 0.3, 0.5)["probe_50g_deflection_pct"],
-        "level": study["level"],
-        "formulation": study.get("formulation", "displacement"),
+        "mesh": "/".join(map(str, study["table_mesh"])),
+        "formulation": study["formulation"],
     }
     tables = {f: table("probe", f) for f in ("finger3d", "finger3d-foam")}
     meta = {f: t[3] for f, t in tables.items()}
@@ -208,8 +210,8 @@ def block(data) -> str:
         f"`finger3d` the point strain at the ring depth, {d['table_peak_pct']['finger3d']:.1f} "
         f"%; `finger3d-foam` the foam layer's mean strain, "
         f"{d['table_peak_pct']['finger3d-foam']:.1f} % (the shipped tables). They are not "
-        "the same quantity on two skins: in section 3c's study (mesh level "
-        f"{d['level']}, {d['formulation']} elements) the mean strain of the bottom 0.5 mm "
+        "the same quantity on two skins: in section 3c's study (mesh "
+        f"{d['mesh']}, {d['formulation']} elements) the mean strain of the bottom 0.5 mm "
         "of the solid rubber itself is "
         f"{d['rubber_layer_0.5_pct'] / d['point_strain_pct']:.2f} of the point strain "
         f"({d['rubber_layer_0.5_pct']:.1f} % against {d['point_strain_pct']:.1f} %), so a "

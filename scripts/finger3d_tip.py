@@ -19,13 +19,19 @@ anywhere on the skin to ``src/tactsense/physics/data/finger3d_tip.npz``:
   cylinder's table does not cover.
 
 ``--study`` also solves every level of ``TIP_LEVELS`` (level 2 takes about 2.5 minutes
-and 5 GB) and stores each level's peaks: the mesh study quoted in docs/model.md. The
-tables are always those of ``--level``.
+and 5 GB) and stores each level's peaks in the table's file. The tables are always those
+of ``--level``. ``--study-only`` solves every level with ``--formulation`` (peaks only,
+no tables: the shipped tables stay as they are) and records them, level by level, in
+``docs/data/finger3d_tip_study.json``: the mesh study docs/model.md quotes
+(``scripts/finger3d_tip_figure.py`` reads it, with the observed order and the
+extrapolated peaks).
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
+import json
 import time
 from pathlib import Path
 
@@ -34,7 +40,9 @@ import numpy as np
 from tactsense.physics import finger3d_tip as tip
 from tactsense.physics.finger3d import Dielectric
 
-OUT = Path(__file__).resolve().parents[1] / "src" / "tactsense" / "physics" / "data"
+ROOT = Path(__file__).resolve().parents[1]
+OUT = ROOT / "src" / "tactsense" / "physics" / "data"
+STUDY = ROOT / "docs" / "data" / "finger3d_tip_study.json"
 S_MM = np.round(np.r_[np.arange(tip.APEX_S_M * 1e3, 12.0, 0.25), 12.0], 4)
 S_TIP_MM = S_MM[S_MM <= 0.5]
 ANGLE_DEG = np.round(np.r_[np.arange(0.0, 40.0, 1.0), np.arange(40.0, 180.01, 4.0)], 3)
@@ -43,6 +51,10 @@ FORCE_N = 0.05 * 9.80665
 STRIP_WIDTH_M = 5.1e-3
 
 
+PLATE_GAP = Dielectric(tip.PLATE_ABOVE_CORE_M)
+"""The rubber between the core and a tactel's plate as a "layer" for the functionals
+only (never assembled): with it they read the mean normal strain over those 0.65 mm,
+the plate's displacement over the gap, instead of the point strain at the plate."""
 FOAM = Dielectric(0.5e-3, 7.0e4, 0.3)
 """The foam dielectric of section 2.3, as ``scripts/finger3d_table.py --foam`` has it."""
 
@@ -78,9 +90,10 @@ def row_functional(solution, row_m, layer=None):
     return solution.normal_strain_functional([[row_m], [0.0], [rho]], [[0.0], [0.0], [1.0]])
 
 
-def solve_level(level, with_tables, formulation="displacement", layer=None):
+def solve_level(level, with_tables, formulation="displacement", layer=None, spec=None):
     start = time.perf_counter()
-    solution = tip.assemble(tip.TIP_LEVELS[level], formulation=formulation, dielectric=layer)
+    spec = tip.TIP_LEVELS[level] if spec is None else spec
+    solution = tip.assemble(spec, formulation=formulation, dielectric=layer)
     s, angle = np.meshgrid(S_MM, ANGLE_DEG, indexing="ij")
     out = {"dofs": solution.n_dofs}
     for name, inner in (("tip", 0.5), ("tip_rim", 0.75)):
@@ -96,6 +109,14 @@ def solve_level(level, with_tables, formulation="displacement", layer=None):
     row1 = solution.solve(row_functional(solution, 1.1e-3, layer))
     out["row1_at_junction"] = solution.influence(row1, 0.0, 0.0).item()
     out["row1_peak"] = solution.influence(row1, 1.1, 0.0).item()
+    if layer is None and not with_tables:
+        # the mesh study: the same tactels read as a mean strain between the core and
+        # the plate (a displacement over 0.65 mm) besides the point strain
+        v = solution.solve(tip_functional(solution, 0.5, layer=PLATE_GAP))
+        meridian = solution.influence(v, S_MM, 0 * S_MM)
+        out["tip_mean_peak"] = (S_MM[int(np.argmin(meridian))], float(meridian.min()))
+        row1 = solution.solve(row_functional(solution, 1.1e-3, PLATE_GAP))
+        out["row1_mean_peak"] = solution.influence(row1, 1.1, 0.0).item()
     out["seconds"] = time.perf_counter() - start
     peak_s, peak = out["tip_peak"]
     print(f"level {level}: {out['dofs']} dof, {out['seconds']:.0f} s; tip peak "
@@ -103,10 +124,69 @@ def solve_level(level, with_tables, formulation="displacement", layer=None):
     return out
 
 
+RADIAL_N_T = (3, 4, 5)
+"""The ``radial`` family: elements through the rubber on level 0's surface mesh (level 0
+itself is its first member), the direction where the cylinder's error lies."""
+
+
+def _study_row(level, spec, out) -> dict:
+    return {
+        "level": level,
+        "mesh": {"n_t": spec.n_t, "h_mm": spec.h_m * 1e3, "n_theta": spec.n_fine_theta},
+        "dofs": int(out["dofs"]),
+        "seconds": out["seconds"],
+        "tip_peak": float(out["tip_peak"][1]),
+        "tip_peak_s_mm": float(out["tip_peak"][0]),
+        "tip_rim_peak": float(out["tip_rim_peak"][1]),
+        "row1_peak": out["row1_peak"],
+        "row1_at_junction": out["row1_at_junction"],
+        "tip_mean_peak": out["tip_mean_peak"][1],
+        "row1_mean_peak": out["row1_mean_peak"],
+    }
+
+
+def study_only(formulation, family="levels", max_level=None) -> None:
+    """Solve a family of meshes (peaks only) and record each as it lands, keeping what
+    is recorded already: ``levels``, the levels of ``TIP_LEVELS`` up to ``max_level``
+    (all if None); ``radial``, level 0's
+    surface with ``RADIAL_N_T`` elements through the rubber."""
+    data = json.loads(STUDY.read_text()) if STUDY.exists() else {}
+    if data.get("formulation") != formulation:
+        data = {"formulation": formulation}
+    if family == "levels":
+        top = len(tip.TIP_LEVELS) - 1 if max_level is None else max_level
+        specs = [(k, spec) for k, spec in enumerate(tip.TIP_LEVELS) if k <= top]
+    else:
+        specs = [(0, dataclasses.replace(tip.TIP_LEVELS[0], n_t=n)) for n in RADIAL_N_T]
+    rows = data.setdefault(family, [])
+    done = {(r["level"], r["mesh"]["n_t"]) for r in rows}
+    for level, spec in specs:
+        if (level, spec.n_t) in done:
+            continue
+        if family == "radial" and spec == tip.TIP_LEVELS[0]:
+            known = [r for r in data.get("levels", []) if r["level"] == 0]
+            if known:
+                rows.append(known[0])
+                continue
+        out = solve_level(level, False, formulation, spec=spec)
+        rows.append(_study_row(level, spec, out))
+        STUDY.parent.mkdir(parents=True, exist_ok=True)
+        tmp = STUDY.with_suffix(".tmp")
+        tmp.write_text(json.dumps(data, indent=1))
+        tmp.replace(STUDY)
+
+
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--level", type=int, default=1, help="mesh level of TIP_LEVELS")
     parser.add_argument("--study", action="store_true", help="also solve every other level")
+    parser.add_argument(
+        "--study-only",
+        choices=("levels", "radial"),
+        help="solve a family of meshes (peaks only, the tables untouched) into "
+        "docs/data/finger3d_tip_study.json: the levels up to --level, or level 0's surface "
+        "with 3, 4, 5 elements through the rubber",
+    )
     parser.add_argument(
         "--formulation",
         choices=("mixed", "displacement"),
@@ -123,6 +203,9 @@ def main(argv=None) -> None:
     args = parser.parse_args(argv)
     layer = FOAM if args.foam else None
     formulation = "mixed" if args.foam else args.formulation
+    if args.study_only:
+        study_only(formulation, args.study_only, args.level)
+        return
     levels = list(range(len(tip.TIP_LEVELS))) if args.study else [args.level]
     study = [solve_level(k, k == args.level, formulation, layer) for k in levels]
     main_level = study[levels.index(args.level)]

@@ -188,27 +188,39 @@ def two_layer_lame(r, pressure, inner, outer, c):
     return u, eps
 
 
-def test_dielectric_layer_matches_two_bonded_cylinders():
-    """A soft layer (7e4 Pa, nu 0.3, 0.5 mm) under the skin, uniform pressure, far cut
-    sliding (plane strain): the layer's mean strain (its top's displacement over its
-    thickness) and the skin's radial strain match the two-layer closed form
-    (``two_layer_lame``, independent of the FEM): the layer's strain within 0.3 % (measured
-    0.05 %), the skin's, a derivative and small beside the layer's, within 1.5 % (measured
-    0.9 %), on the coarsest mesh."""
+@pytest.mark.parametrize(
+    ("modulus", "nu", "n_dielectric"),
+    [(7.0e4, 0.3, 1), (7.0e4, 0.3, 2), (1.5e5, 0.49, 1), (1.5e5, 0.49, 2)],
+)
+def test_dielectric_layer_matches_two_bonded_cylinders(modulus, nu, n_dielectric):
+    """A soft layer (0.5 mm: the foam, 7e4 Pa, nu 0.3, in displacement form; or a nearly
+    incompressible rubber, 1.5e5 Pa, nu 0.49, with a pressure field of its own) under the
+    skin, uniform pressure, far cut sliding (plane strain): the layer's mean strain (its
+    top's displacement over its thickness) and the skin's radial strain match the
+    two-layer closed form (``two_layer_lame``, independent of the FEM): the layer's strain
+    within 0.3 % for the foam (measured 0.05 %) and 1 % for the nearly incompressible
+    rubber, whose strain is small (measured 0.37 % with one element), the skin's, a
+    derivative and small beside the layer's, within 1.5 % (measured 0.9 %), on the
+    coarsest mesh, with one or two elements through the layer."""
+    from dataclasses import replace
+
     from skfem.models.elasticity import lame_parameters
 
-    layer = f.Dielectric(0.5e-3, 7.0e4, 0.3)
+    layer = f.Dielectric(0.5e-3, modulus, nu)
+    assert (nu > f.LAYER_PRESSURE_NU) == (nu == 0.49)
     pressure = 1.0e3
     area = 4 * np.pi * f.OUTER_M * SMALL.length_m
+    spec = replace(SMALL, n_dielectric=n_dielectric)
     sol = f.solve_load(
-        lambda x, s: 1.0 + 0 * x, pressure * area, spec=SMALL, far_end="sliding", dielectric=layer
+        lambda x, s: 1.0 + 0 * x, pressure * area, spec=spec, far_end="sliding", dielectric=layer
     )
+    assert len(sol.shell.nodes[2]) == SMALL.n_r + n_dielectric + 1
     inner = lame_parameters(layer.youngs_pa, layer.poisson_ratio)
     outer = lame_parameters(f.YOUNGS_PA, 0.49)
     c = f.CORE_M + layer.thickness_m
     u_c, _ = two_layer_lame(c, pressure, inner, outer, c)
     got = sol.dielectric_strain(np.array([0.0, 5e-3]), np.array([0.0, 2.0]))
-    np.testing.assert_allclose(got, u_c / layer.thickness_m, rtol=3e-3)
+    np.testing.assert_allclose(got, u_c / layer.thickness_m, rtol=3e-3 if nu < 0.4 else 1e-2)
     depth = np.array([1.0e-3, 2.0e-3])
     _, eps = two_layer_lame(f.OUTER_M - depth, pressure, inner, outer, c)
     np.testing.assert_allclose(
@@ -229,24 +241,71 @@ def _dielectric_script():
     return module
 
 
+def test_several_loads_on_one_factorisation_equal_one_solve_each():
+    """``solve_loads`` (one factorisation, the dielectric study's knife and probe) gives
+    what ``solve_load`` gives for each load alone, to rounding (1e-9 of the peak)."""
+    layer = f.Dielectric(0.5e-3, 7.0e4, 0.3)
+    pressure, _ = f.hertz_probe()
+    loads = [(f.knife_edge(), 0.5), (pressure, 0.05 * 9.80665)]
+    together = f.solve_loads(loads, spec=SMALL, dielectric=layer)
+    xs = np.array([0.0, 2e-3, 6e-3])
+    for (shape, force), joint in zip(loads, together, strict=True):
+        alone = f.solve_load(shape, force, spec=SMALL, dielectric=layer)
+        want = alone.dielectric_strain(xs, 0 * xs)
+        np.testing.assert_allclose(
+            joint.dielectric_strain(xs, 0 * xs), want, atol=1e-9 * np.abs(want).max()
+        )
+
+
 def test_model_md_dielectric_block_is_the_recorded_study():
     """docs/model.md's dielectric table is generated from the study's recorded results
-    (docs/data/finger3d_dielectric.json, written by the script's --solve)."""
+    (docs/data/finger3d_dielectric.json, written by the script's --solve): every case on
+    the table's mesh, mixed elements."""
     import json
 
     script = _dielectric_script()
     data = json.loads(script.DATA.read_text())
-    assert len(data["cases"]) == len(script.CASES)
+    assert data["formulation"] == "mixed"
+    assert len(script.table_rows(data)) == len(script.CASES)
     assert script.block(data) in script.DOC.read_text()
+
+
+def test_recorded_dielectric_study_converges_through_the_skin_and_the_layer():
+    """The recorded convergence study (section 3c). The solid skin's point strain at the
+    ring depth grows monotonically as the skin is refined (3, 4, 6 elements) at an
+    observed order above 1.5 (quadratic elements on a smooth solution; the locking
+    displacement model gave below 1), and the table's mesh is within 3 % of its
+    extrapolated value. What the capacitor reads, the layer's mean strain, a mean through
+    the layer, moves by under 1 % over the skin's refinement and over the layer's (1, 2,
+    3 elements), and the table is within 1 % of the converged value: the bounds
+    docs/model.md states."""
+    import json
+
+    script = _dielectric_script()
+    data = json.loads(script.DATA.read_text())
+    study = script.convergence(data)
+    assert set(study) == set(script.STUDY_CASES)
+    for k, fams in study.items():
+        radial = fams["radial"]["peaks"]
+        table = data["solves"][script._key(k, script.TABLE_MESH)]["probe_50g_deflection_pct"]
+        if script.CASES[k] is None:
+            assert radial[0] < radial[1] < radial[2]
+            assert fams["radial"]["order"] > 1.5
+            assert abs(table / fams["converged"] - 1) < 0.03
+        else:
+            assert max(radial) / min(radial) - 1 < 0.01
+            layer = fams["layer"]["peaks"]
+            assert max(layer) / min(layer) - 1 < 0.01
+            assert abs(table / fams["converged"] - 1) < 0.01
 
 
 @pytest.mark.slow
 def test_regression_dielectric_study_is_reproduced():
-    """One case of the recorded study, solved again: the fitted depth and nu agree to the
-    printed digits.
+    """The foam case of the recorded study on its cheapest mesh, solved again: the probe's
+    peak, the fitted depth and nu agree with the record.
 
     Regression test, not a check of correctness: the same solver and the same mesh as
-    the table's, so it shows the recorded study is what today's code computes (the
+    the record's, so it shows the recorded study is what today's code computes (the
     pipeline has not changed), and would pass with a wrong solver. Correctness is
     checked against independent solutions in this file (Lame, two bonded
     cylinders, a flat bonded layer, the mesh study).
@@ -255,18 +314,12 @@ def test_regression_dielectric_study_is_reproduced():
 
     script = _dielectric_script()
     data = json.loads(script.DATA.read_text())
-    case = next(c for c in data["cases"] if c["modulus_pa"] == 7.0e4 and c["poisson_ratio"] == 0.3)
-    assert case["thickness_mm"] == 0.5
-    layer = f.Dielectric(0.5e-3, 7.0e4, 0.3)
-    sol = f.solve_load(
-        f.knife_edge(),
-        0.5,
-        spec=f.LEVELS[data["level"]],
-        dielectric=layer,
-        formulation=data.get("formulation", "displacement"),
+    foam = script.CASES.index((7.0e4, 0.3, 0.5e-3))
+    mesh = script.RADIAL_MESHES[0]
+    record = data["solves"][script._key(foam, mesh)]
+    again = script.solve_case(foam, mesh)
+    assert again["probe_50g_deflection_pct"] == pytest.approx(
+        record["probe_50g_deflection_pct"], rel=1e-6
     )
-    along = sol.dielectric_strain(script.XS, 0 * script.XS)
-    full = np.concatenate([along[:0:-1], along])
-    depth, nu, _ = script.fit_2d(np.array(data["x_mm"]) * 1e-3, full)
-    assert abs(depth * 1e3 - case["fit_depth_mm"]) < 0.005
-    assert abs(nu - case["fit_nu"]) < 0.005
+    assert abs(again["fit_depth_mm"] - record["fit_depth_mm"]) < 0.005
+    assert abs(again["fit_nu"] - record["fit_nu"]) < 0.005

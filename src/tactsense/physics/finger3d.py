@@ -15,9 +15,10 @@ finger, ``(y, z) = r (sin theta, cos theta)``.
 The mesh is a structured tensor-product hexahedral mesh in ``(r, theta, x)``
 (``MeshHex.init_tensor``) mapped onto the shell, graded toward the load, with
 triquadratic elements (``ElementHex2``). Rubber is nearly incompressible
-(nu = 0.5 in the paper); a pure displacement formulation locks as nu -> 0.5, so
-the model uses nu = 0.49 by default with quadratic elements, which lock only
-mildly; :func:`poisson_study` quantifies the effect of nu = 0.45 / 0.48 / 0.49.
+(nu = 0.5 in the paper); a pure displacement formulation locks as nu -> 0.5, so the
+model solves for displacement and pressure together by default (Taylor-Hood, the forms
+in :mod:`tactsense.physics.finger3d_forms`), with nu = 0.49 (``scripts/
+finger3d_convergence.py`` gives the peak against nu from 0.45 to 0.5).
 
 Strain is the radial (normal) strain ``eps_rr = du_r/dr`` [-] (compressive
 negative), at the ring depth 3.2 mm under the outer surface by default.
@@ -31,10 +32,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy import sparse
-from scipy.sparse.linalg import spsolve
+from scipy.sparse.linalg import splu
 from skfem import (
     Basis,
-    BilinearForm,
     ElementHex1,
     ElementHex2,
     FacetBasis,
@@ -46,8 +46,19 @@ from skfem import (
 from skfem.models.elasticity import lame_parameters
 
 from tactsense._validation import check_choice
+from tactsense.physics.finger3d_forms import (
+    LAYER_PRESSURE_NU as LAYER_PRESSURE_NU,
+)
+from tactsense.physics.finger3d_forms import (
+    YOUNGS_PA,
+    _stiffness,
+    _stiffness_layered,
+    mixed_layered,
+)
+from tactsense.physics.finger3d_forms import (
+    mixed_system as mixed_system,
+)
 
-YOUNGS_PA = 2.5e5
 OUTER_M = 12.7e-3
 CORE_M = 8.85e-3
 RING_DEPTH_M = 3.2e-3
@@ -70,8 +81,9 @@ class MeshSpec:
     length_m : float
         Distance from the load to the clamped cut [m].
     dielectric_m : float
-        Thickness of a layer on the core meshed apart (one element through it), so that
-        a dielectric of its own material can fill it (:class:`Dielectric`) [m]; 0: none.
+        Thickness of a layer on the core meshed apart (``n_dielectric`` elements through
+        it), so that a dielectric of its own material can fill it (:class:`Dielectric`)
+        [m]; 0: none.
     """
 
     n_r: int = 2
@@ -80,6 +92,8 @@ class MeshSpec:
     fine_m: float = 6e-3
     length_m: float = 25e-3
     dielectric_m: float = 0.0
+    n_dielectric: int = 1
+    """Elements through the dielectric layer (when ``dielectric_m`` > 0)."""
     radial_growth: float = 1.0
     """Ratio of each element's thickness to the one below it, from the core out (1:
     uniform; above 1 the elements thin toward the core, where the strain's gradient
@@ -145,6 +159,8 @@ class ShellMesh:
     end: np.ndarray
     nodes: tuple
     cell_of: np.ndarray
+    dielectric_m: float = 0.0
+    """Thickness of the layer meshed apart on the core [m] (0: none)."""
 
     def find_cells(self, x, theta, r):
         """Cell containing box coordinates (x, theta, r): exact on the structured box."""
@@ -165,7 +181,8 @@ def build_mesh(spec: MeshSpec = LEVELS[0]) -> ShellMesh:
     """
     if spec.dielectric_m > 0:
         top = CORE_M + spec.dielectric_m
-        r = np.concatenate([[CORE_M], radial_nodes(top, spec.n_r, spec.radial_growth)])
+        layer = np.linspace(CORE_M, top, spec.n_dielectric + 1)[:-1]
+        r = np.concatenate([layer, radial_nodes(top, spec.n_r, spec.radial_growth)])
     else:
         r = radial_nodes(CORE_M, spec.n_r, spec.radial_growth)
     theta = _graded(spec.fine_m / OUTER_M, np.pi, spec.n_fine, spec.n_coarse)
@@ -191,6 +208,7 @@ def build_mesh(spec: MeshSpec = LEVELS[0]) -> ShellMesh:
         sym_x=facets(0, 0.0),
         sym_y=np.concatenate([facets(1, 0.0), facets(1, np.pi)]),
         end=facets(0, spec.length_m),
+        dielectric_m=spec.dielectric_m,
     )
 
 
@@ -270,8 +288,8 @@ class Solution:
         """Mean radial strain of the dielectric layer [-] (compression negative): its
         top's radial displacement over its thickness (the bottom is bonded to the core),
         the capacitor's fractional deflection ``dd / d_o`` with a minus sign."""
-        thickness = self.shell.nodes[2][1] - CORE_M
-        if self.shell.nodes[2][1] >= OUTER_M or not self.has_dielectric:
+        thickness = self.shell.dielectric_m
+        if thickness <= 0 or not self.has_dielectric:
             raise ValueError("this solution has no dielectric layer")
         top = CORE_M + thickness
         return self.radial_displacement(x, theta, np.full(np.shape(x), top)) / thickness
@@ -292,97 +310,6 @@ class Solution:
             probe = self._probes(x.ravel(), theta.ravel(), rr)
             radial.append((probe @ self.u[1]) * sin + (probe @ self.u[2]) * cos)
         return ((radial[0] - radial[1]) / (2 * step)).reshape(x.shape)
-
-
-def _gradient_blocks(basis, weight=None):
-    """The nine scalar blocks ``G_ij = int w d_i(phi_a) d_j(phi_b)`` (``w``: a function of
-    the quadrature points' coordinates, or 1), six assembled: ``G_ji = G_ij^T``."""
-    g = {}
-    for i in range(3):
-        for j in range(i, 3):
-            if weight is None:
-                form = BilinearForm(lambda u, v, w, i=i, j=j: v.grad[i] * u.grad[j])
-            else:
-                form = BilinearForm(lambda u, v, w, i=i, j=j: weight(w.x) * v.grad[i] * u.grad[j])
-            g[i, j] = asm(form, basis)
-            g[j, i] = g[i, j].T
-    return g
-
-
-def _elasticity(g_lam, g_mu):
-    """Block (c, d) of the stiffness: ``G^lam_cd + G^mu_dc + delta_cd sum_i G^mu_ii``."""
-    trace = g_mu[0, 0] + g_mu[1, 1] + g_mu[2, 2]
-    blocks = [
-        [g_lam[c, d] + g_mu[d, c] + (trace if c == d else 0 * trace) for d in range(3)]
-        for c in range(3)
-    ]
-    return sparse.bmat(blocks, format="csr")
-
-
-def _stiffness(basis, lam, mu):
-    """Elasticity stiffness, component-major dofs [u_x; u_y; u_z].
-
-    Assembled from the six scalar blocks ``G_ij = int d_i(phi_a) d_j(phi_b)``
-    (much faster than the vector element's form): block (c, d) is
-    ``lam G_cd + mu delta_cd sum_i G_ii + mu G_dc``.
-    """
-    g = _gradient_blocks(basis)
-    return _elasticity({k: lam * v for k, v in g.items()}, {k: mu * v for k, v in g.items()})
-
-
-def _stiffness_layered(basis, rubber, dielectric, top_m):
-    """Elasticity stiffness with the material chosen per quadrature point by its radius:
-    ``dielectric`` (lam, mu) below ``top_m`` (an element boundary), ``rubber`` above."""
-
-    def material(k):
-        return lambda x: np.where(np.hypot(x[1], x[2]) < top_m, dielectric[k], rubber[k])
-
-    return _elasticity(_gradient_blocks(basis, material(0)), _gradient_blocks(basis, material(1)))
-
-
-def _divergence_blocks(basis, pressure_basis, region=None):
-    """``B = [B_x, B_y, B_z]`` with ``B_c[q, a] = int w psi_q d_c(phi_a)`` (``psi``: the
-    pressure's basis, ``w`` the indicator ``region(x)`` of where the pressure lives, or 1):
-    ``B u`` tests ``div u``; shape (pressure dofs, 3 N)."""
-    w_of = (lambda x: 1.0) if region is None else region
-    blocks = [
-        asm(BilinearForm(lambda u, v, w, c=c: w_of(w.x) * v * u.grad[c]), basis, pressure_basis)
-        for c in range(3)
-    ]
-    return sparse.hstack(blocks, format="csr")
-
-
-def mixed_system(stiffness, basis, pressure_basis, inverse_lam, incompressible=None):
-    """The displacement-pressure (u-p) system of nearly incompressible elasticity.
-
-    ``sigma = 2 mu eps(u) - p I`` with ``p = -lam div u`` held weakly on the pressure's
-    own (lower-order, continuous) basis where ``incompressible(x)`` is 1 (everywhere if
-    None): Taylor-Hood, inf-sup stable, so the rubber (nu 0.49, or 0.5 exactly) does not
-    lock as the pure displacement form does (``docs/model.md``, section 3a).
-
-    Parameters
-    ----------
-    stiffness : sparse matrix (3 N, 3 N)
-        The displacement block ``A``: ``2 mu eps(u) : eps(v)`` everywhere, plus
-        ``lam (div u)(div v)`` only where the material is compressible (a dielectric).
-    inverse_lam : callable
-        ``1 / lam`` [1/Pa] at points (3, ...) [m] (0 for nu = 0.5).
-    incompressible : callable, optional
-        Indicator (0 or 1) of the region the pressure lives on, at points (3, ...).
-
-    Returns
-    -------
-    matrix : sparse matrix
-        The symmetric, indefinite ``[[A, -B^T], [-B, -M / lam]]`` over ``[u; p]``.
-    support : ndarray
-        The pressure dofs that carry anything (the others are dropped by the caller).
-    """
-    inside = (lambda x: np.ones(np.shape(x)[1:])) if incompressible is None else incompressible
-    divergence = _divergence_blocks(basis, pressure_basis, inside)
-    mass = asm(BilinearForm(lambda u, v, w: inside(w.x) * inverse_lam(w.x) * u * v), pressure_basis)
-    support = asm(BilinearForm(lambda u, v, w: inside(w.x) * u * v), pressure_basis).diagonal()
-    matrix = sparse.bmat([[stiffness, -divergence.T], [-divergence, -mass]], format="csr")
-    return matrix, np.nonzero(support > 0)[0]
 
 
 def _fixed_dofs(basis, shell: ShellMesh, far_end):
@@ -444,6 +371,28 @@ def solve_load(
     -------
     Solution
     """
+    (solution,) = solve_loads(
+        [(pressure, force_n)],
+        spec=spec,
+        poisson_ratio=poisson_ratio,
+        far_end=far_end,
+        dielectric=dielectric,
+        formulation=formulation,
+    )
+    return solution
+
+
+def solve_loads(
+    loads,
+    *,
+    spec: MeshSpec = LEVELS[0],
+    poisson_ratio=0.49,
+    far_end="clamped",
+    dielectric: Dielectric | None = None,
+    formulation: str = "mixed",
+) -> list[Solution]:
+    """:func:`solve_load` for several loads ``[(pressure, force_n), ...]`` on one mesh:
+    assembled and factorised once (the same numbers as one call per load)."""
     check_choice(far_end, "far_end", ("clamped", "sliding"))
     check_choice(formulation, "formulation", ("mixed", "displacement"))
     if dielectric is not None:
@@ -464,28 +413,32 @@ def solve_load(
         n_pressure = 0
     top = FacetBasis(shell.mesh, ElementHex2(), facets=shell.outer, intorder=6)
 
+    fixed = _fixed_dofs(basis, shell, far_end)
+    free = np.setdiff1d(np.arange(3 * basis.N + n_pressure), fixed)
+    lu = splu(stiffness[free][:, free].tocsc())
+    solutions = []
+    for pressure, force_n in loads:
+        f = np.concatenate([_load_vector(top, pressure, force_n), np.zeros(n_pressure)])
+        u = np.zeros(3 * basis.N + n_pressure)
+        u[free] = lu.solve(f[free])
+        solutions.append(
+            Solution(basis, u[: 3 * basis.N].reshape(3, -1), shell, dielectric is not None)
+        )
+    return solutions
+
+
+def _load_vector(top: FacetBasis, pressure, force_n) -> np.ndarray:
+    """The outer surface's load vector (component-major) of the pressure shape
+    ``pressure(x, s)`` scaled to ``force_n`` [N] on the whole finger."""
+
     def shape(w):
         theta, _ = _polar(w.x)
         return pressure(w.x[0], OUTER_M * theta)
 
     scale = 0.25 * force_n / asm(LinearForm(lambda v, w: shape(w) * v), top).sum()
-    f = np.concatenate(
+    return np.concatenate(
         [asm(LinearForm(lambda v, w, c=c: -scale * shape(w) * w.n[c] * v), top) for c in range(3)]
     )
-    f = np.concatenate([f, np.zeros(n_pressure)])
-    fixed = _fixed_dofs(basis, shell, far_end)
-    u = np.zeros(3 * basis.N + n_pressure)
-    free = np.setdiff1d(np.arange(3 * basis.N + n_pressure), fixed)
-    u[free] = spsolve(stiffness[free][:, free].tocsc(), f[free])
-    return Solution(basis, u[: 3 * basis.N].reshape(3, -1), shell, dielectric is not None)
-
-
-def _lame(youngs_pa, poisson_ratio):
-    """(lam, mu) [Pa]; lam infinite at nu 0.5 (only the mixed form takes it)."""
-    mu = youngs_pa / (2 * (1 + poisson_ratio))
-    if poisson_ratio >= 0.5:
-        return np.inf, mu
-    return youngs_pa * poisson_ratio / ((1 + poisson_ratio) * (1 - 2 * poisson_ratio)), mu
 
 
 def _mixed_stiffness(basis, shell: ShellMesh, poisson_ratio, dielectric):
@@ -500,29 +453,6 @@ def _mixed_stiffness(basis, shell: ShellMesh, poisson_ratio, dielectric):
         return (np.hypot(x[1], x[2]) >= top).astype(float)
 
     return mixed_layered(basis, pressure_basis, poisson_ratio, dielectric, rubber)
-
-
-def mixed_layered(basis, pressure_basis, poisson_ratio, dielectric=None, rubber=None):
-    """The u-p matrix of the skin's rubber (nu ``poisson_ratio``), and of a compressible
-    ``dielectric`` where the indicator ``rubber(x)`` is 0, restricted to the pressure dofs
-    that carry anything: (matrix, their count). Shared by the cylinder and the tip."""
-    lam, mu = _lame(YOUNGS_PA, poisson_ratio)
-    if dielectric is None:
-        g = _gradient_blocks(basis)
-        stiffness = _elasticity({k: 0 * v for k, v in g.items()}, {k: mu * v for k, v in g.items()})
-        matrix, keep = mixed_system(stiffness, basis, pressure_basis, lambda x: 0 * x[0] + 1 / lam)
-    else:
-        soft_lam, soft_mu = _lame(dielectric.youngs_pa, dielectric.poisson_ratio)
-        stiffness = _elasticity(
-            _gradient_blocks(basis, lambda x: soft_lam * (1 - rubber(x))),
-            _gradient_blocks(basis, lambda x: np.where(rubber(x) > 0, mu, soft_mu)),
-        )
-        matrix, keep = mixed_system(
-            stiffness, basis, pressure_basis, lambda x: rubber(x) / lam, rubber
-        )
-    n_u = 3 * basis.N
-    rows = np.concatenate([np.arange(n_u), n_u + keep])
-    return matrix[rows][:, rows], len(keep)
 
 
 def lame_radial_strain(r, pressure_pa, poisson_ratio, youngs_modulus=YOUNGS_PA):

@@ -59,12 +59,9 @@ from skfem import (
 from skfem.models.elasticity import lame_parameters
 
 from tactsense._validation import check_choice
-from tactsense.physics.finger3d import (
-    CORE_M,
-    OUTER_M,
-    RING_DEPTH_M,
+from tactsense.physics.finger3d import CORE_M, OUTER_M, RING_DEPTH_M, _graded
+from tactsense.physics.finger3d_forms import (
     YOUNGS_PA,
-    _graded,
     _lame,
     _stiffness,
     mixed_layered,
