@@ -280,26 +280,38 @@ def joint_fit(signal, seg, row, col, force, sensor, model, noise_var=None, max_c
     frames = np.asarray(seg["frame"])
     order = np.argsort(frames, kind="stable")
     bounds = np.flatnonzero(np.diff(frames[order])) + 1
+    described = math.sqrt(signal_noise_variance(sensor))
+    fitted = []  # first pass: each frame's contacts from the seeds, the noise described
     for group in np.split(order, bounds):
         good = group[np.isfinite(force[group]) & np.isfinite(row[group])]
         if len(good) == 0:
             continue
-        f = int(frames[good[0]])
-        frame = np.asarray(signal[f], float)
-        sigma = math.sqrt(signal_noise_variance(sensor))
+        frame = np.asarray(signal[int(frames[good[0]])], float)
         q, rss = None, np.inf
         for a0 in _seed_radii(model, seg, good):  # the best of a few starting sizes
             q2, rss2 = _fit_frame(
                 model, frame, row[good] * px, col[good] * py,
-                force[good], a0, sigma=sigma,
+                force[good], a0, sigma=described,
             )  # fmt: skip
             if rss2 < rss:
                 q, rss = q2, rss2
+        fitted.append((good, frame, q, rss))
+    if noise_var is not None:  # the frames' own noise where it exceeds the described
+        seen = data_noise_variance(model, [(frame, q) for _, frame, q, _ in fitted])
+        noise_var = max(noise_var, seen)
+    for good, frame, q, rss in fitted:
         parents = np.arange(len(good))
-        if noise_var is not None and max_contacts > len(good):
-            sigma = sigma + MODEL_ERROR * float(np.abs(frame).max())
-            moments = [(seg["rr"][i], seg["cc"][i], seg["rc"][i]) for i in good]
-            q, parents, rss = _order(model, frame, q, rss, moments, sigma**2, max_contacts)
+        if noise_var is not None and max_contacts > 1:
+            sigma = math.sqrt(noise_var) + MODEL_ERROR * float(np.abs(frame).max())
+            if len(good) > 1:  # a watershed region on noise alone: no contact there
+                q, rss, kept = _prune(model, frame, q, rss, list(parents), sigma**2)
+                parents = np.asarray(kept)
+            if max_contacts > len(q):
+                moments = [(seg["rr"][i], seg["cc"][i], seg["rc"][i]) for i in good]
+                q, local, rss = _order(
+                    model, frame, q, rss, [moments[p] for p in parents], sigma**2, max_contacts
+                )
+                parents = parents[local]
         seen = set()
         for j, p in enumerate(parents):
             i = good[p]
@@ -312,6 +324,61 @@ def joint_fit(signal, seg, row, col, force, sensor, model, noise_var=None, max_c
         for p in set(range(len(good))) - seen:  # an original pruned away: its row goes
             dropped.append(good[p])
     return row, col, force, radius, flat, added, dropped
+
+
+QUIET_SHARE = 0.02
+"""A taxel is quiet where the fitted contacts' signal is below this share of their
+largest [-]: what it reads there is noise (and rounding)."""
+
+MIN_QUIET = 32
+"""Fewest quiet readings on the noise's side that :func:`data_noise_variance` judges the
+noise from [-] (fewer: the described noise stands)."""
+
+HALF_NORMAL_MEDIAN = 0.6744897501960817
+"""Median of |n| for n ~ N(0, 1) [-]."""
+
+
+def data_noise_variance(model, fitted) -> float:
+    """The noise's variance [-^2] the frames themselves show, 0 where they cannot tell
+    (fewer than :data:`MIN_QUIET` readings to judge from), from ``fitted``: each frame
+    (rows, cols) [-] with its contacts (k, NP). A robust scale, pooled over the frames:
+    a few unmodelled readings (a contact's tail, a second contact, a region fitted on
+    noise) move a quantile little.
+
+    * Signed readings (capacitive): the residual of each frame against its strongest
+      contact alone (refitted), the median of its magnitude over the half-normal's
+      (0.674 sigma), times n / (n - 5) (the fit's five parameters took their share of
+      the residual): up to half the taxels may carry signal the one contact does not
+      explain. (The contacts fitted on noise regions leave no quiet taxel on a
+      capacitive pad: their modelled tension reaches every taxel.)
+    * A resistive taxel's noise at rest is clipped at zero (the converter's rail: it
+      reads max(n, 0)): over the quiet taxels (the contacts' signal below
+      :data:`QUIET_SHARE` of its largest), the median of the readings above zero over
+      the half-normal's median (0.674 sigma).
+
+    Why: the described read noise (``read_noise_counts``) may be far below what the pad
+    reads (a preset's 0.3 counts against 1-2 % of full scale on real arrays, 41-82
+    counts); weighed with it, every noise blob passes the information criterion as a
+    contact."""
+    values = []
+    for frame, q in fitted:
+        v = np.asarray(frame, float)
+        if model.capacitive:
+            one = q[int(np.argmax(q[:, 2]))][None, :]
+            one, _ = _fit_frame(model, v, *one.T)
+            m = model.signal(one[:, :2], one[:, 2], one[:, 3], one[:, 4], signed=True)
+            values.append(np.abs(v - m).ravel())
+        else:
+            m = model.signal(q[:, :2], q[:, 2], q[:, 3], q[:, 4], signed=True)
+            quiet = np.abs(m) <= QUIET_SHARE * max(float(np.abs(m).max()), 1e-300)
+            values.append(v[quiet & (v > 0)])
+    v = np.concatenate(values) if values else np.zeros(0)
+    if v.size < MIN_QUIET:
+        return 0.0
+    if model.capacitive:  # the fit's five parameters took their share of the residual
+        n = model.x_taxel.size * model.y_taxel.size
+        return float((np.median(v) / HALF_NORMAL_MEDIAN) ** 2 * n / max(n - NP, 1))
+    return float((np.median(v) / HALF_NORMAL_MEDIAN) ** 2)
 
 
 def _seed_radii(model, seg, good):
