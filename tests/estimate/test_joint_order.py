@@ -85,7 +85,7 @@ def test_pad4_pair_near_the_bound(angle_deg, cx, cy, truth_from):
     minimum before round 9 (placed 1.4-2.8 mm off: 55-120x the two-contact bound): two
     contacts, RMS position error within 4x the bound, on the Hankel solution's frames
     and on the estimator's own model's (quantized: what the algorithm reaches without
-    the table's error). Measured: 0.5x / 2.7x / 1.1x (Hankel) and 3.1x / 0.6x / 0.7x
+    the table's error). Measured: 0.73x / 2.7x / 0.62x (Hankel) and 3.1x / 0.58x / 0.59x
     (model). A bound on the RMS over placements, not on one: quantization is a fixed
     error per placement, not a fresh draw; over the table's twenty placements at 1.5
     pitches the RMS ratio is 2.5x (goal 2x, docs/contacts.md)."""
