@@ -139,8 +139,8 @@ frame's largest signal [-] (the table: 1e-3 against the Hankel transform,
 tests/_layer_truth.py), added to the noise's standard deviation when the criterion
 weighs a fit's residual."""
 
-MAX_POLISHED = 3
-"""Most contacts of a frame :func:`_polish` re-seeds (its starts grow as k^2)."""
+MAX_POLISHED = 2
+"""Most contacts of a frame :func:`_polish` re-seeds (its starts grow as k^2: pairs only)."""
 
 SPLIT_MIN_SHARE = 0.1
 """Each of two contacts found by a split carries at least this share of their force."""
