@@ -149,6 +149,8 @@ def noisy_rows():
             snr = float(np.median(np.abs(clean - rest).max(axis=(1, 2)))) / sd
             for told in (False, True):
                 est = spec.replace(flaws__read_noise_counts=sd) if told else spec
+                # the tables of a description are built on its first call: not timed
+                find_contacts(frames[:1], est, baseline=baseline, method="joint")
                 t0 = time.perf_counter()
                 fit = find_contacts(frames, est, baseline=baseline, method="joint", max_contacts=3)
                 dt = (time.perf_counter() - t0) / NOISY_FRAMES
@@ -188,7 +190,7 @@ def noisy_main() -> None:
         who = "the true noise" if told else "the preset (0.3 counts)"
         lines.append(
             f"| {name} | {noise} | {snr:.1f} | {who} | {one:.0f} % | {near:.0f} % | {pos:.3f} | "
-            f"{force:.1f} | {1e3 * dt:.0f} ms |"
+            f"{force:.1f} | {1e3 * dt:.1f} ms |"
         )
     lines += ["", NOISY_END]
     replace_block(ROOT / "docs" / "contacts.md", NOISY_BEGIN, NOISY_END, "\n".join(lines))
