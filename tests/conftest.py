@@ -21,7 +21,7 @@ def any_preset(request):
 # ---- the joint fit's tables kept in a folder of the session's own (r8-padjoint) ----
 @pytest.fixture(autouse=True, scope="session")
 def _table_cache_folder(tmp_path_factory):
-    """The pad fit's tables (``physics._pad_model.cached_table``) go to a temporary
+    """The pad fit's tables and the frames' (``physics._hertz_table.cached_response_table``) go to a temporary
     folder, not the user's cache."""
     import os
 

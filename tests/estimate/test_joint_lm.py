@@ -121,26 +121,34 @@ def test_pairs_on_pad4_in_every_orientation():
 
 
 def test_tables_kept_on_disk(tmp_path, monkeypatch):
-    """The fit's table is written once to the cache folder and read back exactly (every
-    factor equal), without building it again; an unwritable folder is no error."""
-    from tactsense.physics import _pad_model
+    """The fit's tables come from the shared disk cache of the frames' tables
+    (``_hertz_table.cached_response_table``): written once to the cache folder and read
+    back exactly (every factor equal) by a new process (the in-process copy cleared)
+    without building it again; an unwritable folder is no error."""
+    from tactsense.physics import _hertz_table, _pad_model
 
+    assert _pad_model.cached_response_table is _hertz_table.cached_response_table
+    cached = _hertz_table.cached_response_table
     layer = load_sensor("pad16").layer
     monkeypatch.setenv("TACTSENSE_CACHE_DIR", str(tmp_path / "cache"))
-    built = _pad_model.cached_table(layer, (1.0, 1.0), "sphere", 1.0, 0.1)
-    assert len(list((tmp_path / "cache").glob("pad_table_*.npz"))) == 1
+    cached.cache_clear()
+    built = cached(layer, (1.0, 1.0), "sphere", 1.0, 0.1)
+    assert len(list((tmp_path / "cache").glob("frames_table_*.npz"))) == 1
 
     def no_build(*args, **kwargs):
         raise AssertionError("built again")
 
-    monkeypatch.setattr(_pad_model, "layer_response_table", no_build)
-    read = _pad_model.cached_table(layer, (1.0, 1.0), "sphere", 1.0, 0.1)
+    cached.cache_clear()
+    monkeypatch.setattr(_hertz_table, "layer_response_table", no_build)
+    read = cached(layer, (1.0, 1.0), "sphere", 1.0, 0.1)
     np.testing.assert_array_equal(read.x_factors, built.x_factors)
     np.testing.assert_array_equal(read.y_factors, built.y_factors)
     assert (read.step_mm, read.a_step_mm, read.peak) == (built.step_mm, built.a_step_mm, built.peak)
     monkeypatch.undo()
+    cached.cache_clear()
     blocked = tmp_path / "file"
     blocked.write_text("")
     monkeypatch.setenv("TACTSENSE_CACHE_DIR", str(blocked / "cache"))  # under a file
-    again = _pad_model.cached_table(layer, (1.0, 1.0), "sphere", 1.0, 0.1)
+    again = cached(layer, (1.0, 1.0), "sphere", 1.0, 0.1)
+    cached.cache_clear()
     np.testing.assert_array_equal(again.x_factors, built.x_factors)

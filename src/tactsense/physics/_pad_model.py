@@ -10,18 +10,12 @@ of a frame jointly through :class:`PadContactModel` (a pad kind's ``contact_mode
 from __future__ import annotations
 
 import functools
-import hashlib
-import inspect
 import math
-import os
-import tempfile
-from pathlib import Path
 
 import numpy as np
 
-from tactsense.physics import _hertz_table, pad_response
 from tactsense.physics._contact_kernel import superpose
-from tactsense.physics._hertz_table import SeparableResponse, layer_response_table
+from tactsense.physics._hertz_table import cached_response_table
 
 FIT_A_STEP_MM = 0.1
 """Step of the fit's table in the pressure radius a [mm], linear between (the model
@@ -56,60 +50,6 @@ def sphere_radius_mm(force_n, contact_radius_mm, modulus_star_pa):
         return np.where(f > 0, 4.0 * modulus_star_pa * a**3 / (3.0 * f) * 1e3, np.nan)
 
 
-def cache_folder() -> Path:
-    """Where the fit's tables are kept between runs: ``$TACTSENSE_CACHE_DIR``, else
-    ``$XDG_CACHE_HOME/tactsense``, else ``~/.cache/tactsense``."""
-    if os.environ.get("TACTSENSE_CACHE_DIR"):
-        return Path(os.environ["TACTSENSE_CACHE_DIR"])
-    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
-    return Path(base) / "tactsense"
-
-
-@functools.lru_cache(maxsize=1)
-def _code_digest() -> str | None:
-    """Digest of the code that makes a table (a change of it makes new tables); None
-    where its source cannot be read (no cache then)."""
-    try:
-        text = inspect.getsource(_hertz_table) + inspect.getsource(pad_response)
-    except (OSError, TypeError):
-        return None
-    return hashlib.sha256(text.encode()).hexdigest()
-
-
-def cached_table(layer, electrode, shape, a_top_mm, a_step_mm) -> SeparableResponse:
-    """:func:`~tactsense.physics._hertz_table.layer_response_table`, kept on disk
-    (:func:`cache_folder`) by a digest of its inputs and of the code that makes it: the
-    first run builds it (seconds to a minute), later runs read it (milliseconds). A
-    folder that cannot be written is no error: the table is then built every run. The
-    file is written under a temporary name and moved into place."""
-    code = _code_digest()
-    if code is None:
-        return layer_response_table(layer, electrode, shape, a_top_mm, a_step_mm)
-    key = repr((layer, tuple(electrode), shape, float(a_top_mm), float(a_step_mm)))
-    digest = hashlib.sha256((key + code).encode()).hexdigest()[:32]
-    path = cache_folder() / f"pad_table_{digest}.npz"
-    fields = ("x_factors", "y_factors", "step_mm", "a_step_mm", "peak", "rank_error")
-    try:
-        with np.load(path) as stored:
-            return SeparableResponse(
-                **{f: stored[f] if stored[f].ndim else float(stored[f]) for f in fields}
-            )
-    except (OSError, KeyError, ValueError):
-        pass
-    table = layer_response_table(layer, electrode, shape, a_top_mm, a_step_mm)
-    partial = None
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with tempfile.NamedTemporaryFile(dir=path.parent, suffix=".part", delete=False) as f:
-            partial = f.name
-            np.savez(f, **{name: getattr(table, name) for name in fields})
-        os.replace(partial, path)
-    except OSError:
-        if partial is not None:
-            Path(partial).unlink(missing_ok=True)
-    return table
-
-
 class PadContactModel:
     """A pad's signal [-] under round contacts at (x, y) [mm], force [N], contact radius
     a [mm] and flat share (a Hertzian sphere's pressure, a flat disc's, or a mix): what
@@ -126,7 +66,7 @@ class PadContactModel:
         self.a_top_mm = FIT_A_STEP_MM * math.ceil(top / FIT_A_STEP_MM + 1e-9)
         electrode = (float(g.electrode_x_mm), float(g.electrode_y_mm))
         self.tables = {
-            shape: cached_table(layer, electrode, shape, self.a_top_mm, FIT_A_STEP_MM)
+            shape: cached_response_table(layer, electrode, shape, self.a_top_mm, FIT_A_STEP_MM)
             for shape in ("sphere", "disc")
         }
         self.factors = {
