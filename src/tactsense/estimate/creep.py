@@ -97,12 +97,12 @@ def creep_applied(sensor, attrs) -> tuple[Viscoelastic | None, float, str]:
     if kind is not None and not kind.array_calibration:  # its calibration's compensation
         return None, 0.0, "none"
     on = None  # the flaws a simulation switched on (None: a measured recording)
-    if not str(attrs.get("source", "")):
+    if _simulated(attrs):
         try:
             scenario = json.loads(str(attrs.get("scenario_json", "{}")))
         except ValueError:
             scenario = {}
-        if isinstance(scenario, dict) and scenario.get("steps"):
+        if isinstance(scenario, dict) and (scenario.get("steps") or _from_mujoco(attrs)):
             on = {f for f in str(attrs.get("flaws", "")).split(",") if f}
     if on is None:
         creep, stiffening = described_compensation(sensor)
@@ -113,6 +113,50 @@ def creep_applied(sensor, attrs) -> tuple[Viscoelastic | None, float, str]:
     if "nonlinearity" not in on:
         return creep, 0.0, "described (simulation)"
     return creep, float(sensor.flaws.nonlinear_saturation), "described (simulation)"
+
+
+MEMORY_FLAWS = ("viscoelastic", "hysteresis", "drift")
+"""The twin's flaws whose reading depends on the past: creep after a lift, a loop,
+a drifting zero."""
+
+
+def _from_mujoco(attrs) -> bool:
+    """Whether the recording was made by ``tactsense mujoco`` (its frames from
+    :func:`~tactsense.simulate.frames_from_contacts`, its flaws listed)."""
+    return str(attrs.get("source", "")).startswith("mujoco")
+
+
+def _simulated(attrs) -> bool:
+    """Whether tactsense made the frames, with the flaws its ``flaws`` attribute lists:
+    ``simulate`` (no ``source``) or ``tactsense mujoco`` (``source`` ``mujoco:...``)."""
+    return not str(attrs.get("source", "")) or _from_mujoco(attrs)
+
+
+def memory_possible(attrs) -> bool:
+    """Whether a recording's readings may carry a memory of earlier loads (creep after a
+    lift, hysteresis, drift), which the long table's baseline re-zeros after a lift
+    (``DriftBaseline``'s ``release``): True for a measured recording (imported,
+    streamed, recorded: its flaws are unknown) and for a simulation with one of
+    :data:`MEMORY_FLAWS` on; False for a simulation or a MuJoCo recording without them,
+    where a reading that falls under a contact is the contact moving (a ball sliding off
+    a taxel), not creep.
+
+    Parameters
+    ----------
+    attrs : dict
+        The recording's attributes (``RecordingReader.attrs``).
+    """
+    if not _simulated(attrs):
+        return True
+    if not _from_mujoco(attrs):
+        try:
+            scenario = json.loads(str(attrs.get("scenario_json", "{}")))
+        except ValueError:
+            return True
+        if not (isinstance(scenario, dict) and scenario.get("steps")):
+            return True
+    on = {f for f in str(attrs.get("flaws", "")).split(",") if f}
+    return bool(on & set(MEMORY_FLAWS))
 
 
 def described_compensation(sensor) -> tuple[Viscoelastic | None, float]:
