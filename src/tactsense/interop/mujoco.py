@@ -58,6 +58,7 @@ from pathlib import Path
 
 import numpy as np
 
+from tactsense.interop._mujoco_calibrate import joint_force_calibration
 from tactsense.interop._mujoco_contacts import (
     DEFAULT_FLAT_RADIUS_MM,
     SLIP_TOLERANCE,
@@ -95,6 +96,7 @@ __all__ = [
     "fingertip_model_path",
     "frame_blocks",
     "frame_count",
+    "joint_force_calibration",
     "load_model",
     "read_controls",
     "record_mujoco",
