@@ -267,9 +267,8 @@ class iter_contacts:
                 threshold=threshold,
                 time_constant_s=math.inf if drift_s is None else drift_s,
                 creep=creep, stiffening=stiffening,
-                # the lift re-zero only where the readings can carry a memory, and not
-                # when the baseline is to stay the first frames' (drift_s None)
-                release=None if drift_s is not None and memory_possible(reader.attrs) else False,
+                # the lift re-zero only where the readings can carry a memory
+                release=None if memory_possible(reader.attrs) else False,
             )  # fmt: skip
         self.tracker = ContactTracker(sensor.scan_period_s, **(tracker_options or {}))
         self._options = dict(calibration=calibration, threshold=threshold,

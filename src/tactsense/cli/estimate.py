@@ -158,7 +158,10 @@ def locate(
             max=1e6,
             help="Long table: time constant [s] with which the baseline follows slow "
             "drift where taxels are untouched (held while touched, as iCub's skin does; "
-            "docs/contacts.md); 0 keeps the first frames' baseline. With a pad's "
+            "docs/contacts.md); 0 keeps the first frames' baseline (a measured "
+            "recording's taxel is still re-zeroed after a lift, for the creep it may "
+            "carry; a simulated or MuJoCo recording without memory flaws never is). "
+            "With a pad's "
             "--calibration it starts from the calibration's baseline; not used with a "
             "finger's.",
         ),
