@@ -96,14 +96,7 @@ def creep_applied(sensor, attrs) -> tuple[Viscoelastic | None, float, str]:
     kind = kind_or_none(sensor)
     if kind is not None and not kind.array_calibration:  # its calibration's compensation
         return None, 0.0, "none"
-    on = None  # the flaws a simulation switched on (None: a measured recording)
-    if _simulated(attrs):
-        try:
-            scenario = json.loads(str(attrs.get("scenario_json", "{}")))
-        except ValueError:
-            scenario = {}
-        if isinstance(scenario, dict) and (scenario.get("steps") or _from_mujoco(attrs)):
-            on = {f for f in str(attrs.get("flaws", "")).split(",") if f}
+    on = _simulation_flaws(attrs)
     if on is None:
         creep, stiffening = described_compensation(sensor)
         return creep, stiffening, "none" if creep is None else "described (sensor file)"
@@ -126,10 +119,21 @@ def _from_mujoco(attrs) -> bool:
     return str(attrs.get("source", "")).startswith("mujoco")
 
 
-def _simulated(attrs) -> bool:
-    """Whether tactsense made the frames, with the flaws its ``flaws`` attribute lists:
-    ``simulate`` (no ``source``) or ``tactsense mujoco`` (``source`` ``mujoco:...``)."""
-    return not str(attrs.get("source", "")) or _from_mujoco(attrs)
+def _simulation_flaws(attrs) -> set[str] | None:
+    """The flaws tactsense switched on where it made the frames (its ``flaws``
+    attribute): ``simulate`` (no ``source``, a scenario with steps) or ``tactsense
+    mujoco`` (``source`` ``mujoco:...``); None for a measured recording (unknown)."""
+    if _from_mujoco(attrs):
+        return {f for f in str(attrs.get("flaws", "")).split(",") if f}
+    if str(attrs.get("source", "")):
+        return None
+    try:
+        scenario = json.loads(str(attrs.get("scenario_json", "{}")))
+    except ValueError:
+        return None
+    if not (isinstance(scenario, dict) and scenario.get("steps")):
+        return None
+    return {f for f in str(attrs.get("flaws", "")).split(",") if f}
 
 
 def memory_possible(attrs) -> bool:
@@ -146,17 +150,8 @@ def memory_possible(attrs) -> bool:
     attrs : dict
         The recording's attributes (``RecordingReader.attrs``).
     """
-    if not _simulated(attrs):
-        return True
-    if not _from_mujoco(attrs):
-        try:
-            scenario = json.loads(str(attrs.get("scenario_json", "{}")))
-        except ValueError:
-            return True
-        if not (isinstance(scenario, dict) and scenario.get("steps")):
-            return True
-    on = {f for f in str(attrs.get("flaws", "")).split(",") if f}
-    return bool(on & set(MEMORY_FLAWS))
+    on = _simulation_flaws(attrs)
+    return on is None or bool(on & set(MEMORY_FLAWS))
 
 
 def described_compensation(sensor) -> tuple[Viscoelastic | None, float]:

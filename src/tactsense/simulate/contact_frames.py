@@ -60,6 +60,18 @@ class ShearIgnoredWarning(UserWarning):
     """Tangential forces were given to a kind whose forward model does not take them."""
 
 
+def _per_contact(name, value, n, k) -> np.ndarray:
+    """``value`` (a number or an (n, k) array) as an (n, k) array of floats, or a
+    :class:`ContactBatchError` naming ``name`` and the shape expected."""
+    array = _array(name, value)
+    try:
+        return np.broadcast_to(array, (n, k))
+    except ValueError:
+        raise ContactBatchError(
+            f"{name} has shape {array.shape}; expected a number or ({n}, {k})"
+        ) from None
+
+
 class ContactBatchError(TactsenseInputError):
     """A :class:`ContactBatch` whose arrays do not fit together or hold bad values."""
 
@@ -131,13 +143,7 @@ class ContactBatch:
             if self.tangential_force_n is None
             else _array("tangential_force_n", self.tangential_force_n, (n, k, 2))
         )
-        radius = _array("radius_mm", self.radius_mm)
-        try:
-            radius = np.broadcast_to(radius, (n, k))
-        except ValueError:
-            raise ContactBatchError(
-                f"radius_mm has shape {radius.shape}; expected a number or ({n}, {k})"
-            ) from None
+        radius = _per_contact("radius_mm", self.radius_mm, n, k)
         if np.any(radius <= 0):
             raise ContactBatchError("radius_mm must be > 0 [mm]")
         if isinstance(self.shape, str):
@@ -161,13 +167,7 @@ class ContactBatch:
         object.__setattr__(self, "tangential_force_n", tangential)
         object.__setattr__(self, "radius_mm", radius)
         if self.friction is not None:
-            friction = _array("friction", self.friction)
-            try:
-                friction = np.broadcast_to(friction, (n, k))
-            except ValueError:
-                raise ContactBatchError(
-                    f"friction has shape {friction.shape}; expected a number or ({n}, {k})"
-                ) from None
+            friction = _per_contact("friction", self.friction, n, k)
             if np.any(friction < 0):
                 raise ContactBatchError("friction must be >= 0 [-] (0: not known)")
             object.__setattr__(self, "friction", friction)
