@@ -432,10 +432,16 @@ def test_pad_contacts_with_ids_trails_and_rezero(page, tmp_path):  # noqa: F811
         rows = page.locator("#contact-rows tr").all_inner_texts()
         assert any(r.startswith("#0") for r in rows) and any(r.startswith("#1") for r in rows)
         # re-zero, then step 6 frames: 5 make the new baseline, the 6th reads nothing
+        # each step waited for (a new frame reaches the page; at the recording's end a step
+        # sends its last frame again): on a loaded machine a click every 60 ms could land
+        # while the previous step was in flight and leave the baseline one frame short
         page.click("#rezero")
         for _ in range(6):
+            before = page.evaluate("() => window.tactsenseView.framesReceived")
             page.click("#step-fwd")
-            page.wait_for_timeout(60)
+            page.wait_for_function(
+                f"() => window.tactsenseView.framesReceived > {before}", timeout=10000
+            )
         page.wait_for_function(
             "() => { const e = window.tactsenseView.latest.estimate;"
             " return e && !e.rezeroing && e.n_contacts === 0; }",
