@@ -40,6 +40,7 @@ from tests._layer_truth import hankel_hertz_strain  # noqa: E402
 
 from tactsense.estimate.contacts import find_contacts  # noqa: E402
 from tactsense.estimate.contacts._joint_lm import residual_jacobian, tables_of  # noqa: E402
+from tactsense.estimate.reading import default_threshold  # noqa: E402
 from tactsense.kinds import kind_of  # noqa: E402
 from tactsense.physics._pad_model import hertz_radius_mm  # noqa: E402
 from tactsense.sensor.registry import load_sensor  # noqa: E402
@@ -51,39 +52,87 @@ SPHERES_MM = (1.0, 3.0, 10.0)
 DISCS_PITCH = (0.5, 1.0, 1.5)
 
 
-def _signal(spec, strain):
-    """The signal [-] a taxel reads, quantized to one A/D count."""
+def _step(spec):
+    """One A/D step in the signal's units [-] (capacitive: of the nominal reading;
+    resistive: of strain)."""
     t = spec.transduction
     if t.kind == "capacitive":
-        step = 1.0 / spec.electronics.nominal_counts
-        return np.round(t.strain_gain * strain / step) * step
-    return np.round(np.maximum(strain, 0.0) * t.counts_per_strain) / t.counts_per_strain
+        return 1.0 / spec.electronics.nominal_counts
+    return 1.0 / t.counts_per_strain
 
 
-def fisher_rank(spec, x, y, load, shape, radius):
-    """(rank of the Fisher matrix of (x, y, force, a), taxels read) of one contact."""
-    model = kind_of(spec).contact_model(spec)
+def _clean(spec, strain):
+    """The signal [-] a taxel reads, not quantized (a resistive taxel reads no tension)."""
     t = spec.transduction
-    per = spec.electronics.nominal_counts if t.kind == "capacitive" else t.counts_per_strain
+    return t.strain_gain * strain if t.kind == "capacitive" else np.maximum(strain, 0.0)
+
+
+def _signal(spec, strain):
+    """The signal [-] a taxel reads, quantized to one A/D count."""
+    step = _step(spec)
+    return np.round(_clean(spec, strain) / step) * step
+
+
+def _truth_parameters(model, x, y, load, shape, radius):
+    """(x, y [mm], F [N], a [mm], flat share [-]) of the truth in the fit's terms."""
     sphere = shape == "sphere"
     a = float(hertz_radius_mm(load, radius, model.modulus_star_pa)) if sphere else radius
-    p = np.array([x, y, load, min(a, model.a_top_mm - 1e-6), 0.0 if sphere else 1.0])
+    return np.array([x, y, load, min(a, model.a_top_mm - 1e-6), 0.0 if sphere else 1.0])
+
+
+def fisher(spec, p):
+    """(rank of the Fisher matrix of (x, y, F, a), rank of that of the fit's five
+    unknowns (x, y, F, a, flat share), the force's Cramer-Rao bound [%] of the five
+    under quantization's variance (one A/D step squared over 12; inf where singular),
+    taxels read) of one contact ``p`` (5,)."""
+    model = kind_of(spec).contact_model(spec)
     n = model.x_taxel.size * model.y_taxel.size
     r, jac = np.empty(n + 1), np.empty((n + 1, 5))
     residual_jacobian(
         p, np.zeros(n), model.x_taxel, model.y_taxel, tables_of(model), not model.capacitive,
         float(model.scale), np.zeros(4), r, jac,
     )  # fmt: skip
-    j = jac[:n, :4] * per  # in A/D steps: the quantization's 1/12 step^2 is the scale
-    j = j / np.maximum(np.linalg.norm(j, axis=0), 1e-300)  # rank in any units
-    s = np.linalg.svd(j, compute_uv=False)
-    return int(np.sum(s > 1e-6 * s[0])), int(np.sum(np.abs(r[:n]) * per >= 0.5))
+    j = jac[:n] / _step(spec)  # in A/D steps: the quantization's 1/12 step^2 is the scale
+    unit = j / np.maximum(np.linalg.norm(j, axis=0), 1e-300)  # rank in any units
+
+    def rank(m):
+        s = np.linalg.svd(m, compute_uv=False)
+        return int(np.sum(s > 1e-6 * s[0]))
+
+    full = rank(unit)
+    bound = np.inf
+    if full == 5:
+        bound = 100.0 * float(np.sqrt(np.linalg.inv(12.0 * j.T @ j)[2, 2])) / p[2]
+    return rank(unit[:, :4]), full, bound, int(np.sum(np.abs(r[:n]) / _step(spec) >= 0.5))
+
+
+def _fit(spec, signal, x, y, load):
+    """(force error [%], position error [pitch], the fit's (x, y, F, a, w)) of the joint
+    fit of one frame; nan where it finds other than one contact."""
+    fit = find_contacts(signal, spec, counts=False, method="joint")
+    if len(fit) != 1:
+        return np.nan, np.nan, None
+    force = 100.0 * (fit.force_n[0] / load - 1.0)
+    pos = np.hypot(fit.x_mm[0] - x, fit.y_mm[0] - y) / spec.grid.row_pitch_mm
+    e = fit.extra
+    p = np.array([fit.x_mm[0], fit.y_mm[0], fit.force_n[0], e["contact_radius_mm"][0]])
+    return force, pos, np.append(p, e["flat_share"][0])
+
+
+def _rss_steps(spec, model, p, signal):
+    """Residual sum of squares [A/D steps^2] of the model at ``p`` against ``signal``."""
+    m = model.signal([p[:2]], [p[2]], [p[3]], [p[4]])
+    return float(np.sum((m - signal) ** 2)) / _step(spec) ** 2
 
 
 def measure(spec, rng):
-    """Rows (shape, size, load, force error %, position error [pitch], found) and the
-    mean time per fit [s]."""
+    """Rows (a dict per case: shape, size, load, force error %, position error [pitch],
+    found, the same for the unquantized frame, the Fisher ranks and bound, taxels read,
+    the RSS at the fit and at the truth [steps^2], the frame's peak [steps]) and the
+    median time per fit [s]."""
     g = spec.grid
+    model = kind_of(spec).contact_model(spec)
+    threshold = default_threshold(spec) / _step(spec)
     out, times = [], []
     for shape, sizes in (("sphere", SPHERES_MM), ("disc", DISCS_PITCH)):
         for size in sizes:
@@ -92,16 +141,24 @@ def measure(spec, rng):
                 x = (g.rows / 2 - 0.5 + rng.uniform()) * g.row_pitch_mm
                 y = (g.cols / 2 - 0.5 + rng.uniform()) * g.col_pitch_mm
                 strain = hankel_hertz_strain(spec, x, y, load, radius_mm=radius, shape=shape)
-                rank, read = fisher_rank(spec, x, y, load, shape, radius)
+                truth = _truth_parameters(model, x, y, load, shape, radius)
+                rank4, rank5, bound, read = fisher(spec, truth)
+                frame = _signal(spec, strain)
                 t0 = time.perf_counter()
-                fit = find_contacts(_signal(spec, strain), spec, counts=False, method="joint")
+                force, pos, p = _fit(spec, frame, x, y, load)
                 times.append(time.perf_counter() - t0)
-                if len(fit) != 1:
-                    out.append((shape, size, load, np.nan, np.nan, len(fit), rank, read))
-                    continue
-                force = 100.0 * (fit.force_n[0] / load - 1.0)
-                pos = np.hypot(fit.x_mm[0] - x, fit.y_mm[0] - y) / g.row_pitch_mm
-                out.append((shape, size, load, force, pos, 1, rank, read))
+                clean_force, clean_pos, _ = _fit(spec, _clean(spec, strain), x, y, load)
+                row = dict(
+                    shape=shape, size=size, load=load, force=force, pos=pos,
+                    found=p is not None, clean_force=clean_force, clean_pos=clean_pos,
+                    rank4=rank4, rank5=rank5, bound=bound, read=read,
+                    rss_fit=np.nan if p is None else _rss_steps(spec, model, p, frame),
+                    rss_truth=_rss_steps(spec, model, truth, frame),
+                    peak=float(np.abs(_clean(spec, strain)).max()) / _step(spec),
+                    threshold=threshold,
+                )  # fmt: skip
+                row["met"] = bool(row["found"] and abs(force) <= 2.0 and pos <= 0.05)
+                out.append(row)
     return out, float(np.median(times))
 
 
@@ -197,6 +254,34 @@ def noisy_main() -> None:
     print("\n".join(lines))
 
 
+MISS_BEGIN = "<!-- generated by scripts/padfit_numbers.py (misses): do not edit by hand -->"
+MISS_END = "<!-- end of scripts/padfit_numbers.py (misses) -->"
+
+
+def _pct(v, digits=2):
+    return "not found" if not np.isfinite(v) else f"{v:+.{digits}f} %"
+
+
+def _miss_line(name, r):
+    """One row of the misses' table."""
+    what = (
+        f"sphere {r['size']:g} mm" if r["shape"] == "sphere" else
+        f"disc {2 * r['size']:g} pitches across"
+    )  # fmt: skip
+    grams = f"{r['load'] / 0.0098:.0f} g"
+    pos = "-" if not np.isfinite(r["pos"]) else f"{r['pos']:.3f}"
+    clean = "not found" if not np.isfinite(r["clean_force"]) else (
+        f"{r['clean_force']:+.2f} % / {r['clean_pos']:.3f}"
+    )  # fmt: skip
+    bound = "singular" if not np.isfinite(r["bound"]) else f"{r['bound']:.2f} %"
+    rss = "-" if not np.isfinite(r["rss_fit"]) else f"{r['rss_fit']:.2g} / {r['rss_truth']:.2g}"
+    return (
+        f"| {name} | {what} | {grams} | {_pct(r['force'])} | {pos} | {clean} | {r['read']} | "
+        f"{r['rank4']} / {r['rank5']} | {bound} | {rss} | {r['peak']:.0f} / "
+        f"{r['threshold']:.0f} |"
+    )
+
+
 def main() -> None:
     if sys.argv[1:] == ["--noisy"]:
         noisy_main()
@@ -211,28 +296,45 @@ def main() -> None:
         "| pad | contacts | worst force error | worst position error | "
         "sphere force (worst) | disc force (worst) | median time per frame | "
         "taxels read (fewest-most) | cases whose Fisher matrix of (x, y, F, a) has full "
-        "rank (4) | cases within 2 % and 0.05 pitch |",
-        "|---|---|---|---|---|---|---|---|---|---|",
+        "rank (4) | ... of the fit's five unknowns (x, y, F, a, flat share) (5) | "
+        "cases within 2 % and 0.05 pitch | ... of those of rank 5 |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    misses = [
+        MISS_BEGIN,
+        "",
+        "| pad | indenter | load | force error | position error [pitch] | unquantized: "
+        "force / position [pitch] | taxels read | rank of (x, y, F, a) / of the five | "
+        "force bound under quantization (five unknowns) | RSS at the fit / at the truth "
+        "[steps^2] | peak / threshold [counts] |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for name, spec in specs:
         kind_of(spec).contact_model(spec)  # build the table outside the timing
         rows, t = measure(spec, rng)
-        found = [r for r in rows if r[5] == 1]
-        sph = [abs(r[3]) for r in found if r[0] == "sphere"]
-        disc = [abs(r[3]) for r in found if r[0] == "disc"]
+        found = [r for r in rows if r["found"]]
+        sph = [abs(r["force"]) for r in found if r["shape"] == "sphere"]
+        disc = [abs(r["force"]) for r in found if r["shape"] == "disc"]
+        full = [r for r in rows if r["rank5"] == 5]
         lines.append(
             f"| {name} | {len(found)} of {len(rows)} found alone | "
-            f"{max(abs(r[3]) for r in found):.2f} % | "
-            f"{max(r[4] for r in found):.3f} pitch | {max(sph):.2f} % | {max(disc):.2f} % | "
-            f"{1e3 * t:.1f} ms | {min(r[7] for r in rows)}-{max(r[7] for r in rows)} | "
-            f"{sum(r[6] == 4 for r in rows)} of {len(rows)} | "
-            f"{sum(abs(r[3]) <= 2 and r[4] <= 0.05 for r in found)} of {len(rows)} |"
+            f"{max(abs(r['force']) for r in found):.2f} % | "
+            f"{max(r['pos'] for r in found):.3f} pitch | {max(sph):.2f} % | {max(disc):.2f} % | "
+            f"{1e3 * t:.1f} ms | {min(r['read'] for r in rows)}-{max(r['read'] for r in rows)} | "
+            f"{sum(r['rank4'] == 4 for r in rows)} of {len(rows)} | {len(full)} of {len(rows)} | "
+            f"{sum(r['met'] for r in rows)} of {len(rows)} | "
+            f"{sum(r['met'] for r in full)} of {len(full)} |"
         )
         for r in rows:
-            print(name, *r, flush=True)
+            print(name, r, flush=True)
+            if not r["met"]:
+                misses.append(_miss_line(name, r))
     lines += ["", END]
-    replace_block(ROOT / "docs" / "contacts.md", BEGIN, END, "\n".join(lines))
-    print("\n".join(lines))
+    misses += ["", MISS_END]
+    doc = ROOT / "docs" / "contacts.md"
+    replace_block(doc, BEGIN, END, "\n".join(lines))
+    replace_block(doc, MISS_BEGIN, MISS_END, "\n".join(misses))
+    print("\n".join([*lines, "", *misses]))
 
 
 if __name__ == "__main__":
