@@ -266,7 +266,7 @@ def _miss_line(name, r):
     """One row of the misses' table."""
     what = (
         f"sphere {r['size']:g} mm" if r["shape"] == "sphere" else
-        f"disc {2 * r['size']:g} pitches across"
+        f"disc {2 * r['size']:g} pitch{'' if r['size'] == 0.5 else 'es'} across"
     )  # fmt: skip
     grams = f"{r['load'] / 0.0098:.0f} g"
     pos = "-" if not np.isfinite(r["pos"]) else f"{r['pos']:.3f}"
