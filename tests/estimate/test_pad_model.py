@@ -29,16 +29,19 @@ def test_hertz_radius_and_its_inverse():
 @pytest.mark.parametrize(("shape", "size", "load"), [("sphere", 10.0, 4.0), ("disc", 2.33, 0.2)])
 def test_the_model_is_the_exact_solution(thick, shape, size, load):
     """The fit's model (table every 0.1 mm of a, linear between) against the Hankel
-    transform at an a between table steps: within 2e-3 of the peak (the truth's own
-    error against the FFT grid is 5.6e-3 of the peak on this pad)."""
+    transform at an a between table steps: within 3e-4 of the peak (measured 5.3e-5
+    and 4.7e-5), the truth averaged over 96 x 96 points of each electrode (its default
+    12 x 12 midpoint rule is itself 1.9e-4 and 4.2e-4 of the peak off here, up to
+    3.1e-3 on pad4: scripts/padfit_numbers.py's TRUTH_SUB)."""
     g = thick.grid
     model = kind_of(thick).contact_model(thick)
     x, y = 7.37 * g.row_pitch_mm, 8.61 * g.col_pitch_mm
-    truth = np.maximum(hankel_hertz_strain(thick, x, y, load, radius_mm=size, shape=shape), 0)
+    strain = hankel_hertz_strain(thick, x, y, load, radius_mm=size, shape=shape, sub=96)
+    truth = np.maximum(strain, 0)
     a = hertz_radius_mm(load, size, model.modulus_star_pa) if shape == "sphere" else size
     assert abs(a / 0.1 - round(a / 0.1)) > 0.1  # between two steps of the table
     mine = model.signal([[x, y]], [load], [a], [1.0 if shape == "disc" else 0.0])
-    assert np.abs(mine - truth).max() < 2e-3 * truth.max()
+    assert np.abs(mine - truth).max() < 3e-4 * truth.max()
 
 
 @pytest.mark.parametrize(
@@ -139,7 +142,7 @@ def test_pad4_light_sphere_misses_by_quantization():
     spec = load_sensor("pad4")
     model = kind_of(spec).contact_model(spec)
     x, y, load = 11.304580393912836, 8.393543762147178, 0.098  # the doc's (seed 34)
-    strain = hankel_hertz_strain(spec, x, y, load, radius_mm=10.0, shape="sphere")
+    strain = hankel_hertz_strain(spec, x, y, load, radius_mm=10.0, shape="sphere", sub=96)
     clean = find_contacts(_read(spec, strain, False), spec, counts=False, method="joint")
     assert len(clean) == 1
     assert abs(clean.force_n[0] / load - 1.0) < 0.005
@@ -172,7 +175,7 @@ def test_four_taxels_do_not_determine_five_unknowns():
     model = kind_of(spec).contact_model(spec)
     g = spec.grid
     x, y, load = 6.3 * g.row_pitch_mm, 16.6 * g.col_pitch_mm, 0.49
-    strain = hankel_hertz_strain(spec, x, y, load, radius_mm=10.0, shape="sphere")
+    strain = hankel_hertz_strain(spec, x, y, load, radius_mm=10.0, shape="sphere", sub=96)
     frame = _read(spec, strain)
     assert np.sum(frame > 0) <= 4
     a = float(hertz_radius_mm(load, 10.0, model.modulus_star_pa))
