@@ -5,11 +5,21 @@ Hertzian spheres (1, 3, 10 mm; Hertz radius of the half space) and flat discs (r
 position, noise-free and quantized to the A/D step; writes the block of docs/contacts.md.
 
 Beside each pad: the taxels that read (at least half an A/D step) and the rank of the
-Fisher matrix of one contact's four unknowns (x, y, force, contact radius) at the truth
-(the estimator's model's closed-form Jacobian, ``_joint_lm.residual_jacobian``; a
-resistive taxel whose model reading is at or below zero tells nothing to first order):
-below 4, no estimator can determine the contact from the frame (the prior on the size
-then sets the force).
+Fisher matrix at the truth (the estimator's model's closed-form Jacobian,
+``_joint_lm.residual_jacobian``; a resistive taxel whose model reading is at or below
+zero tells nothing to first order) of one contact's four unknowns with the shape given
+(x, y, force, contact radius) and of the fit's five (the flat share too: the fit does
+not know the shape): below 5, no estimator that does not know the shape can determine
+the contact from the frame (the prior on the size then sets the force).
+
+The misses' block (r10): each case outside 2 % and 0.05 pitch with the same frame
+fitted unquantized, the force's Cramer-Rao bound with the five unknowns under
+quantization's variance (one A/D step squared over 12), the residual sum of squares
+of the model at the fit and at the truth [A/D steps^2] (a fit below the truth's is no
+local minimum of the search), the frame's peak against the contact threshold, and
+where the Fisher matrix is singular the forces that the model fits to the frame as
+well as the truth (:func:`force_range`). The truth's electrode mean uses
+:data:`TRUTH_SUB` points a side.
 
     PYTHONPATH=src python scripts/padfit_numbers.py
     PYTHONPATH=src python scripts/padfit_numbers.py --noisy   # the noisy block only
@@ -131,6 +141,46 @@ def _rss_steps(spec, model, p, signal):
     return float(np.sum((m - signal) ** 2)) / _step(spec) ** 2
 
 
+RANGE_STEP = 0.01
+"""Step of the force's profile [share of the true force]."""
+
+RANGE_REACH = 0.6
+"""Farthest the force's profile goes from the truth [share of the true force]."""
+
+
+def force_range(spec, model, frame, truth, rss_truth):
+    """(lowest, highest) force error [%] of the contacts the fit's model fits to
+    ``frame`` as well as the truth ``p`` (5,) does (RSS at most ``rss_truth``
+    [steps^2]): the force's profile, stepped by :data:`RANGE_STEP` from the truth each
+    way (to :data:`RANGE_REACH`), (x, y, a, flat share) refitted by SciPy at each from
+    the last. Where the frame does not determine the contact, the forces it allows (a
+    continuation along one path: the set may reach farther)."""
+    from scipy.optimize import least_squares
+
+    step = _step(spec)
+    lo = [-np.inf, -np.inf, 0.0, 0.0]
+    hi = [np.inf, np.inf, model.a_top_mm, 1.0]
+    ends = []
+    for sign in (-1.0, 1.0):
+        q = truth[[0, 1, 3, 4]].copy()
+        share = 0.0
+        while share < RANGE_REACH:
+            force = truth[2] * (1.0 + sign * (share + RANGE_STEP))
+
+            def misfit(v, force=force):
+                return (model.signal([v[:2]], [force], [v[2]], [v[3]]) - frame).ravel() / step
+
+            with np.errstate(all="ignore"):
+                fit = least_squares(
+                    misfit, np.clip(q, lo, hi), bounds=(lo, hi), x_scale=[0.1, 0.1, 0.1, 0.1]
+                )
+            if np.sum(fit.fun**2) > rss_truth:
+                break
+            q, share = fit.x, share + RANGE_STEP
+        ends.append(100.0 * sign * share)
+    return ends[0], ends[1]
+
+
 def measure(spec, rng):
     """Rows (a dict per case: shape, size, load, force error %, position error [pitch],
     found, the same for the unquantized frame, the Fisher ranks and bound, taxels read,
@@ -166,6 +216,9 @@ def measure(spec, rng):
                     threshold=threshold,
                 )  # fmt: skip
                 row["met"] = bool(row["found"] and abs(force) <= 2.0 and pos <= 0.05)
+                row["range"] = (np.nan, np.nan)
+                if not row["met"] and rank5 < 5:
+                    row["range"] = force_range(spec, model, frame, truth, row["rss_truth"])
                 out.append(row)
     return out, float(np.median(times))
 
@@ -285,10 +338,15 @@ def _miss_line(name, r):
     )  # fmt: skip
     bound = "singular" if not np.isfinite(r["bound"]) else f"{r['bound']:.2f} %"
     rss = "-" if not np.isfinite(r["rss_fit"]) else f"{r['rss_fit']:.2g} / {r['rss_truth']:.2g}"
+    lo, hi = (v + 0.0 for v in r["range"])  # no "-0"
+    cap = 100.0 * RANGE_REACH - 1e-9
+    span = "-" if not np.isfinite(lo) else (
+        f"{'below ' if lo <= -cap else ''}{lo:+.0f} to {'above ' if hi >= cap else ''}{hi:+.0f} %"
+    )  # fmt: skip
     return (
         f"| {name} | {what} | {grams} | {_pct(r['force'])} | {pos} | {clean} | {r['read']} | "
         f"{r['rank4']} / {r['rank5']} | {bound} | {rss} | {r['peak']:.0f} / "
-        f"{r['threshold']:.0f} |"
+        f"{r['threshold']:.0f} | {span} |"
     )
 
 
@@ -316,8 +374,9 @@ def main() -> None:
         "| pad | indenter | load | force error | position error [pitch] | unquantized: "
         "force / position [pitch] | taxels read | rank of (x, y, F, a) / of the five | "
         "force bound under quantization (five unknowns) | RSS at the fit / at the truth "
-        "[steps^2] | peak / threshold [counts] |",
-        "|---|---|---|---|---|---|---|---|---|---|---|",
+        "[steps^2] | peak / threshold [counts] | forces that fit the frame as well as the "
+        "truth (singular cases) |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for name, spec in specs:
         kind_of(spec).contact_model(spec)  # build the table outside the timing
