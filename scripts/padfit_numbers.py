@@ -5,11 +5,21 @@ Hertzian spheres (1, 3, 10 mm; Hertz radius of the half space) and flat discs (r
 position, noise-free and quantized to the A/D step; writes the block of docs/contacts.md.
 
 Beside each pad: the taxels that read (at least half an A/D step) and the rank of the
-Fisher matrix of one contact's four unknowns (x, y, force, contact radius) at the truth
-(the estimator's model's closed-form Jacobian, ``_joint_lm.residual_jacobian``; a
-resistive taxel whose model reading is at or below zero tells nothing to first order):
-below 4, no estimator can determine the contact from the frame (the prior on the size
-then sets the force).
+Fisher matrix at the truth (the estimator's model's closed-form Jacobian,
+``_joint_lm.residual_jacobian``; a resistive taxel whose model reading is at or below
+zero tells nothing to first order) of one contact's four unknowns with the shape given
+(x, y, force, contact radius) and of the fit's five (the flat share too: the fit does
+not know the shape): below 5, no estimator that does not know the shape can determine
+the contact from the frame (the prior on the size then sets the force).
+
+The misses' block (r10): each case outside 2 % and 0.05 pitch with the same frame
+fitted unquantized, the force's Cramer-Rao bound with the five unknowns under
+quantization's variance (one A/D step squared over 12), the residual sum of squares
+of the model at the fit and at the truth [A/D steps^2] (a fit below the truth's is no
+local minimum of the search), the frame's peak against the contact threshold, and
+where the Fisher matrix is singular the forces that the model fits to the frame as
+well as the truth (:func:`force_range`). The truth's electrode mean uses
+:data:`TRUTH_SUB` points a side.
 
     PYTHONPATH=src python scripts/padfit_numbers.py
     PYTHONPATH=src python scripts/padfit_numbers.py --noisy   # the noisy block only
@@ -40,6 +50,7 @@ from tests._layer_truth import hankel_hertz_strain  # noqa: E402
 
 from tactsense.estimate.contacts import find_contacts  # noqa: E402
 from tactsense.estimate.contacts._joint_lm import residual_jacobian, tables_of  # noqa: E402
+from tactsense.estimate.reading import default_threshold  # noqa: E402
 from tactsense.kinds import kind_of  # noqa: E402
 from tactsense.physics._pad_model import hertz_radius_mm  # noqa: E402
 from tactsense.sensor.registry import load_sensor  # noqa: E402
@@ -49,41 +60,135 @@ END = "<!-- end of scripts/padfit_numbers.py -->"
 LOADS_N = (0.098, 0.49, 4.9)
 SPHERES_MM = (1.0, 3.0, 10.0)
 DISCS_PITCH = (0.5, 1.0, 1.5)
+TRUTH_SUB = 96
+"""Points a side of the truth's midpoint rule over each electrode (``sub`` of
+``analysis.layer_truth.taxel_strain``): its default 12 leaves 1.4-3.1e-3 of the frame's
+peak of quadrature error on the presets (the 4-mm electrodes of pad4 under a 0.6-mm
+contact 2 mm deep the most), larger than the fit's table's own error; at 96 the truth
+and the table agree within 2e-5 to 1.6e-4 of the peak (r10-single3)."""
+
+
+def _step(spec):
+    """One A/D step in the signal's units [-] (capacitive: of the nominal reading;
+    resistive: of strain)."""
+    t = spec.transduction
+    if t.kind == "capacitive":
+        return 1.0 / spec.electronics.nominal_counts
+    return 1.0 / t.counts_per_strain
+
+
+def _clean(spec, strain):
+    """The signal [-] a taxel reads, not quantized (a resistive taxel reads no tension)."""
+    t = spec.transduction
+    return t.strain_gain * strain if t.kind == "capacitive" else np.maximum(strain, 0.0)
 
 
 def _signal(spec, strain):
     """The signal [-] a taxel reads, quantized to one A/D count."""
-    t = spec.transduction
-    if t.kind == "capacitive":
-        step = 1.0 / spec.electronics.nominal_counts
-        return np.round(t.strain_gain * strain / step) * step
-    return np.round(np.maximum(strain, 0.0) * t.counts_per_strain) / t.counts_per_strain
+    step = _step(spec)
+    return np.round(_clean(spec, strain) / step) * step
 
 
-def fisher_rank(spec, x, y, load, shape, radius):
-    """(rank of the Fisher matrix of (x, y, force, a), taxels read) of one contact."""
-    model = kind_of(spec).contact_model(spec)
-    t = spec.transduction
-    per = spec.electronics.nominal_counts if t.kind == "capacitive" else t.counts_per_strain
+def _truth_parameters(model, x, y, load, shape, radius):
+    """(x, y [mm], F [N], a [mm], flat share [-]) of the truth in the fit's terms."""
     sphere = shape == "sphere"
     a = float(hertz_radius_mm(load, radius, model.modulus_star_pa)) if sphere else radius
-    p = np.array([x, y, load, min(a, model.a_top_mm - 1e-6), 0.0 if sphere else 1.0])
+    return np.array([x, y, load, min(a, model.a_top_mm - 1e-6), 0.0 if sphere else 1.0])
+
+
+def fisher(spec, p):
+    """(rank of the Fisher matrix of (x, y, F, a), rank of that of the fit's five
+    unknowns (x, y, F, a, flat share), the force's Cramer-Rao bound [%] of the five
+    under quantization's variance (one A/D step squared over 12; inf where singular),
+    taxels read) of one contact ``p`` (5,)."""
+    model = kind_of(spec).contact_model(spec)
     n = model.x_taxel.size * model.y_taxel.size
     r, jac = np.empty(n + 1), np.empty((n + 1, 5))
     residual_jacobian(
         p, np.zeros(n), model.x_taxel, model.y_taxel, tables_of(model), not model.capacitive,
         float(model.scale), np.zeros(4), r, jac,
     )  # fmt: skip
-    j = jac[:n, :4] * per  # in A/D steps: the quantization's 1/12 step^2 is the scale
-    j = j / np.maximum(np.linalg.norm(j, axis=0), 1e-300)  # rank in any units
-    s = np.linalg.svd(j, compute_uv=False)
-    return int(np.sum(s > 1e-6 * s[0])), int(np.sum(np.abs(r[:n]) * per >= 0.5))
+    j = jac[:n] / _step(spec)  # in A/D steps: the quantization's 1/12 step^2 is the scale
+    unit = j / np.maximum(np.linalg.norm(j, axis=0), 1e-300)  # rank in any units
+
+    def rank(m):
+        s = np.linalg.svd(m, compute_uv=False)
+        return int(np.sum(s > 1e-6 * s[0]))
+
+    full = rank(unit)
+    bound = np.inf
+    if full == 5:
+        bound = 100.0 * float(np.sqrt(np.linalg.inv(12.0 * j.T @ j)[2, 2])) / p[2]
+    return rank(unit[:, :4]), full, bound, int(np.sum(np.abs(r[:n]) / _step(spec) >= 0.5))
+
+
+def _fit(spec, signal, x, y, load):
+    """(force error [%], position error [pitch], the fit's (x, y, F, a, w)) of the joint
+    fit of one frame; nan where it finds other than one contact."""
+    fit = find_contacts(signal, spec, counts=False, method="joint")
+    if len(fit) != 1:
+        return np.nan, np.nan, None
+    force = 100.0 * (fit.force_n[0] / load - 1.0)
+    pos = np.hypot(fit.x_mm[0] - x, fit.y_mm[0] - y) / spec.grid.row_pitch_mm
+    e = fit.extra
+    p = np.array([fit.x_mm[0], fit.y_mm[0], fit.force_n[0], e["contact_radius_mm"][0]])
+    return force, pos, np.append(p, e["flat_share"][0])
+
+
+def _rss_steps(spec, model, p, signal):
+    """Residual sum of squares [A/D steps^2] of the model at ``p`` against ``signal``."""
+    m = model.signal([p[:2]], [p[2]], [p[3]], [p[4]])
+    return float(np.sum((m - signal) ** 2)) / _step(spec) ** 2
+
+
+RANGE_STEP = 0.01
+"""Step of the force's profile [share of the true force]."""
+
+RANGE_REACH = 0.6
+"""Farthest the force's profile goes from the truth [share of the true force]."""
+
+
+def force_range(spec, model, frame, truth, rss_truth):
+    """(lowest, highest) force error [%] of the contacts the fit's model fits to
+    ``frame`` as well as the truth ``p`` (5,) does (RSS at most ``rss_truth``
+    [steps^2]): the force's profile, stepped by :data:`RANGE_STEP` from the truth each
+    way (to :data:`RANGE_REACH`), (x, y, a, flat share) refitted by SciPy at each from
+    the last. Where the frame does not determine the contact, the forces it allows (a
+    continuation along one path: the set may reach farther)."""
+    from scipy.optimize import least_squares
+
+    step = _step(spec)
+    lo = [-np.inf, -np.inf, 0.0, 0.0]
+    hi = [np.inf, np.inf, model.a_top_mm, 1.0]
+    ends = []
+    for sign in (-1.0, 1.0):
+        q = truth[[0, 1, 3, 4]].copy()
+        share = 0.0
+        while share < RANGE_REACH:
+            force = truth[2] * (1.0 + sign * (share + RANGE_STEP))
+
+            def misfit(v, force=force):
+                return (model.signal([v[:2]], [force], [v[2]], [v[3]]) - frame).ravel() / step
+
+            with np.errstate(all="ignore"):
+                fit = least_squares(
+                    misfit, np.clip(q, lo, hi), bounds=(lo, hi), x_scale=[0.1, 0.1, 0.1, 0.1]
+                )
+            if np.sum(fit.fun**2) > rss_truth:
+                break
+            q, share = fit.x, share + RANGE_STEP
+        ends.append(100.0 * sign * share)
+    return ends[0], ends[1]
 
 
 def measure(spec, rng):
-    """Rows (shape, size, load, force error %, position error [pitch], found) and the
-    mean time per fit [s]."""
+    """Rows (a dict per case: shape, size, load, force error %, position error [pitch],
+    found, the same for the unquantized frame, the Fisher ranks and bound, taxels read,
+    the RSS at the fit and at the truth [steps^2], the frame's peak [steps]) and the
+    median time per fit [s]."""
     g = spec.grid
+    model = kind_of(spec).contact_model(spec)
+    threshold = default_threshold(spec) / _step(spec)
     out, times = [], []
     for shape, sizes in (("sphere", SPHERES_MM), ("disc", DISCS_PITCH)):
         for size in sizes:
@@ -91,17 +196,30 @@ def measure(spec, rng):
             for load in LOADS_N:
                 x = (g.rows / 2 - 0.5 + rng.uniform()) * g.row_pitch_mm
                 y = (g.cols / 2 - 0.5 + rng.uniform()) * g.col_pitch_mm
-                strain = hankel_hertz_strain(spec, x, y, load, radius_mm=radius, shape=shape)
-                rank, read = fisher_rank(spec, x, y, load, shape, radius)
+                strain = hankel_hertz_strain(
+                    spec, x, y, load, radius_mm=radius, shape=shape, sub=TRUTH_SUB
+                )
+                truth = _truth_parameters(model, x, y, load, shape, radius)
+                rank4, rank5, bound, read = fisher(spec, truth)
+                frame = _signal(spec, strain)
                 t0 = time.perf_counter()
-                fit = find_contacts(_signal(spec, strain), spec, counts=False, method="joint")
+                force, pos, p = _fit(spec, frame, x, y, load)
                 times.append(time.perf_counter() - t0)
-                if len(fit) != 1:
-                    out.append((shape, size, load, np.nan, np.nan, len(fit), rank, read))
-                    continue
-                force = 100.0 * (fit.force_n[0] / load - 1.0)
-                pos = np.hypot(fit.x_mm[0] - x, fit.y_mm[0] - y) / g.row_pitch_mm
-                out.append((shape, size, load, force, pos, 1, rank, read))
+                clean_force, clean_pos, _ = _fit(spec, _clean(spec, strain), x, y, load)
+                row = dict(
+                    shape=shape, size=size, load=load, force=force, pos=pos,
+                    found=p is not None, clean_force=clean_force, clean_pos=clean_pos,
+                    rank4=rank4, rank5=rank5, bound=bound, read=read,
+                    rss_fit=np.nan if p is None else _rss_steps(spec, model, p, frame),
+                    rss_truth=_rss_steps(spec, model, truth, frame),
+                    peak=float(np.abs(_clean(spec, strain)).max()) / _step(spec),
+                    threshold=threshold,
+                )  # fmt: skip
+                row["met"] = bool(row["found"] and abs(force) <= 2.0 and pos <= 0.05)
+                row["range"] = (np.nan, np.nan)
+                if not row["met"] and rank5 < 5:
+                    row["range"] = force_range(spec, model, frame, truth, row["rss_truth"])
+                out.append(row)
     return out, float(np.median(times))
 
 
@@ -140,7 +258,9 @@ def noisy_rows():
             lo = np.array([0.5 * g.row_pitch_mm, 0.5 * g.col_pitch_mm])
             hi = np.array([(g.rows - 1.5) * g.row_pitch_mm, (g.cols - 1.5) * g.col_pitch_mm])
             where = lo + (hi - lo) * rng.uniform(size=(NOISY_FRAMES, 2))
-            strain = np.stack([taxel_strain(spec, x, y, 0.49, 1.6) for x, y in where])
+            strain = np.stack(
+                [taxel_strain(spec, x, y, 0.49, 1.6, sub=TRUTH_SUB) for x, y in where]
+            )
             sd = share * (2**spec.electronics.adc_bits - 1)
             baseline = np.median(_noisy_counts(spec, np.zeros((5, *spec.shape)), sd, rng), axis=0)
             frames = _noisy_counts(spec, strain, sd, rng)
@@ -197,6 +317,39 @@ def noisy_main() -> None:
     print("\n".join(lines))
 
 
+MISS_BEGIN = "<!-- generated by scripts/padfit_numbers.py (misses): do not edit by hand -->"
+MISS_END = "<!-- end of scripts/padfit_numbers.py (misses) -->"
+
+
+def _pct(v, digits=2):
+    return "not found" if not np.isfinite(v) else f"{v:+.{digits}f} %"
+
+
+def _miss_line(name, r):
+    """One row of the misses' table."""
+    what = (
+        f"sphere {r['size']:g} mm" if r["shape"] == "sphere" else
+        f"disc {2 * r['size']:g} pitch{'' if r['size'] == 0.5 else 'es'} across"
+    )  # fmt: skip
+    grams = f"{r['load'] / 0.0098:.0f} g"
+    pos = "-" if not np.isfinite(r["pos"]) else f"{r['pos']:.3f}"
+    clean = "not found" if not np.isfinite(r["clean_force"]) else (
+        f"{r['clean_force']:+.2f} % / {r['clean_pos']:.3f}"
+    )  # fmt: skip
+    bound = "singular" if not np.isfinite(r["bound"]) else f"{r['bound']:.2f} %"
+    rss = "-" if not np.isfinite(r["rss_fit"]) else f"{r['rss_fit']:.2g} / {r['rss_truth']:.2g}"
+    lo, hi = (v + 0.0 for v in r["range"])  # no "-0"
+    cap = 100.0 * RANGE_REACH - 1e-9
+    span = "-" if not np.isfinite(lo) else (
+        f"{'below ' if lo <= -cap else ''}{lo:+.0f} to {'above ' if hi >= cap else ''}{hi:+.0f} %"
+    )  # fmt: skip
+    return (
+        f"| {name} | {what} | {grams} | {_pct(r['force'])} | {pos} | {clean} | {r['read']} | "
+        f"{r['rank4']} / {r['rank5']} | {bound} | {rss} | {r['peak']:.0f} / "
+        f"{r['threshold']:.0f} | {span} |"
+    )
+
+
 def main() -> None:
     if sys.argv[1:] == ["--noisy"]:
         noisy_main()
@@ -211,28 +364,46 @@ def main() -> None:
         "| pad | contacts | worst force error | worst position error | "
         "sphere force (worst) | disc force (worst) | median time per frame | "
         "taxels read (fewest-most) | cases whose Fisher matrix of (x, y, F, a) has full "
-        "rank (4) | cases within 2 % and 0.05 pitch |",
-        "|---|---|---|---|---|---|---|---|---|---|",
+        "rank (4) | ... of the fit's five unknowns (x, y, F, a, flat share) (5) | "
+        "cases within 2 % and 0.05 pitch | ... of those of rank 5 |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    misses = [
+        MISS_BEGIN,
+        "",
+        "| pad | indenter | load | force error | position error [pitch] | unquantized: "
+        "force / position [pitch] | taxels read | rank of (x, y, F, a) / of the five | "
+        "force bound under quantization (five unknowns) | RSS at the fit / at the truth "
+        "[steps^2] | peak / threshold [counts] | forces that fit the frame as well as the "
+        "truth (singular cases) |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for name, spec in specs:
         kind_of(spec).contact_model(spec)  # build the table outside the timing
         rows, t = measure(spec, rng)
-        found = [r for r in rows if r[5] == 1]
-        sph = [abs(r[3]) for r in found if r[0] == "sphere"]
-        disc = [abs(r[3]) for r in found if r[0] == "disc"]
+        found = [r for r in rows if r["found"]]
+        sph = [abs(r["force"]) for r in found if r["shape"] == "sphere"]
+        disc = [abs(r["force"]) for r in found if r["shape"] == "disc"]
+        full = [r for r in rows if r["rank5"] == 5]
         lines.append(
             f"| {name} | {len(found)} of {len(rows)} found alone | "
-            f"{max(abs(r[3]) for r in found):.2f} % | "
-            f"{max(r[4] for r in found):.3f} pitch | {max(sph):.2f} % | {max(disc):.2f} % | "
-            f"{1e3 * t:.1f} ms | {min(r[7] for r in rows)}-{max(r[7] for r in rows)} | "
-            f"{sum(r[6] == 4 for r in rows)} of {len(rows)} | "
-            f"{sum(abs(r[3]) <= 2 and r[4] <= 0.05 for r in found)} of {len(rows)} |"
+            f"{max(abs(r['force']) for r in found):.2f} % | "
+            f"{max(r['pos'] for r in found):.3f} pitch | {max(sph):.2f} % | {max(disc):.2f} % | "
+            f"{1e3 * t:.1f} ms | {min(r['read'] for r in rows)}-{max(r['read'] for r in rows)} | "
+            f"{sum(r['rank4'] == 4 for r in rows)} of {len(rows)} | {len(full)} of {len(rows)} | "
+            f"{sum(r['met'] for r in rows)} of {len(rows)} | "
+            f"{sum(r['met'] for r in full)} of {len(full)} |"
         )
         for r in rows:
-            print(name, *r, flush=True)
+            print(name, r, flush=True)
+            if not r["met"]:
+                misses.append(_miss_line(name, r))
     lines += ["", END]
-    replace_block(ROOT / "docs" / "contacts.md", BEGIN, END, "\n".join(lines))
-    print("\n".join(lines))
+    misses += ["", MISS_END]
+    doc = ROOT / "docs" / "contacts.md"
+    replace_block(doc, BEGIN, END, "\n".join(lines))
+    replace_block(doc, MISS_BEGIN, MISS_END, "\n".join(misses))
+    print("\n".join([*lines, "", *misses]))
 
 
 if __name__ == "__main__":

@@ -29,16 +29,19 @@ def test_hertz_radius_and_its_inverse():
 @pytest.mark.parametrize(("shape", "size", "load"), [("sphere", 10.0, 4.0), ("disc", 2.33, 0.2)])
 def test_the_model_is_the_exact_solution(thick, shape, size, load):
     """The fit's model (table every 0.1 mm of a, linear between) against the Hankel
-    transform at an a between table steps: within 2e-3 of the peak (the truth's own
-    error against the FFT grid is 5.6e-3 of the peak on this pad)."""
+    transform at an a between table steps: within 3e-4 of the peak (measured 5.3e-5
+    and 4.7e-5), the truth averaged over 96 x 96 points of each electrode (its default
+    12 x 12 midpoint rule is itself 1.9e-4 and 4.2e-4 of the peak off here, up to
+    3.1e-3 on pad4: scripts/padfit_numbers.py's TRUTH_SUB)."""
     g = thick.grid
     model = kind_of(thick).contact_model(thick)
     x, y = 7.37 * g.row_pitch_mm, 8.61 * g.col_pitch_mm
-    truth = np.maximum(hankel_hertz_strain(thick, x, y, load, radius_mm=size, shape=shape), 0)
+    strain = hankel_hertz_strain(thick, x, y, load, radius_mm=size, shape=shape, sub=96)
+    truth = np.maximum(strain, 0)
     a = hertz_radius_mm(load, size, model.modulus_star_pa) if shape == "sphere" else size
     assert abs(a / 0.1 - round(a / 0.1)) > 0.1  # between two steps of the table
     mine = model.signal([[x, y]], [load], [a], [1.0 if shape == "disc" else 0.0])
-    assert np.abs(mine - truth).max() < 2e-3 * truth.max()
+    assert np.abs(mine - truth).max() < 3e-4 * truth.max()
 
 
 @pytest.mark.parametrize(
@@ -90,3 +93,120 @@ def test_joint_on_a_kind_without_a_response_table():
     finger = load_sensor("initial")
     with pytest.raises(TactsenseInputError, match="method 'joint' works on pads"):
         find_contacts(np.zeros((1, *finger.shape)), finger, counts=False, method="joint")
+
+
+def _step(spec):
+    """One A/D step in signal units [-]."""
+    t = spec.transduction
+    return 1.0 / (
+        spec.electronics.nominal_counts if t.kind == "capacitive" else t.counts_per_strain
+    )
+
+
+def _read(spec, strain, quantize=True):
+    """What a taxel reads [-]: quantized to one A/D step or not."""
+    t = spec.transduction
+    s = t.strain_gain * strain if t.kind == "capacitive" else np.maximum(strain, 0.0)
+    return np.round(s / _step(spec)) * _step(spec) if quantize else s
+
+
+def _fisher_fd(spec, p, unknowns=5):
+    """Fisher matrix of (x, y, F, a, flat share)[:unknowns] of one contact under
+    quantization's variance (step^2 / 12), from central finite differences of the
+    model's signal (not the compiled fit's closed-form Jacobian)."""
+    model = kind_of(spec).contact_model(spec)
+    steps = np.array([1e-3, 1e-3, 1e-4 * p[2], 1e-3, 1e-3])
+    cols = []
+    for i in range(unknowns):
+        up, down = p.copy(), p.copy()
+        up[i] += steps[i]
+        down[i] -= steps[i]
+        if i == 4:  # the flat share lives in [0, 1]: a one-sided difference at its end
+            up[i], down[i] = min(up[i], 1.0), max(down[i], 0.0)
+        f = [model.signal([q[:2]], [q[2]], [q[3]], [q[4]]).ravel() for q in (up, down)]
+        cols.append((f[0] - f[1]) / (up[i] - down[i]))
+    j = np.column_stack(cols) / _step(spec)
+    return 12.0 * j.T @ j
+
+
+def test_pad4_light_sphere_misses_by_quantization():
+    """pad4 (capacitive, 5-mm pitch): a 10-mm sphere at 10 g peaks at some 50 A/D steps.
+    Quantized, the fit reads -4.4 % (docs/contacts.md's misses); the cause is the
+    quantization, by two numbers: the same frame unquantized is within 0.5 % (measured
+    +0.34 % at the doc's placement), and the Cramer-Rao bound of the force with the
+    fit's five unknowns under quantization's variance (step^2 / 12) exceeds the goal's
+    2 % (measured 3.9 %): no unbiased estimator meets 2 % there reliably. And the fit
+    is no local minimum: its residual is below the truth's (1.15 against 1.48 steps^2;
+    without the prior on the size the least-squares optimum reads -4.9 %: the prior
+    does not pull it off)."""
+    spec = load_sensor("pad4")
+    model = kind_of(spec).contact_model(spec)
+    x, y, load = 11.304580393912836, 8.393543762147178, 0.098  # the doc's (seed 34)
+    strain = hankel_hertz_strain(spec, x, y, load, radius_mm=10.0, shape="sphere", sub=96)
+    clean = find_contacts(_read(spec, strain, False), spec, counts=False, method="joint")
+    assert len(clean) == 1
+    assert abs(clean.force_n[0] / load - 1.0) < 0.005
+    a = float(hertz_radius_mm(load, 10.0, model.modulus_star_pa))
+    truth = np.array([x, y, load, a, 0.0])
+    bound = np.sqrt(np.linalg.inv(_fisher_fd(spec, truth))[2, 2]) / load
+    assert bound > 0.02
+    frame = _read(spec, strain)
+    fit = find_contacts(frame, spec, counts=False, method="joint")
+    assert len(fit) == 1
+    e = fit.extra
+    mine = model.signal(
+        [[fit.x_mm[0], fit.y_mm[0]]], fit.force_n, e["contact_radius_mm"], e["flat_share"]
+    )
+    there = model.signal([[x, y]], [load], [a], [0.0])
+    assert np.sum((mine - frame) ** 2) <= np.sum((there - frame) ** 2)
+
+
+def test_four_taxels_do_not_determine_five_unknowns():
+    """pad12x32 (resistive, 2-mm pitch): a 10-mm sphere at 50 g reads on 4 taxels.
+    The Fisher matrix of (x, y, F, a) has full rank there, but the fit has a fifth
+    unknown, the flat share (sphere or disc), and four readings cannot determine five:
+    that matrix has rank 4. Shown with a witness found here by SciPy (not the joint
+    fit's search): a flat disc, whose frame rounds to the sphere's at every taxel (within
+    half an A/D step), carries a force more than 2 % off the sphere's (the goal cannot
+    be met on this frame by any estimator)."""
+    from scipy.optimize import least_squares
+
+    spec = load_sensor("pad12x32")
+    model = kind_of(spec).contact_model(spec)
+    g = spec.grid
+    x, y, load = 6.3 * g.row_pitch_mm, 16.6 * g.col_pitch_mm, 0.49
+    strain = hankel_hertz_strain(spec, x, y, load, radius_mm=10.0, shape="sphere", sub=96)
+    frame = _read(spec, strain)
+    assert np.sum(frame > 0) <= 4
+    a = float(hertz_radius_mm(load, 10.0, model.modulus_star_pa))
+    truth = np.array([x, y, load, a, 0.0])
+    assert np.linalg.matrix_rank(_fisher_fd(spec, truth, 4), tol=None) == 4
+    s = np.linalg.svd(_fisher_fd(spec, truth), compute_uv=False)
+    assert s[-1] < 1e-9 * s[0]  # five unknowns: singular
+
+    def misfit(q):
+        return (model.signal([q[:2]], [q[2]], [q[3]], [1.0]) - frame).ravel() / _step(spec)
+
+    disc = least_squares(misfit, [x, y, load, a], x_scale=[0.1, 0.1, 0.01, 0.1]).x
+    assert np.abs(misfit(disc)).max() < 0.5
+    assert abs(disc[2] / load - 1.0) > 0.02
+
+
+def test_the_truths_quadrature_over_the_electrode():
+    """The Hankel truth's taxel is a midpoint rule over its electrode: on pad4 (4-mm
+    electrodes, read 2 mm deep) under a 1-mm sphere at 10 g, 12 x 12 points (round 9's
+    frames) are more than 2e-3 of the peak off 96 x 96 (measured 3.1e-3), and the fit's
+    table is within 3e-4 of the latter (measured 2.2e-4): the error round 9 took for the
+    table's was the truth's (scripts/padfit_numbers.py's TRUTH_SUB)."""
+    spec = load_sensor("pad4")
+    model = kind_of(spec).contact_model(spec)
+    g = spec.grid
+    x, y, load = 1.7 * g.row_pitch_mm, 1.8 * g.col_pitch_mm, 0.098
+    coarse, fine = (
+        hankel_hertz_strain(spec, x, y, load, radius_mm=1.0, sub=sub) for sub in (12, 96)
+    )
+    peak = np.abs(fine).max()
+    assert np.abs(coarse - fine).max() > 2e-3 * peak
+    a = float(hertz_radius_mm(load, 1.0, model.modulus_star_pa))
+    mine = model.signal([[x, y]], [load], [a]) / spec.transduction.strain_gain
+    assert np.abs(mine - fine).max() < 3e-4 * peak
