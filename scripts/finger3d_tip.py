@@ -143,6 +143,10 @@ def solve_level(level, with_tables, formulation="displacement", layer=None, spec
 RADIAL_N_T = (3, 4, 5)
 """The ``radial`` family: elements through the rubber on level 0's surface mesh (level 0
 itself is its first member), the direction where the cylinder's error lies."""
+SURFACE_N_T = 3
+"""The ``surface`` family: the surface meshes of ``TIP_LEVELS`` (along the meridian and
+around) with level 0's ``SURFACE_N_T`` elements through the rubber (level 0 itself is its
+first member): cheaper than the levels, whose finest did not fit a solve's 10 minutes."""
 
 
 def _study_row(level, spec, out) -> dict:
@@ -169,22 +173,28 @@ def _study_row(level, spec, out) -> dict:
 def study_only(formulation, family="levels", max_level=None) -> None:
     """Solve a family of meshes (peaks only) and record each as it lands, keeping what
     is recorded already: ``levels``, the levels of ``TIP_LEVELS`` up to ``max_level``
-    (all if None); ``radial``, level 0's
-    surface with ``RADIAL_N_T`` elements through the rubber."""
+    (all if None); ``radial``, level 0's surface with ``RADIAL_N_T`` elements through the
+    rubber; ``surface``, the levels' surfaces up to ``max_level`` with ``SURFACE_N_T``."""
     data = json.loads(STUDY.read_text()) if STUDY.exists() else {}
     if data.get("formulation") != formulation:
         data = {"formulation": formulation}
     if family == "levels":
         top = len(tip.TIP_LEVELS) - 1 if max_level is None else max_level
         specs = [(k, spec) for k, spec in enumerate(tip.TIP_LEVELS) if k <= top]
-    else:
+    elif family == "radial":
         specs = [(0, dataclasses.replace(tip.TIP_LEVELS[0], n_t=n)) for n in RADIAL_N_T]
+    else:
+        specs = [
+            (k, dataclasses.replace(spec, n_t=SURFACE_N_T))
+            for k, spec in enumerate(tip.TIP_LEVELS)
+            if max_level is None or k <= max_level
+        ]
     rows = data.setdefault(family, [])
     done = {(r["level"], r["mesh"]["n_t"]) for r in rows}
     for level, spec in specs:
         if (level, spec.n_t) in done:
             continue
-        if family == "radial" and spec == tip.TIP_LEVELS[0]:
+        if family != "levels" and spec == tip.TIP_LEVELS[0]:
             known = [r for r in data.get("levels", []) if r["level"] == 0]
             if known:
                 rows.append(known[0])
@@ -203,10 +213,11 @@ def main(argv=None) -> None:
     parser.add_argument("--study", action="store_true", help="also solve every other level")
     parser.add_argument(
         "--study-only",
-        choices=("levels", "radial"),
+        choices=("levels", "radial", "surface"),
         help="solve a family of meshes (peaks only, the tables untouched) into "
-        "docs/data/finger3d_tip_study.json: the levels up to --level, or level 0's surface "
-        "with 3, 4, 5 elements through the rubber",
+        "docs/data/finger3d_tip_study.json: the levels up to --level, level 0's surface "
+        "with 3, 4, 5 elements through the rubber, or the levels' surfaces up to --level "
+        "with 3 through it",
     )
     parser.add_argument(
         "--formulation",
