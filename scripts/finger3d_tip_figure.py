@@ -486,8 +486,8 @@ def figure(n) -> None:
 
     fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.2))
     s = n["s"]
-    left.plot(s, n["three"], "k-", lw=2, label="3-D, plate: outer half of the face")
-    left.plot(s, n["rim"], "k:", lw=1.5, label="3-D, plate: outer quarter")
+    left.plot(s, n["three"], "k-", lw=2, label="3-D, gap's mean strain, plate: outer half")
+    left.plot(s, n["rim"], "k:", lw=1.5, label="3-D, gap's mean strain, plate: outer quarter")
     left.plot(s, n["twin"], "C0--", label="twin (6 mm deep, at 45 deg)")
     position, depth, _, _ = n["fit"]
     left.plot(s, n["fitted"], "C1-.",
