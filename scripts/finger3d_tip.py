@@ -24,12 +24,17 @@ anywhere on the skin to ``src/tactsense/physics/data/finger3d_tip.npz``:
   own table (``finger3d_probe.npz``) reads it, so the two meet at the junction; the foam
   layer's mean strain with ``--foam``.
 
-``--study`` also solves every level of ``TIP_LEVELS`` (level 2 takes about 2.5 minutes
-and 5 GB) and stores each level's peaks in the table's file. The tables are always those
-of ``--level``. ``--study-only`` solves every level with ``--formulation`` (peaks only,
-no tables: the shipped tables stay as they are) and records them, level by level, in
-``docs/data/finger3d_tip_study.json``: the mesh study docs/model.md quotes
-(``scripts/finger3d_tip_figure.py`` reads it, with the observed order and the
+``--study`` also solves every level of ``TIP_LEVELS`` and stores each level's peaks in
+the table's file (level 2, 140,580 dof in mixed form, did not finish within 10 minutes
+on a shared 2-core machine). The tables are always those of ``--level`` (level 1, mixed:
+about 80 s of CPU and 3.3 GB). ``--study-only`` solves a family of meshes with
+``--formulation`` (peaks only, no tables: the shipped tables stay as they are) and records
+them, mesh by mesh, in ``docs/data/finger3d_tip_study.json``: the levels, the ``radial``
+family (level 0's surface, 3-5 elements through the rubber) or the ``surface`` family
+(the levels' surfaces, 3 through; level 1's and level 2's together in about 90 s of
+CPU, 3.4 GB at most). Each mesh records the tip's peak both as the table reads it (the gap's mean
+strain) and as the point strain at the plate. docs/model.md quotes the study
+(``scripts/finger3d_tip_figure.py`` reads it, with the observed orders and the
 extrapolated peaks).
 """
 
