@@ -484,7 +484,7 @@ def figure(n) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.2))
+    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.8))
     s = n["s"]
     left.plot(s, n["three"], "k-", lw=2, label="3-D, gap's mean strain, plate: outer half")
     left.plot(s, n["rim"], "k:", lw=1.5, label="3-D, gap's mean strain, plate: outer quarter")
@@ -495,14 +495,14 @@ def figure(n) -> None:
     left.axvline(0.0, color="0.6", lw=0.8)
     left.axvline(APEX_MM, color="0.6", lw=0.8)
     left.axvline(-RADIUS_MM * np.radians(RIM_DEG), color="0.8", lw=0.8, ls=":")
-    left.text(-RADIUS_MM * np.radians(RIM_DEG) + 0.3, left.get_ylim()[1] * 0.9, "core's rim",
+    left.text(-RADIUS_MM * np.radians(RIM_DEG) + 0.3, left.get_ylim()[1] * 0.78, "core's rim",
               fontsize=8)  # fmt: skip
     left.axhline(0.0, color="0.8", lw=0.8)
     left.text(APEX_MM + 0.3, left.get_ylim()[1] * 0.9, "apex", fontsize=8)
     left.text(0.3, left.get_ylim()[1] * 0.9, "junction", fontsize=8)
     left.set_xlabel("probe position along the meridian, s [mm] (negative: on the tip)")
     left.set_ylabel("tip-row deflection per newton [1/N]")
-    left.legend(fontsize=8)
+    left.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2)
     left.set_title("Tip row, probe moving over the tip (cf. Fig. 14)", fontsize=10)
     a = n["angles"]
     right.plot(a, n["around_3d"], "k-", lw=2, label="3-D")
