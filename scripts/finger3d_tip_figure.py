@@ -446,7 +446,7 @@ def block(n) -> str:
             for m, g in n["gap"][a].items()
         ),
         "",
-        f"Mesh study (`scripts/finger3d_tip.py --study-only levels` and `radial`, "
+        f"Mesh study (`scripts/finger3d_tip.py --study-only levels`, `radial` and `surface`, "
         f"{st['formulation']} elements; the table is level {int(n['level'])}, "
         f"{n['formulation']} elements; row 1's point strain, before the rings, is what the "
         "tip's table holds for the cylinder's rows):",
