@@ -176,21 +176,26 @@ def test_tip_tactel_reads_compression_over_the_tip_and_little_on_the_cylinder(co
     assert np.abs(meridian[s > 4]).max() < 0.02 * abs(meridian[peak])
 
 
-@pytest.mark.slow
-def test_mesh_study_tip_peak_converges():
-    """Levels 0-2: the tip tactel's peak per newton (the gap's mean strain, as the table
-    reads it) changes by under 3 % and stays at the same latitude within one element."""
-    values = []
-    for spec in tip.TIP_LEVELS:
-        solution = tip.assemble(spec)
-        _, g = _tip_sector(solution)
-        v = solution.solve(g)
-        s = np.linspace(-16.0, -4.0, 97)
+def test_regression_recorded_study_level_0_is_a_fresh_solve():
+    """Regression test, not a check of correctness (the same solver on the same mesh):
+    the recorded mesh study's level 0 (docs/data/finger3d_tip_study.json) is what today's
+    code computes, the tip's peak read both ways (the gap's mean strain the table holds
+    and the point strain at the plate), to 1e-6. Level 0 only: the finer levels take
+    minutes (the recorded seconds)."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[2] / "scripts" / "finger3d_tip.py"
+    loader = importlib.util.spec_from_file_location("finger3d_tip_script", path)
+    script = importlib.util.module_from_spec(loader)
+    loader.loader.exec_module(script)
+    recorded = next(r for r in _tip_study()["levels"] if r["level"] == 0)
+    solution = tip.assemble(tip.TIP_LEVELS[0], formulation="mixed")
+    s = script.S_MM
+    for reading, key in (("mean", "tip_mean_peak"), ("point", "tip_peak")):
+        v = solution.solve(script.tip_functional(solution, 0.5, reading=reading))
         meridian = solution.influence(v, s, 0 * s)
-        values.append((meridian.min(), s[np.argmin(meridian)]))
-    peaks = np.array([p for p, _ in values])
-    assert np.max(np.abs(peaks / peaks[-1] - 1)) < 0.03
-    assert np.ptp([s for _, s in values]) <= 1.5
+        assert meridian.min() == pytest.approx(recorded[key], rel=1e-6), reading
 
 
 def _tip_study():
@@ -249,14 +254,16 @@ def test_recorded_tip_study_does_not_converge_through_the_rubber():
         assert values.max() / values.min() - 1 < 0.03
 
 
-def test_recorded_tip_study_the_tabulated_mean_strain_is_stable():
+def test_recorded_tip_study_the_tabulated_mean_strain_is_stable_not_converged():
     """What the tip table reads since round 10, the gap's mean strain over the electrode
-    (``tip_mean_peak``), in the recorded study: over every mesh (levels, radial and
-    surface families) its peak spreads under 5 % (measured 4.4 %); refined over the
-    surface (the levels' surfaces with 3 elements through the rubber) its changes shrink,
-    so Richardson finds an order, and the table's level lies within 1 % of that
-    extrapolation (measured -0.2 %). The point strain over the same surface meshes does
-    not converge (the step refuses it). Fails when a re-run study disagrees."""
+    (``tip_mean_peak``), in the recorded study (docs/model.md section 3b states it):
+    over every mesh (levels 0-2, radial and surface families) its peak spreads under 8 %
+    (measured 7.2 %), less than half the point strain's spread over the same meshes
+    (measured 22 %); refined over the surface alone its changes shrink (Richardson finds
+    an order), but over the levels they do not (-2.5 %, -2.6 %: no order, nothing to
+    extrapolate), and the table's level 1 lies within 4 % of level 2 (measured +2.7 %).
+    When a better discretisation converges, or a re-run study disagrees, this fails and
+    the page's finding must change with it."""
     import importlib.util
     from pathlib import Path
 
@@ -265,15 +272,23 @@ def test_recorded_tip_study_the_tabulated_mean_strain_is_stable():
     script = importlib.util.module_from_spec(loader)
     loader.loader.exec_module(script)
     study = _tip_study()
-    every = [abs(r["tip_mean_peak"]) for f in ("levels", "radial", "surface") for r in study[f]]
-    assert max(every) / min(every) - 1 < 0.05
+    rows = [r for f in ("levels", "radial", "surface") for r in study[f]]
+
+    def spread(name):
+        values = [abs(r[name]) for r in rows]
+        return max(values) / min(values) - 1
+
+    assert spread("tip_mean_peak") < 0.08
+    assert spread("tip_mean_peak") < 0.5 * spread("tip_peak")
     surface = study["surface"]
     assert [r["level"] for r in surface] == [0, 1, 2]
     assert {r["mesh"]["n_t"] for r in surface} == {3}
-    sizes = [r["mesh"]["h_mm"] for r in surface]
-    order, limit = script.richardson(sizes, [r["tip_mean_peak"] for r in surface])
+    order, _ = script.richardson(
+        [r["mesh"]["h_mm"] for r in surface], [r["tip_mean_peak"] for r in surface]
+    )
     assert order > 0
-    table = next(r for r in study["levels"] if r["level"] == 1)
-    assert abs(table["tip_mean_peak"] / limit - 1) < 0.01
+    levels = study["levels"]
+    assert [r["level"] for r in levels] == [0, 1, 2]
     with pytest.raises(ValueError, match="shrink"):
-        script.richardson(sizes, [r["tip_peak"] for r in surface])
+        script.richardson([r["mesh"]["h_mm"] for r in levels], [r["tip_mean_peak"] for r in levels])
+    assert abs(levels[1]["tip_mean_peak"] / levels[2]["tip_mean_peak"] - 1) < 0.04
