@@ -22,6 +22,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 import tactsense as ts
+from tactsense.physics import finger3d_tip as tip
 from tactsense.physics.array_response import deflection_batch
 from tactsense.physics.contact import Probe
 from tactsense.physics.finger3d_table import (
@@ -126,6 +127,7 @@ def numbers():
         "gap": gap,
         "level": t["mesh_level"],
         "formulation": str(t.get("formulation", "displacement")),
+        "reading": str(t.get("tip_reading", "point normal strain at the plate")),
     }
 
 
@@ -178,11 +180,10 @@ def latitude(s_mm):
 
 
 STUDIED = ("tip_peak", "tip_rim_peak", "row1_peak", "row1_at_junction")
-MEAN = ("tip_mean_peak", "row1_mean_peak")
-"""The tip tactel's and row 1's peaks read as a mean strain between core and plate."""
-"""What the mesh study extrapolates: the tip tactel's peak (its plate the face's outer half
-and outer quarter), the first cylinder row's peak and its reading of a probe at the
-junction, per newton."""
+"""The point strains the mesh study tries to extrapolate (the tip tactel's peak, its plate
+the face's outer half and outer quarter, the first cylinder row's peak and its reading of
+a probe at the junction, per newton); the tabulated tip, the gap's mean strain, is read
+by ``_study_prose``."""
 
 
 def tip_study() -> dict:
@@ -197,6 +198,7 @@ def tip_study() -> dict:
         "formulation": data["formulation"],
         "rows": data["levels"],
         "radial": data.get("radial", []),
+        "surface": data.get("surface", []),
         "fits": {},
         "converged": {},
     }
@@ -213,11 +215,6 @@ def tip_study() -> dict:
             if same and not np.isnan(out["fits"][name][0]):
                 surface = level1[name] - same[0][name]
                 out["converged"][name] = out["fits"][name][1] + surface
-        for name in MEAN:
-            try:
-                out["fits"][name] = richardson(sizes, [r[name] for r in radial])
-            except ValueError:
-                out["fits"][name] = (float("nan"), radial[-1][name])
     out["cylinder_per_n"] = _cylinder_converged_per_newton()
     return out
 
@@ -255,6 +252,139 @@ def _junction_note(st, level) -> str:
     )
 
 
+def _path(rows, name) -> str:
+    v = [-r[name] for r in rows]
+    steps = ", ".join(f"{100 * (b / a - 1):+.1f} %" for a, b in itertools.pairwise(v))
+    return f"{' -> '.join(f'{x:.4f}' for x in v)} ({steps})"
+
+
+def _spread(rows, name) -> float:
+    v = [abs(r[name]) for r in rows]
+    return 100 * (max(v) / min(v) - 1)
+
+
+def _order(rows, name, size):
+    """(observed order, extrapolated value) by Richardson over three ``rows``, or None
+    when the changes do not shrink (or there are not three)."""
+    if len(rows) != 3:
+        return None
+    try:
+        return richardson([size(r) for r in rows], [r[name] for r in rows])
+    except ValueError:
+        return None
+
+
+def _study_prose(st, level) -> list[str]:
+    """What the mesh study says of the tabulated tip (the gap's mean strain) and of the
+    point strains the tables no longer hold at the tip."""
+    levels, radial, surface = st["rows"], st["radial"], st["surface"]
+    table = next(r for r in levels if r["level"] == level)
+    finest = max(levels, key=lambda r: r["level"])
+    everything = levels + [r for r in radial + surface if r not in levels]
+    everything = [r for k, r in enumerate(everything) if r not in everything[:k]]
+
+    def h(r):
+        return r["mesh"]["h_mm"]
+
+    by_level = _order(levels, "tip_mean_peak", h)
+    by_thickness = _order(radial, "tip_mean_peak", lambda r: 1.0 / r["mesh"]["n_t"])
+    by_surface = _order(surface, "tip_mean_peak", h)
+    text = (
+        "The tip's table reads the gap's mean strain over the electrode. Over the levels "
+        f"(refined everywhere) its peak goes {_path(levels, 'tip_mean_peak')}"
+    )
+    if by_level is not None:
+        text += (
+            f": observed order {by_level[0]:.2f} (size: the element along the meridian, "
+            f"real ratios), extrapolated {-by_level[1]:.5f} per newton. "
+        )
+    elif len(levels) == 3:
+        text += ": the changes do not shrink, so no order is observable. "
+    else:
+        text += ". "
+    text += (
+        f"Refined through the rubber on level 0's surface (3, 4, 5 elements) "
+        f"{_path(radial, 'tip_mean_peak')}"
+        + (
+            ": no order. "
+            if by_thickness is None
+            else f": order {by_thickness[0]:.2f}, extrapolated {-by_thickness[1]:.5f}. "
+        )
+    )
+    if len(surface) > 1:
+        text += (
+            "Refined over the surface with 3 elements through the rubber (the levels' "
+            f"surfaces) {_path(surface, 'tip_mean_peak')}"
+            + (
+                f": order {by_surface[0]:.2f}, extrapolated {-by_surface[1]:.5f}. "
+                if by_surface is not None
+                else ": no order. "
+            )
+        )
+    text += (
+        "The two directions do not add: on level 0's surface the thickness barely moves "
+        "the mean, on finer surfaces it lowers it. So the tabulated quantity is stable "
+        f"to the spread of the study's {len(everything)} meshes, "
+        f"{min(abs(r['tip_mean_peak']) for r in everything):.4f} to "
+        f"{max(abs(r['tip_mean_peak']) for r in everything):.4f} per newton "
+        f"({_spread(everything, 'tip_mean_peak'):.1f} %), but not converged: the table's "
+        f"level {level} ({-table['tip_mean_peak']:.5f}) reads "
+        f"{100 * (table['tip_mean_peak'] / finest['tip_mean_peak'] - 1):+.1f} % from level "
+        f"{finest['level']} ({-finest['tip_mean_peak']:.5f}), and the levels give no limit "
+        "to extrapolate to. "
+    )
+    point_levels = _order(levels, "tip_peak", h)
+    text += (
+        "The point strain at the plate, which the table held before, is far less stable: "
+        f"over the same meshes it spreads {_spread(everything, 'tip_peak'):.0f} %, through "
+        f"the rubber {_path(radial, 'tip_peak')} with no monotone order (a derivative, "
+        "discontinuous between quadratic tetrahedra, at a point whose element changes "
+        "with the mesh, 0.65 mm from the rigid face whose rim is a corner of the rubber)"
+        + (
+            f"; over the levels {_path(levels, 'tip_peak')} its changes shrink (order "
+            f"{point_levels[0]:.2f}, extrapolated {-point_levels[1]:.4f}), but with the "
+            "thickness alone they do not, so that order is not trusted. "
+            if point_levels is not None
+            else ". "
+        )
+    )
+    text += (
+        "Row 1's point strain, which the tip's table still holds for the cylinder's rows "
+        "under probes on the hemisphere (the cylinder's own table reads it, and there it "
+        f"converges: section 3a), spreads {_spread(everything, 'row1_peak'):.0f} % over "
+        f"the study's meshes (levels {_path(levels, 'row1_peak')}), its mean strain "
+        f"{_spread(everything, 'row1_mean_peak'):.1f} %. For scale, the cylinder's "
+        "converged point strain under the probe (section 3a, the hemisphere far away) is "
+        f"{-st['cylinder_per_n']:.4f} per newton; row 1, 1.1 mm from the junction, reads "
+        f"{100 * table['row1_peak'] / st['cylinder_per_n']:.0f} % of it on the table's "
+        f"level and {100 * finest['row1_peak'] / st['cylinder_per_n']:.0f} % on level "
+        f"{finest['level']}."
+    )
+    if finest["level"] < len(tip.TIP_LEVELS) - 1:
+        spec = tip.TIP_LEVELS[finest["level"] + 1]
+        text += (
+            f" Level {finest['level'] + 1} ({spec.n_t} elements, {spec.h_m * 1e3:g} mm, "
+            f"{spec.n_fine_theta} around: {_dofs(spec):,} dof) is not in the study: its "
+            "factorisation did not finish within the 10 minutes a solve may take on the "
+            "shared 2-core machine."
+        )
+    elif finest["level"] > level:
+        text += (
+            f" Level {finest['level']} is in the study only ({finest['dofs']:,} dof, "
+            f"{finest['seconds']:.0f} s for its six readings on the shared 2-core "
+            "machine); the table, some thirty solves on one factorisation, stays on "
+            f"level {level}."
+        )
+    return [text]
+
+
+def _dofs(spec) -> int:
+    """Displacement unknowns of a tip mesh (quadratic tetrahedra), without assembling."""
+    from skfem import Basis, ElementTetP2
+
+    return 3 * Basis(tip.build_tip_mesh(spec).mesh, ElementTetP2(), intorder=1).N
+
+
 def block(n) -> str:
     p3, v3 = n["peak_3d"]
     pr, vr = n["peak_rim"]
@@ -263,19 +393,27 @@ def block(n) -> str:
     position, depth, gain, rms = n["fit"]
     cyl, from_tip = n["junction"]
     st = n["study"]
+    at_level = next(r for r in st["rows"] if r["level"] == int(n["level"]))
+    pp, vp = at_level["tip_peak_s_mm"], -at_level["tip_peak"]
     lines = [
         BEGIN,
         "",
         "| tip row, probe moving over the meridian | peak at (s, latitude) "
         "| peak deflection per newton [1/N] |",
         "|---|---|---|",
-        f"| 3-D, plate the face's outer half (tabulated) | {p3:.2f} mm, {latitude(p3):.0f} deg "
-        f"| {v3:.4f} |",
-        f"| 3-D, plate the face's outer quarter | {pr:.2f} mm, {latitude(pr):.0f} deg | {vr:.4f} |",
+        f"| 3-D, plate the face's outer half, the gap's mean strain (tabulated) "
+        f"| {p3:.2f} mm, {latitude(p3):.0f} deg | {v3:.4f} |",
+        f"| 3-D, plate the face's outer quarter, the gap's mean strain "
+        f"| {pr:.2f} mm, {latitude(pr):.0f} deg | {vr:.4f} |",
+        f"| 3-D, plate the face's outer half, point strain at the plate (mesh study, level "
+        f"{int(n['level'])}; tabulated before round 10) | {pp:.2f} mm, {latitude(pp):.0f} deg "
+        f"| {vp:.4f} |",
         f"| twin (half plane, depth 6 mm at 45 deg) | {pt:.2f} mm, {latitude(pt):.0f} deg "
         f"| {vt:.4f} |",
         "",
-        f"Deflection per newton of the 50-g probe (compression positive). The 3-D tip reads "
+        f"The tip's table reads the {n['reading']}. Deflection per newton of the 50-g probe "
+        f"(compression positive); the gap's mean reads {v3 / vp:.2f} times the point "
+        f"strain at its top. The 3-D tip reads "
         f"{v3 / vt:.2f} times the twin's peak. After normalising each to its peak, the two "
         f"profiles differ by {100 * n['shape_rms']:.0f} % of the peak (RMS over the meridian). "
         f"The 3-D tactel reads tension (a deflection of {-tv:.4f} per newton) for a probe at "
@@ -326,104 +464,34 @@ def block(n) -> str:
             for m, g in n["gap"][a].items()
         ),
         "",
-        f"Mesh study (`scripts/finger3d_tip.py --study-only levels` and `radial`, "
+        f"Mesh study (`scripts/finger3d_tip.py --study-only levels`, `radial` and `surface`, "
         f"{st['formulation']} elements; the table is level {int(n['level'])}, "
-        f"{n['formulation']} elements; row 1's point strain, before the rings):",
+        f"{n['formulation']} elements; row 1's point strain, before the rings, is what the "
+        "tip's table holds for the cylinder's rows):",
         "",
         "| mesh | elements through the rubber, along the meridian [mm], around the fine zone "
-        "| dof | solve [s] | tip peak deflection [1/N] | at s [mm] "
-        "| outer-quarter plate [1/N] | row 1 peak [1/N] | row 1, probe at the junction [1/N] "
-        "| tip peak, mean strain [1/N] | row 1 peak, mean strain [1/N] |",
+        "| dof | solve [s] | tip peak, the gap's mean strain (tabulated) [1/N] "
+        "| tip peak, point strain at the plate [1/N] | at s [mm] "
+        "| outer-quarter plate, point [1/N] | row 1 peak, point (tabulated) [1/N] "
+        "| row 1, probe at the junction, point (tabulated) [1/N] "
+        "| row 1 peak, mean strain [1/N] |",
         "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     radial_only = [r for r in st["radial"] if r not in st["rows"]]
+    surface_only = [r for r in st["surface"] if r not in st["rows"]]
     for label, r in [
         *((f"level {r['level']}", r) for r in st["rows"]),
         *((f"level 0's surface, {r['mesh']['n_t']} through", r) for r in radial_only),
+        *((f"level {r['level']}'s surface, {r['mesh']['n_t']} through", r) for r in surface_only),
     ]:
         m = r["mesh"]
         lines.append(
             f"| {label} | {m['n_t']}, {m['h_mm']:g}, {m['n_theta']} | {r['dofs']:,} "
-            f"| {r['seconds']:.0f} | {-r['tip_peak']:.4f} | {r['tip_peak_s_mm']:.2f} "
-            f"| {-r['tip_rim_peak']:.4f} | {-r['row1_peak']:.4f} "
-            f"| {-r['row1_at_junction']:.4f} | {-r['tip_mean_peak']:.4f} "
-            f"| {-r['row1_mean_peak']:.4f} |"
+            f"| {r['seconds']:.0f} | {-r['tip_mean_peak']:.4f} | {-r['tip_peak']:.4f} "
+            f"| {r['tip_peak_s_mm']:.2f} | {-r['tip_rim_peak']:.4f} | {-r['row1_peak']:.4f} "
+            f"| {-r['row1_at_junction']:.4f} | {-r['row1_mean_peak']:.4f} |"
         )
-    if st["fits"] and not any(np.isnan(st["fits"][k][0]) for k in STUDIED):
-        cells = []
-        for name in STUDIED:
-            order, limit = st["fits"][name]
-            text = "none (changes do not shrink)" if np.isnan(order) else f"{order:.2f}"
-            cells.append(f"{-limit:.4f} (order {text})")
-        tip_cell, rim_cell, row_cell, junction_cell = cells
-        lines.append(
-            f"| radial family extrapolated | | | | {tip_cell} | | {rim_cell} | {row_cell} "
-            f"| {junction_cell} | | |"
-        )
-    if st["fits"] and len(st["converged"]) < len(STUDIED):
-        radial = st["radial"]
-
-        def spread(name):
-            v = [abs(r[name]) for r in radial]
-            return 100 * (max(v) / min(v) - 1)
-
-        def path(name):
-            v = [-r[name] for r in radial]
-            steps = ", ".join(f"{100 * (b / a - 1):+.0f} %" for a, b in itertools.pairwise(v))
-            return f"{' -> '.join(f'{x:.4f}' for x in v)} ({steps})"
-
-        level = next(r for r in st["rows"] if r["level"] == int(n["level"]))
-        cylinder = -st["cylinder_per_n"]
-        lines += [
-            "",
-            "Refined through the rubber on level 0's surface (3, 4, 5 elements), the changes "
-            f"do not shrink: the tip's peak {path('tip_peak')}, row 1's peak "
-            f"{path('row1_peak')}. No order is observable and nothing is extrapolated: the "
-            "tip's point strains are known only to the spread of these meshes. The same "
-            "tactels read as a mean strain between the core and the plate (the plate's "
-            "displacement over its 0.65 mm: a displacement, continuous, where the point "
-            "strain is a derivative, discontinuous between quadratic tetrahedra, at a point "
-            "whose element changes with the mesh) vary far less: the tip's "
-            f"{path('tip_mean_peak')}, row 1's {path('row1_mean_peak')}; over the three "
-            f"meshes they spread by {spread('tip_mean_peak'):.1f} % and "
-            f"{spread('row1_mean_peak'):.1f} %, the point strains by "
-            f"{spread('tip_peak'):.0f} % and {spread('row1_peak'):.0f} % (no monotone "
-            "order in either, so nothing is extrapolated). For "
-            "scale, the cylinder's converged point strain under the probe (section 3a, the "
-            f"hemisphere far away) is {cylinder:.4f} per newton; row 1, 1.1 mm from the "
-            f"junction, reads {100 * -level['row1_peak'] / cylinder:.0f} % of it on the "
-            f"table's level and {100 * -radial[-1]['row1_peak'] / cylinder:.0f} % on the "
-            "finest thickness mesh."
-            + (
-                ""
-                if len(st["rows"]) == 3
-                else " Level 2 (5 elements, 0.8 mm, 10 around) did not finish within the "
-                "round's time on the shared machine."
-            ),
-        ]
-    if len(st["converged"]) == len(STUDIED):
-        conv = [f"{-st['converged'][k]:.4f}" for k in STUDIED]
-        lines.append(
-            f"| converged estimate | | | | {conv[0]} | | {conv[1]} | {conv[2]} | {conv[3]} |"
-        )
-        level = next(r for r in st["rows"] if r["level"] == int(n["level"]))
-        errors = [100 * (level[k] / st["converged"][k] - 1) for k in STUDIED]
-        lines += [
-            "",
-            "The radial family refines level 0's mesh through the rubber (3, 4, 5 elements: "
-            "ratios 4/3 and 5/4), extrapolated by Richardson with those ratios; the "
-            "surface's share is level 1 less the radial family's mesh of the same "
-            "thickness (4 elements), and the converged estimate adds the two, taken as "
-            "additive (section 3a). The table's level reads "
-            + ", ".join(f"{e:+.1f} %" for e in errors)
-            + " from the converged estimate (the columns in order)."
-            + (
-                ""
-                if len(st["rows"]) == 3
-                else " Level 2 (5 elements, 0.8 mm, 10 around) did not finish within the "
-                "round's time on the shared machine."
-            ),
-        ]
+    lines += ["", *_study_prose(st, int(n["level"]))]
     lines += ["", END]
     return "\n".join(lines)
 
@@ -434,10 +502,10 @@ def figure(n) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.2))
+    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.8))
     s = n["s"]
-    left.plot(s, n["three"], "k-", lw=2, label="3-D, plate: outer half of the face")
-    left.plot(s, n["rim"], "k:", lw=1.5, label="3-D, plate: outer quarter")
+    left.plot(s, n["three"], "k-", lw=2, label="3-D, gap's mean strain, plate: outer half")
+    left.plot(s, n["rim"], "k:", lw=1.5, label="3-D, gap's mean strain, plate: outer quarter")
     left.plot(s, n["twin"], "C0--", label="twin (6 mm deep, at 45 deg)")
     position, depth, _, _ = n["fit"]
     left.plot(s, n["fitted"], "C1-.",
@@ -445,14 +513,14 @@ def figure(n) -> None:
     left.axvline(0.0, color="0.6", lw=0.8)
     left.axvline(APEX_MM, color="0.6", lw=0.8)
     left.axvline(-RADIUS_MM * np.radians(RIM_DEG), color="0.8", lw=0.8, ls=":")
-    left.text(-RADIUS_MM * np.radians(RIM_DEG) + 0.3, left.get_ylim()[1] * 0.9, "core's rim",
+    left.text(-RADIUS_MM * np.radians(RIM_DEG) + 0.3, left.get_ylim()[1] * 0.78, "core's rim",
               fontsize=8)  # fmt: skip
     left.axhline(0.0, color="0.8", lw=0.8)
     left.text(APEX_MM + 0.3, left.get_ylim()[1] * 0.9, "apex", fontsize=8)
     left.text(0.3, left.get_ylim()[1] * 0.9, "junction", fontsize=8)
     left.set_xlabel("probe position along the meridian, s [mm] (negative: on the tip)")
     left.set_ylabel("tip-row deflection per newton [1/N]")
-    left.legend(fontsize=8)
+    left.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2)
     left.set_title("Tip row, probe moving over the tip (cf. Fig. 14)", fontsize=10)
     a = n["angles"]
     right.plot(a, n["around_3d"], "k-", lw=2, label="3-D")

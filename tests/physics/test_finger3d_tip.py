@@ -78,6 +78,38 @@ def test_spherical_shell_on_a_rigid_core_matches_the_closed_form(sphere_solution
         np.testing.assert_allclose(got, tip.sphere_radial_strain(r, pressure, nu), rtol=0.02)
 
 
+@pytest.mark.parametrize("nu, form", [(0.49, "displacement"), (0.49, "mixed")])
+def test_mean_strain_over_a_gap_matches_the_shell_closed_form(sphere_solutions, nu, form):
+    """What the tip table reads since round 10: the mean normal strain of the gap between
+    the core and a plate, the plate's normal displacement over the gap
+    (``normal_displacement_functional`` / d), averaged over points of an electrode.
+    Independent check: the spherical shell on its rigid core under uniform pressure,
+    where the layer of thickness d on the core has mean radial strain u_r(a + d) / d,
+    u_r = A (r - a^3 / r^2) (closed form, ``sphere_radial_displacement``). d = 0.65 mm
+    (the solid skin's gap) and 0.5 mm (the foam's), on the coarsest mesh (3 elements
+    through 3.85 mm: the gap lies inside the first element), at a patch of points around
+    the apex and one at mid-latitude. Bounds: the electrode's mean within 1 % (measured
+    0.1-0.5 %); each point alone within 1 % with mixed elements (the tables'; measured
+    0.1-0.7 %) and 2.5 % in displacement form (measured up to 2.2 %, at the apex whose
+    meridians the mesh merges)."""
+    solution = sphere_solutions[nu, form]
+    pressure = 1.0e3
+    f = solution.pressure_load(lambda x: 1.0 + 0 * x[0], pressure * 2 * np.pi * tip.OUTER_M**2)
+    u = solution.solve(f)
+    psi = np.array([np.pi / 2 - 1e-4, 1.45, 1.3, 1.3, 0.6])
+    theta = np.array([0.0, 0.3, 0.1, 1.2, 2.0])
+    d_hat = np.stack([-np.sin(psi), np.cos(psi) * np.sin(theta), np.cos(psi) * np.cos(theta)])
+    for gap in (0.65e-3, 0.5e-3):
+        points = d_hat * (tip.CORE_M + gap)
+        g = solution.normal_displacement_functional(points, d_hat) / gap
+        want = tip.sphere_radial_displacement(tip.CORE_M + gap, pressure, nu) / gap
+        assert g @ u.ravel() == pytest.approx(want, rel=0.01)
+        for k in range(len(psi)):  # each point alone, not only the mean
+            one = solution.normal_displacement_functional(points[:, [k]], d_hat[:, [k]])
+            bound = 0.01 if form == "mixed" else 0.025
+            assert one @ u.ravel() / gap == pytest.approx(want, rel=bound)
+
+
 @pytest.fixture(scope="module")
 def coarse():
     return tip.assemble(COARSE)
@@ -144,21 +176,26 @@ def test_tip_tactel_reads_compression_over_the_tip_and_little_on_the_cylinder(co
     assert np.abs(meridian[s > 4]).max() < 0.02 * abs(meridian[peak])
 
 
-@pytest.mark.slow
-def test_mesh_study_tip_peak_converges():
-    """Levels 0-2: the tip tactel's peak per newton changes by under 3 % and stays at the
-    same latitude within one element."""
-    values = []
-    for spec in tip.TIP_LEVELS:
-        solution = tip.assemble(spec)
-        _, g = _tip_sector(solution)
-        v = solution.solve(g)
-        s = np.linspace(-16.0, -4.0, 97)
+def test_regression_recorded_study_level_0_is_a_fresh_solve():
+    """Regression test, not a check of correctness (the same solver on the same mesh):
+    the recorded mesh study's level 0 (docs/data/finger3d_tip_study.json) is what today's
+    code computes, the tip's peak read both ways (the gap's mean strain the table holds
+    and the point strain at the plate), to 1e-6. Level 0 only: the finer levels take
+    minutes (the recorded seconds)."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[2] / "scripts" / "finger3d_tip.py"
+    loader = importlib.util.spec_from_file_location("finger3d_tip_script", path)
+    script = importlib.util.module_from_spec(loader)
+    loader.loader.exec_module(script)
+    recorded = next(r for r in _tip_study()["levels"] if r["level"] == 0)
+    solution = tip.assemble(tip.TIP_LEVELS[0], formulation="mixed")
+    s = script.S_MM
+    for reading, key in (("mean", "tip_mean_peak"), ("point", "tip_peak")):
+        v = solution.solve(script.tip_functional(solution, 0.5, reading=reading))
         meridian = solution.influence(v, s, 0 * s)
-        values.append((meridian.min(), s[np.argmin(meridian)]))
-    peaks = np.array([p for p, _ in values])
-    assert np.max(np.abs(peaks / peaks[-1] - 1)) < 0.03
-    assert np.ptp([s for _, s in values]) <= 1.5
+        assert meridian.min() == pytest.approx(recorded[key], rel=1e-6), reading
 
 
 def _tip_study():
@@ -172,16 +209,19 @@ def _tip_study():
 def test_recorded_tip_study_holds_the_shipped_tables_level():
     """The recorded mesh study (docs/data/finger3d_tip_study.json, mixed elements) holds
     the shipped table's level: its level-1 peaks are the table's own study values (to
-    rounding), and the radial family starts from level 0's mesh."""
+    rounding; the tip's as the gap's mean strain, which the table now reads), and the
+    radial family starts from level 0's mesh."""
     from pathlib import Path
 
     study = _tip_study()
     shipped = np.load(Path(tip.__file__).parent / "data" / "finger3d_tip.npz", allow_pickle=False)
     assert study["formulation"] == str(shipped["formulation"]) == "mixed"
+    assert str(shipped["tip_reading"]).startswith("mean normal strain of the gap")
     level = int(shipped["mesh_level"])
     row = next(r for r in study["levels"] if r["level"] == level)
     k = list(shipped["study_levels"]).index(level)
-    assert row["tip_peak"] == pytest.approx(float(shipped["study_tip_peak"][k]), rel=1e-9)
+    # the table reads the gap's mean strain: the study's tip_mean_peak
+    assert row["tip_mean_peak"] == pytest.approx(float(shipped["study_tip_peak"][k]), rel=1e-9)
     assert row["row1_peak"] == pytest.approx(float(shipped["study_row1_peak"][k]), rel=1e-9)
     first = study["radial"][0]["mesh"]
     assert first["n_t"] == tip.TIP_LEVELS[0].n_t and first["h_mm"] == tip.TIP_LEVELS[0].h_m * 1e3
@@ -212,3 +252,43 @@ def test_recorded_tip_study_does_not_converge_through_the_rubber():
     for name in ("tip_mean_peak", "row1_mean_peak"):
         values = np.abs([r[name] for r in radial])
         assert values.max() / values.min() - 1 < 0.03
+
+
+def test_recorded_tip_study_the_tabulated_mean_strain_is_stable_not_converged():
+    """What the tip table reads since round 10, the gap's mean strain over the electrode
+    (``tip_mean_peak``), in the recorded study (docs/model.md section 3b states it):
+    over every mesh (levels 0-2, radial and surface families) its peak spreads under 8 %
+    (measured 7.2 %), less than half the point strain's spread over the same meshes
+    (measured 22 %); refined over the surface alone its changes shrink (Richardson finds
+    an order), but over the levels they do not (-2.5 %, -2.6 %: no order, nothing to
+    extrapolate), and the table's level 1 lies within 4 % of level 2 (measured +2.7 %).
+    When a better discretisation converges, or a re-run study disagrees, this fails and
+    the page's finding must change with it."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[2] / "scripts" / "finger3d_convergence.py"
+    loader = importlib.util.spec_from_file_location("finger3d_convergence", path)
+    script = importlib.util.module_from_spec(loader)
+    loader.loader.exec_module(script)
+    study = _tip_study()
+    rows = [r for f in ("levels", "radial", "surface") for r in study[f]]
+
+    def spread(name):
+        values = [abs(r[name]) for r in rows]
+        return max(values) / min(values) - 1
+
+    assert spread("tip_mean_peak") < 0.08
+    assert spread("tip_mean_peak") < 0.5 * spread("tip_peak")
+    surface = study["surface"]
+    assert [r["level"] for r in surface] == [0, 1, 2]
+    assert {r["mesh"]["n_t"] for r in surface} == {3}
+    order, _ = script.richardson(
+        [r["mesh"]["h_mm"] for r in surface], [r["tip_mean_peak"] for r in surface]
+    )
+    assert order > 0
+    levels = study["levels"]
+    assert [r["level"] for r in levels] == [0, 1, 2]
+    with pytest.raises(ValueError, match="shrink"):
+        script.richardson([r["mesh"]["h_mm"] for r in levels], [r["tip_mean_peak"] for r in levels])
+    assert abs(levels[1]["tip_mean_peak"] / levels[2]["tip_mean_peak"] - 1) < 0.04

@@ -147,11 +147,14 @@ def tip_table(forward: str = "finger3d") -> dict:
 
 
 def tip_row_strain_per_newton(s_mm, d_angle_deg, *, plate: str = "tip", forward="finger3d"):
-    """Mean normal strain of the tip row's tactel per newton of the probe [1/N], the
-    probe at surface coordinate ``s_mm`` (apex -19.95 mm to 12 mm; 0 beyond) and
-    ``d_angle_deg`` from the tactel; ``plate="tip_rim"``: the outer quarter of the
-    face only (the plate-size sensitivity); ``forward="finger3d-foam"``: the skin on the
-    foam, read as the foam layer's mean strain."""
+    """Normal strain of the tip row's tactel per newton of the probe [1/N], as its
+    capacitor reads it: the mean strain of the gap between the core's end face and the
+    plate (the plate's displacement over the gap), averaged over the plate; the probe at
+    surface coordinate ``s_mm`` (apex -19.95 mm to 12 mm; 0 beyond) and ``d_angle_deg``
+    from the tactel. The gap is the 0.65 mm of rubber under the plate for ``"finger3d"``
+    (the cylinder's rows read the point strain instead: ``docs/model.md`` section 3d) and
+    the foam layer for ``"finger3d-foam"``. ``plate="tip_rim"``: the outer quarter of the
+    face only (the plate-size sensitivity)."""
     t = tip_table(forward)
     s = np.asarray(s_mm, dtype=float)
     values = t[f"{plate}_strain_per_n"]

@@ -546,7 +546,20 @@ def sphere_radial_strain(r, pressure_pa, poisson_ratio, youngs_modulus=YOUNGS_PA
     mu) A - 4 mu B / r^3 = -p`` at ``r = b``: ``A = -p / (3 lam + 2 mu + 4 mu a^3 / b^3)``,
     and ``eps_rr = A - 2 B / r^3 = A (1 + 2 a^3 / r^3)``.
     """
-    lam, mu = lame_parameters(youngs_modulus, poisson_ratio)
     a3 = CORE_M**3
-    big_a = -pressure_pa / (3 * lam + 2 * mu + 4 * mu * a3 / OUTER_M**3)
+    big_a = _shell_coefficient(pressure_pa, poisson_ratio, youngs_modulus)
     return big_a * (1 + 2 * a3 / np.asarray(r, float) ** 3)
+
+
+def sphere_radial_displacement(r, pressure_pa, poisson_ratio, youngs_modulus=YOUNGS_PA):
+    """u_r [m] in the same shell (:func:`sphere_radial_strain`): ``A (r - a^3 / r^2)``,
+    zero on the core; ``u_r(a + d) / d`` is the mean radial strain of the layer of
+    thickness ``d`` on the core, what a capacitor whose dielectric is that layer reads."""
+    r = np.asarray(r, float)
+    big_a = _shell_coefficient(pressure_pa, poisson_ratio, youngs_modulus)
+    return big_a * (r - CORE_M**3 / r**2)
+
+
+def _shell_coefficient(pressure_pa, poisson_ratio, youngs_modulus):
+    lam, mu = lame_parameters(youngs_modulus, poisson_ratio)
+    return -pressure_pa / (3 * lam + 2 * mu + 4 * mu * CORE_M**3 / OUTER_M**3)
