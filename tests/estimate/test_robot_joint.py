@@ -109,3 +109,29 @@ def test_bad_method_is_refused_in_one_line():
     for method in ("fit", "cop", "Joint", None):
         with pytest.raises(TactsenseInputError, match="takes one of interpolate, joint"):
             HandLocator(skin, baselines, method=method)
+
+
+def test_locate_run_method_joint_writes_the_size_columns_and_its_note(tmp_path):
+    """``tactsense locate RUN/ --method joint``: the contacts table has the joint fit's
+    size columns (NaN on the dome), its pad rows equal HandLocator(method="joint")'s on
+    the recording, and the closing note is the joint one (not the probe caveat)."""
+    import pyarrow.parquet
+    from typer.testing import CliRunner
+
+    from tactsense.cli import app
+    from tactsense.robot_batch import locate_robot_recording
+    from tests.estimate._robot_sim import write_pressed_recording
+
+    run = write_pressed_recording(tmp_path / "run", small_skin(), frames=10)
+    out = tmp_path / "c.parquet"
+    result = CliRunner().invoke(app, ["locate", str(run), "--method", "joint", "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    text = " ".join(result.output.split())
+    assert "fitted each pad patch's contacts with their size" in text
+    assert "1.6-mm probe" not in text
+    table = pyarrow.parquet.read_table(out).to_pydict()
+    assert tuple(table) == JOINT_COLUMNS
+    assert sorted(set(table["frame"])) == [5, 6, 7, 8, 9]  # the pad, pressed from frame 5
+    again = locate_robot_recording(run, method="joint").contacts
+    np.testing.assert_allclose(table["force_n"], again["force_n"], rtol=1e-12)
+    assert np.isfinite(table["contact_radius_mm"]).all()
