@@ -50,6 +50,7 @@ def test_joint_rows_are_find_contacts_joint_and_point_sets_keep_theirs(pressed):
     rows = _rows(mine, "pad")
     order = np.lexsort((table.contact, table.frame))
     np.testing.assert_array_equal(mine["frame"][rows], table.frame[order])
+    assert ((table.row > -0.5) & (table.row < 15.5)).all()  # none off the taxels here
     for column, values in (("x_mm", table.x_mm), ("y_mm", table.y_mm),
                            ("force_n", table.force_n),
                            ("contact_radius_mm", table.extra["contact_radius_mm"]),
@@ -101,6 +102,32 @@ def test_a_broad_contacts_force_reads_right_with_joint_and_low_without():
         force[method] = np.linalg.norm(total[:, :3], axis=1)
     np.testing.assert_allclose(force["joint"], 2.0, rtol=0.02)
     assert (force["interpolate"] < 0.6 * 2.0).all()
+
+
+def test_a_contact_fitted_off_the_taxels_has_no_force_and_adds_nothing():
+    """A 1-N sphere (5-mm radius) one pitch beyond the palm pad's first row, without
+    flaws: the joint fit places it there (row -1.0) with 120 N, since the taxels see only
+    its flank; the hand lists it with a NaN force (OFF_TAXELS), and its wrench is zero.
+    The same sphere inside the pad keeps its fitted force."""
+    sensor = skin_preset("hand4").patch("palm_0").sensor
+    skin = RobotSkin(name="palm", base_link="palm", links=("palm",), joints=(),
+                     patches=(Patch("pad", sensor, "palm", Pose((0.0, 0.0, 0.0))),))  # fmt: skip
+    where = np.array([[-2.0, 10.0], [9.0, 10.0]])[:, None, :]
+    batch = ContactBatch(where, np.full((2, 1), 1.0), radius_mm=5.0)
+    frames = frames_from_contacts(sensor, batch, flaws="none").reshape(2, *sensor.shape)
+    baseline = frames_from_contacts(sensor, ContactBatch(where[:1], np.zeros((1, 1))), flaws="none")
+    baseline = baseline.reshape(sensor.shape)
+    table = find_contacts(frames, sensor, baseline=baseline, method="joint")
+    off = table.frame == 0
+    assert off.sum() == 1 and table.row[off][0] < -0.5 and table.force_n[off][0] > 10.0
+    result = HandLocator(skin, {"pad": baseline}, method="joint").locate(frames.reshape(2, -1))
+    c = result.contacts
+    first = c["frame"] == 0
+    assert first.sum() == 1 and np.isnan(c["force_n"][first]).all()
+    assert c["flags"][first][0] & 32  # EDGE
+    np.testing.assert_array_equal(result.total[0], 0.0)
+    np.testing.assert_allclose(c["force_n"][~first], table.force_n[~off], rtol=1e-12)
+    assert np.linalg.norm(result.total[1, :3]) > 0.5
 
 
 def test_bad_method_is_refused_in_one_line():

@@ -53,6 +53,13 @@ from tactsense.estimate.results import Flag
 from tactsense.kinds import kind_of
 from tactsense.robot import RobotSkin
 
+OFF_TAXELS = 0.5
+"""With ``method="joint"``: a pad contact whose fitted centre lies more than this many
+pitches beyond the patch's outer taxels has no force (NaN): beyond the edge the frame
+trades the contact's distance for its force (docs/contacts.md, "Two contacts fitted
+jointly": a contact 4 mm beyond the last taxel fitted with 2.0 N for 0.49 N; on the docs'
+grasp a 33-kN contact two pitches off the palm, docs/robot.md)."""
+
 
 class HandLocator:
     """Contacts and wrenches of a whole skin, one compiled call per block of hand frames.
@@ -361,7 +368,12 @@ class HandLocator:
     def _joint_contacts(self, counts, fresh) -> tuple:
         """The joint fit's contacts of every :data:`~._robot_kernel.MODE_GIVEN` patch's
         new frames (one :func:`find_contacts` call per patch and block), in the slots
-        :func:`~._robot_kernel.hand_block` reads (``given_*``)."""
+        :func:`~._robot_kernel.hand_block` reads (``given_*``).
+
+        A contact the fit places off the patch's taxels (its centre more than half a
+        pitch beyond the outer rows or columns; flagged ``EDGE``) keeps its row with a NaN
+        force, which adds nothing to a wrench (as a saturated contact's): the taxels see
+        only its flank, where the fit trades distance for force (:data:`OFF_TAXELS`)."""
         k = self.max_contacts
         joint = np.flatnonzero(self._mode == K.MODE_GIVEN)
         start = np.zeros(len(self.patch_names), np.int64)
@@ -395,6 +407,10 @@ class HandLocator:
             )  # fmt: skip
             slot = start[p] + table.frame
             rank = table.contact
+            rows, cols = shape
+            off = (table.row < -OFF_TAXELS) | (table.row > rows - 1 + OFF_TAXELS)
+            off |= (table.col < -OFF_TAXELS) | (table.col > cols - 1 + OFF_TAXELS)
+            table.force_n[off] = np.nan  # off the taxels: listed, adds nothing (OFF_TAXELS)
             count[start[p] : start[p] + len(new)] = np.bincount(table.frame, minlength=len(new))
             rc[slot, rank, 0], rc[slot, rank, 1] = table.row, table.col
             value[slot, rank], force[slot, rank] = table.peak, table.force_n
@@ -482,6 +498,7 @@ __all__ = [
     "CONTACT_COLUMNS",
     "HAND_METHODS",
     "JOINT_COLUMNS",
+    "OFF_TAXELS",
     "WRENCH_COLUMNS",
     "HandLocator",
     "JointStates",
