@@ -80,13 +80,14 @@ def grasp_rows(every: int) -> tuple[list[str], dict]:
                 if what == "hold":
                     force = np.linalg.norm(result.total[:, :3], axis=1)
                     per_frame = np.bincount(result.contacts["frame"], minlength=len(chosen))
+                    no_force = int(np.isnan(result.contacts["force_n"]).sum())
             error = 100.0 * (force / truth - 1.0)
             within = int(np.sum(np.abs(error) <= 5.0))
             rows.append(
                 f"| {label} | `{method}` | {len(hold)} | {np.median(truth):.2f} | "
                 f"{np.median(force):.2f} | {np.median(error):+.1f} | "
                 f"{error.min():+.1f} to {error.max():+.1f} | {within} of {len(hold)} | "
-                f"{int(per_frame.min())}-{int(per_frame.max())} | "
+                f"{int(per_frame.min())}-{int(per_frame.max())} | {no_force} | "
                 f"{1e3 * seconds['hold']:.0f} | {1e3 * seconds['idle']:.1f} |"
             )
             notes[(flaws, method)] = error
@@ -96,7 +97,8 @@ def grasp_rows(every: int) -> tuple[list[str], dict]:
 
 
 def palm_rows() -> list[str]:
-    from tactsense.estimate.contacts import find_contacts
+    from tactsense.estimate.contacts import default_threshold, find_contacts
+    from tactsense.estimate.reading import signal_from_counts
     from tactsense.robot import load_skin
     from tactsense.simulate import ContactBatch, frames_from_contacts
 
@@ -116,7 +118,9 @@ def palm_rows() -> list[str]:
                     flaws=flaws, rng=1,
                 )  # fmt: skip
                 baseline = np.median(rest.reshape(5, *shape), axis=0)
-                cells = []
+                signal, _ = signal_from_counts(frames, baseline, sensor)
+                read = (signal > default_threshold(sensor)).sum(axis=(1, 2))
+                cells = [" ".join(str(int(r)) for r in read)]
                 for method in METHODS:
                     started = time.perf_counter()
                     table = find_contacts(frames, sensor, baseline=baseline, method=method)
@@ -154,20 +158,21 @@ def main() -> None:
             "fit):",
             "",
             "| flaws | method | hand frames | truth [N] | located, median [N] | error, median "
-            "[%] | range [%] | within 5 % | contacts per frame | ms per touched frame | "
-            "ms per untouched frame |",
-            "|---|---|---|---|---|---|---|---|---|---|---|",
+            "[%] | range [%] | within 5 % | contacts per frame | contacts without force | "
+            "ms per touched frame | ms per untouched frame |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|",
             *grasp,
             "",
             "The palm's pad alone (hand4's 18 x 18 pad, 2-mm pitch) under one sphere at four "
             "places within a taxel ((17, 17), (17.5, 17), (18, 18), (17.3, 17.7) mm), "
             "`find_contacts` (the hand's rows are its, tested exactly): the total located "
-            "force's error [%] at each place, the most contacts a frame was split into, and "
-            "the joint fit's time per frame:",
+            "force's error [%] at each place, the taxels above the threshold at each place, the "
+            "most contacts a frame was split into, and the joint fit's time per frame:",
             "",
-            "| sphere radius [mm] | force [N] | flaws | `interpolate` error [%] | contacts "
-            "| `joint` error [%] | contacts | `joint` ms per frame |",
-            "|---|---|---|---|---|---|---|---|",
+            "| sphere radius [mm] | force [N] | flaws | taxels above the threshold | "
+            "`interpolate` error [%] | contacts | `joint` error [%] | contacts | `joint` ms "
+            "per frame |",
+            "|---|---|---|---|---|---|---|---|---|",
             *palm,
             END,
         ]
