@@ -50,6 +50,56 @@ def _grasp(skin, flaws: str):
     return largest.name, simulate_grasp(skin, Grasp(item, force_n=2.0, flaws=flaws))
 
 
+def _off_taxel_forces(locator, streams, name: str, frames) -> np.ndarray:
+    """The forces [N] ``find_contacts(method="joint")`` gives the contacts it fits off the
+    patch's taxels (beyond ``OFF_TAXELS``), which the hand lists without force."""
+    from tactsense.estimate.contacts import find_contacts
+    from tactsense.estimate.robot import OFF_TAXELS
+
+    p = locator.patch_names.index(name)
+    sensor = locator.skin.patches[p].sensor
+    shape = tuple(sensor.shape)
+    off, size = locator._offset[p], int(np.prod(shape))
+    table = find_contacts(
+        streams[name].frames[frames], sensor,
+        baseline=locator._baseline[off : off + size].reshape(shape),
+        dead=locator._unusable[off : off + size].reshape(shape), method="joint",
+    )  # fmt: skip
+    rows, cols = shape
+    beyond = (table.row < -OFF_TAXELS) | (table.row > rows - 1 + OFF_TAXELS)
+    beyond |= (table.col < -OFF_TAXELS) | (table.col > cols - 1 + OFF_TAXELS)
+    return np.column_stack([table.force_n, table.row, table.col])[beyond]
+
+
+def _off_list(rows) -> str:
+    found = "; ".join(f"{f:,.1f} N at row {r:.2f}, column {c:.2f}" for f, r, c in rows)
+    return found or "none"
+
+
+def edge_sentence() -> str:
+    """A 1-N sphere (5-mm radius) one pitch beyond the palm pad's first row, noise-free:
+    what the joint fit gives it."""
+    from tactsense.estimate.contacts import find_contacts
+    from tactsense.robot import load_skin
+    from tactsense.simulate import ContactBatch, frames_from_contacts
+
+    sensor = load_skin("hand4").patch("palm_0").sensor
+    where = np.array([[[-2.0, 10.0]]])
+    frames = frames_from_contacts(sensor, ContactBatch(where, [[1.0]], radius_mm=5.0),
+                                  flaws="none")  # fmt: skip
+    rest = frames_from_contacts(sensor, ContactBatch(where, [[0.0]]), flaws="none")
+    table = find_contacts(frames.reshape(sensor.shape), sensor,
+                          baseline=rest.reshape(sensor.shape), method="joint")  # fmt: skip
+    found = ", ".join(
+        f"row {r:.2f}, column {c:.2f} with {f:.1f} N" for r, c, f in
+        zip(table.row, table.col, table.force_n, strict=True)
+    ) or "nothing"  # fmt: skip
+    return (
+        "A 1-N sphere of 5-mm radius one pitch beyond the palm pad's first row (row -1, "
+        f"column 5), without flaws: the joint fit finds {found}."
+    )
+
+
 def grasp_rows(every: int) -> tuple[list[str], dict]:
     from tactsense.estimate.robot import HandLocator
     from tactsense.robot import load_skin
@@ -81,6 +131,8 @@ def grasp_rows(every: int) -> tuple[list[str], dict]:
                     force = np.linalg.norm(result.total[:, :3], axis=1)
                     per_frame = np.bincount(result.contacts["frame"], minlength=len(chosen))
                     no_force = int(np.isnan(result.contacts["force_n"]).sum())
+            if method == "joint" and flaws == "all":  # the fit's own force of those
+                notes["raw"] = _off_taxel_forces(locator, streams, name, hold)
             error = 100.0 * (force / truth - 1.0)
             within = int(np.sum(np.abs(error) <= 5.0))
             rows.append(
@@ -174,6 +226,12 @@ def main() -> None:
             "per frame |",
             "|---|---|---|---|---|---|---|---|---|",
             *palm,
+            "",
+            "Contacts the joint fit placed off the palm's taxels in the grasp's hold frames "
+            "above (every flaw; the hand lists them without force): "
+            + _off_list(notes["raw"])
+            + ".",
+            edge_sentence(),
             END,
         ]
     )
