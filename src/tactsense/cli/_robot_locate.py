@@ -55,7 +55,8 @@ JOINT_CAVEAT = (
 METHOD_HELP = (
     " On a robot recording's folder: 'interpolate' (default) or 'joint' (each pad patch's "
     "contacts fitted jointly with their size, then placed and summed into wrenches; "
-    "point-set patches keep their estimator; docs/robot.md)."
+    "point-set patches keep their estimator; 1-4 s per hand frame with a broad contact "
+    "on a pad: docs/robot.md)."
 )
 
 
