@@ -76,13 +76,15 @@ def iter_robot_blocks(
     baseline_frames: int = 5,
     threshold: float | None = None,
     max_contacts: int = 8,
+    method: str = "interpolate",
     block_frames: int = 4096,
     progress: Callable[[int, int], None] | None = None,
     warnings: list[str] | None = None,
 ):
     """:func:`locate_robot_recording` block by block: yields a :class:`RobotContacts` per
     ``block_frames`` hand frames (memory bounded by the block, whatever the length; a
-    folder's frames are read a block at a time)."""
+    folder's frames are read a block at a time). ``method``: a pad patch's estimator,
+    ``"interpolate"`` or ``"joint"`` (:class:`HandLocator`)."""
     if not (isinstance(baseline_frames, int) and baseline_frames >= 1):
         raise TactsenseInputError(
             f"baseline_frames must be a positive integer; got {baseline_frames!r}"
@@ -102,7 +104,9 @@ def iter_robot_blocks(
                 continue
             first = streams.frames(patch.name, 0, baseline_frames).astype(float)
             baselines[patch.name] = np.nanmedian(first, axis=0)
-        locator = HandLocator(skin, baselines, threshold=threshold, max_contacts=max_contacts)
+        locator = HandLocator(
+            skin, baselines, threshold=threshold, max_contacts=max_contacts, method=method
+        )
         if isinstance(joints, Mapping):
             locator.joint_array(joints, 1)
         present = [name for name in names if name in streams.times]

@@ -1356,3 +1356,34 @@ def test_mjslip2_bad_input(mjslip2_workspace, line, names):
 
 
 # ---- /r9-mjslip2 ----
+
+
+# ---- hand joint fit (r10-handjoint) ----
+HANDJOINT_BAD = [
+    # --method on a robot recording's folder: 'interpolate' or 'joint' only; with joint,
+    # the other single-array options are still refused, and so are the robot's bad ones
+    ("locate RUN --method cop --out OUT", "takes --method interpolate or joint"),
+    ("locate RUN --method bogus --out OUT", "--method apply to a single array's recording"),
+    ("locate RUN --method joint --workers 2 --out OUT", "--workers apply to a single array"),
+    ("locate RUN --method joint --drift-s 0 --out OUT", "--drift-s apply to a single array"),
+    ("locate RUN --method joint --joints j3=5 --out OUT", "outside its limits"),
+    ("locate RUN --method joint --max-contacts 99 --out OUT", "--max-contacts"),
+    ("locate RUN --method joint --out DIR/x.h5", "go to .parquet or .csv"),
+    ("locate REC --method joint --joints j1=0 --out OUT", "apply to a robot recording's folder"),
+]
+
+
+@pytest.mark.parametrize("line, names", HANDJOINT_BAD, ids=[line for line, _ in HANDJOINT_BAD])
+def test_handjoint_bad_options(workspace, handloc_run, line, names):
+    out = workspace / "handjoint_never_written.parquet"
+    args = (
+        line.replace("RUN", str(handloc_run)).replace("REC", str(workspace / "rec.h5"))
+        .replace("OUT", str(out)).replace("DIR", str(workspace)).split()
+    )  # fmt: skip
+    _check(runner.invoke(app, args), names)
+    assert not out.exists()
+    assert not (workspace / "handjoint_never_written_wrenches.parquet").exists()
+    assert not [p for p in workspace.iterdir() if ".partial" in p.name]
+
+
+# ---- /hand joint fit (r10-handjoint) ----

@@ -11,6 +11,7 @@ from pathlib import Path
 
 from tactsense._validation import TactsenseInputError
 from tactsense.cli._common import atomic_output, check_output, console, fail, inside, progress_bar
+from tactsense.estimate._robot_tables import HAND_METHODS
 
 OUTPUT_FORMATS = (".parquet", ".csv")
 
@@ -41,9 +42,21 @@ WRENCHES_HELP = (
 
 FORCE_CAVEAT = (
     "note: force_n [N] is the amplitude of a 1.6-mm probe's response ('interpolate'): a "
-    "broad contact (a large object) reads low; for a pad patch's force fitted with the "
-    "contact's size, locate its own stream: tactsense locate RUN/streams/PATCH.h5 "
-    "--method joint (docs/contacts.md says where that can and cannot tell force)"
+    "broad contact (a large object) reads low; for pad patches' forces fitted with each "
+    "contact's size, add --method joint (slower; docs/robot.md gives the figures, "
+    "docs/contacts.md says where the fit can and cannot tell force)"
+)
+JOINT_CAVEAT = (
+    "note: --method joint fitted each pad patch's contacts with their size "
+    "(contact_radius_mm, flat_share); point-set patches keep their own estimator (no "
+    "size-aware fit; NaN in those columns); a pad that reads too few taxels per contact "
+    "cannot tell size from force (docs/contacts.md)"
+)
+METHOD_HELP = (
+    " On a robot recording's folder: 'interpolate' (default) or 'joint' (each pad patch's "
+    "contacts fitted jointly with their size, then placed and summed into wrenches; "
+    "point-set patches keep their estimator; 1-4 s per hand frame with a broad contact "
+    "on a pad: docs/robot.md)."
 )
 
 
@@ -123,8 +136,12 @@ def run_robot_locate(
     threshold: float | None,
     max_contacts: int,
     single_array_options: dict,
+    method: str = "interpolate",
 ) -> None:
-    """Locate a robot recording's contacts and write the contacts and wrench tables."""
+    """Locate a robot recording's contacts and write the contacts and wrench tables.
+
+    ``single_array_options`` maps each single-array option to whether it was given (a
+    ``--method`` other than :data:`HAND_METHODS` counts as one)."""
     from tactsense.io.robot_recording import read_robot_skin
     from tactsense.robot_batch import iter_robot_blocks
 
@@ -133,7 +150,8 @@ def run_robot_locate(
         if unused:
             raise TactsenseInputError(
                 f"{', '.join(unused)} apply to a single array's recording; the hand's "
-                "estimator uses 'interpolate' with each stream's first frames as baseline"
+                f"estimator takes --method {' or '.join(HAND_METHODS)}, with each stream's "
+                "first frames as baseline (locate RUN/streams/PATCH.h5 for the others)"
             )
         if out.suffix.lower() not in OUTPUT_FORMATS:
             raise TactsenseInputError(
@@ -171,7 +189,8 @@ def run_robot_locate(
             try:
                 for part in iter_robot_blocks(
                     recording, joints=source, baseline_frames=baseline_frames,
-                    threshold=threshold, max_contacts=max_contacts, warnings=warnings,
+                    threshold=threshold, max_contacts=max_contacts, method=method,
+                    warnings=warnings,
                     progress=lambda done, total: bar.update(task, completed=done, total=total),
                 ):  # fmt: skip
                     writers[0].write(part.contacts_table())
@@ -192,6 +211,7 @@ def run_robot_locate(
         soft_wrap=True, markup=False, highlight=False, emoji=False,
     )  # fmt: skip
     if rows:
-        console.print(FORCE_CAVEAT, soft_wrap=True, markup=False, highlight=False, emoji=False)
+        note = JOINT_CAVEAT if method == "joint" else FORCE_CAVEAT
+        console.print(note, soft_wrap=True, markup=False, highlight=False, emoji=False)
     for line in warnings:
         console.print(f"warning: {line}", soft_wrap=True, markup=False, highlight=False)

@@ -148,6 +148,7 @@ def locate(
             "about 300 us a contact; docs/accuracy.md) or 'joint' (pads: every contact of "
             "a frame fitted jointly with its size and indenter shape, contacts added by a "
             "likelihood criterion; tens of ms a frame; docs/contacts.md)."
+            + _robot.METHOD_HELP  # r10-handjoint
         ),
     ] = "interpolate",
     drift_s: Annotated[
@@ -226,13 +227,14 @@ def locate(
                                               wrenches)  # fmt: skip
     if is_robot_recording(recording):
         single = {"--calibration": calibration is not None, "--contacts": contacts,
-                  "--method": method != "interpolate", "--chunk-frames": chunk_frames is not None,
+                  "--method": method not in _robot.HAND_METHODS,  # r10-handjoint
+                  "--chunk-frames": chunk_frames is not None,
                   "--workers": workers != 1, "--drift-s": drift_s != 2.0}  # fmt: skip
         _robot.run_robot_locate(
             recording, out, force=force, quiet=quiet, joints=joints, joints_csv=joints_csv,
             joints_bag=joints_bag, joints_topic=joints_topic, wrenches=wrenches,
             baseline_frames=baseline_frames, threshold=threshold, max_contacts=max_contacts,
-            single_array_options=single,
+            single_array_options=single, method=method,  # r10-handjoint: --method joint
         )  # fmt: skip
         return
     if robot_options:

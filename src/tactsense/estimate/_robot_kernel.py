@@ -6,7 +6,9 @@ A hand frame is every taxel of the skin in one flat vector (the patches in skin 
 each patch's taxels row by row). Per patch the mathematics is the single-array
 estimator's (:func:`~tactsense.estimate.contacts.find_contacts`, method
 ``interpolate``, a fixed baseline): the pads through the same compiled passes
-(``segment_into``, ``amplitude_fit``, ``merged_force``), the point sets through
+(``segment_into``, ``amplitude_fit``, ``merged_force``), or, for a pad patch of a
+locator built with ``method="joint"``, its contacts as the joint fit gave them outside
+this call (:data:`MODE_GIVEN`: placed and summed here like any other), the point sets through
 :mod:`._robot_points` (the neighbour graph's segmentation and the quadratic peak of
 ``estimate.contacts.points``, compiled). The forward kinematics are URDF's, as
 :meth:`tactsense.robot.RobotSkin.link_poses`.
@@ -28,7 +30,8 @@ F_ROW, F_COL, F_XS, F_YS, F_ZS = 0, 1, 2, 3, 4
 F_XL, F_YL, F_ZL, F_NXL, F_NYL, F_NZL = 5, 6, 7, 8, 9, 10
 F_XB, F_YB, F_ZB, F_NXB, F_NYB, F_NZB = 11, 12, 13, 14, 15, 16
 F_FORCE, F_PEAK = 17, 18
-N_FLOAT = 19
+F_RADIUS, F_FLAT = 19, 20  # the joint fit's contact radius [mm] and flat share (else NaN)
+N_FLOAT = 21
 I_FRAME, I_PATCH, I_LINK, I_RANK, I_TAXELS, I_FLAGS = 0, 1, 2, 3, 4, 5
 N_INT = 6
 
@@ -40,6 +43,7 @@ N_PARAM = 16
 
 MODE_PAD = 0
 MODE_POINTS = 1
+MODE_GIVEN = 2  # a pad whose contacts were found before the call (the joint fit)
 
 
 @jit(nogil=True)
@@ -193,6 +197,8 @@ def hand_block(
     k_amp, amp_step, k_sig, sig_step, k_max, halves,
     max_contacts, tolerance, max_iterations, pair_ridge, merged_gain, merged_spread, flag_bits,
     held, held_count, out_i, out_f, wrench_link, wrench_total, contacts_link,
+    given_start, given_count, given_rc, given_value, given_force, given_taxels, given_flags,
+    given_size,
 ):  # fmt: skip
     """Contacts and wrenches of ``n`` hand frames.
 
@@ -204,6 +210,11 @@ def hand_block(
     returned; -1 when they do not fit); ``wrench_link`` (n, L, 6) per link in its own
     frame, ``wrench_total`` (n, 6) the grasp's total in the base frame about the base
     origin [N, N mm], ``contacts_link`` (n, L) contacts held on each link.
+
+    A :data:`MODE_GIVEN` patch's contacts come in ``given_*``: its ``i``-th new frame
+    is slot ``given_start[p] + i`` with ``given_count`` contacts, their row and column
+    [taxel] (S, K, 2), peak, force [N], taxels, flags and (radius [mm], flat share) in
+    ``given_size`` (S, K, 2).
     """
     nan_flag, sat_flag, dead_flag, nc_flag, edge_flag = (
         flag_bits[0], flag_bits[1], flag_bits[2], flag_bits[3], flag_bits[4]
@@ -236,7 +247,8 @@ def hand_block(
                 patch_contacts[f, p] = held_count[p]
             continue
         which = np.empty(n_new, np.int64)
-        signal = np.empty((n_new, rows, cols))
+        given = p_mode[p] == MODE_GIVEN
+        signal = np.empty((0 if given else n_new, rows, cols))
         rail = np.zeros((n_new, rows, cols), np.bool_)
         frame_flags = np.zeros(n_new, np.int64)
         any_unusable = False
@@ -249,7 +261,7 @@ def hand_block(
                 continue
             which[i] = f
             flag = dead_flag if any_unusable else 0
-            for t in range(size):
+            for t in range(0 if given else size):
                 value = float(counts[f, off + t])
                 d, bits = taxel_signal(
                     value, baseline[off + t], unusable[off + t], param[P_FULL_SCALE],
@@ -270,13 +282,28 @@ def hand_block(
         count = np.zeros(n_new, np.int64)
         point = np.empty((n_new, k, 3))
         normal_at = np.empty((n_new, k), np.int64)
-        if p_mode[p] == MODE_PAD:
+        size_of = np.full((n_new, k, 2), np.nan)
+        if given:
+            for f in range(n_new):
+                slot = given_start[p] + f
+                count[f] = given_count[slot]
+                for j in range(count[f]):
+                    rc[f, j, 0] = given_rc[slot, j, 0]
+                    rc[f, j, 1] = given_rc[slot, j, 1]
+                    value[f, j] = given_value[slot, j]
+                    force[f, j] = given_force[slot, j]
+                    taxels[f, j] = given_taxels[slot, j]
+                    flags[f, j] = given_flags[slot, j]
+                    size_of[f, j, 0] = given_size[slot, j, 0]
+                    size_of[f, j, 1] = given_size[slot, j, 1]
+        elif p_mode[p] == MODE_PAD:
             pad_patch(
                 signal, rail, param, k_amp[p_kernel[p]], amp_step, k_sig[p_kernel[p]], sig_step,
                 k_max[p_kernel[p]], halves, k, tolerance, max_iterations, pair_ridge,
                 merged_gain, merged_spread, frame_flags, sat_flag, nc_flag, edge_flag,
                 rc, value, force, taxels, flags, count,
             )  # fmt: skip
+        if p_mode[p] != MODE_POINTS:
             for f in range(n_new):
                 for j in range(count[f]):
                     point[f, j, 0] = rc[f, j, 0] * param[P_ROW_PITCH]
@@ -327,6 +354,8 @@ def hand_block(
                 out_f[row, F_ZS] = point[i, j, 2]
                 out_f[row, F_FORCE] = force[i, j]
                 out_f[row, F_PEAK] = value[i, j]
+                out_f[row, F_RADIUS] = size_of[i, j, 0]
+                out_f[row, F_FLAT] = size_of[i, j, 1]
                 out_i[row, I_FRAME] = f
                 out_i[row, I_PATCH] = p
                 out_i[row, I_LINK] = link

@@ -19,6 +19,16 @@ the base frame [mm] with the unit outward normal there; its normal force [N] and
 vector (``-force_n * normal``) in both frames [N]; interpolated peak signal [-], taxels
 and flags (:class:`~tactsense.estimate.results.Flag`)."""
 
+JOINT_COLUMNS = (*CONTACT_COLUMNS, "contact_radius_mm", "flat_share")
+"""Columns of the long table with ``method="joint"``: :data:`CONTACT_COLUMNS` and the
+joint fit's contact radius [mm] and flat share [-] (the share of the force pressed as a
+uniform pressure over the disc, the rest as a Hertzian sphere's: ``find_contacts``'s
+extras of the same names, docs/contacts.md); NaN on point-set patches,
+which keep their own estimator."""
+
+HAND_METHODS = ("interpolate", "joint")
+"""How the hand's estimator finds a pad patch's contacts (:class:`HandLocator`)."""
+
 WRENCH_COLUMNS = (
     "time_s", "frame", "link", "what", "contacts", "force_x_n", "force_y_n", "force_z_n",
     "torque_x_n_mm", "torque_y_n_mm", "torque_z_n_mm",

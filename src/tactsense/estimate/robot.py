@@ -11,6 +11,13 @@ kinds estimate no tangential force today) and sums per link the wrench about the
 origin (force [N], torque [N mm], in the link's frame), as the ROS tactile toolbox's
 merger does, and the grasp's total in the base frame about the base origin.
 
+With ``method="joint"`` each pad patch's contacts are instead
+``find_contacts(..., method="joint")``'s (every contact of a frame fitted jointly with
+its size: position, force, contact radius and flat share; the patch's new frames of a
+block in one call), run before the compiled call and handed to it, which places them
+and sums the wrenches exactly as for ``interpolate``; point-set patches keep their
+estimator (the neighbour graph's peak: they have no size-aware fit).
+
 :func:`locate_robot_recording` runs it over a robot recording (each patch at its own
 rate: a hand frame at each frame of the fastest stream, each patch contributing its
 latest frame; its contacts written once per frame of its own, at that frame's time, its
@@ -35,10 +42,23 @@ from tactsense.estimate._robot_params import (
     _points_parameters,
     locate_robot_reference,
 )
-from tactsense.estimate._robot_tables import CONTACT_COLUMNS, WRENCH_COLUMNS, RobotContacts
+from tactsense.estimate._robot_tables import (
+    CONTACT_COLUMNS,
+    HAND_METHODS,
+    JOINT_COLUMNS,
+    WRENCH_COLUMNS,
+    RobotContacts,
+)
 from tactsense.estimate.results import Flag
 from tactsense.kinds import kind_of
 from tactsense.robot import RobotSkin
+
+OFF_TAXELS = 0.5
+"""With ``method="joint"``: a pad contact whose fitted centre lies more than this many
+pitches beyond the patch's outer taxels has no force (NaN): beyond the edge the frame
+trades the contact's distance for its force (docs/contacts.md, "Two contacts fitted
+jointly": a contact 4 mm beyond the last taxel fitted with 2.0 N for 0.49 N; on the docs'
+grasp a 33-kN contact two pitches off the palm, docs/robot.md)."""
 
 
 class HandLocator:
@@ -55,6 +75,13 @@ class HandLocator:
         (:func:`~tactsense.estimate.contacts.default_threshold`).
     max_contacts : int
         At most this many contacts per patch and frame (1-64), the largest kept.
+    method : {"interpolate", "joint"}
+        How a pad patch's contacts are found: ``"interpolate"`` (the default: the paper's
+        interpolation and a 1.6-mm probe's amplitude as force, compiled with the rest)
+        or ``"joint"`` (the size-aware joint fit of
+        :func:`~tactsense.estimate.contacts.find_contacts`: a broad contact's force
+        right where ``interpolate`` reads it low; tens of ms to about a second per
+        touched pad frame). Point-set patches keep their own estimator either way.
     """
 
     def __init__(
@@ -64,6 +91,7 @@ class HandLocator:
         *,
         threshold: float | Mapping[str, float] | None = None,
         max_contacts: int = 8,
+        method: str = "interpolate",
     ):
         from tactsense.estimate.contacts import default_threshold
         from tactsense.estimate.contacts.pad import MERGED_GAIN, MERGED_HALVES, MERGED_SPREAD
@@ -75,6 +103,12 @@ class HandLocator:
             raise TactsenseInputError(
                 f"max_contacts must be an integer in 1-64; got {max_contacts!r}"
             )
+        if method not in HAND_METHODS:
+            raise TactsenseInputError(
+                f"method {method!r}: the hand's estimator takes one of "
+                f"{', '.join(HAND_METHODS)} ('fit' and 'cop' work on a patch's own stream)"
+            )
+        self.method = method
         self.skin = skin
         self.patch_names = tuple(p.name for p in skin.patches)
         self.links = tuple(skin._order())
@@ -110,6 +144,7 @@ class HandLocator:
         self._cols = np.array([p.sensor.shape[1] for p in skin.patches], np.int64)
         self._link = np.array([link_index[p.link] for p in skin.patches], np.int64)
         self._kernel_of = np.zeros(n_patches, np.int64)
+        self._thresholds = np.zeros(n_patches)
         self._param = np.zeros((n_patches, K.N_PARAM))
         self._pose = np.array([p.origin.matrix() for p in skin.patches]).reshape(-1, 4, 4)
         self._baseline = np.zeros(self.n_taxels)
@@ -143,6 +178,8 @@ class HandLocator:
                     pad_kernels[key] = len(kernel_list)
                     kernel_list.append(tables)
                 self._kernel_of[p] = pad_kernels[key]
+                if method == "joint":
+                    self._mode[p] = K.MODE_GIVEN
             elif not kind.image_grid and kind.multi_contact:
                 self._mode[p] = K.MODE_POINTS
                 param, positions, neighbours, kernel = _points_parameters(sensor, float(value))
@@ -160,6 +197,7 @@ class HandLocator:
                     f"patch {patch.name!r} is a {kind.label}: the hand's estimator places the "
                     "contacts of pads and point sets; locate this patch's stream on its own"
                 )
+            self._thresholds[p] = float(value)
             resistive, falling, per_count = reading_mode(sensor)
             param[K.P_FULL_SCALE] = float(2**sensor.electronics.adc_bits - 1)
             param[K.P_RESISTIVE] = float(resistive)
@@ -305,6 +343,7 @@ class HandLocator:
         wrench_link = np.empty((n, n_links, 6))
         wrench_total = np.empty((n, 6))
         contacts_link = np.empty((n, n_links), np.int64)
+        given = self._joint_contacts(counts, fresh)
         with deferred_interrupts():
             m = K.hand_block(
                 np.ascontiguousarray(counts), fresh, q, self._parent, self._jtype, self._origin,
@@ -314,7 +353,7 @@ class HandLocator:
                 self._nb_offset, self._pt_kernel, self._pt_offset, self._k_amp, self._amp_step,
                 self._k_sig, self._sig_step, self._k_max, self._halves, *self._settings,
                 self._flag_bits, self._held, self._held_count, out_i, out_f, wrench_link,
-                wrench_total, contacts_link,
+                wrench_total, contacts_link, *given,
             )  # fmt: skip
         time_s = np.arange(first_frame, first_frame + n, dtype=float) if time_s is None else time_s
         time_s = np.asarray(time_s, float)
@@ -325,6 +364,60 @@ class HandLocator:
             build=lambda: self._tables(out_i[:m], out_f[:m], wrench_link, wrench_total,
                                        contacts_link, time_s, row_time, first_frame),
         )  # fmt: skip
+
+    def _joint_contacts(self, counts, fresh) -> tuple:
+        """The joint fit's contacts of every :data:`~._robot_kernel.MODE_GIVEN` patch's
+        new frames (one :func:`find_contacts` call per patch and block), in the slots
+        :func:`~._robot_kernel.hand_block` reads (``given_*``).
+
+        A contact the fit places off the patch's taxels (its centre more than half a
+        pitch beyond the outer rows or columns; flagged ``EDGE``) keeps its row with a NaN
+        force, which adds nothing to a wrench (as a saturated contact's): the taxels see
+        only its flank, where the fit trades distance for force (:data:`OFF_TAXELS`)."""
+        k = self.max_contacts
+        joint = np.flatnonzero(self._mode == K.MODE_GIVEN)
+        start = np.zeros(len(self.patch_names), np.int64)
+        slots = 0
+        for p in joint:
+            start[p] = slots
+            slots += int(fresh[:, p].sum())
+        count = np.zeros(max(slots, 1), np.int64)
+        rc = np.zeros((max(slots, 1), k, 2))
+        value = np.zeros((max(slots, 1), k))
+        force = np.zeros((max(slots, 1), k))
+        taxels = np.zeros((max(slots, 1), k), np.int64)
+        flags = np.zeros((max(slots, 1), k), np.int64)
+        size = np.full((max(slots, 1), k, 2), np.nan)
+        if slots == 0:
+            return start, count, rc, value, force, taxels, flags, size
+        from tactsense.estimate.contacts import find_contacts
+
+        for p in joint:
+            new = np.flatnonzero(fresh[:, p])
+            if len(new) == 0:
+                continue
+            sensor = self.skin.patches[p].sensor
+            off, taxels_p = self._offset[p], int(self._rows[p] * self._cols[p])
+            shape = tuple(sensor.shape)
+            table = find_contacts(
+                counts[new, off : off + taxels_p].reshape(len(new), *shape), sensor,
+                baseline=self._baseline[off : off + taxels_p].reshape(shape),
+                dead=self._unusable[off : off + taxels_p].reshape(shape),
+                threshold=float(self._thresholds[p]), max_contacts=k, method="joint",
+            )  # fmt: skip
+            slot = start[p] + table.frame
+            rank = table.contact
+            rows, cols = shape
+            off = (table.row < -OFF_TAXELS) | (table.row > rows - 1 + OFF_TAXELS)
+            off |= (table.col < -OFF_TAXELS) | (table.col > cols - 1 + OFF_TAXELS)
+            table.force_n[off] = np.nan  # off the taxels: listed, adds nothing (OFF_TAXELS)
+            count[start[p] : start[p] + len(new)] = np.bincount(table.frame, minlength=len(new))
+            rc[slot, rank, 0], rc[slot, rank, 1] = table.row, table.col
+            value[slot, rank], force[slot, rank] = table.peak, table.force_n
+            taxels[slot, rank], flags[slot, rank] = table.taxels, table.flags
+            size[slot, rank, 0] = table.extra["contact_radius_mm"]
+            size[slot, rank, 1] = table.extra["flat_share"]
+        return start, count, rc, value, force, taxels, flags, size
 
     def _tables(
         self, out_i, out_f, wrench_link, wrench_total, contacts_link, time_s, row_time, first
@@ -355,6 +448,9 @@ class HandLocator:
         contacts["peak"] = out_f[:, K.F_PEAK].copy()
         contacts["taxels"] = out_i[:, K.I_TAXELS].copy()
         contacts["flags"] = out_i[:, K.I_FLAGS].copy()
+        if self.method == "joint":  # the joint fit's size (NaN on point sets)
+            contacts["contact_radius_mm"] = out_f[:, K.F_RADIUS].copy()
+            contacts["flat_share"] = out_f[:, K.F_FLAT].copy()
         n = len(time_s)
         links = np.flatnonzero(self._link_has_patch)
         per = len(links) + 1
@@ -400,6 +496,9 @@ def hand_frame_grid(streams_time_s: Mapping[str, np.ndarray], patch_names) -> tu
 
 __all__ = [
     "CONTACT_COLUMNS",
+    "HAND_METHODS",
+    "JOINT_COLUMNS",
+    "OFF_TAXELS",
     "WRENCH_COLUMNS",
     "HandLocator",
     "JointStates",
