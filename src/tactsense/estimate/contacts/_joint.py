@@ -290,6 +290,54 @@ def _pair_seeds(model, q, c, d):
             yield seed
 
 
+RELOCATE_STEP = 0.5
+"""Spacing of the positions :func:`_relocate_seeds` tries for a contact [pitch]."""
+
+RELOCATE_BEST = 2
+"""Positions :func:`_relocate_seeds` keeps per contact (the largest gains, a pitch apart)."""
+
+
+def _relocate_seeds(model, frame, q, c):
+    """Seeds with contact ``c`` moved to where it best explains what the others leave:
+    its response at unit force (its own radius and flat share) at every
+    :data:`RELOCATE_STEP` pitch over the fit's box, its force the least-squares
+    amplitude against the residual of the others (kept), and the :data:`RELOCATE_BEST`
+    positions of largest gain (at least a pitch apart) kept. The layer is linear, so
+    for one contact the search over positions is global (a matched filter); what it
+    escapes is a pair whose one contact slid along the ridge where a farther contact
+    with more force reads alike (a contact beyond the pad's edge fitted at the box's
+    bound: issue 34 item 2)."""
+    px, py = model.pitch_mm
+    lo, hi = _bounds(model, frame, 1)
+    others = np.delete(q, c, axis=0)
+    rest = np.asarray(frame, float) - model.signal(
+        others[:, :2], others[:, 2], others[:, 3], others[:, 4], signed=True
+    )
+    xs = np.arange(lo[0], hi[0] + 1e-9, RELOCATE_STEP * px)
+    ys = np.arange(lo[1], hi[1] + 1e-9, RELOCATE_STEP * py)
+    found = []
+    for x in xs:
+        for y in ys:
+            r = model.signal([[x, y]], [1.0], [q[c, 3]], [q[c, 4]], signed=True)
+            rr = float(np.sum(r * r))
+            if rr <= 0.0:
+                continue
+            f = float(np.sum(r * rest)) / rr
+            if f > 0.0:
+                found.append((f * f * rr, x, y, f))
+    found.sort(reverse=True)
+    kept = []
+    for _, x, y, f in found:
+        if all(np.hypot((x - u) / px, (y - v) / py) >= 1.0 for u, v, _ in kept):
+            kept.append((x, y, f))
+        if len(kept) == RELOCATE_BEST:
+            break
+    for x, y, f in kept:
+        seed = q.copy()
+        seed[c, :3] = x, y, f
+        yield seed
+
+
 def _polish(model, frame, q, rss, sigma):
     """The frame's k >= 2 contacts refitted from other starts, the lowest residual kept
     (same k, same order): each pair re-seeded about its centre (:func:`_pair_seeds`).
@@ -305,6 +353,10 @@ def _polish(model, frame, q, rss, sigma):
                     q2, rss2 = _fit_frame(model, frame, *seed.T, sigma=sigma)
                     if rss2 < best[1]:
                         best = (q2, rss2)
+            for seed in _relocate_seeds(model, frame, q, c):
+                q2, rss2 = _fit_frame(model, frame, *seed.T, sigma=sigma)
+                if rss2 < best[1]:
+                    best = (q2, rss2)
         if best[1] >= rss * (1.0 - 1e-6):
             break
         q, rss = best
@@ -386,13 +438,17 @@ def joint_fit(signal, seg, row, col, force, sensor, model, noise_var=None, max_c
             if len(good) > 1:  # a watershed region on noise alone: no contact there
                 q, rss, kept = _prune(model, frame, q, rss, list(parents), sigma**2)
                 parents = np.asarray(kept)
+            polished = None
+            if 1 < len(q) <= MAX_POLISHED:  # the order is judged against k's best fit
+                q, rss = _polish(model, frame, q, rss, sigma)
+                polished = rss
             if max_contacts > len(q):
                 moments = [(seg["rr"][i], seg["cc"][i], seg["rc"][i]) for i in good]
                 q, local, rss = _order(
                     model, frame, q, rss, [moments[p] for p in parents], sigma**2, max_contacts
                 )
                 parents = parents[local]
-            if 1 < len(q) <= MAX_POLISHED:
+            if 1 < len(q) <= MAX_POLISHED and rss != polished:
                 q, rss = _polish(model, frame, q, rss, sigma)
         seen = set()
         for j, p in enumerate(parents):

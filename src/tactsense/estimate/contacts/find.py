@@ -252,11 +252,16 @@ def _grid_contacts(
             model = kind.contact_model(sensor) if method == "joint" else None
             if model is not None:  # each contact's size; more contacts (r6-padfit)
                 from tactsense.estimate.contacts._joint import fit_sizes
+                from tactsense.estimate.contacts._joint_errors import standard_errors
 
                 seg, row, col, force, radius, flat = fit_sizes(
                     signal, seg, row, col, force, sensor, model, max_contacts
                 )
                 extra["contact_radius_mm"], extra["flat_share"] = radius, flat
+                sd = standard_errors(
+                    signal, seg["frame"], row, col, force, radius, flat, sensor, model
+                )
+                extra["x_sd_mm"], extra["y_sd_mm"], extra["force_sd_n"] = sd.T
                 n = len(seg["frame"])
                 flags, z, peak = np.zeros(n, np.int64), np.zeros(n), seg["value"]
             x = row * g.row_pitch_mm
