@@ -105,7 +105,9 @@ def find_contacts(
     method : {"interpolate", "cop", "fit", "joint"}
         How a contact's position is found (:data:`METHODS`); ``"joint"`` (pads): every
         contact of a frame fitted jointly with its size, contacts added by a likelihood
-        criterion (docs/contacts.md).
+        criterion, each with its standard errors from the Fisher matrix at the fit
+        (extras ``x_sd_mm``, ``y_sd_mm`` [mm], ``force_sd_n`` [N]; NaN where the frame
+        does not determine the contact) (docs/contacts.md).
     first_frame : int
         Added to the ``frame`` column (pieces of a longer recording).
     saddle : float
