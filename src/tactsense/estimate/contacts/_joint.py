@@ -15,17 +15,12 @@ import warnings
 import numpy as np
 from scipy.optimize import least_squares
 
+from tactsense.estimate.contacts._joint_fisher import NP, fisher_sd
 from tactsense.estimate.contacts._joint_lm import levenberg_marquardt, tables_of
 from tactsense.estimate.reading import signal_noise_variance
 
 SEED_RADIUS_MM = 1.0
 """Contact radius the fit starts from [mm]."""
-
-NP = 5
-"""Parameters per contact: x, y [mm], force [N], contact radius a [mm], flat share [-]
-(the share of the force pressed as a flat disc's uniform pressure, the rest as a Hertzian
-sphere's)."""
-
 
 PRIOR_RADIUS_MM = 1.6
 """The prior's sphere: the scenarios' probe [mm]. Where a frame cannot tell a contact's
@@ -236,6 +231,34 @@ def _order(model, frame, q, rss, moments, noise_var, max_contacts):
     if len(q) > len(moments):
         q, rss, parents = _prune(model, frame, q, rss, parents, noise_var)
     return q, np.asarray(parents), rss
+
+
+WALD_Z = 2.0
+"""Fewest standard errors a contact's force must stand from zero [-] (a Wald test at
+about 95 %) where the frame's Fisher matrix is regular."""
+
+
+def _drop_undetermined(model, frame, q, rss, parents, sigma):
+    """While one of k >= 2 contacts has a force within :data:`WALD_Z` of its standard
+    error of zero (:func:`._joint_fisher.fisher_sd`, at the fit), the one with the
+    fewest goes and the others are refitted jointly: a contact the frame does not
+    determine, however much it lowered the residual (a contact beyond the taxels' reach
+    whose tail soaks up what the model leaves: issue 38's 18.5-N contact outside the
+    taxels). Where the matrix is singular (a resistive pad whose few compressed taxels
+    cannot tell position, force and size apart) the information criterion alone
+    decides."""
+    prior = np.array([sigma, PRIOR_WIDTH, PRIOR_RADIUS_MM, model.modulus_star_pa])
+    while len(q) > 1:
+        sd = fisher_sd(model, frame, q, prior)[:, 2]
+        with np.errstate(all="ignore"):
+            z = np.where(np.isfinite(sd) & (sd > 0), q[:, 2] / sd, np.inf)
+        c = int(np.argmin(z))
+        if z[c] >= WALD_Z:
+            break
+        rest = np.delete(q, c, axis=0)
+        q, rss = _fit_frame(model, frame, *rest.T, sigma=sigma)
+        parents = [p for i, p in enumerate(parents) if i != c]
+    return q, rss, parents
 
 
 def _prune(model, frame, q, rss, parents, noise_var):
@@ -450,6 +473,9 @@ def joint_fit(signal, seg, row, col, force, sensor, model, noise_var=None, max_c
                 parents = parents[local]
             if 1 < len(q) <= MAX_POLISHED and rss != polished:
                 q, rss = _polish(model, frame, q, rss, sigma)
+            if len(q) > 1:
+                q, rss, kept = _drop_undetermined(model, frame, q, rss, list(parents), sigma)
+                parents = np.asarray(kept)
         seen = set()
         for j, p in enumerate(parents):
             i = good[p]
