@@ -234,24 +234,31 @@ def _order(model, frame, q, rss, moments, noise_var, max_contacts):
 
 
 WALD_Z = 2.0
-"""Fewest standard errors a contact's force must stand from zero [-] (a Wald test at
-about 95 %) where the frame's Fisher matrix is regular."""
+"""Fewest standard errors the force of a contact beyond the outer taxels must stand
+from zero [-] (a Wald test at about 95 %) where the frame's Fisher matrix is regular."""
 
 
 def _drop_undetermined(model, frame, q, rss, parents, sigma):
-    """While one of k >= 2 contacts has a force within :data:`WALD_Z` of its standard
-    error of zero (:func:`._joint_fisher.fisher_sd`, at the fit), the one with the
-    fewest goes and the others are refitted jointly: a contact the frame does not
-    determine, however much it lowered the residual (a contact beyond the taxels' reach
-    whose tail soaks up what the model leaves: issue 38's 18.5-N contact outside the
-    taxels). Where the matrix is singular (a resistive pad whose few compressed taxels
-    cannot tell position, force and size apart) the information criterion alone
-    decides."""
+    """While one of k >= 2 contacts lies beyond the outer taxels with a force within
+    :data:`WALD_Z` of its standard error of zero (:func:`._joint_fisher.fisher_sd`, at
+    the fit), the one with the fewest goes and the others are refitted jointly. Beyond
+    the outer taxels the frame reads a contact's tail only, where a farther contact with
+    more force reads alike: there the information criterion accepts a contact whose
+    tail soaks up what the model leaves (issue 38's 18.5-N contact outside the taxels),
+    so it must also be determined. Within the taxels the criterion alone decides (its
+    contacts are in reach; a Wald test there drops real pairs under noise, its sigma
+    carrying the model's error), and so it does where the matrix is singular."""
     prior = np.array([sigma, PRIOR_WIDTH, PRIOR_RADIUS_MM, model.modulus_star_pa])
     while len(q) > 1:
+        outside = (
+            (q[:, 0] < model.x_taxel[0]) | (q[:, 0] > model.x_taxel[-1])
+            | (q[:, 1] < model.y_taxel[0]) | (q[:, 1] > model.y_taxel[-1])
+        )  # fmt: skip
+        if not outside.any():
+            break
         sd = fisher_sd(model, frame, q, prior)[:, 2]
         with np.errstate(all="ignore"):
-            z = np.where(np.isfinite(sd) & (sd > 0), q[:, 2] / sd, np.inf)
+            z = np.where(outside & np.isfinite(sd) & (sd > 0), q[:, 2] / sd, np.inf)
         c = int(np.argmin(z))
         if z[c] >= WALD_Z:
             break
