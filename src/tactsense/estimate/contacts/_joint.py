@@ -240,14 +240,12 @@ from zero [-] (a Wald test at about 95 %) where the frame's Fisher matrix is reg
 
 def _drop_undetermined(model, frame, q, rss, parents, sigma):
     """While one of k >= 2 contacts lies beyond the outer taxels with a force within
-    :data:`WALD_Z` of its standard error of zero (:func:`._joint_fisher.fisher_sd`, at
-    the fit), the one with the fewest goes and the others are refitted jointly. Beyond
-    the outer taxels the frame reads a contact's tail only, where a farther contact with
-    more force reads alike: there the information criterion accepts a contact whose
-    tail soaks up what the model leaves (issue 38's 18.5-N contact outside the taxels),
-    so it must also be determined. Within the taxels the criterion alone decides (its
-    contacts are in reach; a Wald test there drops real pairs under noise, its sigma
-    carrying the model's error), and so it does where the matrix is singular."""
+    :data:`WALD_Z` of its standard error of zero (:func:`._joint_fisher.fisher_sd`),
+    the one with the fewest goes, the others refitted jointly. There the frame reads a
+    tail only, where a farther contact with more force reads alike, and the criterion
+    accepts a tail that soaks up what the model leaves (issue 38's 18.5-N contact).
+    Within the taxels (in reach; a Wald test drops real noisy pairs there, its sigma
+    carrying the model's error) or where the matrix is singular, the criterion decides."""
     prior = np.array([sigma, PRIOR_WIDTH, PRIOR_RADIUS_MM, model.modulus_star_pa])
     while len(q) > 1:
         outside = (
@@ -339,10 +337,8 @@ def _relocate_seeds(model, frame, q, c):
     bound: issue 34 item 2)."""
     px, py = model.pitch_mm
     lo, hi = _bounds(model, frame, 1)
-    others = np.delete(q, c, axis=0)
-    rest = np.asarray(frame, float) - model.signal(
-        others[:, :2], others[:, 2], others[:, 3], others[:, 4], signed=True
-    )
+    o = np.delete(q, c, axis=0)
+    rest = np.asarray(frame, float) - model.signal(o[:, :2], o[:, 2], o[:, 3], o[:, 4], signed=True)
     xs = np.arange(lo[0], hi[0] + 1e-9, RELOCATE_STEP * px)
     ys = np.arange(lo[1], hi[1] + 1e-9, RELOCATE_STEP * py)
     found = []
@@ -355,13 +351,12 @@ def _relocate_seeds(model, frame, q, c):
             f = float(np.sum(r * rest)) / rr
             if f > 0.0:
                 found.append((f * f * rr, x, y, f))
-    found.sort(reverse=True)
     kept = []
-    for _, x, y, f in found:
-        if all(np.hypot((x - u) / px, (y - v) / py) >= 1.0 for u, v, _ in kept):
+    for _, x, y, f in sorted(found, reverse=True):
+        if len(kept) < RELOCATE_BEST and all(
+            np.hypot((x - u) / px, (y - v) / py) >= 1 for u, v, _ in kept
+        ):
             kept.append((x, y, f))
-        if len(kept) == RELOCATE_BEST:
-            break
     for x, y, f in kept:
         seed = q.copy()
         seed[c, :3] = x, y, f
