@@ -10,6 +10,7 @@ a local minimum along the ridge where a farther contact with more force reads al
 import numpy as np
 
 from tactsense.estimate.contacts import find_contacts
+from tactsense.estimate.contacts._joint import _drop_undetermined
 from tactsense.estimate.contacts._joint_errors import _fisher_sd
 from tactsense.kinds import kind_of
 from tactsense.physics._pad_model import hertz_radius_mm
@@ -82,3 +83,21 @@ def test_no_taxel_reads_the_contact_its_errors_are_nan():
     frame = model.signal(inside[:, :2], inside[:, 2], inside[:, 3])
     sd = _fisher_sd(model, frame, inside, 1e-4)
     assert np.all(np.isfinite(sd)) and np.all(sd > 0)
+
+
+def test_undetermined_contact_beyond_the_taxels_goes():
+    """A second contact 1.8 pitches beyond pad4's last row with 20 mN (its force within
+    two standard errors of zero) goes, and the frame's one contact is refitted; the same
+    weak contact within the taxels stays (there the information criterion decides, not
+    the Wald test)."""
+    spec = load_sensor("pad4")
+    model = kind_of(spec).contact_model(spec)
+    one = np.array([[7.0, 8.0, 0.49, 1.1, 0.0]])
+    frame = model.signal(one[:, :2], one[:, 2], one[:, 3])
+    sigma = 1.0 / spec.electronics.nominal_counts
+    for x, kept in ((24.0, 1), (12.0, 2)):
+        q = np.vstack([one, [x, 8.0, 0.02, 1.0, 0.0]])
+        q2, _, parents = _drop_undetermined(model, frame, q, 0.0, [0, 1], sigma)
+        assert len(q2) == kept == len(parents)
+        if kept == 1:  # refitted alone: its own force (noise-free model frame)
+            assert abs(q2[0, 2] / 0.49 - 1.0) < 0.01
