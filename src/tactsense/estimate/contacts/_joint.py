@@ -234,24 +234,25 @@ def _order(model, frame, q, rss, moments, noise_var, max_contacts):
 
 
 WALD_Z = 2.0
-"""Fewest standard errors the force of a contact beyond the outer taxels must stand
-from zero [-] (a Wald test at about 95 %) where the frame's Fisher matrix is regular."""
+"""Fewest standard errors the force of a contact at the box's bound must stand from
+zero [-] (a Wald test at about 95 %) where the frame's Fisher matrix is regular."""
 
 
 def _drop_undetermined(model, frame, q, rss, parents, sigma):
-    """While one of k >= 2 contacts lies beyond the outer taxels with a force within
-    :data:`WALD_Z` of its standard error of zero (:func:`._joint_fisher.fisher_sd`),
-    the one with the fewest goes, the others refitted jointly. There the frame reads a
-    tail only, where a farther contact with more force reads alike, and the criterion
-    accepts a tail that soaks up what the model leaves (issue 38's 18.5-N contact).
-    Within the taxels (in reach; a Wald test drops real noisy pairs there, its sigma
-    carrying the model's error) or where the matrix is singular, the criterion decides."""
+    """While one of k >= 2 contacts sits at the box's bound (its position the search's
+    limit, not a maximum of the likelihood) with a force within :data:`WALD_Z` of its
+    standard error of zero (:func:`._joint_fisher.fisher_sd`), the one with the fewest
+    goes, the others refitted jointly: a tail beyond the taxels that soaks up what the
+    model leaves (issue 38's 18.5-N contact). Elsewhere (a Wald test drops real noisy
+    pairs, its sigma carrying the model's error) or where the matrix is singular, the
+    information criterion alone decides."""
     prior = np.array([sigma, PRIOR_WIDTH, PRIOR_RADIUS_MM, model.modulus_star_pa])
     while len(q) > 1:
-        outside = (
-            (q[:, 0] < model.x_taxel[0]) | (q[:, 0] > model.x_taxel[-1])
-            | (q[:, 1] < model.y_taxel[0]) | (q[:, 1] > model.y_taxel[-1])
-        )  # fmt: skip
+        lo, hi = _bounds(model, frame, 1)
+        edge = 1e-6 * max(model.pitch_mm)
+        outside = (np.abs(q[:, :2] - lo[:2]) < edge).any(1) | (
+            np.abs(q[:, :2] - hi[:2]) < edge
+        ).any(1)
         if not outside.any():
             break
         sd = fisher_sd(model, frame, q, prior)[:, 2]
