@@ -328,14 +328,11 @@ RELOCATE_BEST = 2
 
 def _relocate_seeds(model, frame, q, c):
     """Seeds with contact ``c`` moved to where it best explains what the others leave:
-    its response at unit force (its own radius and flat share) at every
-    :data:`RELOCATE_STEP` pitch over the fit's box, its force the least-squares
-    amplitude against the residual of the others (kept), and the :data:`RELOCATE_BEST`
-    positions of largest gain (at least a pitch apart) kept. The layer is linear, so
-    for one contact the search over positions is global (a matched filter); what it
-    escapes is a pair whose one contact slid along the ridge where a farther contact
-    with more force reads alike (a contact beyond the pad's edge fitted at the box's
-    bound: issue 34 item 2)."""
+    its unit response (own radius and flat share) every :data:`RELOCATE_STEP` pitch
+    over the box, its force the least-squares amplitude, the :data:`RELOCATE_BEST`
+    largest gains a pitch apart kept: a global search for one contact of a linear
+    layer (a matched filter). It escapes a contact beyond the edge slid along the ridge
+    where a farther contact with more force reads alike (issue 34 item 2)."""
     px, py = model.pitch_mm
     lo, hi = _bounds(model, frame, 1)
     o = np.delete(q, c, axis=0)
