@@ -32,6 +32,7 @@ taken at their word.
     PYTHONPATH=src python scripts/padfit_pairs.py
     PYTHONPATH=src python scripts/padfit_pairs.py --part pad16 pad16.json   # one pad
     PYTHONPATH=src python scripts/padfit_pairs.py --combine pad4.json pad16.json ...
+    PYTHONPATH=src python scripts/padfit_pairs.py --cases   # pad4's edge and split cases
 """
 
 from __future__ import annotations
@@ -195,10 +196,61 @@ def part(name):
     return out
 
 
+EDGE_CASE = (3.0, 22.5, 12.03857663562793, 9.024432197200483)
+"""pad4's placement (separation [pitch], orientation [deg], midpoint [mm]) whose one
+contact sits 4 mm beyond the last taxel row (the table's seed, 3 pitches)."""
+
+SPLIT_CASE = (2.0, 0.0, 8.497879215274335, 8.2356348953169)
+"""pad4's placement that round 9 fitted with three contacts (the table's seed, 2 pitches)."""
+
+ROUND9_EDGE_FIT = ((24.6568, 13.6766, 2.0212, 1.7344, 1.0), (5.175, 6.1533, 0.495, 1.2455, 0.0))
+"""Round 9's fit of :data:`EDGE_CASE` (x, y [mm], force [N], a [mm], flat share), its
+local minimum at the box's bound, refitted here from itself."""
+
+
+def cases() -> None:
+    """The figures the prose of docs/contacts.md quotes on pad4's two cases: the chi-square
+    (RSS over the fit's sigma^2) of each fit and each contact's reported errors."""
+    import math
+
+    from tactsense.estimate.contacts import _joint
+    from tactsense.estimate.contacts._joint_errors import _fisher_sd
+    from tactsense.estimate.reading import signal_noise_variance
+
+    spec = load_sensor("pad4")
+    model = kind_of(spec).contact_model(spec)
+    a = float(hertz_radius_mm(LOAD_N, 1.6, model.modulus_star_pa))
+    for label, (sep, angle, cx, cy) in (("edge", EDGE_CASE), ("split", SPLIT_CASE)):
+        th = np.radians(angle)
+        half = 0.5 * sep * spec.grid.row_pitch_mm * np.array([np.cos(th), np.sin(th)])
+        centre = np.array([cx, cy])
+        truth = np.array([centre + half, centre - half])
+        strain = sum(hankel_hertz_strain(spec, x, y, LOAD_N) for x, y in truth)
+        frame = _signal(spec, strain, 0.0, None)
+        sigma = math.sqrt(signal_noise_variance(spec))
+        sigma += _joint.MODEL_ERROR * float(np.abs(frame).max())
+        starts = {"from the truth": np.array([[*t, LOAD_N, a, 0.0] for t in truth])}
+        if label == "edge":
+            starts["from round 9's fit"] = np.array(ROUND9_EDGE_FIT)
+        print(label, "truth [mm]", truth.round(3).tolist())
+        for name, q0 in starts.items():
+            q, rss = _joint._fit_frame(model, frame, *q0.T, sigma=sigma)
+            sd = _fisher_sd(model, frame, q, sigma)
+            print(f"  {name}: chi-square {rss / sigma**2:.2f}; x, y [mm], F [N]:",
+                  q[:, :3].round(4).tolist(), "their errors:", sd.round(4).tolist())  # fmt: skip
+        fit = find_contacts(frame, spec, counts=False, method="joint")
+        errors = [fit.extra[k].round(4).tolist() for k in ("x_sd_mm", "y_sd_mm", "force_sd_n")]
+        found = np.column_stack([fit.x_mm, fit.y_mm, fit.force_n]).round(4).tolist()
+        print("  find_contacts:", found, "errors x, y, F:", errors)
+
+
 def main(argv=None) -> None:
     import json
 
     argv = sys.argv[1:] if argv is None else argv
+    if argv[:1] == ["--cases"]:
+        cases()
+        return
     if argv[:1] == ["--part"]:
         Path(argv[2]).write_text(json.dumps(part(argv[1])))
         return
