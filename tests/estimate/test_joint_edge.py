@@ -45,8 +45,8 @@ def test_standard_errors_match_the_scatter():
     """On the estimator's own model's frames (no model error) with Gaussian read noise
     of 8 counts (the estimator told it), a 100-g contact on pad4: the median reported
     error of x, y and force against the scatter of the fits over 40 frames. Independent:
-    the scatter is sampled, the errors come from the Fisher matrix. Measured 1.04 /
-    0.99 / 1.06 (60 frames). Bounds 0.7-1.4: a standard deviation from 40 draws is
+    the scatter is sampled, the errors come from the Fisher matrix. Measured 0.95 /
+    0.97 / 1.03 (docs/contacts.md). Bounds 0.7-1.4: a standard deviation from 40 draws is
     within 11 % (one sigma) of the truth, and the fit's sigma adds the model's 0.2 % of
     the peak (0.4 counts) to the noise."""
     spec = load_sensor("pad4")
