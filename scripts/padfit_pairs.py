@@ -23,11 +23,16 @@ the noise's variance (read noise, plus one A/D step squared over 12 for quantiza
 Its rank says whether the frame can determine the pair at all (rank 6: it can; less:
 no estimator can, whatever the algorithm); where it is full, the bound on the RMS
 position error per contact, sqrt((C_x1 + C_y1 + C_x2 + C_y2) / 2), set against the
-resolved pairs' RMS error (the ratio: goal at most 2).
+resolved pairs' RMS error (the ratio: goal at most 2). Beside it, the resolved pairs'
+RMS error over the RMS of the errors the fit reports itself (``x_sd_mm``, ``y_sd_mm``:
+the Fisher matrix at the fit under the noise the fit weighs, model error included;
+pairs whose matrix is singular left out): near 1 where the reported errors can be
+taken at their word.
 
     PYTHONPATH=src python scripts/padfit_pairs.py
     PYTHONPATH=src python scripts/padfit_pairs.py --part pad16 pad16.json   # one pad
     PYTHONPATH=src python scripts/padfit_pairs.py --combine pad4.json pad16.json ...
+    PYTHONPATH=src python scripts/padfit_pairs.py --cases   # pad4's edge and split cases
 """
 
 from __future__ import annotations
@@ -103,8 +108,9 @@ def bound(spec, truth, noise_counts):
 
 
 def pair_case(spec, estimator_spec, sep, angle_deg, rng, noise_counts):
-    """(resolved, RMS position error [mm] or nan, (rank, bound [mm], taxels read)) for
-    one placement."""
+    """(resolved, RMS position error [mm] or nan, (rank, bound [mm], taxels read), the
+    fit's own reported RMS position error per contact [mm] (from ``x_sd_mm`` and
+    ``y_sd_mm``; nan where not resolved or singular)) for one placement."""
     g = spec.grid
     cx = (g.rows / 2 - 0.5 + rng.uniform()) * g.row_pitch_mm
     cy = (g.cols / 2 - 0.5 + rng.uniform()) * g.col_pitch_mm
@@ -117,13 +123,16 @@ def pair_case(spec, estimator_spec, sep, angle_deg, rng, noise_counts):
     fisher = bound(spec, truth, noise_counts)
     fit = find_contacts(signal, estimator_spec, counts=False, method="joint")
     if len(fit) != 2:
-        return False, np.nan, fisher
+        return False, np.nan, fisher, np.nan
     est = np.column_stack([fit.x_mm, fit.y_mm])
     d = np.hypot(*(truth[:, None, :] - est[None, :, :]).transpose(2, 0, 1))
     err = min(np.hypot(d[0, 0], d[1, 1]), np.hypot(d[0, 1], d[1, 0])) / np.sqrt(2)
     limit = 0.5 * sep * min(g.row_pitch_mm, g.col_pitch_mm)
     ok = min(max(d[0, 0], d[1, 1]), max(d[0, 1], d[1, 0])) < limit
-    return bool(ok), float(err) if ok else np.nan, fisher
+    reported = np.sqrt(np.mean(fit.extra["x_sd_mm"] ** 2 + fit.extra["y_sd_mm"] ** 2))
+    if not ok:
+        return False, np.nan, fisher, np.nan
+    return True, float(err), fisher, float(reported)
 
 
 def _rms_ratio(pairs):
@@ -144,11 +153,16 @@ def measure(name, noisy, rng):
     bounds = [[] for _ in SEPARATIONS]
     full = np.zeros(len(SEPARATIONS))
     read = [[] for _ in SEPARATIONS]
+    reported = [[] for _ in SEPARATIONS]
     for i, sep in enumerate(SEPARATIONS):
         for j, angle in enumerate(ORIENTATIONS):
             for _ in range(PHASES):
-                ok, err, (rank, crb, taxels) = pair_case(spec, estimator, sep, angle, rng, noise)
+                ok, err, (rank, crb, taxels), own = pair_case(
+                    spec, estimator, sep, angle, rng, noise
+                )
                 share[i, j] += ok / PHASES
+                if ok and np.isfinite(own):
+                    reported[i].append((err, own))
                 full[i] += (rank == 6) / (PHASES * len(ORIENTATIONS))
                 read[i].append(taxels)
                 if ok:
@@ -160,7 +174,9 @@ def measure(name, noisy, rng):
     # the resolved pairs' RMS error over the RMS bound, where the bound is finite
     ratio = [_rms_ratio(np.array(b)) if b else np.nan for b in bounds]
     taxels = [float(np.median(t)) for t in read]
-    return share, rms, ratio, full.tolist(), taxels
+    # against the fit's own reported errors, where they are finite
+    own = [_rms_ratio(np.array(b)) if b else np.nan for b in reported]
+    return share, rms, ratio, full.tolist(), taxels, own
 
 
 def part(name):
@@ -168,21 +184,73 @@ def part(name):
     out = {}
     for noisy in (False, True):
         rng = np.random.default_rng([342, PADS.index(name), int(noisy)])
-        share, rms, ratio, full, taxels = measure(name, noisy, rng)
+        share, rms, ratio, full, taxels, own = measure(name, noisy, rng)
         out[str(noisy)] = {
             "share": share.tolist(),
             "rms": rms,
             "ratio": ratio,
             "full": full,
             "taxels": taxels,
+            "own": own,
         }
     return out
+
+
+EDGE_CASE = (3.0, 22.5, 12.03857663562793, 9.024432197200483)
+"""pad4's placement (separation [pitch], orientation [deg], midpoint [mm]) whose one
+contact sits 4 mm beyond the last taxel row (the table's seed, 3 pitches)."""
+
+SPLIT_CASE = (2.0, 0.0, 8.497879215274335, 8.2356348953169)
+"""pad4's placement that round 9 fitted with three contacts (the table's seed, 2 pitches)."""
+
+ROUND9_EDGE_FIT = ((24.6568, 13.6766, 2.0212, 1.7344, 1.0), (5.175, 6.1533, 0.495, 1.2455, 0.0))
+"""Round 9's fit of :data:`EDGE_CASE` (x, y [mm], force [N], a [mm], flat share), its
+local minimum at the box's bound, refitted here from itself."""
+
+
+def cases() -> None:
+    """The figures the prose of docs/contacts.md quotes on pad4's two cases: the chi-square
+    (RSS over the fit's sigma^2) of each fit and each contact's reported errors."""
+    import math
+
+    from tactsense.estimate.contacts import _joint
+    from tactsense.estimate.contacts._joint_errors import _fisher_sd
+    from tactsense.estimate.reading import signal_noise_variance
+
+    spec = load_sensor("pad4")
+    model = kind_of(spec).contact_model(spec)
+    a = float(hertz_radius_mm(LOAD_N, 1.6, model.modulus_star_pa))
+    for label, (sep, angle, cx, cy) in (("edge", EDGE_CASE), ("split", SPLIT_CASE)):
+        th = np.radians(angle)
+        half = 0.5 * sep * spec.grid.row_pitch_mm * np.array([np.cos(th), np.sin(th)])
+        centre = np.array([cx, cy])
+        truth = np.array([centre + half, centre - half])
+        strain = sum(hankel_hertz_strain(spec, x, y, LOAD_N) for x, y in truth)
+        frame = _signal(spec, strain, 0.0, None)
+        sigma = math.sqrt(signal_noise_variance(spec))
+        sigma += _joint.MODEL_ERROR * float(np.abs(frame).max())
+        starts = {"from the truth": np.array([[*t, LOAD_N, a, 0.0] for t in truth])}
+        if label == "edge":
+            starts["from round 9's fit"] = np.array(ROUND9_EDGE_FIT)
+        print(label, "truth [mm]", truth.round(3).tolist())
+        for name, q0 in starts.items():
+            q, rss = _joint._fit_frame(model, frame, *q0.T, sigma=sigma)
+            sd = _fisher_sd(model, frame, q, sigma)
+            print(f"  {name}: chi-square {rss / sigma**2:.2f}; x, y [mm], F [N]:",
+                  q[:, :3].round(4).tolist(), "their errors:", sd.round(4).tolist())  # fmt: skip
+        fit = find_contacts(frame, spec, counts=False, method="joint")
+        errors = [fit.extra[k].round(4).tolist() for k in ("x_sd_mm", "y_sd_mm", "force_sd_n")]
+        found = np.column_stack([fit.x_mm, fit.y_mm, fit.force_n]).round(4).tolist()
+        print("  find_contacts:", found, "errors x, y, F:", errors)
 
 
 def main(argv=None) -> None:
     import json
 
     argv = sys.argv[1:] if argv is None else argv
+    if argv[:1] == ["--cases"]:
+        cases()
+        return
     if argv[:1] == ["--part"]:
         Path(argv[2]).write_text(json.dumps(part(argv[1])))
         return
@@ -200,6 +268,7 @@ def main(argv=None) -> None:
                 r["ratio"],
                 r["full"],
                 r["taxels"],
+                r["own"],
             )
     write(results)
 
@@ -230,9 +299,10 @@ def write(results) -> None:
         "| pad | noise | resolved at "
         + " / ".join(f"{s:g}" for s in SEPARATIONS)
         + " pitches, worst orientation [%] | all orientations [%] | RMS position error of "
-        "resolved pairs [mm] | its ratio to the two-contact bound | placements whose "
-        "Fisher matrix has full rank (6) [%] | taxels read (median) |",
-        "|---|---|---|---|---|---|---|---|",
+        "resolved pairs [mm] | its ratio to the two-contact bound | its ratio to the fit's "
+        "own reported errors | placements whose Fisher matrix has full rank (6) [%] | "
+        "taxels read (median) |",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
 
     def joined(values, form):
@@ -242,13 +312,14 @@ def write(results) -> None:
 
     for name in PADS:
         for noisy in (False, True):
-            share, rms, ratio, full, taxels = results[(name, noisy)]
+            share, rms, ratio, full, taxels, own = results[(name, noisy)]
             worst = joined(100 * share.min(axis=1), ".0f")
             mean = joined(100 * share.mean(axis=1), ".0f")
             label = "1 % of full scale" if noisy else "quantized"
             lines.append(
                 f"| {name} | {label} | {worst} | {mean} | {joined(rms, '.2f')} | "
-                f"{joined(ratio, '.1f')} | {joined([100 * f for f in full], '.0f')} | "
+                f"{joined(ratio, '.1f')} | {joined(own, '.1f')} | "
+                f"{joined([100 * f for f in full], '.0f')} | "
                 f"{joined(taxels, '.0f')} |"
             )
     lines += ["", END]

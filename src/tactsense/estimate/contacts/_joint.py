@@ -15,17 +15,12 @@ import warnings
 import numpy as np
 from scipy.optimize import least_squares
 
+from tactsense.estimate.contacts._joint_fisher import NP, fisher_sd
 from tactsense.estimate.contacts._joint_lm import levenberg_marquardt, tables_of
 from tactsense.estimate.reading import signal_noise_variance
 
 SEED_RADIUS_MM = 1.0
 """Contact radius the fit starts from [mm]."""
-
-NP = 5
-"""Parameters per contact: x, y [mm], force [N], contact radius a [mm], flat share [-]
-(the share of the force pressed as a flat disc's uniform pressure, the rest as a Hertzian
-sphere's)."""
-
 
 PRIOR_RADIUS_MM = 1.6
 """The prior's sphere: the scenarios' probe [mm]. Where a frame cannot tell a contact's
@@ -238,6 +233,40 @@ def _order(model, frame, q, rss, moments, noise_var, max_contacts):
     return q, np.asarray(parents), rss
 
 
+WALD_Z = 2.0
+"""Fewest standard errors the force of a contact at the box's bound must stand from
+zero [-] (a Wald test at about 95 %) where the frame's Fisher matrix is regular."""
+
+
+def _drop_undetermined(model, frame, q, rss, parents, sigma):
+    """While one of k >= 2 contacts sits at the box's bound (its position the search's
+    limit, not a maximum of the likelihood) with a force within :data:`WALD_Z` of its
+    standard error of zero (:func:`._joint_fisher.fisher_sd`), the one with the fewest
+    goes, the others refitted jointly: a tail beyond the taxels that soaks up what the
+    model leaves (issue 38's 18.5-N contact). Elsewhere (a Wald test drops real noisy
+    pairs, its sigma carrying the model's error) or where the matrix is singular, the
+    information criterion alone decides."""
+    prior = np.array([sigma, PRIOR_WIDTH, PRIOR_RADIUS_MM, model.modulus_star_pa])
+    while len(q) > 1:
+        lo, hi = _bounds(model, frame, 1)
+        edge = 1e-6 * max(model.pitch_mm)
+        outside = (np.abs(q[:, :2] - lo[:2]) < edge).any(1) | (
+            np.abs(q[:, :2] - hi[:2]) < edge
+        ).any(1)
+        if not outside.any():
+            break
+        sd = fisher_sd(model, frame, q, prior)[:, 2]
+        with np.errstate(all="ignore"):
+            z = np.where(outside & np.isfinite(sd) & (sd > 0), q[:, 2] / sd, np.inf)
+        c = int(np.argmin(z))
+        if z[c] >= WALD_Z:
+            break
+        rest = np.delete(q, c, axis=0)
+        q, rss = _fit_frame(model, frame, *rest.T, sigma=sigma)
+        parents = [p for i, p in enumerate(parents) if i != c]
+    return q, rss, parents
+
+
 def _prune(model, frame, q, rss, parents, noise_var):
     """Backward elimination after splits: while a fit without one of the contacts (the
     others its seed, refitted jointly) explains the frame as well by the Bayesian
@@ -290,6 +319,48 @@ def _pair_seeds(model, q, c, d):
             yield seed
 
 
+RELOCATE_STEP = 0.5
+"""Spacing of the positions :func:`_relocate_seeds` tries for a contact [pitch]."""
+
+RELOCATE_BEST = 2
+"""Positions :func:`_relocate_seeds` keeps per contact (the largest gains, a pitch apart)."""
+
+
+def _relocate_seeds(model, frame, q, c):
+    """Seeds with contact ``c`` moved to where it best explains what the others leave:
+    its unit response (own radius and flat share) every :data:`RELOCATE_STEP` pitch
+    over the box, its force the least-squares amplitude, the :data:`RELOCATE_BEST`
+    largest gains a pitch apart kept: a global search for one contact of a linear
+    layer (a matched filter). It escapes a contact beyond the edge slid along the ridge
+    where a farther contact with more force reads alike (issue 34 item 2)."""
+    px, py = model.pitch_mm
+    lo, hi = _bounds(model, frame, 1)
+    o = np.delete(q, c, axis=0)
+    rest = np.asarray(frame, float) - model.signal(o[:, :2], o[:, 2], o[:, 3], o[:, 4], signed=True)
+    xs = np.arange(lo[0], hi[0] + 1e-9, RELOCATE_STEP * px)
+    ys = np.arange(lo[1], hi[1] + 1e-9, RELOCATE_STEP * py)
+    found = []
+    for x in xs:
+        for y in ys:
+            r = model.signal([[x, y]], [1.0], [q[c, 3]], [q[c, 4]], signed=True)
+            rr = float(np.sum(r * r))
+            if rr <= 0.0:
+                continue
+            f = float(np.sum(r * rest)) / rr
+            if f > 0.0:
+                found.append((f * f * rr, x, y, f))
+    kept = []
+    for _, x, y, f in sorted(found, reverse=True):
+        if len(kept) < RELOCATE_BEST and all(
+            np.hypot((x - u) / px, (y - v) / py) >= 1 for u, v, _ in kept
+        ):
+            kept.append((x, y, f))
+    for x, y, f in kept:
+        seed = q.copy()
+        seed[c, :3] = x, y, f
+        yield seed
+
+
 def _polish(model, frame, q, rss, sigma):
     """The frame's k >= 2 contacts refitted from other starts, the lowest residual kept
     (same k, same order): each pair re-seeded about its centre (:func:`_pair_seeds`).
@@ -305,6 +376,10 @@ def _polish(model, frame, q, rss, sigma):
                     q2, rss2 = _fit_frame(model, frame, *seed.T, sigma=sigma)
                     if rss2 < best[1]:
                         best = (q2, rss2)
+            for seed in _relocate_seeds(model, frame, q, c):
+                q2, rss2 = _fit_frame(model, frame, *seed.T, sigma=sigma)
+                if rss2 < best[1]:
+                    best = (q2, rss2)
         if best[1] >= rss * (1.0 - 1e-6):
             break
         q, rss = best
@@ -386,14 +461,21 @@ def joint_fit(signal, seg, row, col, force, sensor, model, noise_var=None, max_c
             if len(good) > 1:  # a watershed region on noise alone: no contact there
                 q, rss, kept = _prune(model, frame, q, rss, list(parents), sigma**2)
                 parents = np.asarray(kept)
+            polished = None
+            if 1 < len(q) <= MAX_POLISHED:  # the order is judged against k's best fit
+                q, rss = _polish(model, frame, q, rss, sigma)
+                polished = rss
             if max_contacts > len(q):
                 moments = [(seg["rr"][i], seg["cc"][i], seg["rc"][i]) for i in good]
                 q, local, rss = _order(
                     model, frame, q, rss, [moments[p] for p in parents], sigma**2, max_contacts
                 )
                 parents = parents[local]
-            if 1 < len(q) <= MAX_POLISHED:
+            if 1 < len(q) <= MAX_POLISHED and rss != polished:
                 q, rss = _polish(model, frame, q, rss, sigma)
+            if len(q) > 1:
+                q, rss, kept = _drop_undetermined(model, frame, q, rss, list(parents), sigma)
+                parents = np.asarray(kept)
         seen = set()
         for j, p in enumerate(parents):
             i = good[p]

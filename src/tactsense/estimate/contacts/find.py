@@ -105,7 +105,9 @@ def find_contacts(
     method : {"interpolate", "cop", "fit", "joint"}
         How a contact's position is found (:data:`METHODS`); ``"joint"`` (pads): every
         contact of a frame fitted jointly with its size, contacts added by a likelihood
-        criterion (docs/contacts.md).
+        criterion, each with its standard errors from the Fisher matrix at the fit
+        (extras ``x_sd_mm``, ``y_sd_mm`` [mm], ``force_sd_n`` [N]; NaN where the frame
+        does not determine the contact) (docs/contacts.md).
     first_frame : int
         Added to the ``frame`` column (pieces of a longer recording).
     saddle : float
@@ -252,11 +254,16 @@ def _grid_contacts(
             model = kind.contact_model(sensor) if method == "joint" else None
             if model is not None:  # each contact's size; more contacts (r6-padfit)
                 from tactsense.estimate.contacts._joint import fit_sizes
+                from tactsense.estimate.contacts._joint_errors import standard_errors
 
                 seg, row, col, force, radius, flat = fit_sizes(
                     signal, seg, row, col, force, sensor, model, max_contacts
                 )
                 extra["contact_radius_mm"], extra["flat_share"] = radius, flat
+                sd = standard_errors(
+                    signal, seg["frame"], row, col, force, radius, flat, sensor, model
+                )
+                extra["x_sd_mm"], extra["y_sd_mm"], extra["force_sd_n"] = sd.T
                 n = len(seg["frame"])
                 flags, z, peak = np.zeros(n, np.int64), np.zeros(n), seg["value"]
             x = row * g.row_pitch_mm
