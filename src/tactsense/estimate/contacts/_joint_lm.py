@@ -192,8 +192,9 @@ FIRST_REACH = 5.0
 def step_units(p0, x_taxel, y_taxel):
     """Units (5 k) of the parameters' steps: a tenth of the taxel pitch in x and y [mm],
     a twentieth of the largest starting force [N], 0.1 mm in a, 0.1 in the flat share
-    (the reference's ``x_scale``, :func:`tactsense.estimate.contacts._joint.
-    _fit_frame_reference`)."""
+    (the ``x_scale`` of the reference fit,
+    :func:`~tactsense.estimate.contacts._joint._fit_frame_reference`); the pitch is
+    the taxels' mean spacing along each axis (the other axis's on a single row)."""
     k = p0.size // 5
     px = (x_taxel[-1] - x_taxel[0]) / (x_taxel.size - 1) if x_taxel.size > 1 else 0.0
     py = (y_taxel[-1] - y_taxel[0]) / (y_taxel.size - 1) if y_taxel.size > 1 else 0.0
