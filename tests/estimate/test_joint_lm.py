@@ -175,8 +175,8 @@ def test_compiled_reaches_the_reference_minimum_on_the_37_percent_frame():
     model, a = 1.208 mm, quantized): in the ten-frame batch the first fit lands in a
     poor minimum (contacts 0.48 and 0.67 N, residual 1.4e-5) and the pair is re-seeded
     twenty ways. SciPy's fit reached the frame's minimum (9.3e-8: both forces 0.49 N)
-    from 4 of the 20; the compiled fit before the trust region from none (best 3.9e-5,
-    so it reported forces 37 % apart); now from 7. Asserted: the compiled best within
+    from 4 of the 20; the compiled fit of round 9 from none (best 3.9e-5, so it
+    reported forces 37 % apart); now from 7. Asserted: the compiled best within
     1 % of the reference's best, and its forces within 1 % of the truth's 0.49 N."""
     spec = load_sensor("pad4")
     model = kind_of(spec).contact_model(spec)
@@ -200,13 +200,13 @@ def test_compiled_against_reference_from_the_same_starts():
     local, so from one start each may settle in another minimum. Asserted: (1) on
     every frame the compiled fit's best residual is within 1 % of the reference's best
     (what the estimator keeps); (2) over the 80 starts the compiled residual exceeds the
-    reference's by more than 10 % from at most 28 (measured 22; 42 before the trust
-    region); (3) where it ends, the first-order condition holds to the tables'
-    resolution: the largest projected gradient in step units (each parameter's unit
-    step's first-order share of the cost, components on a bound pushing outward
-    excluded) is below 0.06 of the cost (measured median 1e-7; the model is
-    piecewise linear in a between the table's nodes, so a minimum at a node keeps a
-    one-sided slope)."""
+    reference's by more than 10 % from at most 28 (measured 19 with both descents, 22
+    with the trust region's alone, 42 with round 9's kernel); (3) where it ends, the
+    first-order condition holds to the tables' resolution: the largest projected
+    gradient in step units (each parameter's unit step's first-order share of the
+    cost, components on a bound pushing outward excluded) is below 0.06 of the cost
+    (the model is piecewise linear in a between the table's nodes, so a minimum at a
+    node keeps a one-sided slope)."""
     from tactsense.estimate.contacts._joint_lm import step_units
 
     spec = load_sensor("pad4")

@@ -11,16 +11,20 @@ ln a as k extra residuals. Everything runs compiled (Numba): one call per frame.
 
 The step is Marquardt's (``(J^T J + lambda diag(J^T J)) delta = -J^T r``) projected on the
 bounds (each parameter clipped into its box after the step); lambda falls by 3 on a step
-that lowers the cost and rises by 4 on one that does not. Each step also stays within a
-trust region in fixed units (:func:`step_units`, SciPy's ``x_scale`` of the reference):
-it starts at :data:`FIRST_REACH` units (half a pitch in position, half a millimetre in a)
-and doubles after a step it cut that lowered the cost, halves after one that did not.
-Why: with Marquardt's scaling alone and lambda from 1e-3 (the kernel before round 10),
-the first, nearly Gauss-Newton steps leapt several millimetres on a pair's tables and
-clipped a contact's force, radius or flat share onto a bound, where the fit settled in a
-worse minimum than SciPy's reaches from the same start (lmcheck, round 10: on the
-``pad4`` pair frame whose forces differed by 37 % none of the twenty re-seeds reached the
-reference's minimum, best residual 3.9e-5 against 9.3e-8).
+that lowers the cost and rises by 4 on one that does not. :func:`levenberg_marquardt`
+descends twice from each start and keeps the lower cost: once with free steps (lambda from
+1e-3) and once within a trust region in fixed units (:func:`step_units`, SciPy's
+``x_scale`` of the reference) that starts at :data:`FIRST_REACH` units (half a pitch in
+position, half a millimetre in a), doubles after a step it cut that lowered the cost and
+halves after one that did not, lambda from :data:`FIRST_LAMBDA`.
+Why: the free descent's first, nearly Gauss-Newton steps can leap several millimetres on
+a pair's tables and clip a contact's force, radius or flat share onto a bound, where the
+fit settles in a worse minimum than SciPy's reaches from the same start (lmcheck, round
+10: on the ``pad4`` pair frame whose forces differed by 37 % none of the twenty re-seeds
+reached the reference's minimum, best residual 3.9e-5 against 9.3e-8); the trust
+region's descent alone, though, lost two noise-free placements of
+``scripts/padfit_pairs.py`` on ``pad4`` that the free descent resolves (1.5 pitches at
+67.5 deg, 2.5 at 0 deg): neither path is the better from every start.
 """
 
 from __future__ import annotations
