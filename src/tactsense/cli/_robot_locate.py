@@ -15,6 +15,10 @@ from tactsense.estimate._robot_tables import HAND_METHODS
 
 OUTPUT_FORMATS = (".parquet", ".csv")
 
+SINGLE_METHODS = ("interpolate", "cop", "fit", "joint")
+"""The single array's methods (``find_contacts``'): one the hand does not take is
+refused as not applying, any other name as unknown."""
+
 JOINTS_HELP = (
     "Robot recordings: a fixed joint state, NAME=POSITION,... [rad for revolute joints, m "
     "for prismatic ones], each within the joint's limits; joints not named are at 0. "
@@ -146,10 +150,16 @@ def run_robot_locate(
     from tactsense.robot_batch import iter_robot_blocks
 
     try:
+        if method not in HAND_METHODS and method not in SINGLE_METHODS:
+            raise TactsenseInputError(
+                f"--method {method!r} is not a method; a robot recording takes "
+                f"{' or '.join(HAND_METHODS)}"
+            )
         unused = [name for name, value in single_array_options.items() if value]
         if unused:
+            verb = "applies" if len(unused) == 1 else "apply"
             raise TactsenseInputError(
-                f"{', '.join(unused)} apply to a single array's recording; the hand's "
+                f"{', '.join(unused)} {verb} to a single array's recording; the hand's "
                 f"estimator takes --method {' or '.join(HAND_METHODS)}, with each stream's "
                 "first frames as baseline (locate RUN/streams/PATCH.h5 for the others)"
             )

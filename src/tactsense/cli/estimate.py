@@ -107,7 +107,12 @@ def _locate_contacts(recording, out, force, quiet, **options) -> None:
 
 @app.command()
 def locate(
-    recording: Annotated[Path, typer.Argument(help="HDF5 recording to analyse.")],
+    recording: Annotated[
+        Path,
+        typer.Argument(
+            help="HDF5 recording to analyse, or a robot recording's folder (docs/robot.md)."
+        ),
+    ],
     out: Annotated[
         Path,
         typer.Option(
@@ -147,7 +152,9 @@ def locate(
             "'fit' (pads: maximum likelihood on the layer's response, the most accurate, "
             "about 300 us a contact; docs/accuracy.md) or 'joint' (pads: every contact of "
             "a frame fitted jointly with its size and indenter shape, contacts added by a "
-            "likelihood criterion; tens of ms a frame; docs/contacts.md)."
+            "likelihood criterion, each with its standard errors; milliseconds a frame on "
+            "pad4, tens to hundreds on pad16 and larger pads, about a second on a large "
+            "contact over many taxels; docs/contacts.md, docs/performance.md)."
             + _robot.METHOD_HELP  # r10-handjoint
         ),
     ] = "interpolate",
@@ -229,7 +236,9 @@ def locate(
         single = {"--calibration": calibration is not None, "--contacts": contacts,
                   "--method": method not in _robot.HAND_METHODS,  # r10-handjoint
                   "--chunk-frames": chunk_frames is not None,
-                  "--workers": workers != 1, "--drift-s": drift_s != 2.0}  # fmt: skip
+                  "--workers": workers != 1, "--drift-s": drift_s != 2.0,
+                  "--friction": friction is not None,  # r10: three-axis options
+                  "--indenter-radius": indenter_radius_mm is not None}  # fmt: skip
         _robot.run_robot_locate(
             recording, out, force=force, quiet=quiet, joints=joints, joints_csv=joints_csv,
             joints_bag=joints_bag, joints_topic=joints_topic, wrenches=wrenches,

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from dataclasses import fields
 from pathlib import Path
 
@@ -153,7 +154,7 @@ class EstimatesWriter:
             self._writer.write_table(table)
         elif self.format == "parquet":
             if self._writer is None:
-                schema = table.schema.with_metadata({"units": str(units)})
+                schema = table.schema.with_metadata({"units": json.dumps(units)})
                 self._writer = pq.ParquetWriter(str(self.path), schema)
             self._writer.write_table(table.replace_schema_metadata(self._writer.schema.metadata))
         else:
@@ -261,7 +262,7 @@ class ContactsWriter(EstimatesWriter):
                 arrow.column_names.index("event"), "event", pa.array(marks, pa.string())
             )
         self.events.extend(events)
-        units = {"time_s": "s", **_contact_units(), "flags": "Flag bits"}
+        units = {"time_s": "s", **_contact_units(arrow.column_names), "flags": "Flag bits"}
         self._append(arrow, units, "tactsense-contacts")
 
     def close(self) -> None:
@@ -291,8 +292,19 @@ def events_sidecar(path: str | Path) -> Path:
     return path.with_name(path.stem + ".events.csv")
 
 
-def _contact_units() -> dict:
-    return dict(ContactTable.UNITS)
+SUFFIX_UNITS = (("_mm_s", "mm/s"), ("_mm2", "mm2"), ("_mm", "mm"), ("_n", "N"),
+                ("_deg", "deg"), ("_s", "s"))  # fmt: skip
+"""An extra column's unit from its name's ending (``x_sd_mm``: mm, ``force_sd_n``: N)."""
+
+
+def _contact_units(names=()) -> dict:
+    """Units of the long table's columns: :attr:`ContactTable.UNITS`, and for the
+    extras of ``names`` their name's ending (:data:`SUFFIX_UNITS`), else "1"."""
+    units = dict(ContactTable.UNITS)
+    for name in names:
+        if name not in units:
+            units[name] = next((u for end, u in SUFFIX_UNITS if name.endswith(end)), "1")
+    return units
 
 
 def _events_table(events) -> pa.Table:

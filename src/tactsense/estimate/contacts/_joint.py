@@ -17,6 +17,7 @@ from scipy.optimize import least_squares
 
 from tactsense.estimate.contacts._joint_fisher import NP, fisher_sd
 from tactsense.estimate.contacts._joint_lm import levenberg_marquardt, tables_of
+from tactsense.estimate.contacts._joint_noise import data_noise_variance as _frames_noise
 from tactsense.estimate.reading import signal_noise_variance
 
 SEED_RADIUS_MM = 1.0
@@ -245,9 +246,19 @@ def _drop_undetermined(model, frame, q, rss, parents, sigma):
     goes, the others refitted jointly: a tail beyond the taxels that soaks up what the
     model leaves (issue 38's 18.5-N contact). Elsewhere (a Wald test drops real noisy
     pairs, its sigma carrying the model's error) or where the matrix is singular, the
-    information criterion alone decides."""
+    information criterion alone decides. First, a contact whose modelled signal is under
+    the noise ``sigma`` [-] on every taxel goes (round 10's trial: a 0.1-mN contact where
+    the taxels read 0, counted in a hand's wrench)."""
     prior = np.array([sigma, PRIOR_WIDTH, PRIOR_RADIUS_MM, model.modulus_star_pa])
     while len(q) > 1:
+        peak = [np.abs(model.signal(c[None, :2], c[None, 2], c[None, 3], c[None, 4])).max()
+                for c in q]  # fmt: skip
+        if min(peak) < sigma:  # reads under the noise on every taxel: no contact (r10)
+            c = int(np.argmin(peak))
+            rest = np.delete(q, c, axis=0)
+            q, rss = _fit_frame(model, frame, *rest.T, sigma=sigma)
+            parents = [p for i, p in enumerate(parents) if i != c]
+            continue
         lo, hi = _bounds(model, frame, 1)
         edge = 1e-6 * max(model.pitch_mm)
         outside = (np.abs(q[:, :2] - lo[:2]) < edge).any(1) | (
@@ -490,59 +501,10 @@ def joint_fit(signal, seg, row, col, force, sensor, model, noise_var=None, max_c
     return row, col, force, radius, flat, added, dropped
 
 
-QUIET_SHARE = 0.02
-"""A taxel is quiet where the fitted contacts' signal is below this share of their
-largest [-]: what it reads there is noise (and rounding)."""
-
-MIN_QUIET = 32
-"""Fewest quiet readings on the noise's side that :func:`data_noise_variance` judges the
-noise from [-] (fewer: the described noise stands)."""
-
-HALF_NORMAL_MEDIAN = 0.6744897501960817
-"""Median of |n| for n ~ N(0, 1) [-]."""
-
-
 def data_noise_variance(model, fitted) -> float:
-    """The noise's variance [-^2] the frames themselves show, 0 where they cannot tell
-    (fewer than :data:`MIN_QUIET` readings to judge from), from ``fitted``: each frame
-    (rows, cols) [-] with its contacts (k, NP). A robust scale, pooled over the frames:
-    a few unmodelled readings (a contact's tail, a second contact, a region fitted on
-    noise) move a quantile little.
-
-    * Signed readings (capacitive): the residual of each frame against its strongest
-      contact alone (refitted), the median of its magnitude over the half-normal's
-      (0.674 sigma), times n / (n - 5) (the fit's five parameters took their share of
-      the residual): up to half the taxels may carry signal the one contact does not
-      explain. (The contacts fitted on noise regions leave no quiet taxel on a
-      capacitive pad: their modelled tension reaches every taxel.)
-    * A resistive taxel's noise at rest is clipped at zero (the converter's rail: it
-      reads max(n, 0)): over the quiet taxels (the contacts' signal below
-      :data:`QUIET_SHARE` of its largest), the median of the readings above zero over
-      the half-normal's median (0.674 sigma).
-
-    Why: the described read noise (``read_noise_counts``) may be far below what the pad
-    reads (a preset's 0.3 counts against 1-2 % of full scale on real arrays, 41-82
-    counts); weighed with it, every noise blob passes the information criterion as a
-    contact."""
-    values = []
-    for frame, q in fitted:
-        v = np.asarray(frame, float)
-        if model.capacitive:
-            one = q[int(np.argmax(q[:, 2]))][None, :]
-            one, _ = _fit_frame(model, v, *one.T)
-            m = model.signal(one[:, :2], one[:, 2], one[:, 3], one[:, 4], signed=True)
-            values.append(np.abs(v - m).ravel())
-        else:
-            m = model.signal(q[:, :2], q[:, 2], q[:, 3], q[:, 4], signed=True)
-            quiet = np.abs(m) <= QUIET_SHARE * max(float(np.abs(m).max()), 1e-300)
-            values.append(v[quiet & (v > 0)])
-    v = np.concatenate(values) if values else np.zeros(0)
-    if v.size < MIN_QUIET:
-        return 0.0
-    if model.capacitive:  # the fit's five parameters took their share of the residual
-        n = model.x_taxel.size * model.y_taxel.size
-        return float((np.median(v) / HALF_NORMAL_MEDIAN) ** 2 * n / max(n - NP, 1))
-    return float((np.median(v) / HALF_NORMAL_MEDIAN) ** 2)
+    """The noise's variance [-^2] the frames themselves show
+    (:func:`._joint_noise.data_noise_variance`, refitting with :func:`_fit_frame`)."""
+    return _frames_noise(model, fitted, _fit_frame)
 
 
 def _seed_radii(model, seg, good):

@@ -44,6 +44,12 @@ def fisher_sd(model, frame, q, prior):
     free = free.ravel()
     out = np.full((k, 3), np.nan)
     j = jac[:, free] / prior[0]
+    # fewer readings (the taxels whose rows carry the fit's slope, and the size's prior)
+    # than free parameters: singular, however the rounding leaves the smallest singular
+    # value (round 10's trial: one taxel read gave errors of 11 m instead of NaN)
+    rows = np.linalg.norm(j, axis=1)
+    if np.sum(rows > 1e-6 * max(float(rows.max(initial=0.0)), 1e-300)) < j.shape[1]:
+        return out
     norms = np.linalg.norm(j, axis=0)
     if not np.all(np.isfinite(j)) or norms.min() <= 0.0:
         return out

@@ -127,6 +127,10 @@ def find_contacts(
         )
     if method not in METHODS:
         raise TactsenseInputError(f"method {method!r}: expected one of {', '.join(METHODS)}")
+    if method in ("fit", "joint") and not (kind.image_grid and kind.response_fit):
+        raise TactsenseInputError(  # r10 trial: a point set took it silently
+            f"method {method!r} works on pads; {sensor.name!r} is a {kind.label}"
+        )
     if not (isinstance(max_contacts, int | np.integer) and 1 <= max_contacts <= 64):
         raise TactsenseInputError(f"max_contacts must be an integer in 1-64; got {max_contacts!r}")
     if not (isinstance(saddle, float | int) and 0.0 < saddle <= 1.0):
