@@ -87,7 +87,13 @@ def data_noise_variance(model, fitted, fit_frame) -> float:
       half-normal's (0.674 sigma), times n / (n - 5 k) (the fit's parameters took their
       share of the residual). Not every contact is refitted: those fitted on noise
       regions would absorb noise (their modelled tension reaches every taxel of a
-      capacitive pad, leaving no quiet one).
+      capacitive pad, leaving no quiet one). Where the frames give at least
+      :data:`MIN_QUIET` differences between successive frames, the smaller of that and
+      what those differences show (their median magnitude over the half-normal's, over
+      sqrt 2): a contact held still changes nothing from frame to frame, its noise does,
+      so a pair the fit did not part (at 1.5 pitches on ``pad4``) is not taken for
+      noise; contacts that move or frames of unrelated presses change more, and the
+      residual's figure stands.
     * A resistive taxel's noise at rest is clipped at zero (the converter's rail: it
       reads max(n, 0)): over the quiet taxels (the contacts' signal below
       :data:`QUIET_SHARE` of its largest), the median of the readings above zero over
@@ -117,4 +123,8 @@ def data_noise_variance(model, fitted, fit_frame) -> float:
         r, k = _pair_residual(model, v, one, alone, q, fit_frame) if n > 2 * NP else (alone, 1)
         values.append(r)
         counts.append(k)
-    return _scale(np.concatenate(values), n, float(np.mean(counts)))
+    variance = _scale(np.concatenate(values), n, float(np.mean(counts)))
+    if len(frames) * n >= MIN_QUIET + n:  # what changes from one frame to the next
+        steps = np.diff(np.stack([v for v, _ in frames]), axis=0).ravel()
+        variance = min(variance, float((np.median(np.abs(steps)) / HALF_NORMAL_MEDIAN) ** 2 / 2))
+    return variance
