@@ -154,7 +154,8 @@ def force_range(spec, model, frame, truth, rss_truth):
     [steps^2]): the force's profile, stepped by :data:`RANGE_STEP` from the truth each
     way (to :data:`RANGE_REACH`), (x, y, a, flat share) refitted by SciPy at each from
     the last. Where the frame does not determine the contact, the forces it allows (a
-    continuation along one path: the set may reach farther)."""
+    continuation along one path: the set may reach farther; :func:`measure` widens it
+    to the fit's own force where the fit leaves no more than the truth)."""
     from scipy.optimize import least_squares
 
     step = _step(spec)

@@ -24,7 +24,7 @@ def test_prose_figures_are_the_blocks():
     words = set(" ".join(cells).split()) | set(re.findall(r"[-+]?[\d,]+\.?\d*", block))
     quoted = {
         "2.00", "1.99", "-0.5", "0.30", "-85.0", "-12.2", "-17.5", "-33.3", "-5.4", "+3.2",
-        "2.06", "19 of 25", "+152.2", "-23.5", "+45.0", "3,897", "1,490",
+        "2.06", "17 of 25", "+45.4", "-23.5", "+26.7",
     }  # fmt: skip
     for figure in quoted:
         assert figure in prose.replace(" %", ""), figure
