@@ -7,6 +7,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -74,8 +75,17 @@ def test_the_column_table_names_every_column(example):
     _cli("locate", "two.h5", "--out", "cols.parquet", cwd=example)
     text = DOC.read_text(encoding="utf-8")
     table = text.split("## The long table", 1)[1].split("### Loading", 1)[0]
-    named = set()
+    named, joint = set(), set()
     for row in table.splitlines():
         if row.startswith("| `"):
-            named |= set(re.findall(r"`([a-z_0-9]+)`", row.split("|")[1]))
+            names = set(re.findall(r"`([a-z_0-9]+)`", row.split("|")[1]))
+            # the rows of `--method joint`'s extras: the columns of that method's table
+            (joint if "(`--method joint`)" in row else named).update(names)
     assert named == set(pd.read_parquet(example / "cols.parquet").columns)
+    from tactsense.estimate.contacts import find_contacts
+    from tactsense.sensor.registry import load_sensor
+
+    spec = load_sensor("pad4")
+    frame = np.zeros(spec.shape)
+    frame[1:3, 1:3] = 0.02  # one contact's worth of signal [-]
+    assert joint == set(find_contacts(frame, spec, counts=False, method="joint").extra)

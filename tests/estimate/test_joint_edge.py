@@ -88,17 +88,18 @@ def test_no_taxel_reads_the_contact_its_errors_are_nan():
 def test_undetermined_contact_at_the_box_bound_goes():
     """A second contact of 20 mN held at the box's bound (2 pitches beyond pad4's last
     row: its force within two standard errors of zero) goes, and the frame's one
-    contact is refitted; the same weak contact off the bound stays, beyond the taxels
-    (1.8 pitches) or within them (there the information criterion decides, not the
-    Wald test: beyond the taxels real noisy pairs have forces under two standard
-    errors)."""
+    contact is refitted; the same weak contact 1.8 pitches beyond the taxels goes too,
+    for another reason (round 10): it reads under the noise on every taxel (0.38 of
+    an A/D step at most); within the taxels (4.8 steps) it stays: there the information
+    criterion decides, not the Wald test (beyond the taxels real noisy pairs have
+    forces under two standard errors)."""
     spec = load_sensor("pad4")
     model = kind_of(spec).contact_model(spec)
     one = np.array([[7.0, 8.0, 0.49, 1.1, 0.0]])
     frame = model.signal(one[:, :2], one[:, 2], one[:, 3])
     sigma = 1.0 / spec.electronics.nominal_counts
     bound = (spec.grid.rows + 1) * spec.grid.row_pitch_mm
-    for x, kept in ((bound, 1), (24.0, 2), (12.0, 2)):
+    for x, kept in ((bound, 1), (24.0, 1), (12.0, 2)):
         q = np.vstack([one, [x, 8.0, 0.02, 1.0, 0.0]])
         q2, _, parents = _drop_undetermined(model, frame, q, 0.0, [0, 1], sigma)
         assert len(q2) == kept == len(parents), x
