@@ -15,8 +15,8 @@ import warnings
 import numpy as np
 from scipy.optimize import least_squares
 
-from tactsense.estimate.contacts._joint_fisher import NP, fisher_sd
-from tactsense.estimate.contacts._joint_lm import levenberg_marquardt, tables_of
+from tactsense.estimate.contacts._joint_fisher import fisher_sd
+from tactsense.estimate.contacts._joint_lm import NP, levenberg_marquardt, tables_of
 from tactsense.estimate.contacts._joint_noise import data_noise_variance as _frames_noise
 from tactsense.estimate.reading import signal_noise_variance
 
@@ -88,14 +88,8 @@ def _fit_frame_reference(model, frame, x0, y0, f0, a0, w0=None, sigma=None):
     prior weighing one noise's worth per width."""
     k = len(x0)
     px, py = model.pitch_mm
-    rows, cols = frame.shape
-    w0 = np.full(k, 0.5) if w0 is None else w0
-    p0 = np.column_stack(
-        [x0, y0, np.maximum(f0, 1e-6), np.clip(a0, 0.0, model.a_top_mm), np.clip(w0, 0, 1)]
-    )
-    lo = np.tile([-2.0 * px, -2.0 * py, 0.0, 0.0, 0.0], k)
-    hi = np.tile([(rows + 1) * px, (cols + 1) * py, np.inf, model.a_top_mm, 1.0], k)
-    p0 = np.clip(p0.ravel(), lo + 1e-9, hi - 1e-9)
+    lo, hi = _bounds(model, frame, k)
+    p0 = _start(model, x0, y0, f0, a0, w0, lo, hi)
     target = frame.ravel()
 
     def residual(p):

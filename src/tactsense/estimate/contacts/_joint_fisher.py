@@ -6,12 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from tactsense.estimate.contacts._joint_lm import residual_jacobian, tables_of
-
-NP = 5
-"""Parameters per contact: x, y [mm], force [N], contact radius a [mm], flat share [-]
-(the share of the force pressed as a flat disc's uniform pressure, the rest as a Hertzian
-sphere's)."""
+from tactsense.estimate.contacts._joint_lm import NP, residual_jacobian, tables_of
 
 SINGULAR = 1e-7
 """Smallest ratio of the least to the largest singular value of the column-scaled

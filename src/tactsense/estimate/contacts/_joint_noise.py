@@ -5,8 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-NP = 5
-"""Parameters per contact (:data:`._joint.NP`)."""
+from tactsense.estimate.contacts._joint_lm import NP
 
 QUIET_SHARE = 0.02
 """A taxel is quiet where the fitted contacts' signal is below this share of their
