@@ -17,6 +17,7 @@ from scipy.optimize import least_squares
 
 from tactsense.estimate.contacts._joint_fisher import fisher_sd
 from tactsense.estimate.contacts._joint_lm import NP, levenberg_marquardt, tables_of
+from tactsense.estimate.contacts._joint_noise import contact_peak
 from tactsense.estimate.contacts._joint_noise import data_noise_variance as _frames_noise
 from tactsense.estimate.reading import signal_noise_variance
 
@@ -245,8 +246,7 @@ def _drop_undetermined(model, frame, q, rss, parents, sigma):
     the taxels read 0, counted in a hand's wrench)."""
     prior = np.array([sigma, PRIOR_WIDTH, PRIOR_RADIUS_MM, model.modulus_star_pa])
     while len(q) > 1:
-        peak = [np.abs(model.signal(c[None, :2], c[None, 2], c[None, 3], c[None, 4])).max()
-                for c in q]  # fmt: skip
+        peak = [contact_peak(model, c, signed=False) for c in q]
         if min(peak) < sigma:  # reads under the noise on every taxel: no contact (r10)
             c = int(np.argmin(peak))
             rest = np.delete(q, c, axis=0)

@@ -31,9 +31,10 @@ def _residuals(model, frame, q, fit_frame):
     return np.abs(frame - m).ravel(), q
 
 
-def _peak(model, c) -> float:
-    """The largest |signal| [-] one contact c (NP,) gives a taxel."""
-    m = model.signal(c[None, :2], c[None, 2], c[None, 3], c[None, 4], signed=True)
+def contact_peak(model, c, signed=True) -> float:
+    """The largest |signal| [-] one contact c (NP,) gives a taxel (``signed=False``: as a
+    resistive taxel reads it, tension at rest)."""
+    m = model.signal(c[None, :2], c[None, 2], c[None, 3], c[None, 4], signed=signed)
     return float(np.abs(m).max())
 
 
@@ -54,11 +55,12 @@ def _pair_residual(model, frame, one, alone, q, fit_frame):
         x, y = np.meshgrid(model.x_taxel, model.y_taxel, indexing="ij")
         seed = one[0].copy()
         seed[:2] = x.ravel()[i], y.ravel()[i]
-        seed[2] = one[0, 2] * abs(r.ravel()[i]) / max(_peak(model, one[0]), 1e-300)
+        seed[2] = one[0, 2] * abs(r.ravel()[i]) / max(contact_peak(model, one[0]), 1e-300)
     both, pair = _residuals(model, frame, np.vstack([one[0], seed]), fit_frame)
     left = float(np.sum(both**2))
     sd = np.sqrt(left / max(n - 2 * NP, 1))
-    if left < 0.1 * float(np.sum(alone**2)) and min(_peak(model, c) for c in pair) > STRONG * sd:
+    weaker = min(contact_peak(model, c) for c in pair)
+    if left < 0.1 * float(np.sum(alone**2)) and weaker > STRONG * sd:
         return both, 2
     return alone, 1
 
